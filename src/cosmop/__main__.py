@@ -1,0 +1,6 @@
+"""``python -m cosmop``: the command line."""
+
+from cosmop.cli import main
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,254 @@
+"""The ``cosmop`` command line.
+
+The library is silent; this module is the friendly layer. Errors in the user's input
+(:class:`~cosmop.errors.CosmopInputError`) are printed as one line, ``error: <message>``, on
+standard error, and the command exits with status 2 -- the same status as a usage error. Other
+exit statuses: 0 for success, 1 for a well-formed problem without a solution (e.g. an infeasible
+scenario).
+
+To add a command, write a thin function decorated with ``@app.command()`` that loads its input
+with :func:`_load` and leaves the work to the library; input errors need no handling there.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from enum import StrEnum
+from pathlib import Path
+from typing import Annotated, Any
+
+import click
+import typer
+from rich.console import Console
+from rich.table import Table
+from rich.text import Text
+from typer.core import TyperGroup
+
+from cosmop import __version__
+from cosmop.automata import DFA
+from cosmop.errors import CosmopInputError, EventSyntaxError
+from cosmop.io import write_atomic
+from cosmop.missions.decomposition import decompose as run_decompose
+from cosmop.missions.mission import GlobalMission
+from cosmop.missions.verification import verify as run_verify
+from cosmop.scenario import Scenario, load_scenario
+
+__all__ = ["EXIT_INPUT_ERROR", "app", "main"]
+
+EXIT_INPUT_ERROR = 2
+"""Exit status for bad input (also click's status for usage errors)."""
+
+
+class _Group(TyperGroup):
+    """Command group that turns input errors into one line on stderr and exit status 2.
+
+    Input errors are :class:`~cosmop.errors.CosmopInputError` (bad files) and
+    :class:`~cosmop.errors.EventSyntaxError` (an event typed on the command line).
+    """
+
+    def invoke(self, ctx: click.Context) -> Any:
+        try:
+            return super().invoke(ctx)
+        except (CosmopInputError, EventSyntaxError) as err:
+            # plain echo, not rich: field paths such as tasks.R1[0] must not be read as markup
+            typer.echo(f"error: {err}", err=True)
+            raise typer.Exit(EXIT_INPUT_ERROR) from None
+
+
+app = typer.Typer(
+    cls=_Group,
+    name="cosmop",
+    help="Cooperative multi-robot mission and motion planning with formal guarantees.",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_show_locals=False,
+)
+
+
+def _version_callback(value: bool) -> None:
+    if value:
+        typer.echo(f"cosmop {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _root(
+    version: Annotated[
+        bool,
+        typer.Option(
+            "--version", callback=_version_callback, is_eager=True, help="Print the version and exit."
+        ),
+    ] = False,
+) -> None:
+    """Cooperative multi-robot mission and motion planning with formal guarantees."""
+
+
+def _stdout() -> Console:
+    """A console on the current standard output (looked up late, so test runners can capture it)."""
+    return Console(file=sys.stdout, highlight=False)
+
+
+def _load(path: Path) -> Scenario:
+    """Load a scenario for a command; a bad file raises ScenarioError, reported by the group."""
+    return load_scenario(path)
+
+
+ScenarioArgument = Annotated[
+    Path, typer.Argument(metavar="SCENARIO", help="Scenario file (YAML).", show_default=False)
+]
+
+
+@app.command()
+def validate(scenario: ScenarioArgument) -> None:
+    """Check a scenario file and summarise it."""
+    loaded = _load(scenario)
+    console = _stdout()
+    console.print(_summary_table(loaded))
+    console.print(Text(f"{scenario}: valid", style="green"))
+
+
+class Method(StrEnum):
+    """How ``decompose`` verifies the local missions."""
+
+    auto = "auto"
+    assume_guarantee = "assume-guarantee"
+    direct = "direct"
+
+
+def _sequence_text(dfa: DFA) -> str:
+    """A local mission as ``a -> b -> c`` when it is one sequence, else its size."""
+    rows = dfa.delta
+    q, seq = dfa.initial, []
+    while len(seq) <= dfa.n_states:
+        out = [j for j in range(dfa.n_events) if rows[q, j] >= 0]
+        if not out:
+            return " -> ".join(seq) if seq else "(no events)"
+        if len(out) > 1:
+            break
+        seq.append(dfa.alphabet[out[0]])
+        q = int(rows[q, out[0]])
+    return f"{dfa.n_states} states, {dfa.n_transitions} transitions"
+
+
+@app.command()
+def decompose(
+    scenario: ScenarioArgument,
+    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object instead of tables.")] = False,
+    method: Annotated[
+        Method, typer.Option(help="Verification: assume-guarantee with L*, direct inclusion, or auto.")
+    ] = Method.auto,
+    dot: Annotated[
+        Path | None,
+        typer.Option(
+            help="Also write each local mission as Graphviz DOT into this DIRECTORY.", show_default=False
+        ),
+    ] = None,
+) -> None:
+    """Decompose the global mission into local missions and verify them (paper, Section III).
+
+    Exit status 0 when the mission is separable and the local missions are proven to satisfy it,
+    1 when it is not (the counterexample and the re-synthesised local missions are shown), 2 on
+    bad input.
+    """
+    loaded = _load(scenario)
+    err = Console(file=sys.stderr, highlight=False)
+    mission = GlobalMission.from_scenario(loaded)
+    with err.status("decomposing by natural projection ...", spinner="dots") as status:
+        result = run_decompose(mission)
+        status.update("verifying (assume-guarantee) ...")
+        verification = run_verify(mission, result.local_missions, method=method.value)
+    if dot is not None:
+        dot.mkdir(parents=True, exist_ok=True)
+        for robot, dfa in result.local_missions.items():
+            write_atomic(dot / f"{robot}.dot", dfa.to_dot(f"K_{robot}"))
+    ok = result.separable and verification.holds
+    if as_json:
+        data = result.to_dict() | {"verification": verification.to_dict()}
+        typer.echo(json.dumps(data, indent=2))
+        raise typer.Exit(0 if ok else 1)
+    console = _stdout()
+    table = Table(title=Text(f"local missions of {loaded.name}"), header_style="bold")
+    for column in ("robot", "events", "states", "local mission K_i = P_i(K)"):
+        table.add_column(column)
+    for robot, dfa in result.local_missions.items():
+        table.add_row(robot, str(len(result.alphabets[robot])), str(dfa.n_states), Text(_sequence_text(dfa)))
+    console.print(table)
+    stats = result.stats
+    console.print(
+        Text(
+            f"separable: {'yes' if result.separable else 'no'}"
+            f"   (largest automaton {stats.largest_automaton} states, {stats.total_s:.3f} s)"
+        )
+    )
+    if result.counterexample is not None:
+        console.print(Text(f"counterexample: {' '.join(result.counterexample)}", style="red"))
+    if result.resynthesis is not None:
+        rs = result.resynthesis
+        console.print(
+            Text(
+                f"re-synthesis: {'sound' if rs.converged else 'did not converge'} after {rs.iterations} "
+                f"counterexample(s)"
+            )
+        )
+        for robot, events in rs.lost_events.items():
+            if events:
+                console.print(Text(f"  {robot} can no longer perform: {', '.join(events)}", style="yellow"))
+    v = verification
+    sizes = ", ".join(str(a.assumption.n_states if a.assumption else 0) for a in v.assumptions) or "-"
+    console.print(
+        Text(
+            f"verification: {'holds' if v.holds else 'fails'} ({v.method}; "
+            f"{v.membership_queries} membership / {v.equivalence_queries} equivalence queries; "
+            f"assumption sizes {sizes}; "
+            f"largest automaton {v.largest_automaton}; {v.time_s:.3f} s)",
+            style="green" if v.holds else "red",
+        )
+    )
+    if v.counterexample is not None:
+        console.print(Text(f"violation: {' '.join(v.counterexample)}", style="red"))
+    raise typer.Exit(0 if ok else 1)
+
+
+def _summary_table(scenario: Scenario) -> Table:
+    """A table with one row per part of the scenario."""
+    scene, mission = scenario.scene, scenario.mission
+    table = Table(title=Text(f"scenario {scenario.name}"), show_header=True, header_style="bold")
+    table.add_column("part")
+    table.add_column("count", justify="right")
+    table.add_column("details")
+
+    def row(part: str, count: int, details: str) -> None:
+        table.add_row(part, str(count), Text(details))  # Text: ids are data, never markup
+
+    row("robots", len(scene.robots), ", ".join(f"{r.id} (size {r.size:g})" for r in scene.robots.values()))
+    row("objects", len(scene.objects), ", ".join(scene.objects) or "-")
+    row(
+        "workspaces",
+        len(scene.workspaces),
+        ", ".join(f"{w.id} ({'point' if w.is_point else 'rectangle'})" for w in scene.workspaces.values())
+        or "-",
+    )
+    row("walls", len(scene.obstacles), "wall segments")
+    events = mission.events
+    if mission.tasks is not None:
+        steps = sum(len(seq) for seq in mission.tasks.values())
+        row(
+            "mission",
+            len(events),
+            f"tasks: {steps} steps for {len(mission.tasks)} robots, {len(events)} events",
+        )
+    else:
+        dfa = mission.dfa
+        row(
+            "mission",
+            len(events),
+            f"dfa: {len(dfa.states)} states, {len(dfa.transitions)} transitions, "
+            f"{len(dfa.marked)} marked, {len(events)} events",
+        )
+    return table
+
+
+def main() -> None:
+    """Run the command line (``python -m cosmop``), with the program name ``cosmop``."""
+    app(prog_name="cosmop")

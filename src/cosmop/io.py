@@ -1,0 +1,83 @@
+"""Small file-system helpers."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import secrets
+from pathlib import Path
+
+__all__ = ["write_atomic"]
+
+
+def write_atomic(path: str | os.PathLike[str], data: str | bytes) -> None:
+    """Replace the file at `path` with `data`, all at once.
+
+    The data are written to a temporary file in the same directory, flushed to disk with
+    ``fsync`` and moved over `path` with :func:`os.replace`, which is atomic on POSIX and
+    Windows. Readers therefore see either the old file or the complete new one, never a
+    half-written file; if anything fails the temporary file is removed and `path` is
+    untouched.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The destination. Its directory must exist.
+    data : str or bytes
+        The new content; text is encoded as UTF-8 (newlines are written as given).
+
+    Notes
+    -----
+    A new file gets the usual permissions (``0o666`` masked by the process umask); an
+    existing file keeps its permission bits.
+    """
+    target = Path(path)
+    if isinstance(data, str):
+        payload = data.encode("utf-8")
+    elif isinstance(data, bytes | bytearray | memoryview):
+        payload = bytes(data)
+    else:
+        raise TypeError(f"write_atomic needs str or bytes, got {type(data).__name__}")
+    directory = target.parent
+    fd, tmp_name = _create_temp(directory, target.name)
+    try:
+        with os.fdopen(fd, "wb") as handle:
+            handle.write(payload)
+            handle.flush()
+            os.fsync(handle.fileno())
+        with contextlib.suppress(OSError):
+            if target.exists():
+                os.chmod(tmp_name, target.stat().st_mode & 0o7777)
+        os.replace(tmp_name, target)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp_name)
+        raise
+    _fsync_directory(directory)
+
+
+def _create_temp(directory: Path, name: str) -> tuple[int, str]:
+    """Create a new, empty temporary file beside the target (mode 0o666 & ~umask)."""
+    flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0)
+    for _ in range(100):
+        candidate = os.path.join(directory, f".{name}.{secrets.token_hex(6)}.tmp")
+        try:
+            return os.open(candidate, flags, 0o666), candidate
+        except FileExistsError:
+            continue
+    raise FileExistsError(f"could not create a temporary file in {directory}")
+
+
+def _fsync_directory(directory: Path) -> None:
+    """Make the rename durable (POSIX); harmless where directories cannot be opened."""
+    if os.name != "posix":
+        return
+    try:
+        fd = os.open(directory, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        with contextlib.suppress(OSError):
+            os.fsync(fd)
+    finally:
+        os.close(fd)

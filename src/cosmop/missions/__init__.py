@@ -1,0 +1,2 @@
+"""Top-down mission layer: events, decomposition by natural projection, separability,
+assume-guarantee verification."""

@@ -1,0 +1,335 @@
+"""Task decomposition by natural projection, separability, counterexample-guided re-synthesis.
+
+Section III of the paper: the local missions are :math:`K^i_{MI} = P_i(K_{MI})`; they jointly
+satisfy the global mission iff :math:`\\|_i K^i_{MI} \\subseteq K_{MI}`.  The converse inclusion
+always holds (:math:`K \\subseteq P_i^{-1} P_i(K)` for every ``i``), so this is the
+*separability* of :math:`K_{MI}` with respect to the local alphabets,
+:math:`K_{MI} = \\|_i P_i(K_{MI})` (the paper's Remark).  When it fails, a counterexample
+:math:`t \\in \\|_i K^i \\setminus K` is used to shrink the local missions,
+:math:`K^i := K^i - P_i(t)`, until the product is included in :math:`K_{MI}`.
+
+Both checks work on the mission's factors (:class:`~cosmop.automata.Composition`):
+:math:`L \\subseteq \\|_j T_j` iff :math:`P_{\\Sigma(T_j)}(L) \\subseteq T_j` for every factor,
+and each projection is computed compositionally, so a mission in tasks form is decomposed and
+checked without building its :math:`4^N`-state product.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from types import MappingProxyType
+
+import numpy as np
+
+from cosmop.automata import (
+    DFA,
+    Composition,
+    complement,
+    inclusion_counterexample,
+    minimize,
+    product,
+    project_composition,
+)
+from cosmop.automata.composition import SizeLog, lift_word
+from cosmop.missions.mission import GlobalMission
+
+Word = tuple[str, ...]
+
+
+def _dfa_dict(dfa: DFA) -> dict:
+    """JSON form of a local mission: ``initial``, ``transitions``, ``alphabet``."""
+    return {
+        "initial": dfa.name_of(dfa.initial),
+        "transitions": [list(t) for t in dfa.transitions()],
+        "alphabet": list(dfa.alphabet),
+        **({} if dfa.marked.all() else {"marked": [dfa.name_of(int(q)) for q in np.flatnonzero(dfa.marked)]}),
+    }
+
+
+def project_locally(
+    mission: Composition, alphabets: Mapping[str, tuple[str, ...]], log: SizeLog | None = None
+) -> dict[str, DFA]:
+    """Local missions :math:`K^i = P_i(K)`, minimal, one per robot.
+
+    Parameters
+    ----------
+    mission : Composition
+        :math:`K` as a product of factors.
+    alphabets : Mapping[str, tuple of str]
+        :math:`\\Sigma_i` by robot.
+    log : SizeLog, optional
+        Records the automata built.
+    """
+    return {
+        robot: project_composition(mission.components, sigma, log=log) for robot, sigma in alphabets.items()
+    }
+
+
+def separability_counterexample(
+    mission: Composition, local: Mapping[str, DFA], log: SizeLog | None = None
+) -> Word | None:
+    """A word of :math:`\\|_i K^i` outside :math:`K`, or ``None`` when :math:`\\|_i K^i \\subseteq K`.
+
+    Factor by factor: :math:`u \\in P_{\\Sigma(T_j)}(\\|_i K^i) \\setminus T_j` is a shortest
+    violation of factor ``j`` (the first violated factor in order), lifted to a word of the
+    product :math:`\\|_i K^i` that projects onto it.
+    """
+    modules = list(local.values())
+    for factor in mission.components:
+        view = project_composition(modules, factor.alphabet, log=log)
+        u = inclusion_counterexample(view, factor)
+        if u is not None:
+            word = lift_word(modules, u, factor.alphabet)
+            if word is None:  # cannot happen: u is a word of the projection
+                raise AssertionError("counterexample does not lift to the product")
+            return word
+    return None
+
+
+def _used_events(dfa: DFA) -> set[str]:
+    """Events on at least one transition."""
+    return {dfa.alphabet[j] for j in np.flatnonzero((dfa.delta >= 0).any(axis=0))}
+
+
+def _without_extensions(dfa: DFA, word: Word) -> DFA:
+    """:math:`L - w\\Sigma^*`: remove ``word`` and all its extensions (keeps prefix-closure)."""
+    n = len(word)
+    cone = DFA.from_transitions(
+        "c0",
+        [
+            *((f"c{k}", e, f"c{k + 1}") for k, e in enumerate(word)),
+            *((f"c{n}", e, f"c{n}") for e in dfa.alphabet),
+        ],
+        marked=[f"c{n}"],
+        alphabet=dfa.alphabet,
+    )
+    return minimize(product(dfa, complement(cone, dfa.alphabet)))
+
+
+@dataclass(frozen=True)
+class Resynthesis:
+    """Outcome of the counterexample-guided re-synthesis of the paper's Remark.
+
+    Attributes
+    ----------
+    local_missions : Mapping[str, DFA]
+        The shrunk local missions.
+    converged : bool
+        ``True`` when :math:`\\|_i K^i \\subseteq K` holds for them (they are sound).
+    iterations : int
+        Counterexamples used.
+    counterexamples : tuple of words
+        The counterexamples, in order.
+    removed : Mapping[str, tuple of words]
+        For each robot, the local words cut off (with all their extensions).
+    lost_events : Mapping[str, tuple of str]
+        For each robot, the events its mission can no longer perform at all.
+    """
+
+    local_missions: Mapping[str, DFA]
+    converged: bool
+    iterations: int
+    counterexamples: tuple[Word, ...]
+    removed: Mapping[str, tuple[Word, ...]]
+    lost_events: Mapping[str, tuple[str, ...]]
+
+    def to_dict(self) -> dict:
+        """JSON-ready form."""
+        return {
+            "converged": self.converged,
+            "iterations": self.iterations,
+            "counterexamples": [list(w) for w in self.counterexamples],
+            "removed": {r: [list(w) for w in ws] for r, ws in self.removed.items() if ws},
+            "lost_events": {r: list(es) for r, es in self.lost_events.items() if es},
+            "local_missions": {r: _dfa_dict(d) for r, d in self.local_missions.items()},
+        }
+
+
+def resynthesize(
+    mission: GlobalMission,
+    local: Mapping[str, DFA],
+    *,
+    max_iterations: int = 100,
+    log: SizeLog | None = None,
+) -> Resynthesis:
+    """Shrink local missions with counterexamples until their product is included in :math:`K`.
+
+    Each round takes a counterexample :math:`t = s\\sigma \\in \\|_i K^i \\setminus K` (its last
+    event :math:`\\sigma` is the step that leaves :math:`K`) and sets
+    :math:`K^i := K^i - P_i(t)\\Sigma_i^*` for the robots ``i`` that own :math:`\\sigma`.
+    Removing the extensions keeps every :math:`K^i` prefix-closed.  (The paper writes the
+    update for every ``i``; for a robot not owning :math:`\\sigma`, :math:`P_i(t)` may be the
+    empty word and removing it would empty the whole local mission.)
+
+    Parameters
+    ----------
+    mission : GlobalMission
+    local : Mapping[str, DFA]
+        Starting local missions (normally the projections).
+    max_iterations : int
+        Cap on the number of counterexamples used; ``converged`` is ``False`` if hit.
+    log : SizeLog, optional
+
+    Returns
+    -------
+    Resynthesis
+        Sound (``converged``) local missions, never larger than the given ones.
+    """
+    current = dict(local)
+    alphabets = {r: set(d.alphabet) for r, d in current.items()}
+    counterexamples: list[Word] = []
+    removed: dict[str, list[Word]] = {r: [] for r in current}
+    converged = False
+    while True:
+        t = separability_counterexample(mission.automaton, current, log=log)
+        if t is None:
+            converged = True
+            break
+        if len(counterexamples) >= max_iterations:
+            break
+        counterexamples.append(t)
+        owners = mission.events[t[-1]].owners if t else frozenset(current)
+        for robot in sorted(owners & set(current)):
+            cut = tuple(e for e in t if e in alphabets[robot])
+            current[robot] = _without_extensions(current[robot], cut)
+            removed[robot].append(cut)
+            if log:
+                log.observe(current[robot])
+    lost = {r: tuple(sorted(_used_events(local[r]) - _used_events(current[r]))) for r in current}
+    return Resynthesis(
+        local_missions=MappingProxyType(current),
+        converged=converged,
+        iterations=len(counterexamples),
+        counterexamples=tuple(counterexamples),
+        removed=MappingProxyType({r: tuple(ws) for r, ws in removed.items()}),
+        lost_events=MappingProxyType(lost),
+    )
+
+
+@dataclass(frozen=True)
+class DecompositionStats:
+    """Where the time and memory of a decomposition went.
+
+    Attributes
+    ----------
+    project_s, separability_s, resynthesis_s, total_s : float
+        Wall-clock seconds per phase.
+    largest_automaton : int
+        Most states of any automaton built (factors of the mission included).
+    automata_built : int
+    mission_factors : int
+        Factors of :math:`K` (1 for an explicit DFA, the number of robots for tasks).
+    mission_factor_states : tuple of int
+        States of each factor.
+    """
+
+    project_s: float
+    separability_s: float
+    resynthesis_s: float
+    total_s: float
+    largest_automaton: int
+    automata_built: int
+    mission_factors: int
+    mission_factor_states: tuple[int, ...]
+
+    def to_dict(self) -> dict:
+        """JSON-ready form."""
+        return {k: (list(v) if isinstance(v, tuple) else v) for k, v in self.__dict__.items()}
+
+
+@dataclass(frozen=True)
+class Decomposition:
+    """Result of :func:`decompose`.
+
+    Attributes
+    ----------
+    alphabets : Mapping[str, tuple of str]
+        :math:`\\Sigma^i_{MI}` by robot.
+    local_missions : Mapping[str, DFA]
+        :math:`K^i_{MI} = P_i(K_{MI})`, minimal.
+    separable : bool
+        Whether :math:`K_{MI} = \\|_i P_i(K_{MI})`.
+    counterexample : tuple of str or None
+        When not separable, a word of :math:`\\|_i P_i(K_{MI})` outside :math:`K_{MI}`.
+    resynthesis : Resynthesis or None
+        When not separable, the re-synthesised (sound) local missions.
+    stats : DecompositionStats
+    """
+
+    alphabets: Mapping[str, tuple[str, ...]]
+    local_missions: Mapping[str, DFA]
+    separable: bool
+    counterexample: Word | None
+    resynthesis: Resynthesis | None
+    stats: DecompositionStats = field(repr=False)
+
+    @property
+    def sound_local_missions(self) -> Mapping[str, DFA]:
+        """Local missions whose product is included in :math:`K_{MI}`, when known.
+
+        The projections if separable, else the re-synthesised ones if they converged.
+        """
+        if self.separable:
+            return self.local_missions
+        if self.resynthesis is not None and self.resynthesis.converged:
+            return self.resynthesis.local_missions
+        raise ValueError("no sound local missions: re-synthesis did not converge")
+
+    def to_dict(self) -> dict:
+        """JSON-ready form (``separable``, ``counterexample``, ``local_missions``, ...)."""
+        return {
+            "separable": self.separable,
+            "counterexample": list(self.counterexample) if self.counterexample is not None else None,
+            "local_missions": {r: _dfa_dict(d) for r, d in self.local_missions.items()},
+            "resynthesis": self.resynthesis.to_dict() if self.resynthesis is not None else None,
+            "stats": self.stats.to_dict(),
+        }
+
+
+def decompose(mission: GlobalMission, *, max_iterations: int = 100) -> Decomposition:
+    """Decompose a global mission into local missions and decide separability.
+
+    Parameters
+    ----------
+    mission : GlobalMission
+        :math:`K_{MI}` with its events and team.
+    max_iterations : int
+        Cap for the re-synthesis when the mission is not separable.
+
+    Returns
+    -------
+    Decomposition
+    """
+    log = SizeLog()
+    for factor in mission.automaton.components:
+        log.observe(factor)
+    t0 = time.perf_counter()
+    alphabets = mission.alphabets
+    local = project_locally(mission.automaton, alphabets, log)
+    t1 = time.perf_counter()
+    cex = separability_counterexample(mission.automaton, local, log)
+    t2 = time.perf_counter()
+    resynthesis = (
+        None if cex is None else resynthesize(mission, local, max_iterations=max_iterations, log=log)
+    )
+    t3 = time.perf_counter()
+    stats = DecompositionStats(
+        project_s=t1 - t0,
+        separability_s=t2 - t1,
+        resynthesis_s=t3 - t2,
+        total_s=t3 - t0,
+        largest_automaton=log.largest,
+        automata_built=log.built,
+        mission_factors=len(mission.automaton.components),
+        mission_factor_states=tuple(f.n_states for f in mission.automaton.components),
+    )
+    return Decomposition(
+        alphabets=MappingProxyType(alphabets),
+        local_missions=MappingProxyType(local),
+        separable=cex is None,
+        counterexample=cex,
+        resynthesis=resynthesis,
+        stats=stats,
+    )

@@ -1,0 +1,259 @@
+"""Mission events: the letters of the mission alphabet.
+
+A mission is a regular language over events. The paper's alphabet (its table of mission
+events) has three kinds of robot events and one coordination event:
+
+========================  ===============  ==================  ================================
+canonical                 compact (paper)  in a task list      meaning
+========================  ===============  ==================  ================================
+``pick(R1,O1)``           ``R1pO1``        ``pick O1``         R1 picks up object O1
+``drop(R1,O1,W1)``        ``R1dO1aW1``     ``drop O1 at W1``   R1 drops O1 off inside workspace W1
+``return(R1)``            ``r1``           ``return``          R1 is back at its initial pose
+``away(O2,R1,R2)``        --               --                  R2 tells R1 that O2 has been moved
+========================  ===============  ==================  ================================
+
+``away(O,A,B)`` is shared by the requester A (for whom it is the request ``?O Away``) and the
+responder B (the response ``!O Away``); one such event exists per (object, requester,
+responder), so that several robots can ask the same responder without deadlock.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+from cosmop.errors import EventSyntaxError
+
+__all__ = ["ACCEPTED_FORMS", "EVENT_KINDS", "ID_PATTERN", "Event", "parse_event"]
+
+ID_PATTERN = r"[A-Za-z_][A-Za-z0-9_-]*"
+"""Regular expression that robot, object and workspace ids must match."""
+
+EVENT_KINDS = ("pick", "drop", "return", "away")
+"""The kinds of mission events."""
+
+ACCEPTED_FORMS = (
+    "pick(R,O)",
+    "drop(R,O,W)",
+    "return(R)",
+    "away(O,A,B)",
+    "in a robot's task list: 'pick O', 'drop O at W', 'return'",
+    "compact: 'R1pO1', 'R1dO1aW1', 'r1'",
+)
+"""Human-readable list of the accepted textual forms of an event (used in error messages)."""
+
+_ID_RE = re.compile(rf"{ID_PATTERN}\Z")
+_CANONICAL_RE = re.compile(r"\s*(?P<kind>[A-Za-z_]\w*)\s*\((?P<args>[^()]*)\)\s*\Z")
+_COMPACT_PICK_RE = re.compile(r"(?P<robot>R\d+)p(?P<obj>O\d+)\Z")
+_COMPACT_DROP_RE = re.compile(r"(?P<robot>R\d+)d(?P<obj>O\d+)a(?P<ws>W\d+)\Z")
+_COMPACT_RETURN_RE = re.compile(r"r(?P<num>\d+)\Z")
+_STEP_PICK_RE = re.compile(rf"pick\s+(?P<obj>{ID_PATTERN})\Z")
+_STEP_DROP_RE = re.compile(rf"drop\s+(?P<obj>{ID_PATTERN})\s+at\s+(?P<ws>{ID_PATTERN})\Z")
+_STEP_RETURN_RE = re.compile(r"return\Z")
+_STEP_USAGE = {"pick": "'pick O'", "drop": "'drop O at W'", "return": "'return'"}
+
+# kind -> names of its arguments in canonical order, as (attribute, description)
+_SIGNATURES: dict[str, tuple[tuple[str, str], ...]] = {
+    "pick": (("robot", "robot"), ("obj", "object")),
+    "drop": (("robot", "robot"), ("obj", "object"), ("workspace", "workspace")),
+    "return": (("robot", "robot"),),
+    "away": (("obj", "object"), ("robot", "requester"), ("responder", "responder")),
+}
+
+
+@dataclass(frozen=True, order=True)
+class Event:
+    """A mission event.
+
+    Parameters
+    ----------
+    kind : {"pick", "drop", "return", "away"}
+        What happens.
+    robot : str
+        The robot that performs a pick, drop or return; for ``away``, the requester A that
+        asked for the object to be moved.
+    obj : str, optional
+        The object picked, dropped or moved away (required for those kinds, else ``None``).
+    workspace : str, optional
+        The workspace the object is dropped in (``drop`` only).
+    responder : str, optional
+        The robot B that moved the object away and answers A (``away`` only, B != A).
+
+    Raises
+    ------
+    EventSyntaxError
+        If the kind is unknown, an id is not of the form ``[A-Za-z_][A-Za-z0-9_-]*``, the
+        fields do not match the kind, or an ``away`` event has requester == responder.
+
+    Notes
+    -----
+    Events are immutable, hashable and totally ordered (by kind, robot, object, workspace,
+    responder), so sets of events can be sorted deterministically.
+    """
+
+    kind: str
+    robot: str
+    obj: str | None = None
+    workspace: str | None = None
+    responder: str | None = None
+
+    def __post_init__(self) -> None:
+        if self.kind not in _SIGNATURES:
+            raise EventSyntaxError(
+                f"unknown event kind {self.kind!r}; expected one of {', '.join(EVENT_KINDS)}"
+            )
+        required = {attr for attr, _ in _SIGNATURES[self.kind]}
+        for attr, description in _SIGNATURES[self.kind]:
+            value = getattr(self, attr)
+            if not isinstance(value, str) or not _ID_RE.match(value):
+                raise EventSyntaxError(
+                    f"{self.kind} event: {description} must be an id matching {ID_PATTERN}, got {value!r}"
+                )
+        for attr in ("obj", "workspace", "responder"):
+            if attr not in required and getattr(self, attr) is not None:
+                raise EventSyntaxError(f"a {self.kind} event has no {attr}, got {getattr(self, attr)!r}")
+        if self.kind == "away" and self.robot == self.responder:
+            raise EventSyntaxError(f"the requester and the responder of {self.name} must be different robots")
+
+    @property
+    def name(self) -> str:
+        """Canonical text, e.g. ``pick(R1,O1)``, ``drop(R1,O1,W1)``, ``return(R1)``, ``away(O2,R1,R2)``."""
+        args = ",".join(getattr(self, attr) for attr, _ in _SIGNATURES[self.kind])
+        return f"{self.kind}({args})"
+
+    @property
+    def owners(self) -> frozenset[str]:
+        """The robots whose alphabets contain this event: ``{A, B}`` for ``away``, else ``{robot}``."""
+        if self.kind == "away":
+            return frozenset((self.robot, self.responder))
+        return frozenset((self.robot,))
+
+    @property
+    def compact(self) -> str | None:
+        """The paper's compact name (``R1pO1``, ``R1dO1aW1``, ``r1``), or ``None`` if it has none.
+
+        Only events whose ids follow the paper's pattern (``R<n>``, ``O<n>``, ``W<n>``) have a
+        compact name; ``away`` events never do.
+        """
+        candidate = {
+            "pick": f"{self.robot}p{self.obj}",
+            "drop": f"{self.robot}d{self.obj}a{self.workspace}",
+            "return": f"r{self.robot[1:]}" if self.robot.startswith("R") else "",
+            "away": "",
+        }[self.kind]
+        return candidate if candidate and _parse_compact(candidate) == self else None
+
+    def __str__(self) -> str:
+        return self.name
+
+
+def parse_event(text: str, robot: str | None = None) -> Event:
+    """Parse the textual form of a mission event.
+
+    Parameters
+    ----------
+    text : str
+        One of the accepted forms: canonical (``pick(R1,O1)``, ``drop(R1,O1,W1)``,
+        ``return(R1)``, ``away(O2,R1,R2)``; whitespace around the parentheses and commas is
+        ignored), the paper's compact names (``R1pO1``, ``R1dO1aW1``, ``r1``; ids must then be
+        ``R<n>``, ``O<n>``, ``W<n>``), or, when `robot` is given, a task step with the robot
+        implied (``pick O1``, ``drop O1 at W1``, ``return``).
+    robot : str, optional
+        The robot whose task list `text` comes from; enables the implied-robot forms. It does
+        not restrict the other forms: ``parse_event("pick(R2,O2)", robot="R1")`` returns R2's
+        event, and checking ownership is the caller's business.
+
+    Returns
+    -------
+    Event
+        The event.
+
+    Raises
+    ------
+    EventSyntaxError
+        If `text` is none of the accepted forms; the message quotes `text` and lists the forms.
+
+    Examples
+    --------
+    >>> parse_event("drop(R1, O1, W1)")
+    Event(kind='drop', robot='R1', obj='O1', workspace='W1', responder=None)
+    >>> parse_event("drop O1 at W1", robot="R1") == parse_event("R1dO1aW1")
+    True
+    """
+    if not isinstance(text, str):
+        raise EventSyntaxError(f"expected an event as text, got {text!r}; {_forms()}")
+    stripped = text.strip()
+
+    canonical = _CANONICAL_RE.match(stripped)
+    if canonical:
+        kind = canonical["kind"]
+        if kind not in _SIGNATURES:
+            raise _error(text, f"unknown event kind {kind!r}")
+        args = [arg.strip() for arg in canonical["args"].split(",")]
+        signature = _SIGNATURES[kind]
+        if len(args) != len(signature) or (len(args) == 1 and not args[0]):
+            wanted = ", ".join(description for _, description in signature)
+            got = 0 if args == [""] else len(args)
+            raise _error(text, f"{kind} takes {len(signature)} argument(s) ({wanted}), got {got}")
+        for arg, (_, description) in zip(args, signature, strict=True):
+            if not _ID_RE.match(arg):
+                raise _error(text, f"the {description} {arg!r} is not an id matching {ID_PATTERN}")
+        fields = {attr: arg for arg, (attr, _) in zip(args, signature, strict=True)}
+        return _build(text, kind=kind, **fields)
+
+    compact = _parse_compact(stripped)
+    if compact is not None:
+        return compact
+
+    step = _parse_step(stripped)
+    if step is not None:
+        if robot is None:
+            raise _error(
+                text, "the robot is implied only inside a robot's task list; write e.g. pick(R1,O1) or R1pO1"
+            )
+        if not isinstance(robot, str) or not _ID_RE.match(robot):
+            raise _error(text, f"the implied robot {robot!r} is not an id matching {ID_PATTERN}")
+        return _build(text, robot=robot, **step)
+
+    words = stripped.split()
+    if words and words[0] in _STEP_USAGE and "(" not in stripped:
+        raise _error(
+            text, f"a {words[0]} task step is written {_STEP_USAGE[words[0]]} with ids matching {ID_PATTERN}"
+        )
+    raise _error(text, "not a mission event")
+
+
+def _parse_compact(text: str) -> Event | None:
+    if match := _COMPACT_PICK_RE.match(text):
+        return Event("pick", match["robot"], match["obj"])
+    if match := _COMPACT_DROP_RE.match(text):
+        return Event("drop", match["robot"], match["obj"], match["ws"])
+    if match := _COMPACT_RETURN_RE.match(text):
+        return Event("return", f"R{match['num']}")
+    return None
+
+
+def _parse_step(text: str) -> dict[str, str] | None:
+    """Recognise an implied-robot task step; returns the Event fields other than the robot."""
+    if match := _STEP_PICK_RE.match(text):
+        return {"kind": "pick", "obj": match["obj"]}
+    if match := _STEP_DROP_RE.match(text):
+        return {"kind": "drop", "obj": match["obj"], "workspace": match["ws"]}
+    if _STEP_RETURN_RE.match(text):
+        return {"kind": "return"}
+    return None
+
+
+def _build(text: str, **fields: str) -> Event:
+    try:
+        return Event(**fields)
+    except EventSyntaxError as err:
+        raise _error(text, str(err)) from None
+
+
+def _forms() -> str:
+    return "accepted forms: " + "; ".join(ACCEPTED_FORMS)
+
+
+def _error(text: str, reason: str) -> EventSyntaxError:
+    return EventSyntaxError(f"invalid event {text!r}: {reason}; {_forms()}")

@@ -1,0 +1,918 @@
+"""Scenarios: the scene (walls, robots, movable objects, workspaces) and the mission.
+
+A scenario file (format version 1) is YAML::
+
+    name: warehouse-2x2
+    scene:
+      obstacles: [[[-2500, -2500], [2500, -2500]], ...]   # wall segments [[x1, y1], [x2, y2]]
+      robots:     {R1: {size: 400, pose: [-2000, -1000, 0]}, ...}   # x, y, heading
+      objects:    {O1: {size: 100, position: [2000, -1000]}, ...}
+      workspaces: {W1: {x: [-1500, -1000], y: [2000, 2500]}, W3: {point: [-4250, 4000]}}
+    mission:
+      tasks: {R1: [pick O1, drop O1 at W1, return], ...}   # or: dfa: {initial, transitions, ...}
+
+Lengths are millimetres and angles degrees; robots and objects are axis-aligned squares of
+side ``size``. :func:`load_scenario` reads such a file and :func:`parse_scenario` validates
+an already-parsed mapping; both return an immutable :class:`Scenario` or raise
+:class:`~cosmop.errors.ScenarioError` naming the file, the field and what was expected.
+
+The YAML dialect is close to YAML 1.2's core schema: only ``true``/``false`` are booleans
+(``yes``, ``no``, ``on``, ``off``, ``y``, ``n`` stay text), integers are decimal, dates stay
+text, and a key repeated inside one mapping is an error instead of silently overriding.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import MappingProxyType, NoneType, UnionType
+from typing import Annotated, Any, Literal, NoReturn, Union, get_args, get_origin
+
+import yaml
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError
+
+from cosmop.errors import EventSyntaxError, ScenarioError
+from cosmop.missions.events import ID_PATTERN, Event, parse_event
+
+__all__ = [
+    "SCENARIO_VERSION",
+    "DfaSpec",
+    "Mission",
+    "MovableObject",
+    "Robot",
+    "Scenario",
+    "Scene",
+    "Wall",
+    "Workspace",
+    "load_scenario",
+    "parse_scenario",
+]
+
+SCENARIO_VERSION = 1
+"""The scenario file format version this module reads (an optional top-level ``version`` key)."""
+
+Point = tuple[float, float]
+
+# ----------------------------------------------------------------------------------------------
+# The loaded scenario: small immutable values
+# ----------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Robot:
+    """A mobile robot: an axis-aligned square.
+
+    Parameters
+    ----------
+    id : str
+        The robot's id, e.g. ``"R1"``.
+    size : float
+        Side of the square footprint, mm (> 0).
+    pose : tuple of float
+        Initial pose ``(x, y, heading)``: centre in mm, heading in degrees.
+    """
+
+    id: str
+    size: float
+    pose: tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class MovableObject:
+    """An object the robots can pick up and drop off: an axis-aligned square.
+
+    Parameters
+    ----------
+    id : str
+        The object's id, e.g. ``"O1"``.
+    size : float
+        Side of the square, mm (> 0).
+    position : tuple of float
+        Initial centre ``(x, y)``, mm.
+    """
+
+    id: str
+    size: float
+    position: Point
+
+
+@dataclass(frozen=True)
+class Workspace:
+    """A place where objects are dropped off: an axis-aligned rectangle or a single point.
+
+    Parameters
+    ----------
+    id : str
+        The workspace's id, e.g. ``"W1"``.
+    x, y : tuple of float, optional
+        The rectangle ``x[0] <= x <= x[1]``, ``y[0] <= y <= y[1]`` (mm); both or neither.
+    point : tuple of float, optional
+        The point ``(x, y)`` (mm), instead of a rectangle.
+    """
+
+    id: str
+    x: Point | None = None
+    y: Point | None = None
+    point: Point | None = None
+
+    def __post_init__(self) -> None:
+        rectangle = self.x is not None and self.y is not None
+        if rectangle == (self.point is not None) or (self.x is None) != (self.y is None):
+            raise ValueError(f"workspace {self.id}: give either x and y ranges, or a point")
+        if rectangle and (self.x[0] > self.x[1] or self.y[0] > self.y[1]):
+            raise ValueError(f"workspace {self.id}: ranges must be [lo, hi] with lo <= hi")
+
+    @property
+    def is_point(self) -> bool:
+        """Whether the workspace is a single point."""
+        return self.point is not None
+
+    @property
+    def center(self) -> Point:
+        """The centre of the rectangle, or the point (mm)."""
+        if self.point is not None:
+            return self.point
+        return ((self.x[0] + self.x[1]) / 2.0, (self.y[0] + self.y[1]) / 2.0)
+
+    def contains(self, x: float, y: float, tol: float = 0.0) -> bool:
+        """Whether the position ``(x, y)`` lies in the workspace (boundary included).
+
+        Parameters
+        ----------
+        x, y : float
+            The position, mm.
+        tol : float, optional
+            Slack in mm added on every side (default 0: exact; a point workspace then
+            contains only that point).
+
+        Returns
+        -------
+        bool
+        """
+        if self.point is not None:
+            return abs(x - self.point[0]) <= tol and abs(y - self.point[1]) <= tol
+        return self.x[0] - tol <= x <= self.x[1] + tol and self.y[0] - tol <= y <= self.y[1] + tol
+
+
+@dataclass(frozen=True)
+class Wall:
+    """A wall: the straight segment from `start` to `end` (mm; the end points differ)."""
+
+    start: Point
+    end: Point
+
+    @property
+    def length(self) -> float:
+        """Length of the segment, mm."""
+        return math.dist(self.start, self.end)
+
+
+def _frozen_mapping(mapping: Mapping[str, Any]) -> Mapping[str, Any]:
+    if isinstance(mapping, MappingProxyType):
+        return mapping
+    return MappingProxyType(dict(mapping))
+
+
+@dataclass(frozen=True)
+class Scene:
+    """The physical scene: walls, robots, movable objects and workspaces.
+
+    The mappings are read-only and keep the order of the scenario file.
+
+    Parameters
+    ----------
+    obstacles : tuple of Wall
+        Wall segments.
+    robots : Mapping[str, Robot]
+        Robots by id.
+    objects : Mapping[str, MovableObject]
+        Movable objects by id.
+    workspaces : Mapping[str, Workspace]
+        Workspaces by id.
+    """
+
+    obstacles: tuple[Wall, ...]
+    robots: Mapping[str, Robot]
+    objects: Mapping[str, MovableObject] = field(default_factory=dict)
+    workspaces: Mapping[str, Workspace] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "obstacles", tuple(self.obstacles))
+        for name in ("robots", "objects", "workspaces"):
+            object.__setattr__(self, name, _frozen_mapping(getattr(self, name)))
+
+
+@dataclass(frozen=True)
+class DfaSpec:
+    """An explicit mission automaton, as written in a scenario file.
+
+    Parameters
+    ----------
+    states : tuple of str
+        All states, in the file's order (``states:`` if given, else order of appearance).
+    initial : str
+        The initial state.
+    marked : tuple of str
+        The marked (accepting) states; by default all states, i.e. a prefix-closed mission.
+    transitions : tuple of (str, Event, str)
+        Deterministic transitions ``(source, event, target)``.
+    """
+
+    states: tuple[str, ...]
+    initial: str
+    marked: tuple[str, ...]
+    transitions: tuple[tuple[str, Event, str], ...]
+
+    @property
+    def alphabet(self) -> tuple[Event, ...]:
+        """The distinct events on the transitions, sorted."""
+        return tuple(sorted({event for _, event, _ in self.transitions}))
+
+
+@dataclass(frozen=True)
+class Mission:
+    """The global mission: per-robot task sequences, or an explicit DFA (exactly one of them).
+
+    Parameters
+    ----------
+    tasks : Mapping[str, tuple of Event], optional
+        One event sequence per robot; the global mission is their parallel composition.
+    dfa : DfaSpec, optional
+        The global mission automaton.
+    """
+
+    tasks: Mapping[str, tuple[Event, ...]] | None = None
+    dfa: DfaSpec | None = None
+
+    def __post_init__(self) -> None:
+        if (self.tasks is None) == (self.dfa is None):
+            raise ValueError("a mission has exactly one of tasks or dfa")
+        if self.tasks is not None:
+            object.__setattr__(
+                self, "tasks", MappingProxyType({robot: tuple(seq) for robot, seq in self.tasks.items()})
+            )
+
+    @property
+    def form(self) -> Literal["tasks", "dfa"]:
+        """``"tasks"`` or ``"dfa"``: how the mission was given."""
+        return "tasks" if self.tasks is not None else "dfa"
+
+    @property
+    def events(self) -> frozenset[Event]:
+        """Every event the mission mentions (its alphabet)."""
+        if self.tasks is not None:
+            return frozenset(event for sequence in self.tasks.values() for event in sequence)
+        return frozenset(self.dfa.alphabet)
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A validated scenario.
+
+    Parameters
+    ----------
+    name : str
+        The scenario's name.
+    scene : Scene
+        Walls, robots, objects and workspaces.
+    mission : Mission
+        The global mission.
+    source : pathlib.Path, optional
+        The file it was loaded from, as given to :func:`load_scenario`.
+    """
+
+    name: str
+    scene: Scene
+    mission: Mission
+    source: Path | None = None
+
+
+# ----------------------------------------------------------------------------------------------
+# YAML: a YAML-1.2-like loader that reports duplicate keys and remembers where things are
+# ----------------------------------------------------------------------------------------------
+
+_TAG = "tag:yaml.org,2002:"
+_REPLACED_TAGS = {_TAG + "bool", _TAG + "int", _TAG + "float", _TAG + "timestamp", _TAG + "value"}
+
+
+class _ScenarioLoader(yaml.SafeLoader):
+    """SafeLoader with core-schema scalars: booleans are only true/false, ints are decimal."""
+
+
+_ScenarioLoader.yaml_implicit_resolvers = {
+    first: [(tag, regexp) for tag, regexp in resolvers if tag not in _REPLACED_TAGS]
+    for first, resolvers in yaml.SafeLoader.yaml_implicit_resolvers.items()
+}
+_ScenarioLoader.add_implicit_resolver(
+    _TAG + "bool", re.compile(r"^(?:true|True|TRUE|false|False|FALSE)$"), list("tTfF")
+)
+_ScenarioLoader.add_implicit_resolver(_TAG + "int", re.compile(r"^[-+]?[0-9]+$"), list("-+0123456789"))
+_ScenarioLoader.add_implicit_resolver(
+    _TAG + "float",
+    re.compile(
+        r"^(?:[-+]?(?:\.[0-9]+|[0-9]+(?:\.[0-9]*)?)(?:[eE][-+]?[0-9]+)?"
+        r"|[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN))$"
+    ),
+    list("-+0123456789."),
+)
+
+
+def _construct_int(loader: _ScenarioLoader, node: yaml.ScalarNode) -> int:
+    text = loader.construct_scalar(node)
+    if re.fullmatch(r"[-+]?[0-9]+", text):
+        return int(text, 10)  # "012" is twelve, not YAML 1.1's octal ten
+    try:  # an explicit !!int tag: accept YAML 1.1's other notations (0x1F, 0o17, ...)
+        return yaml.SafeLoader.construct_yaml_int(loader, node)
+    except ValueError:
+        raise yaml.constructor.ConstructorError(
+            None, None, f"{text!r} is not an integer", node.start_mark
+        ) from None
+
+
+_ScenarioLoader.add_constructor(_TAG + "int", _construct_int)
+
+_Path = tuple[str | int, ...]
+_Marks = dict[_Path, tuple[int, int]]
+
+
+def _load_yaml(text: str, file: str) -> tuple[Any, _Marks]:
+    """Parse YAML text; return the data and the (line, column) of every field path."""
+    loader = _ScenarioLoader(text)
+    try:
+        node = loader.get_single_node()
+        marks: _Marks = {}
+        if node is not None:
+            _index_nodes(loader, node, (), marks, set(), file)
+        data = loader.construct_document(node) if node is not None else None
+    except yaml.MarkedYAMLError as err:
+        mark = err.problem_mark or err.context_mark
+        problem = err.problem or err.context or "malformed YAML"
+        if err.context and err.problem:
+            problem = f"{problem} ({err.context})"
+        raise ScenarioError(
+            f"invalid YAML: {problem}",
+            file=file,
+            line=None if mark is None else mark.line + 1,
+            column=None if mark is None else mark.column + 1,
+        ) from None
+    except yaml.YAMLError as err:
+        raise ScenarioError(f"invalid YAML: {err}", file=file) from None
+    finally:
+        loader.dispose()
+    return data, marks
+
+
+def _index_nodes(
+    loader: _ScenarioLoader, node: yaml.Node, path: _Path, marks: _Marks, visited: set[int], file: str
+) -> None:
+    """Record the position of every field and reject keys repeated within one mapping."""
+    if id(node) in visited:  # an alias of an anchored node: already indexed
+        return
+    visited.add(id(node))
+    if isinstance(node, yaml.SequenceNode):
+        for index, item in enumerate(node.value):
+            marks.setdefault((*path, index), _position(item))
+            _index_nodes(loader, item, (*path, index), marks, visited, file)
+    elif isinstance(node, yaml.MappingNode):
+        first_seen: dict[Any, int] = {}
+        for key_node, value_node in node.value:
+            if key_node.tag == _TAG + "merge":  # "<<: *anchor": merged keys may be overridden
+                _index_nodes(loader, value_node, path, {}, visited, file)
+                continue
+            if not isinstance(key_node, yaml.ScalarNode):
+                continue  # complex keys: the constructor rejects unhashable ones
+            key = loader.construct_object(key_node, deep=True)
+            line, column = _position(key_node)
+            if key in first_seen:
+                raise ScenarioError(
+                    f"duplicate key {key!r} (first defined on line {first_seen[key]}); "
+                    "every key and id must appear once in its mapping",
+                    file=file,
+                    field=_format_path((*path, key)),
+                    line=line,
+                    column=column,
+                )
+            first_seen[key] = line
+            marks.setdefault((*path, key), (line, column))
+            _index_nodes(loader, value_node, (*path, key), marks, visited, file)
+
+
+def _position(node: yaml.Node) -> tuple[int, int]:
+    return node.start_mark.line + 1, node.start_mark.column + 1
+
+
+def _format_path(path: _Path) -> str:
+    """``("scene", "robots", "R1", "pose", 0)`` -> ``scene.robots.R1.pose[0]``."""
+    text = ""
+    for part in path:
+        if isinstance(part, int) and not isinstance(part, bool):
+            text += f"[{part}]"
+        elif isinstance(part, str) and re.fullmatch(r"[A-Za-z0-9_-]+", part):
+            text += f".{part}" if text else part
+        else:
+            text += f"[{part!r}]"
+    return text
+
+
+# ----------------------------------------------------------------------------------------------
+# Structure: pydantic models of the file format
+# ----------------------------------------------------------------------------------------------
+
+
+def _none_to(empty: Any) -> BeforeValidator:
+    """``objects:`` with nothing under it (null) means an empty collection."""
+    return BeforeValidator(lambda value: type(empty)() if value is None else value)
+
+
+def _int_state_to_str(value: Any) -> Any:
+    return str(value) if isinstance(value, int) and not isinstance(value, bool) else value
+
+
+_Number = Annotated[float, Field(strict=True, allow_inf_nan=False)]
+_Positive = Annotated[float, Field(strict=True, allow_inf_nan=False, gt=0)]
+_Text = Annotated[str, Field(strict=True)]
+_StateName = Annotated[str, BeforeValidator(_int_state_to_str), Field(strict=True, min_length=1)]
+_Pair = tuple[_Number, _Number]
+
+
+class _Model(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class _RobotModel(_Model):
+    size: _Positive
+    pose: tuple[_Number, _Number, _Number]
+
+
+class _ObjectModel(_Model):
+    size: _Positive
+    position: _Pair
+
+
+class _WorkspaceModel(_Model):
+    x: _Pair | None = None
+    y: _Pair | None = None
+    point: _Pair | None = None
+
+
+class _SceneModel(_Model):
+    obstacles: Annotated[list[tuple[_Pair, _Pair]], _none_to([])] = []
+    robots: Annotated[dict[_Text, _RobotModel], Field(min_length=1)]
+    objects: Annotated[dict[_Text, _ObjectModel], _none_to({})] = {}
+    workspaces: Annotated[dict[_Text, _WorkspaceModel], _none_to({})] = {}
+
+
+class _DfaModel(_Model):
+    initial: _StateName
+    transitions: list[tuple[_StateName, _Text, _StateName]]
+    states: list[_StateName] | None = None
+    marked: list[_StateName] | None = None
+
+
+class _MissionModel(_Model):
+    tasks: dict[_Text, Annotated[list[_Text], _none_to([])]] | None = None
+    dfa: _DfaModel | None = None
+
+
+class _ScenarioModel(_Model):
+    version: Annotated[int, Field(strict=True)] | None = None
+    name: Annotated[str, Field(strict=True, min_length=1)]
+    scene: _SceneModel
+    mission: _MissionModel
+
+
+_WALL = "a wall [[x1, y1], [x2, y2]]: two points of two numbers each (mm)"
+_RANGE = "a range [lo, hi] of two numbers with lo <= hi (mm)"
+_STATE = "a state name"
+# What is expected at a field; "*" stands for any id, "#" for any list index.
+_EXPECTED: dict[tuple[str, ...], str] = {
+    ("version",): f"{SCENARIO_VERSION}, the scenario format version",
+    ("name",): "a non-empty name (text)",
+    ("scene", "obstacles"): "a list of walls [[x1, y1], [x2, y2]]",
+    ("scene", "obstacles", "#"): _WALL,
+    ("scene", "robots"): "a non-empty mapping from robot ids to {size, pose}",
+    ("scene", "robots", "*", "size"): "a positive number (side of the square robot, mm)",
+    ("scene", "robots", "*", "pose"): "a pose [x, y, heading]: three numbers (mm, mm, degrees)",
+    ("scene", "objects"): "a mapping from object ids to {size, position}",
+    ("scene", "objects", "*", "size"): "a positive number (side of the square object, mm)",
+    ("scene", "objects", "*", "position"): "a position [x, y]: two numbers (mm)",
+    ("scene", "workspaces"): "a mapping from workspace ids to {x: [lo, hi], y: [lo, hi]} or {point: [x, y]}",
+    ("scene", "workspaces", "*"): "{x: [lo, hi], y: [lo, hi]} or {point: [x, y]}",
+    ("scene", "workspaces", "*", "x"): _RANGE,
+    ("scene", "workspaces", "*", "y"): _RANGE,
+    ("scene", "workspaces", "*", "point"): "a point [x, y]: two numbers (mm)",
+    ("mission",): "exactly one of tasks: {robot: [steps]} or dfa: {initial, transitions}",
+    ("mission", "tasks"): "a mapping from robot ids to lists of task steps",
+    ("mission", "tasks", "*"): "a list of task steps such as [pick O1, drop O1 at W1, return]",
+    ("mission", "tasks", "*", "#"): "a task step (text) such as 'pick O1', 'drop O1 at W1' or 'return'",
+    ("mission", "dfa", "initial"): _STATE,
+    ("mission", "dfa", "states"): "a list of state names",
+    ("mission", "dfa", "states", "#"): _STATE,
+    ("mission", "dfa", "marked"): "a list of state names",
+    ("mission", "dfa", "marked", "#"): _STATE,
+    ("mission", "dfa", "transitions"): "a list of transitions [state, event, state]",
+    (
+        "mission",
+        "dfa",
+        "transitions",
+        "#",
+    ): 'a transition [state, event, state], e.g. [q0, "pick(R1,O1)", q1]',
+}
+
+
+def _unwrap(annotation: Any) -> Any:
+    while True:
+        origin = get_origin(annotation)
+        if origin is Annotated:
+            annotation = get_args(annotation)[0]
+        elif origin in (Union, UnionType):
+            members = [arg for arg in get_args(annotation) if arg is not NoneType]
+            if len(members) != 1:
+                return annotation
+            annotation = members[0]
+        else:
+            return annotation
+
+
+def _model_at(path: _Path) -> type[BaseModel] | None:
+    """The pydantic model describing the mapping at `path`, if that position is a model."""
+    annotation: Any = _ScenarioModel
+    for part in path:
+        annotation = _unwrap(annotation)
+        if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+            if part not in annotation.model_fields:
+                return None
+            annotation = annotation.model_fields[part].annotation
+        elif get_origin(annotation) is dict:
+            annotation = get_args(annotation)[1]
+        elif get_origin(annotation) is list:
+            annotation = get_args(annotation)[0]
+        else:
+            return None
+    annotation = _unwrap(annotation)
+    return annotation if isinstance(annotation, type) and issubclass(annotation, BaseModel) else None
+
+
+def _describe_keys(model: type[BaseModel]) -> str:
+    keys = [name if info.is_required() else f"{name} (optional)" for name, info in model.model_fields.items()]
+    return "a mapping with keys " + ", ".join(keys)
+
+
+def _expected_at(loc: _Path) -> tuple[_Path, str | None]:
+    """The field to report for an error at `loc`, and what is expected there."""
+    for length in range(len(loc), -1, -1):
+        prefix = loc[:length]
+        for pattern, text in _EXPECTED.items():
+            if len(pattern) == length and all(
+                _matches(p, part) for p, part in zip(pattern, prefix, strict=True)
+            ):
+                return prefix, text
+        model = _model_at(prefix)
+        if model is not None:
+            return prefix, _describe_keys(model)
+    return loc, None
+
+
+def _matches(pattern: str, part: str | int) -> bool:
+    if pattern == "#":
+        return isinstance(part, int)
+    return pattern == "*" or pattern == part
+
+
+def _lookup(data: Any, path: _Path) -> tuple[bool, Any]:
+    for part in path:
+        if isinstance(data, Mapping):
+            if part not in data:
+                return False, None
+        elif not (isinstance(data, list) and isinstance(part, int) and 0 <= part < len(data)):
+            return False, None
+        data = data[part]
+    return True, data
+
+
+def _show_points(*points: Point) -> str:
+    return "[" + ", ".join(f"[{x:g}, {y:g}]" for x, y in points) + "]"
+
+
+def _show(value: Any) -> str:
+    if value is None:
+        return "nothing (null)"
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    text = repr(value)
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
+# ----------------------------------------------------------------------------------------------
+# Building and checking the scenario
+# ----------------------------------------------------------------------------------------------
+
+
+class _Builder:
+    """Validates one scenario mapping and builds the :class:`Scenario`."""
+
+    def __init__(self, data: Any, file: str | None, marks: _Marks | None) -> None:
+        self.data = data
+        self.file = file
+        self.marks = marks or {}
+
+    def fail(self, path: _Path, expected: str) -> NoReturn:
+        line = column = None
+        for length in range(len(path), 0, -1):
+            if path[:length] in self.marks:
+                line, column = self.marks[path[:length]]
+                break
+        raise ScenarioError(
+            expected, file=self.file, field=_format_path(path) if path else None, line=line, column=column
+        )
+
+    # -- structure ----------------------------------------------------------------------------
+
+    def validate_structure(self) -> _ScenarioModel:
+        if not isinstance(self.data, Mapping):
+            what = (
+                "the file is empty"
+                if self.data is None
+                else f"got {type(self.data).__name__} {_show(self.data)}"
+            )
+            self.fail((), f"expected a mapping with keys name, scene, mission at the top level; {what}")
+        try:
+            return _ScenarioModel.model_validate(self.data)
+        except ValidationError as exc:
+            errors = exc.errors(include_url=False)
+            first = min(
+                enumerate(errors),
+                key=lambda item: (self._line_of(tuple(item[1]["loc"])), item[0]),
+            )[1]
+            self._structure_error(first)
+
+    def _line_of(self, loc: _Path) -> float:
+        for length in range(len(loc), 0, -1):
+            if loc[:length] in self.marks:
+                return self.marks[loc[:length]][0]
+        return math.inf
+
+    def _structure_error(self, error: Mapping[str, Any]) -> NoReturn:
+        loc: _Path = tuple(error["loc"])
+        kind = error["type"]
+        if "[key]" in loc:
+            cut = loc.index("[key]")
+            key = loc[cut - 1]
+            self.fail(loc[: cut - 1], f"keys here must be ids (text), got {_show(key)}")
+        if kind == "extra_forbidden":
+            model = _model_at(loc[:-1])
+            allowed = ", ".join(model.model_fields) if model is not None else "none"
+            self.fail(loc, f"unknown key {loc[-1]!r}; expected one of: {allowed}")
+        if kind == "missing" and isinstance(loc[-1], str):
+            path, text = _expected_at(loc)
+            detail = f": expected {text}" if text is not None and path == loc else ""
+            self.fail(loc, f"missing required key {loc[-1]!r}{detail}")
+        path, text = _expected_at(loc)
+        if text is None:
+            self.fail(loc, str(error["msg"]))
+        found, value = _lookup(self.data, path)
+        shown = _show(value) if found else "nothing"
+        self.fail(path, f"expected {text}, got {shown}")
+
+    # -- semantics ----------------------------------------------------------------------------
+
+    def build(self, source: Path | None) -> Scenario:
+        model = self.validate_structure()
+        if model.version is not None and model.version != SCENARIO_VERSION:
+            self.fail(("version",), f"expected {_EXPECTED[('version',)]}, got {model.version}")
+        scene = self.build_scene(model.scene)
+        mission = self.build_mission(model.mission, scene)
+        return Scenario(name=model.name, scene=scene, mission=mission, source=source)
+
+    def build_scene(self, model: _SceneModel) -> Scene:
+        owner_of_id: dict[str, _Path] = {}
+        kinds = {"robots": "a robot", "objects": "an object", "workspaces": "a workspace"}
+        for group in ("robots", "objects", "workspaces"):
+            for ident in getattr(model, group):
+                path = ("scene", group, ident)
+                if not re.fullmatch(ID_PATTERN, ident):
+                    self.fail(path, f"expected an id matching {ID_PATTERN}, got {ident!r}")
+                if ident in owner_of_id:
+                    other = owner_of_id[ident]
+                    self.fail(
+                        path,
+                        f"id {ident!r} is already used by {kinds[other[1]]} ({_format_path(other)}); "
+                        "ids must be unique across robots, objects and workspaces",
+                    )
+                owner_of_id[ident] = path
+
+        walls = []
+        for index, (start, end) in enumerate(model.obstacles):
+            if start == end:
+                self.fail(
+                    ("scene", "obstacles", index),
+                    f"expected a wall with two distinct end points, got {_show_points(start, end)}",
+                )
+            walls.append(Wall(start, end))
+
+        robots = {ident: Robot(ident, r.size, r.pose) for ident, r in model.robots.items()}
+        objects = {ident: MovableObject(ident, o.size, o.position) for ident, o in model.objects.items()}
+        workspaces = {ident: self.build_workspace(ident, w) for ident, w in model.workspaces.items()}
+        return Scene(obstacles=tuple(walls), robots=robots, objects=objects, workspaces=workspaces)
+
+    def build_workspace(self, ident: str, model: _WorkspaceModel) -> Workspace:
+        path = ("scene", "workspaces", ident)
+        if model.point is not None:
+            if model.x is not None or model.y is not None:
+                self.fail(path, "expected either {x: [lo, hi], y: [lo, hi]} or {point: [x, y]}, not both")
+            return Workspace(ident, point=model.point)
+        if model.x is None and model.y is None:
+            self.fail(path, "expected {x: [lo, hi], y: [lo, hi]} or {point: [x, y]}, got neither")
+        for axis in ("x", "y"):
+            bounds = getattr(model, axis)
+            if bounds is None:
+                self.fail((*path, axis), f"missing required key {axis!r}: expected {_RANGE}")
+            if bounds[0] > bounds[1]:
+                self.fail((*path, axis), f"expected {_RANGE}, got lo = {bounds[0]:g} > hi = {bounds[1]:g}")
+        return Workspace(ident, x=model.x, y=model.y)
+
+    def build_mission(self, model: _MissionModel, scene: Scene) -> Mission:
+        if (model.tasks is None) == (model.dfa is None):
+            got = "both" if model.tasks is not None else "neither"
+            self.fail(("mission",), f"expected exactly one of 'tasks' or 'dfa', got {got}")
+        if model.tasks is not None:
+            return Mission(tasks=self.build_tasks(model.tasks, scene))
+        return Mission(dfa=self.build_dfa(model.dfa, scene))
+
+    def build_tasks(self, tasks: Mapping[str, list[str]], scene: Scene) -> dict[str, tuple[Event, ...]]:
+        result = {}
+        for robot, steps in tasks.items():
+            if robot not in scene.robots:
+                self.fail(
+                    ("mission", "tasks", robot), f"unknown robot {robot!r}; {_known('robots', scene.robots)}"
+                )
+            events = []
+            for index, text in enumerate(steps):
+                path = ("mission", "tasks", robot, index)
+                event = self.parse(path, text, robot)
+                if robot not in event.owners:
+                    owners = " and ".join(sorted(event.owners))
+                    self.fail(
+                        path,
+                        f"expected an event of robot {robot}, got {event.name}, which belongs to {owners}",
+                    )
+                self.check_references(path, event, scene)
+                events.append(event)
+            result[robot] = tuple(events)
+        return result
+
+    def build_dfa(self, model: _DfaModel, scene: Scene) -> DfaSpec:
+        base = ("mission", "dfa")
+        listed = self.unique_states((*base, "states"), model.states) if model.states is not None else None
+
+        def known(path: _Path, state: str, role: str) -> None:
+            if listed is not None and state not in listed:
+                self.fail(path, f"unknown {role} state {state!r}; it is not in mission.dfa.states")
+
+        known((*base, "initial"), model.initial, "initial")
+        order: dict[str, None] = dict.fromkeys(listed if listed is not None else [model.initial])
+        first_transition: dict[tuple[str, Event], tuple[int, str]] = {}
+        transitions = []
+        for index, (source, text, target) in enumerate(model.transitions):
+            path = (*base, "transitions", index)
+            known((*path, 0), source, "source")
+            known((*path, 2), target, "target")
+            event = self.parse((*path, 1), text, None)
+            self.check_references((*path, 1), event, scene)
+            if (source, event) in first_transition:
+                other, other_target = first_transition[(source, event)]
+                if other_target == target:
+                    problem = f"repeats transitions[{other}] ({source} --{event.name}--> {target})"
+                else:
+                    problem = (
+                        f"nondeterministic: from state {source!r}, event {event.name} leads to "
+                        f"{other_target!r} (transitions[{other}]) and to {target!r}"
+                    )
+                self.fail(path, f"{problem}; expected at most one transition per state and event")
+            first_transition[(source, event)] = (index, target)
+            order.setdefault(source)
+            order.setdefault(target)
+            transitions.append((source, event, target))
+        states = tuple(order)
+
+        if model.marked is None:
+            marked = states
+        else:
+            marked = self.unique_states((*base, "marked"), model.marked)
+            for index, state in enumerate(marked):
+                if state not in order:
+                    where = "mission.dfa.states" if listed is not None else "the transitions or initial"
+                    self.fail(
+                        (*base, "marked", index), f"unknown marked state {state!r}; it is not in {where}"
+                    )
+        return DfaSpec(
+            states=states, initial=model.initial, marked=tuple(marked), transitions=tuple(transitions)
+        )
+
+    def unique_states(self, path: _Path, states: list[str]) -> tuple[str, ...]:
+        seen: dict[str, int] = {}
+        for index, state in enumerate(states):
+            if state in seen:
+                self.fail((*path, index), f"duplicate state {state!r} (already at index {seen[state]})")
+            seen[state] = index
+        return tuple(states)
+
+    def parse(self, path: _Path, text: str, robot: str | None) -> Event:
+        try:
+            return parse_event(text, robot=robot)
+        except EventSyntaxError as err:
+            self.fail(path, str(err))
+
+    def check_references(self, path: _Path, event: Event, scene: Scene) -> None:
+        for robot in sorted(event.owners):
+            if robot not in scene.robots:
+                self.fail(path, f"unknown robot {robot!r} in {event.name}; {_known('robots', scene.robots)}")
+        if event.obj is not None and event.obj not in scene.objects:
+            self.fail(
+                path, f"unknown object {event.obj!r} in {event.name}; {_known('objects', scene.objects)}"
+            )
+        if event.workspace is not None and event.workspace not in scene.workspaces:
+            self.fail(
+                path,
+                f"unknown workspace {event.workspace!r} in {event.name}; "
+                f"{_known('workspaces', scene.workspaces)}",
+            )
+
+
+def _known(group: str, ids: Mapping[str, Any]) -> str:
+    if not ids:
+        return f"the scene has no {group}"
+    return f"the scene's {group} are " + ", ".join(ids)
+
+
+# ----------------------------------------------------------------------------------------------
+# Public entry points
+# ----------------------------------------------------------------------------------------------
+
+
+def parse_scenario(data: Mapping[str, Any], source: str | os.PathLike[str] | None = None) -> Scenario:
+    """Validate a scenario given as a mapping (e.g. already-parsed YAML or JSON).
+
+    Parameters
+    ----------
+    data : Mapping
+        The scenario, with the structure of a version-1 scenario file.
+    source : str or os.PathLike, optional
+        Where the data came from; used in error messages and kept as ``Scenario.source``.
+
+    Returns
+    -------
+    Scenario
+        The validated scenario.
+
+    Raises
+    ------
+    ScenarioError
+        If the data are not a valid scenario; the error names the field and what was expected.
+    """
+    file = None if source is None else os.fspath(source)
+    return _Builder(data, file, None).build(None if source is None else Path(source))
+
+
+def load_scenario(path: str | os.PathLike[str]) -> Scenario:
+    """Load and validate a scenario file (YAML, format version 1).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The scenario file.
+
+    Returns
+    -------
+    Scenario
+        The validated scenario; ``source`` is `path`.
+
+    Raises
+    ------
+    ScenarioError
+        If the file cannot be read, is not valid YAML (the line is given), repeats a key, or is
+        not a valid scenario; the error names the file, the field and what was expected.
+    """
+    file = os.fspath(path)
+    try:
+        raw = Path(path).read_bytes()
+    except FileNotFoundError:
+        raise ScenarioError("file not found", file=file) from None
+    except IsADirectoryError:
+        raise ScenarioError("is a directory, expected a scenario file", file=file) from None
+    except PermissionError:
+        raise ScenarioError("permission denied: cannot read the file", file=file) from None
+    except OSError as err:
+        raise ScenarioError(f"cannot read the file: {err.strerror or err}", file=file) from None
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError as err:
+        raise ScenarioError(
+            f"expected UTF-8 text, found an invalid byte at offset {err.start}", file=file
+        ) from None
+    data, marks = _load_yaml(text, file)
+    return _Builder(data, file, marks).build(Path(path))

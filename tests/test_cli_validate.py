@@ -1,0 +1,164 @@
+"""The command line: ``cosmop validate``, ``--version`` and the handling of bad input."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from cosmop import __version__
+from cosmop.cli import EXIT_INPUT_ERROR, app
+from cosmop.io import write_atomic
+
+EXAMPLE_DIR = Path(__file__).resolve().parents[1] / "examples" / "01_warehouse_2x2"
+TASKS_FILE = EXAMPLE_DIR / "scenario.yaml"
+DFA_FILE = EXAMPLE_DIR / "scenario_dfa.yaml"
+
+runner = CliRunner()
+
+
+def bad_scenario(tmp_path: Path) -> Path:
+    """The example with R1's second step naming a workspace that does not exist."""
+    path = tmp_path / "bad.yaml"
+    write_atomic(path, TASKS_FILE.read_text().replace("drop O1 at W1", "drop O1 at W9"))
+    return path
+
+
+def test_validate_tasks_example() -> None:
+    result = runner.invoke(app, ["validate", str(TASKS_FILE)])
+    assert result.exit_code == 0, result.output
+    out = result.stdout
+    assert "warehouse-2x2" in out
+    for fragment in ("robots", "R1", "R2", "objects", "O1", "O2", "workspaces", "W1", "W2", "walls", "6"):
+        assert fragment in out
+    assert "tasks: 6 steps for 2 robots, 6 events" in out
+    assert "valid" in out
+    assert result.stderr == ""
+
+
+def test_validate_dfa_example() -> None:
+    result = runner.invoke(app, ["validate", str(DFA_FILE)])
+    assert result.exit_code == 0, result.output
+    assert "dfa: 16 states, 24 transitions, 16 marked, 6 events" in result.stdout
+
+
+def test_validate_point_workspace(tmp_path: Path) -> None:
+    path = tmp_path / "s.yaml"
+    text = TASKS_FILE.read_text().replace(
+        "    W2: {x: [1000, 1500], y: [2000, 2500]}",
+        "    W2: {x: [1000, 1500], y: [2000, 2500]}\n    W3: {point: [-2250, 2000]}",
+    )
+    write_atomic(path, text)
+    result = runner.invoke(app, ["validate", str(path)])
+    assert result.exit_code == 0, result.output
+    assert "W3 (point)" in result.stdout
+
+
+def test_bad_scenario_is_one_line_on_stderr_with_status_2(tmp_path: Path) -> None:
+    path = bad_scenario(tmp_path)
+    result = runner.invoke(app, ["validate", str(path)])
+    assert result.exit_code == EXIT_INPUT_ERROR == 2
+    assert result.stdout == ""
+    lines = result.stderr.splitlines()
+    assert len(lines) == 1
+    assert lines[0].startswith(f"error: {path}: mission.tasks.R1[1]: unknown workspace 'W9'")
+    assert "Traceback" not in result.output
+    assert result.exception is None or isinstance(result.exception, SystemExit)
+
+
+def test_markup_like_text_is_printed_verbatim(tmp_path: Path) -> None:
+    # field paths contain [brackets]; they must not be swallowed as rich markup
+    path = tmp_path / "bad.yaml"
+    write_atomic(path, TASKS_FILE.read_text().replace("[pick O2,", '["[bold]pick O2",'))
+    result = runner.invoke(app, ["validate", str(path)])
+    assert result.exit_code == 2
+    assert "mission.tasks.R2[0]: invalid event '[bold]pick O2'" in result.stderr
+
+
+@pytest.mark.parametrize(
+    ("content", "fragment"),
+    [
+        ("name: [unclosed\n", "invalid YAML"),
+        ("", "the file is empty"),
+        ("name: x\nname: y\n", "duplicate key 'name'"),
+    ],
+)
+def test_other_bad_files(tmp_path: Path, content: str, fragment: str) -> None:
+    path = tmp_path / "s.yaml"
+    write_atomic(path, content)
+    result = runner.invoke(app, ["validate", str(path)])
+    assert result.exit_code == 2
+    assert result.stderr.startswith(f"error: {path}: ")
+    assert fragment in result.stderr
+    assert "Traceback" not in result.output
+
+
+def test_missing_file(tmp_path: Path) -> None:
+    path = tmp_path / "absent.yaml"
+    result = runner.invoke(app, ["validate", str(path)])
+    assert result.exit_code == 2
+    assert result.stderr.strip() == f"error: {path}: file not found"
+
+
+def test_usage_errors_exit_2() -> None:
+    missing_argument = runner.invoke(app, ["validate"])
+    assert missing_argument.exit_code == 2
+    assert "Missing argument" in missing_argument.output
+    unknown_command = runner.invoke(app, ["frobnicate"])
+    assert unknown_command.exit_code == 2
+    assert "Traceback" not in missing_argument.output + unknown_command.output
+
+
+def test_version() -> None:
+    result = runner.invoke(app, ["--version"])
+    assert result.exit_code == 0
+    assert result.stdout.strip() == f"cosmop {__version__}"
+
+
+def test_help_lists_validate() -> None:
+    result = runner.invoke(app, ["--help"])
+    assert result.exit_code == 0
+    assert "validate" in result.stdout
+
+
+def _run_module(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
+    env = {**os.environ, "NO_COLOR": "1", "PYTHONIOENCODING": "utf-8"}
+    return subprocess.run(
+        [sys.executable, "-m", "cosmop", *args],
+        capture_output=True,
+        text=True,
+        cwd=cwd,
+        env=env,
+        timeout=120,
+        check=False,
+    )
+
+
+def test_python_dash_m_reports_bad_input_without_traceback(tmp_path: Path) -> None:
+    path = bad_scenario(tmp_path)
+    proc = _run_module("validate", path.name, cwd=tmp_path)
+    assert proc.returncode == 2
+    assert proc.stdout == ""
+    assert proc.stderr.splitlines() == [
+        f"error: bad.yaml: mission.tasks.R1[1]: unknown workspace 'W9' in drop(R1,O1,W9); "
+        f"the scene's workspaces are W1, W2 ({_position(path, 'W9')})"
+    ]
+    assert "Traceback" not in proc.stderr
+
+
+def test_python_dash_m_validates_the_example(tmp_path: Path) -> None:
+    proc = _run_module("validate", str(TASKS_FILE), cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert "warehouse-2x2" in proc.stdout
+    assert proc.stderr == ""
+
+
+def _position(path: Path, needle: str) -> str:
+    for number, line in enumerate(path.read_text().splitlines(), 1):
+        if needle in line:
+            return f"line {number}, column {line.index('drop O1') + 1}"
+    raise AssertionError(needle)
