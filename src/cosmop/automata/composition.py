@@ -150,6 +150,9 @@ def project_composition(
     observe = log.observe if log else (lambda d: d)
     parts: list[DFA] = []
     for members in _clusters(components):
+        touches = any(target & set(components[i].alphabet) for i in members)
+        if not touches and all(components[i].marked[components[i].initial] for i in members):
+            continue  # contributes {ε}: the empty word is in every factor, so the cluster is not empty
         order = _order(components, members, target)
         acc: DFA | None = None
         for k, i in enumerate(order):

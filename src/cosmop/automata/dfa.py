@@ -229,20 +229,26 @@ class DFA:
             for q, j in zip(rows, cols, strict=True)
         ]
 
-    def to_dict(self) -> dict:
-        """The DFA form of the scenario file: ``initial``, ``transitions``, ``alphabet``, ``marked``.
+    def to_dict(self, *, with_alphabet: bool = False) -> dict:
+        """The DFA form of the scenario file: ``initial``, ``transitions`` (+ ``states``, ``marked``).
 
-        ``marked`` is omitted when every state is marked (a prefix-closed mission).
+        ``marked`` is omitted when every state is marked (a prefix-closed mission), ``states``
+        when every state appears on a transition or is initial.  ``with_alphabet`` adds the
+        sorted ``alphabet`` (events without transitions are otherwise lost).
         """
         data: dict = {
             "initial": self.name_of(self.initial),
             "transitions": [list(t) for t in self.transitions()],
-            "alphabet": list(self.alphabet),
         }
+        on_edges = set(np.flatnonzero((self.delta >= 0).any(axis=1))) | set(
+            self.delta[self.delta >= 0].tolist()
+        )
+        if len(on_edges | {self.initial}) < self.n_states:
+            data["states"] = [self.name_of(q) for q in range(self.n_states)]
         if not self.marked.all():
             data["marked"] = [self.name_of(int(q)) for q in np.flatnonzero(self.marked)]
-        if self.n_transitions == 0:
-            data["states"] = [self.name_of(q) for q in range(self.n_states)]
+        if with_alphabet:
+            data["alphabet"] = list(self.alphabet)
         return data
 
     @classmethod

@@ -38,16 +38,6 @@ from cosmop.missions.mission import GlobalMission
 Word = tuple[str, ...]
 
 
-def _dfa_dict(dfa: DFA) -> dict:
-    """JSON form of a local mission: ``initial``, ``transitions``, ``alphabet``."""
-    return {
-        "initial": dfa.name_of(dfa.initial),
-        "transitions": [list(t) for t in dfa.transitions()],
-        "alphabet": list(dfa.alphabet),
-        **({} if dfa.marked.all() else {"marked": [dfa.name_of(int(q)) for q in np.flatnonzero(dfa.marked)]}),
-    }
-
-
 def project_locally(
     mission: Composition, alphabets: Mapping[str, tuple[str, ...]], log: SizeLog | None = None
 ) -> dict[str, DFA]:
@@ -143,7 +133,7 @@ class Resynthesis:
             "counterexamples": [list(w) for w in self.counterexamples],
             "removed": {r: [list(w) for w in ws] for r, ws in self.removed.items() if ws},
             "lost_events": {r: list(es) for r, es in self.lost_events.items() if es},
-            "local_missions": {r: _dfa_dict(d) for r, d in self.local_missions.items()},
+            "local_missions": {r: d.to_dict(with_alphabet=True) for r, d in self.local_missions.items()},
         }
 
 
@@ -282,7 +272,7 @@ class Decomposition:
         return {
             "separable": self.separable,
             "counterexample": list(self.counterexample) if self.counterexample is not None else None,
-            "local_missions": {r: _dfa_dict(d) for r, d in self.local_missions.items()},
+            "local_missions": {r: d.to_dict(with_alphabet=True) for r, d in self.local_missions.items()},
             "resynthesis": self.resynthesis.to_dict() if self.resynthesis is not None else None,
             "stats": self.stats.to_dict(),
         }

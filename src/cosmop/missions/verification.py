@@ -27,10 +27,10 @@ automaton small when the mission has structure:
 2. *Cone of influence*: for factor ``j`` only the robots that own an event of
    :math:`\\Sigma(T_j)`, and the robots linked to them through shared (coordination) events,
    matter; robots outside that cluster interleave freely and cannot affect the projection.
-3. *Asymmetric rule per factor*: the guarantor :math:`M_1` is the first robot owning an event of
-   :math:`T_j`; the rest of the cluster is the environment :math:`M_2`, abstracted exactly by
-   the compositional projection onto :math:`\\Sigma_A`.  A cluster of one robot is checked
-   directly.
+3. *Asymmetric rule per factor*: the guarantor :math:`M_1` is the robot owning most events of
+   :math:`T_j` (the first in team order on ties); the rest of the cluster is the environment
+   :math:`M_2`, abstracted exactly by the compositional projection onto :math:`\\Sigma_A`.
+   A cluster of one robot is checked directly.
 
 With ``method="auto"`` a factor whose environment abstraction exceeds
 ``max_environment_states`` is checked directly instead (an explicit global DFA over N robots
@@ -399,7 +399,8 @@ def verify(
     counterexample: Word | None = None
     for j, factor in enumerate(mission.automaton.components):
         sigma = set(factor.alphabet)
-        owners = [r for r in local if alphabets[r] & sigma]
+        # the guarantor is the robot owning most of the factor's events (team order breaks ties)
+        owners = sorted((r for r in local if alphabets[r] & sigma), key=lambda r: -len(alphabets[r] & sigma))
         cluster = _cluster(set(owners), alphabets)
         modules = [local[r] for r in cluster]
         environment_robots = [r for r in cluster if owners and r != owners[0]]
