@@ -196,8 +196,11 @@ def lift_word(
 
     Returns ``None`` when no word of the product projects onto ``word``.
     """
-    target = set(alphabet)
-    pinned = DFA.from_word(tuple(word), target, closed=False)
+    # events of the target that no component knows never occur in the product
+    known = set(alphabet) & {e for c in components for e in c.alphabet}
+    if not set(word) <= known:
+        return None
+    pinned = DFA.from_word(tuple(word), known, closed=False)
     groups = _clusters([pinned, *components])
     head: tuple[str, ...] = ()
     tail: list[str] = []

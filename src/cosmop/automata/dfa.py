@@ -72,8 +72,11 @@ class DFA:
             raise ValueError(f"initial state {self.initial} out of range 0..{n - 1}")
         if delta.size and (delta.min() < -1 or delta.max() >= n):
             raise ValueError("delta refers to a state out of range")
-        if self.state_names is not None and len(self.state_names) != n:
-            raise ValueError("state_names must name every state")
+        if self.state_names is not None:
+            if len(self.state_names) != n:
+                raise ValueError("state_names must name every state")
+            if len(set(self.state_names)) != n:
+                raise ValueError("state_names must be distinct")
         delta.flags.writeable = False
         marked.flags.writeable = False
         object.__setattr__(self, "delta", delta)

@@ -270,10 +270,10 @@ def project(dfa: DFA, events: Iterable[str]) -> DFA:
         row = [-1] * len(target)
         for j, col in observable:
             succ = dfa.delta[current, col]
-            succ = np.unique(succ[succ >= 0])
+            succ = succ[succ >= 0]
             if succ.size == 0:
                 continue
-            subset = closure(succ.astype(np.int32))
+            subset = closure(succ)  # the closure deduplicates
             key = subset.tobytes()
             sid = ids.get(key)
             if sid is None:
