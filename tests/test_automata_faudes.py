@@ -64,26 +64,8 @@ CHECKS = settings(max_examples=int(40 * SCALE), deadline=None, suppress_health_c
 # ---------------------------------------------------------------------------------------------
 
 
-def to_fd(dfa: DFA):
-    """Our DFA as a libFAUDES generator (plain Python ints: the adapter rejects numpy ints)."""
-    rows, cols = np.nonzero(dfa.delta >= 0)
-    transitions = [(int(q), dfa.alphabet[j], int(dfa.delta[q, j])) for q, j in zip(rows, cols, strict=True)]
-    marked = [int(q) for q in np.flatnonzero(dfa.marked)]
-    return ref.to_faudes(dfa.alphabet, dfa.n_states, dfa.initial, marked, transitions)
-
-
-def from_fd(gen) -> DFA:
-    """A deterministic libFAUDES generator as our DFA (no states: the empty language)."""
-    alphabet, n, initial, marked, transitions = ref.from_faudes(gen)
-    if n == 0:
-        return DFA.empty(alphabet)
-    col = {e: j for j, e in enumerate(alphabet)}
-    delta = np.full((n, len(alphabet)), -1, dtype=np.int32)
-    for src, ev, dst in transitions:
-        delta[src, col[ev]] = dst
-    mask = np.zeros(n, dtype=bool)
-    mask[marked] = True
-    return DFA(tuple(alphabet), delta, initial, mask)
+to_fd = ref.dfa_to_faudes
+from_fd = ref.faudes_to_dfa
 
 
 def assert_same_language(ours: DFA, gen) -> None:

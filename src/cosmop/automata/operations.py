@@ -192,12 +192,7 @@ def parallel(*dfas: DFA) -> DFA:
     :math:`\\Sigma_1 \\cup \\Sigma_2` (the paper's Definition of the synchronous product).
     Components are folded left to right; only accessible states are built.
     """
-    if not dfas:
-        raise ValueError("parallel needs at least one DFA")
-    result = dfas[0]
-    for other in dfas[1:]:
-        result = _pair(result, other, synchronous=True)
-    return result
+    return _fold(dfas, synchronous=True)
 
 
 def product(*dfas: DFA) -> DFA:
@@ -206,11 +201,16 @@ def product(*dfas: DFA) -> DFA:
     Languages are sets of words over the union of the alphabets, so an event that one
     component does not know is blocked.  With equal alphabets this equals :func:`parallel`.
     """
+    return _fold(dfas, synchronous=False)
+
+
+def _fold(dfas: Sequence[DFA], *, synchronous: bool) -> DFA:
+    """Left fold of :func:`_pair` over at least one DFA."""
     if not dfas:
-        raise ValueError("product needs at least one DFA")
+        raise ValueError("a product needs at least one DFA")
     result = dfas[0]
     for other in dfas[1:]:
-        result = _pair(result, other, synchronous=False)
+        result = _pair(result, other, synchronous=synchronous)
     return result
 
 

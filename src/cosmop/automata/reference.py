@@ -60,6 +60,10 @@ from collections.abc import Iterable, Iterator
 from types import ModuleType
 from typing import TYPE_CHECKING, TypeAlias
 
+import numpy as np
+
+from cosmop.automata.dfa import DFA
+
 if TYPE_CHECKING:  # pragma: no cover - typing only
     import faudes
 
@@ -537,3 +541,27 @@ def minimal_states(g: GeneratorLike) -> int:
         res = _new_generator(fd, "statemin")
         fd.StateMin(work, res)
         return int(res.Size())
+
+
+def dfa_to_faudes(dfa: DFA) -> faudes.Generator:
+    """A :class:`cosmop.automata.DFA` as a libFAUDES generator (same marked language)."""
+    rows, cols = np.nonzero(dfa.delta >= 0)
+    transitions = [(int(q), dfa.alphabet[j], int(dfa.delta[q, j])) for q, j in zip(rows, cols, strict=True)]
+    return to_faudes(dfa.alphabet, dfa.n_states, dfa.initial, np.flatnonzero(dfa.marked), transitions)
+
+
+def faudes_to_dfa(gen: faudes.Generator) -> DFA:
+    """A deterministic libFAUDES generator as a :class:`cosmop.automata.DFA`.
+
+    A generator without states (libFAUDES's empty language) becomes :meth:`DFA.empty`.
+    """
+    alphabet, n, initial, marked, transitions = from_faudes(gen)
+    if n == 0:
+        return DFA.empty(alphabet)
+    col = {e: j for j, e in enumerate(alphabet)}
+    delta = np.full((n, len(alphabet)), -1, dtype=np.int32)
+    for src, ev, dst in transitions:
+        delta[src, col[ev]] = dst
+    mask = np.zeros(n, dtype=bool)
+    mask[list(marked)] = True
+    return DFA(tuple(alphabet), delta, initial, mask)
