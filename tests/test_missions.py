@@ -218,3 +218,13 @@ def test_projection_of_the_explicit_dfa_matches_plain_projection(paper_dfa):
     k = paper_dfa.automaton.components[0]
     result = decompose(paper_dfa)
     assert equivalent(result.local_missions["R1"], project(k, R1))
+
+
+def test_lstar_round_cap_never_claims_a_proof(paper_dfa, ordered):
+    # one L* round is not enough to learn R2's sequence: no proof, so the factor is decided directly
+    local = decompose(paper_dfa).local_missions
+    capped = verify(paper_dfa, local, method="assume-guarantee", max_rounds=1)
+    assert capped.holds and capped.checks[0].method == "direct (L* round cap)"
+    assert not capped.assumptions[0].holds
+    bad = verify(ordered, decompose(ordered).local_missions, method="assume-guarantee", max_rounds=1)
+    assert not bad.holds and bad.counterexample == ("pick(R2,O2)",)

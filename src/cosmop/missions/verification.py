@@ -122,7 +122,8 @@ class FactorCheck:
     ----------
     factor : int
     method : str
-        ``"direct"`` (compositional projection and inclusion) or ``"assume-guarantee"``.
+        ``"direct"`` (compositional projection and inclusion), ``"assume-guarantee"``, or
+        ``"direct (L* round cap)"`` when learning stopped at its cap before a proof.
     robots : tuple of str
         The cluster of robots that can influence the factor.
     holds : bool
@@ -272,9 +273,10 @@ def _to_dfa(hypothesis, interface: Sequence[str]) -> DFA:
 
 def _learn_assumption(
     m1: DFA, environment: DFA, spec: DFA, interface: tuple[str, ...], log: SizeLog, max_rounds: int
-) -> tuple[bool, DFA | None, Word | None, int, int]:
+) -> tuple[bool | None, DFA | None, Word | None, int, int]:
     """Run L* for an assumption over ``interface``; returns (holds, A, violation, #mq, #eq).
 
+    ``holds`` is ``None`` when L* reached ``max_rounds`` before the premises were proved.
     ``violation`` is a word over :math:`\\Sigma_{M_1} \\cup \\Sigma_A` of :math:`M_1` composed
     with the environment's interface behaviour that violates ``spec``.
     """
@@ -311,6 +313,7 @@ def _learn_assumption(
         def __init__(self, alphabet: list[str], sul: SUL) -> None:
             super().__init__(alphabet, sul)
             self.last: DFA | None = None
+            self.proved = False
 
         def find_cex(self, hypothesis):
             counts["equivalence"] += 1
@@ -320,7 +323,8 @@ def _learn_assumption(
             if w is not None:  # premise 1 fails: the conjecture admits a harmful interface word
                 return tuple(e for e in w if e in interface)
             c = inclusion_counterexample(environment, a)
-            if c is None:  # both premises hold
+            if c is None:  # both premises hold: the rule proves the factor
+                self.proved = True
                 return None
             if member(c):  # the conjecture is too strong
                 return c
@@ -343,7 +347,9 @@ def _learn_assumption(
         return False, teacher.last, word, counts["membership"], counts["equivalence"]
     except SystemExit as exc:  # AALpy's reaction to inconsistent answers
         raise RuntimeError(f"L*: inconsistent membership answers ({exc})") from None
-    return True, teacher.last, None, counts["membership"], counts["equivalence"]
+    # L* also stops at the round cap without a proof: then the factor is undecided (None)
+    holds = True if teacher.proved else None
+    return holds, teacher.last, None, counts["membership"], counts["equivalence"]
 
 
 def _cluster(start: set[str], alphabets: Mapping[str, set[str]]) -> list[str]:
@@ -416,6 +422,7 @@ def verify(
             )
             if method == "auto" and abstraction.n_states > max_environment_states:
                 use_ag = False
+        holds: bool | None = None
         if use_ag:
             assert abstraction is not None
             holds, assumption, violation, mq, eq = _learn_assumption(
@@ -431,18 +438,21 @@ def verify(
                     environment_states=abstraction.n_states,
                     membership_queries=mq,
                     equivalence_queries=eq,
-                    holds=holds,
+                    holds=bool(holds),
                 )
             )
             if violation is not None:
                 counterexample = lift_word(modules, violation, alphabets[owners[0]] | set(interface))
-        else:
+        if holds is None:  # direct check: by method, or because L* stopped at its round cap
             view = project_composition(modules, factor.alphabet, log=log)
             u = inclusion_counterexample(view, factor)
             holds = u is None
             if u is not None:
                 counterexample = lift_word(modules, u, factor.alphabet)
-        checks.append(FactorCheck(j, "assume-guarantee" if use_ag else "direct", tuple(cluster), holds))
+            method_used = "direct" if not use_ag else "direct (L* round cap)"
+        else:
+            method_used = "assume-guarantee"
+        checks.append(FactorCheck(j, method_used, tuple(cluster), holds))
         if not holds:
             break
     return Verification(
