@@ -78,7 +78,8 @@ class AssumptionReport:
     environment_states : int
         States of the environment's abstraction :math:`P_{\\Sigma_A}(M_2)`.
     membership_queries, equivalence_queries : int
-        Queries answered by the teacher (membership queries after AALpy's cache).
+        Membership queries that reached the teacher (AALpy's cache answers repeats) and
+        conjectures checked.
     holds : bool
     """
 
@@ -286,7 +287,7 @@ def _learn_assumption(
     counts = {"membership": 0, "equivalence": 0}
     oracle = _Membership(m1, spec, interface)
 
-    def member(word: Word) -> bool:
+    def member(word: Word) -> bool:  # the teacher's own queries (AALpy counts its own)
         counts["membership"] += 1
         return oracle(word)
 
@@ -304,7 +305,6 @@ def _learn_assumption(
             pass
 
         def step(self, letter):
-            counts["membership"] += 1
             if letter is not None:
                 self.pairs = oracle.advance(self.pairs, letter)
             return oracle.holds(self.pairs)
@@ -344,12 +344,12 @@ def _learn_assumption(
     except _RealViolation as violation:
         pinned = DFA.from_word(violation.word, interface, closed=False)
         word = satisfaction_counterexample(parallel(m1, pinned), spec)
-        return False, teacher.last, word, counts["membership"], counts["equivalence"]
+        return False, teacher.last, word, sul.num_queries + counts["membership"], counts["equivalence"]
     except SystemExit as exc:  # AALpy's reaction to inconsistent answers
         raise RuntimeError(f"L*: inconsistent membership answers ({exc})") from None
     # L* also stops at the round cap without a proof: then the factor is undecided (None)
     holds = True if teacher.proved else None
-    return holds, teacher.last, None, counts["membership"], counts["equivalence"]
+    return holds, teacher.last, None, sul.num_queries + counts["membership"], counts["equivalence"]
 
 
 def _cluster(start: set[str], alphabets: Mapping[str, set[str]]) -> list[str]:
