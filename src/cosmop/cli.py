@@ -18,7 +18,6 @@ from enum import StrEnum
 from pathlib import Path
 from typing import Annotated, Any
 
-import click
 import typer
 from rich.console import Console
 from rich.table import Table
@@ -37,7 +36,7 @@ from cosmop.scenario import Scenario, load_scenario
 __all__ = ["EXIT_INPUT_ERROR", "app", "main"]
 
 EXIT_INPUT_ERROR = 2
-"""Exit status for bad input (also click's status for usage errors)."""
+"""Exit status for bad input (also the status of command-line usage errors)."""
 
 
 class _Group(TyperGroup):
@@ -47,7 +46,7 @@ class _Group(TyperGroup):
     :class:`~cosmop.errors.EventSyntaxError` (an event typed on the command line).
     """
 
-    def invoke(self, ctx: click.Context) -> Any:
+    def invoke(self, ctx: typer.Context) -> Any:
         try:
             return super().invoke(ctx)
         except (CosmopInputError, EventSyntaxError) as err:
