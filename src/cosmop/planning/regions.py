@@ -1,0 +1,127 @@
+"""Sound region constraints for GoTo: where a square robot may move in a straight line.
+
+The paper's GoTo specification (Section IV-B) keeps both ends of each straight motion in one
+region "below, above, left or right" of every wall segment.  Its formulas have sign typos and
+a ``(1 + m)`` factor that is wrong for a square footprint (see DESIGN.md).  This module states
+the intent exactly and soundly.
+
+For a wall from :math:`p` to :math:`q`, direction :math:`w = q - p` and normal
+:math:`n = (-w_y, w_x)`, and a robot whose footprint is the axis-aligned square of half-side
+:math:`h` centred at :math:`c`, the four regions are the closed half-planes
+
+.. math::
+
+   n \\cdot (c - p) \\ge h(|n_x| + |n_y|), \\quad
+   n \\cdot (c - p) \\le -h(|n_x| + |n_y|), \\quad
+   w \\cdot (c - p) \\le -h(|w_x| + |w_y|), \\quad
+   w \\cdot (c - q) \\ge h(|w_x| + |w_y|).
+
+:math:`h(|v_x| + |v_y|)` is the support of the square in direction :math:`v`, so each region
+holds exactly the squares lying in a closed half-plane that meets the wall at most on its
+boundary.  A half-plane is convex, so if both end squares of a motion lie in it, the whole
+swept area (the convex hull of the two squares) does too.  The motion then never overlaps the
+wall; touching it is allowed.  The coefficients are not normalised: with integer wall
+coordinates and an integer side every coefficient is an integer or a half-integer, so an SMT
+encoding over the rationals is exact.
+
+Objects are axis-aligned squares too.  Their four regions are the paper's
+left/right/below/above with clearance :math:`d = (l_b + l_r)/2`, which is exact for
+touching.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from fractions import Fraction
+
+
+@dataclass(frozen=True)
+class HalfPlane:
+    """The closed half-plane :math:`a x + b y \\ge c` of robot centres (mm).
+
+    Attributes
+    ----------
+    a, b, c : Fraction
+        Exact coefficients.
+    label : str
+        Which side it is (``"left of wall 3"``, ...), for explanations.
+    """
+
+    a: Fraction
+    b: Fraction
+    c: Fraction
+    label: str = ""
+
+    def contains(self, x: float, y: float) -> bool:
+        """Whether the centre ``(x, y)`` lies in the half-plane (exact for rational input)."""
+        return Fraction(x) * self.a + Fraction(y) * self.b >= self.c
+
+
+def _support(vx: Fraction, vy: Fraction, half: Fraction) -> Fraction:
+    """Support of the axis-aligned square of half-side ``half`` in direction ``v``."""
+    return half * (abs(vx) + abs(vy))
+
+
+def wall_regions(
+    start: tuple[float, float], end: tuple[float, float], side: float, name: str = "wall"
+) -> tuple[HalfPlane, HalfPlane, HalfPlane, HalfPlane]:
+    """The four regions around a wall segment for a square robot of side ``side``.
+
+    Parameters
+    ----------
+    start, end : (float, float)
+        The wall's end points :math:`p \\ne q` (mm).
+    side : float
+        The robot's side length (mm).
+    name : str
+        Used in the labels.
+
+    Returns
+    -------
+    tuple of HalfPlane
+        ``(one side, other side, before start, after end)``: a straight motion whose two end
+        centres lie in one of them never overlaps the wall.
+    """
+    px, py = Fraction(start[0]), Fraction(start[1])
+    qx, qy = Fraction(end[0]), Fraction(end[1])
+    wx, wy = qx - px, qy - py
+    if wx == 0 and wy == 0:
+        raise ValueError("a wall needs two distinct end points")
+    nx, ny = -wy, wx
+    half = Fraction(side) / 2
+    sn, sw = _support(nx, ny, half), _support(wx, wy, half)
+    return (
+        HalfPlane(nx, ny, nx * px + ny * py + sn, f"left of {name}"),
+        HalfPlane(-nx, -ny, -(nx * px + ny * py) + sn, f"right of {name}"),
+        HalfPlane(-wx, -wy, -(wx * px + wy * py) + sw, f"before the start of {name}"),
+        HalfPlane(wx, wy, wx * qx + wy * qy + sw, f"past the end of {name}"),
+    )
+
+
+def object_regions(
+    position: tuple[float, float], object_side: float, robot_side: float, name: str = "object"
+) -> tuple[HalfPlane, HalfPlane, HalfPlane, HalfPlane]:
+    """The four regions around a resting square object for a square robot.
+
+    ``(left, right, below, above)`` of the object with clearance
+    :math:`d = (l_b + l_r)/2`: e.g. left is :math:`x \\le o_x - d`.
+    """
+    ox, oy = Fraction(position[0]), Fraction(position[1])
+    d = (Fraction(object_side) + Fraction(robot_side)) / 2
+    one, zero = Fraction(1), Fraction(0)
+    return (
+        HalfPlane(-one, zero, -(ox - d), f"left of {name}"),
+        HalfPlane(one, zero, ox + d, f"right of {name}"),
+        HalfPlane(zero, -one, -(oy - d), f"below {name}"),
+        HalfPlane(zero, one, oy + d, f"above {name}"),
+    )
+
+
+def motion_is_clear(
+    regions: tuple[HalfPlane, ...], start: tuple[float, float], end: tuple[float, float]
+) -> HalfPlane | None:
+    """The first region containing both end centres of a straight motion, or ``None``."""
+    for region in regions:
+        if region.contains(*start) and region.contains(*end):
+            return region
+    return None
