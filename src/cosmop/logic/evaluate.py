@@ -1,0 +1,244 @@
+"""Exact evaluation of CLTLB(D) formulas on finite traces.
+
+A trace :math:`\\rho` of length :math:`K` is a sequence of :math:`K+1` mappings from variable
+name to value, :math:`\\rho(0), \\dots, \\rho(K)`. The semantics is the one stated in
+:mod:`cosmop.logic.formulas` (the paper's Definition "Semantics" with strong next and previous,
+out-of-range atoms false, :math:`\\mathit{Last}[\\phi]` read at :math:`K`); arithmetic is exact
+(``int`` and :class:`~fractions.Fraction`).
+
+The evaluator computes, for every distinct sub-formula, its truth value at all instants at once,
+children before parents: :math:`O(|\\phi| \\cdot K)` work, with the temporal operators by their
+fixpoint characterisations (for :math:`k < K`)
+
+.. math::
+
+    \\phi\\,\\mathbf{U}\\,\\psi\\,[k] = \\psi[k] \\vee (\\phi[k] \\wedge \\phi\\,\\mathbf{U}\\,\\psi\\,[k+1]),
+    \\qquad \\phi\\,\\mathbf{U}\\,\\psi\\,[K] = \\psi[K],
+
+and symmetrically for :math:`\\mathbf{S}` from instant 0. Neither the trace length nor the
+formula depth is limited by Python's recursion limit.
+"""
+
+from __future__ import annotations
+
+import operator
+from collections.abc import Callable, Mapping, Sequence
+from fractions import Fraction
+
+from cosmop.logic.formulas import (
+    Always,
+    And,
+    BoolConst,
+    Compare,
+    Eventually,
+    Formula,
+    Iff,
+    Implies,
+    Last,
+    LinExpr,
+    Max,
+    Min,
+    Next,
+    Not,
+    Or,
+    Prev,
+    Shifted,
+    Since,
+    Until,
+    Var,
+    as_formula,
+    normalize_value,
+    subformulas,
+)
+
+__all__ = ["evaluate", "evaluate_all"]
+
+Trace = Sequence[Mapping[str, object]]
+
+_COMPARE: dict[str, Callable[[object, object], bool]] = {
+    "<=": operator.le,
+    "<": operator.lt,
+    ">=": operator.ge,
+    ">": operator.gt,
+    "==": operator.eq,
+}
+
+
+def evaluate(formula: object, trace: Trace, k: int = 0) -> bool:
+    """Whether ``formula`` holds on ``trace`` at instant ``k``: :math:`\\rho, k \\models \\phi`.
+
+    Parameters
+    ----------
+    formula : Formula or bool Var
+    trace : sequence of mapping
+        :math:`\\rho(0), \\dots, \\rho(K)` with :math:`K \\ge 0`: each mapping gives a value to every
+        variable the formula reads at that instant (``bool`` for bool variables, integers for
+        int ones, ``int``/``Fraction``/``float`` for real ones; floats are read as typed, e.g.
+        ``0.1`` is :math:`1/10`). Extra names are ignored.
+    k : int, default 0
+        The instant, :math:`0 \\le k \\le K`. A formula holds on a trace when it holds at 0.
+
+    Returns
+    -------
+    bool
+
+    Raises
+    ------
+    ValueError
+        If the trace is empty or ``k`` is outside :math:`[0, K]`.
+    KeyError
+        If a needed value is missing.
+    TypeError
+        If a value does not fit its variable's sort.
+
+    Examples
+    --------
+    >>> from cosmop.logic import ints, Eventually
+    >>> (x,) = ints("x")
+    >>> evaluate(Eventually(x.next().eq(x + 1)), [{"x": 0}, {"x": 5}, {"x": 6}])
+    True
+    """
+    values = evaluate_all(formula, trace)
+    if isinstance(k, bool) or not isinstance(k, int) or not 0 <= k < len(values):
+        raise ValueError(f"instant {k!r} is outside the trace's instants 0..{len(values) - 1}")
+    return values[k]
+
+
+def evaluate_all(formula: object, trace: Trace) -> list[bool]:
+    """The truth value of ``formula`` at every instant of ``trace``.
+
+    Parameters
+    ----------
+    formula : Formula or bool Var
+    trace : sequence of mapping
+        As for :func:`evaluate`.
+
+    Returns
+    -------
+    list of bool
+        Entry :math:`k` is :math:`\\rho, k \\models \\phi`, for :math:`k = 0, \\dots, K`.
+    """
+    root = as_formula(formula)
+    return _Evaluator(trace).column(root)
+
+
+class _Evaluator:
+    """Truth columns of sub-formulas on one trace, memoised by (structural) node."""
+
+    def __init__(self, trace: Trace) -> None:
+        if isinstance(trace, Mapping) or not isinstance(trace, Sequence):
+            raise TypeError("a trace is a sequence of mappings (one per instant)")
+        if len(trace) == 0:
+            raise ValueError("a trace has at least one instant (K >= 0)")
+        self.trace = trace
+        self.K = len(trace) - 1
+        self.columns: dict[Formula, list[bool]] = {}
+        self.values: dict[tuple[Var, int], bool | int | Fraction] = {}
+
+    # -- values -------------------------------------------------------------------------------
+    def value(self, var: Var, i: int) -> bool | int | Fraction:
+        key = (var, i)
+        cached = self.values.get(key)
+        if cached is None:
+            state = self.trace[i]
+            try:
+                raw = state[var.name]
+            except KeyError:
+                raise KeyError(f"instant {i} of the trace has no value for variable {var.name!r}") from None
+            try:
+                cached = normalize_value(var.sort, raw)
+            except TypeError as error:
+                raise TypeError(f"variable {var.name!r} at instant {i}: {error}") from None
+            self.values[key] = cached
+        return cached
+
+    def linear(self, expr: LinExpr, k: int) -> Fraction:
+        total = expr.const
+        for term, coefficient in expr.terms:
+            total += coefficient * self.term(term, k)
+        return total
+
+    def term(self, term: Shifted | Max | Min, k: int) -> Fraction:
+        if isinstance(term, Shifted):
+            return Fraction(self.value(term.var, k + term.offset))  # type: ignore[arg-type]
+        left, right = self.linear(term.left, k), self.linear(term.right, k)
+        return max(left, right) if isinstance(term, Max) else min(left, right)
+
+    # -- formulas -----------------------------------------------------------------------------
+    def column(self, root: Formula) -> list[bool]:
+        for node in subformulas(root):
+            if node not in self.columns:
+                self.columns[node] = self._compute(node)
+        return self.columns[root]
+
+    def _in_range(self, offsets: frozenset[int]) -> range:
+        """The instants k at which every k + o, o in offsets, lies in [0, K]."""
+        if not offsets:
+            return range(self.K + 1)
+        return range(max(0, -min(offsets)), min(self.K, self.K - max(offsets)) + 1)
+
+    def _compute(self, node: Formula) -> list[bool]:
+        K, col = self.K, self.columns
+        n = K + 1
+        kind = type(node)
+        if kind is BoolConst:
+            return [node.value] * n  # type: ignore[attr-defined]
+        if kind is Shifted:
+            assert isinstance(node, Shifted)
+            out = [False] * n
+            for k in self._in_range(node.offsets):
+                out[k] = bool(self.value(node.var, k + node.offset))
+            return out
+        if kind is Compare:
+            assert isinstance(node, Compare)
+            test = _COMPARE[node.op]
+            out = [False] * n
+            for k in self._in_range(node.offsets):
+                out[k] = test(self.linear(node.expr, k), node.const)
+            return out
+        children = [col[c] for c in node.children]
+        if kind is Not:
+            return [not v for v in children[0]]
+        if kind is And:
+            return [all(c[k] for c in children) for k in range(n)]
+        if kind is Or:
+            return [any(c[k] for c in children) for k in range(n)]
+        if kind is Implies:
+            a, b = children
+            return [(not a[k]) or b[k] for k in range(n)]
+        if kind is Iff:
+            a, b = children
+            return [a[k] == b[k] for k in range(n)]
+        if kind is Next:
+            (a,) = children
+            return [k < K and a[k + 1] for k in range(n)]
+        if kind is Prev:
+            (a,) = children
+            return [k > 0 and a[k - 1] for k in range(n)]
+        if kind is Last:
+            (a,) = children
+            return [a[K]] * n
+        if kind in (Until, Eventually, Always):
+            if kind is Until:
+                hold, goal = children
+            else:
+                hold, goal = [True] * n, children[0]
+            out = [False] * n
+            if kind is Always:
+                # G f = ~F ~f, and F = true U.
+                out[K] = goal[K]
+                for k in range(K - 1, -1, -1):
+                    out[k] = goal[k] and out[k + 1]
+                return out
+            out[K] = goal[K]
+            for k in range(K - 1, -1, -1):
+                out[k] = goal[k] or (hold[k] and out[k + 1])
+            return out
+        if kind is Since:
+            hold, goal = children
+            out = [False] * n
+            out[0] = goal[0]
+            for k in range(1, n):
+                out[k] = goal[k] or (hold[k] and out[k - 1])
+            return out
+        raise TypeError(f"not a formula node: {node!r}")

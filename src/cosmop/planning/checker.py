@@ -1,0 +1,846 @@
+"""The exact plan checker: is a plan sound for its scene and mission?
+
+This module checks a :class:`~cosmop.planning.plan.PlanSet` against the scenario with exact
+geometry (shapely 2 predicates on the double coordinates), independently of any SMT encoding,
+so that a synthesised plan can be trusted -- or a hand-made plan debugged.
+
+Let :math:`l` be the robot's side, :math:`b` an object's side and :math:`d = (l + b)/2`
+(mm). Robots and objects are axis-aligned squares; a heading never changes a footprint.
+*Overlap* always means that the interiors intersect: touching is allowed. For every instant
+:math:`k = 1, \\dots, K` the transition from state :math:`k-1` to state :math:`k` by the
+primitive of step :math:`k` must satisfy (state 0 is the scenario: the robot at its initial
+pose, every object at its scenario position, neither carried nor away):
+
+``GoTo``
+    No object's position, carried or away flag changes. The swept area -- the convex hull of
+    the robot's squares at the two positions -- overlaps no wall segment and no square of an
+    object that is neither carried nor away in state :math:`k-1`.
+``PickUp(O)``
+    The pose is unchanged, the heading is 0° and the robot stands in front of O:
+    :math:`(x, y) = (O.x - d, O.y)`. Before, nothing is carried and O is not away; after, O
+    and only O is carried. Positions and away flags are unchanged. The gripper does not reach
+    through a wall: no wall overlaps the union of the robot's and O's squares.
+``DropOff(O)``
+    The pose is unchanged and the heading is 0°. Before, O is the only carried object; after,
+    nothing is carried and O lies at :math:`(x + d, y)`. Other positions and all away flags
+    are unchanged. O's square overlaps no wall and no other object that is neither carried
+    nor away, and the gripper does not reach through a wall (as for ``PickUp``).
+``Req(O)``
+    The pose, positions and carried flags are unchanged; O's away flag goes from false to
+    true, the others are unchanged. The requester leaves room for whoever picks O: its square
+    does not overlap the square of side :math:`l` centred at :math:`(O.x - d, O.y)`.
+``Res(O)``
+    Nothing changes, and O is carried before and after.
+
+Positions change only on ``DropOff`` (the paper's :math:`\\phi_{carry}`): a carried object
+keeps the position where it was picked up. Numbers are compared with a tolerance of
+:data:`TOLERANCE` (mm or degrees); headings modulo 360°.
+
+The plan's ``mission`` must be realised in order: there are instants
+:math:`0 \\le i_1 < i_2 < \\dots` with event *m* holding at :math:`i_m` -- ``pick(R,O)``: step
+*i* is ``PickUp(O)``; ``drop(R,O,W)``: step *i* is ``DropOff(O)`` and O's position in state *i*
+lies in W; ``return(R)``: the pose in state *i* is the initial pose; ``away(O,A,B)``: step *i*
+is ``Req(O)`` for the requester A, ``Res(O)`` for the responder B.
+
+:func:`check_plan` adds the checks that involve the whole plan set: the plan names the
+scenario, every robot exists, a task-list mission is contained in each robot's plan (the
+coordinator only adds ``away`` events), and request/response pairs agree with the missions.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from shapely import Polygon, box
+from shapely.geometry import LineString
+from shapely.geometry.base import BaseGeometry
+
+from cosmop.errors import EventSyntaxError
+from cosmop.missions.events import Event, parse_event
+from cosmop.planning.plan import PlanSet, RobotPlan, State, Step, _fmt, _point, initial_state
+from cosmop.scenario import Scenario, Scene, Wall
+
+__all__ = [
+    "RULES",
+    "TOLERANCE",
+    "CheckReport",
+    "Violation",
+    "check_plan",
+    "check_robot_plan",
+    "overlaps",
+    "square",
+    "swept_square",
+]
+
+TOLERANCE = 1e-6
+"""Tolerance of numeric equality, mm or degrees."""
+
+RULES: Mapping[str, str] = {
+    "scenario": "the plan names another scenario",
+    "robot": "the plan is for a robot the scene does not have",
+    "objects": "a step does not list exactly the scene's objects, or names an unknown object",
+    "robot-static": "the robot moved during a primitive other than GoTo",
+    "position": "an object moved other than by being dropped off",
+    "carried": "a carried flag is wrong (picking, dropping, carrying)",
+    "away": "an away flag is wrong (only Req sets one)",
+    "wall": "the robot's swept area or a dropped object overlaps a wall, or the gripper reaches through one",
+    "object-collision": "the robot's swept area or a dropped object overlaps a resting object",
+    "pick-pose": "PickUp from a pose other than facing the object at distance d",
+    "drop-pose": "DropOff at a heading other than 0 or the object not put at distance d in front",
+    "req-room": "the requester stands where a robot picking the object must stand",
+    "mission": "a mission event is not realised in order, or does not belong to the robot or scenario",
+    "coordination": "a request/response pair and the missions disagree",
+}
+"""The rule identifiers of :class:`Violation`, with what each one means."""
+
+
+# ----------------------------------------------------------------------------------------------
+# Results
+# ----------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Violation:
+    """One way a plan breaks a rule.
+
+    Parameters
+    ----------
+    robot : str or None
+        The robot whose plan breaks the rule; ``None`` for the plan set as a whole.
+    instant : int or None
+        The instant *k* (step ``k``, ``steps[k-1]`` in the file) where it happens; ``None``
+        when the rule concerns the whole plan (e.g. the mission).
+    rule : str
+        The rule's identifier, a key of :data:`RULES`.
+    message : str
+        What is wrong, naming the robot, the instant and the primitive.
+    """
+
+    robot: str | None
+    instant: int | None
+    rule: str
+    message: str
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON form: ``{"robot", "instant", "rule", "message"}``."""
+        return {"robot": self.robot, "instant": self.instant, "rule": self.rule, "message": self.message}
+
+
+@dataclass(frozen=True)
+class CheckReport:
+    """The result of :func:`check_plan`.
+
+    Parameters
+    ----------
+    ok : bool
+        Whether the plan breaks no rule.
+    violations : tuple of Violation
+        Every violation found, by robot and instant.
+    checked_steps : int
+        The number of steps checked (over all robots of the scene).
+    """
+
+    ok: bool
+    violations: tuple[Violation, ...]
+    checked_steps: int
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON form: ``{"ok", "checked_steps", "violations": [...]}``."""
+        return {
+            "ok": self.ok,
+            "checked_steps": self.checked_steps,
+            "violations": [v.to_dict() for v in self.violations],
+        }
+
+
+# ----------------------------------------------------------------------------------------------
+# Geometry
+# ----------------------------------------------------------------------------------------------
+
+
+def square(x: float, y: float, side: float) -> Polygon:
+    """The axis-aligned square of side `side` centred at ``(x, y)`` (mm)."""
+    half = side / 2.0
+    return box(x - half, y - half, x + half, y + half)
+
+
+def swept_square(start: Iterable[float], end: Iterable[float], side: float) -> Polygon:
+    """The area swept by a square moving in a straight line: the convex hull of its two squares.
+
+    Parameters
+    ----------
+    start, end : iterable of float
+        Centres ``(x, y, ...)`` at the two ends (mm); further items (a heading) are ignored.
+    side : float
+        The square's side, mm.
+
+    Returns
+    -------
+    shapely.Polygon
+    """
+    x0, y0, *_ = start
+    x1, y1, *_ = end
+    first = square(x0, y0, side)
+    if abs(x1 - x0) == 0 and abs(y1 - y0) == 0:
+        return first
+    return first.union(square(x1, y1, side)).convex_hull
+
+
+def overlaps(a: BaseGeometry, b: BaseGeometry) -> bool:
+    """Whether the interiors of `a` and `b` intersect (touching does not count).
+
+    For a segment against a polygon this is ``seg.intersects(poly) and not seg.touches(poly)``:
+    a segment running along the boundary, or ending on it, only touches.
+    """
+    return a.intersects(b) and not a.touches(b)
+
+
+def _wall_line(wall: Wall) -> LineString:
+    return LineString([wall.start, wall.end])
+
+
+def _wall_text(wall: Wall) -> str:
+    (x1, y1), (x2, y2) = wall.start, wall.end
+    return f"[[{_fmt(x1)},{_fmt(y1)}],[{_fmt(x2)},{_fmt(y2)}]]"
+
+
+# ----------------------------------------------------------------------------------------------
+# Small predicates
+# ----------------------------------------------------------------------------------------------
+
+
+def _eq(a: float, b: float) -> bool:
+    return abs(a - b) <= TOLERANCE
+
+
+def _points_eq(p: Iterable[float], q: Iterable[float]) -> bool:
+    return all(_eq(a, b) for a, b in zip(p, q, strict=True))
+
+
+def _angle_eq(a: float, b: float) -> bool:
+    diff = (a - b) % 360.0
+    return min(diff, 360.0 - diff) <= TOLERANCE
+
+
+def _pose_eq(p: Iterable[float], q: Iterable[float]) -> bool:
+    px, py, ph = p
+    qx, qy, qh = q
+    return _eq(px, qx) and _eq(py, qy) and _angle_eq(ph, qh)
+
+
+def _pose(pose: Iterable[float]) -> str:
+    x, y, heading = pose
+    return f"({_fmt(x)}, {_fmt(y)}, {_fmt(heading)}°)"
+
+
+def _yes(flag: bool) -> str:
+    return "true" if flag else "false"
+
+
+def _nth(n: int) -> str:
+    suffix = "th" if 10 <= n % 100 <= 20 else {1: "st", 2: "nd", 3: "rd"}.get(n % 10, "th")
+    return f"{n}{suffix}"
+
+
+# ----------------------------------------------------------------------------------------------
+# One robot's plan
+# ----------------------------------------------------------------------------------------------
+
+
+class _RobotChecker:
+    """Checks one robot's plan; collects violations."""
+
+    def __init__(self, scene: Scene, robot_id: str, plan: RobotPlan) -> None:
+        self.scene = scene
+        self.robot_id = robot_id
+        self.plan = plan
+        self.side = scene.robots[robot_id].size
+        self.initial = initial_state(scene, robot_id)
+        self.states: list[State] = [self.initial, *(step.state for step in plan.steps)]
+        self.walls = [(wall, _wall_line(wall)) for wall in scene.obstacles]
+        self.violations: list[Violation] = []
+
+    # -- reporting ---------------------------------------------------------------------------
+
+    def add(self, k: int | None, rule: str, message: str, labelled: bool = False) -> None:
+        """Record a violation; the message is prefixed with the robot, instant and primitive.
+
+        `labelled` messages already start with the primitive (``GoTo from ...``).
+        """
+        if k is None:
+            prefix = f"{self.robot_id}: "
+        elif labelled:
+            prefix = f"{self.robot_id} at instant {k}: "
+        else:
+            prefix = f"{self.robot_id} at instant {k}, {self.plan.steps[k - 1].label}: "
+        self.violations.append(Violation(self.robot_id, k, rule, prefix + message))
+
+    def gap(self, oid: str) -> float:
+        """d = (l + b)/2 for this robot and object `oid`."""
+        return (self.side + self.scene.objects[oid].size) / 2.0
+
+    # -- driver ------------------------------------------------------------------------------
+
+    def run(self) -> list[Violation]:
+        scene_objects = list(self.scene.objects)
+        wanted = set(scene_objects)
+        complete = [True]  # instant 0 (the scenario) is complete
+        for k, step in enumerate(self.plan.steps, 1):
+            listed = set(step.objects)
+            ok = True
+            if listed != wanted:
+                missing = [o for o in scene_objects if o not in listed]
+                extra = [o for o in step.objects if o not in wanted]
+                parts = []
+                if missing:
+                    parts.append(f"missing {', '.join(missing)}")
+                if extra:
+                    parts.append(f"{', '.join(extra)} not in the scene")
+                self.add(
+                    k,
+                    "objects",
+                    f"every step must list every object of the scene ({', '.join(scene_objects) or 'none'}); "
+                    + "; ".join(parts),
+                )
+                ok = False
+            if step.object is not None and step.object not in wanted:
+                self.add(
+                    k,
+                    "objects",
+                    f"{step.object} is not an object of the scene ({', '.join(scene_objects) or 'none'})",
+                )
+                ok = False
+            complete.append(ok)
+        for k, step in enumerate(self.plan.steps, 1):
+            if complete[k - 1] and complete[k]:
+                self.transition(k, step, self.states[k - 1], self.states[k])
+        self.mission()
+        # by instant, plan-wide (mission) violations last; stable within an instant
+        return sorted(self.violations, key=lambda v: (v.instant is None, v.instant or 0))
+
+    def transition(self, k: int, step: Step, prev: State, cur: State) -> None:
+        if step.primitive == "GoTo":
+            self.goto(k, step, prev, cur)
+        elif step.primitive == "PickUp":
+            self.pickup(k, step, prev, cur)
+        elif step.primitive == "DropOff":
+            self.dropoff(k, step, prev, cur)
+        elif step.primitive == "Req":
+            self.req(k, step, prev, cur)
+        else:
+            self.res(k, step, prev, cur)
+
+    # -- frame conditions --------------------------------------------------------------------
+
+    def robot_static(self, k: int, prev: State, cur: State) -> None:
+        if not _pose_eq(prev.robot, cur.robot):
+            self.add(
+                k,
+                "robot-static",
+                f"the robot moves from {_pose(prev.robot)} to {_pose(cur.robot)}; "
+                f"only GoTo moves the robot, so keep the pose of instant {k - 1}",
+            )
+
+    def positions_static(self, k: int, prev: State, cur: State, moved: str | None = None) -> None:
+        for oid, before in prev.objects.items():
+            if oid == moved:
+                continue
+            after = cur.objects[oid].position
+            if not _points_eq(before.position, after):
+                carried = " (a carried object stays where it was picked up)" if before.carried else ""
+                self.add(
+                    k,
+                    "position",
+                    f"{oid} moves from {_point(before.position)} to {_point(after)}; "
+                    f"objects move only when dropped off{carried}",
+                )
+
+    def flags_static(self, k: int, prev: State, cur: State, flag: str, changed: str | None = None) -> None:
+        for oid, before in prev.objects.items():
+            if oid == changed:
+                continue
+            old, new = getattr(before, flag), getattr(cur.objects[oid], flag)
+            if old != new:
+                why = (
+                    "only PickUp and DropOff change what is carried"
+                    if flag == "carried"
+                    else "only Req marks an object as moved away"
+                )
+                self.add(k, flag, f"the {flag} flag of {oid} changes from {_yes(old)} to {_yes(new)}; {why}")
+
+    def heading_zero(self, k: int, cur: State, rule: str, verb: str) -> None:
+        if not _angle_eq(cur.robot[2], 0.0):
+            self.add(
+                k,
+                rule,
+                f"the robot's heading is {_fmt(cur.robot[2])}°, but objects are {verb} at heading 0° "
+                "(facing +x)",
+            )
+
+    def resting(self, state: State, exclude: str | None = None) -> Iterable[tuple[str, Any]]:
+        """Objects neither carried nor away in `state`, with their squares."""
+        for oid, obj in state.objects.items():
+            if oid != exclude and not obj.carried and not obj.away:
+                x, y = obj.position
+                yield oid, square(x, y, self.scene.objects[oid].size)
+
+    # -- primitives --------------------------------------------------------------------------
+
+    def goto(self, k: int, step: Step, prev: State, cur: State) -> None:
+        self.positions_static(k, prev, cur)
+        self.flags_static(k, prev, cur, "carried")
+        self.flags_static(k, prev, cur, "away")
+        area = swept_square(prev.robot, cur.robot, self.side)
+        (x0, y0, _), (x1, y1, _) = prev.robot, cur.robot
+        if _eq(x0, x1) and _eq(y0, y1):
+            motion, verb_wall, verb_obj = f"GoTo staying at {_point((x0, y0))}", "overlaps", "overlaps"
+        else:
+            motion, verb_wall, verb_obj = (
+                f"GoTo from {_point((x0, y0))} to {_point((x1, y1))}",
+                "crosses",
+                "sweeps over",
+            )
+        for wall, line in self.walls:
+            if overlaps(line, area):
+                self.add(
+                    k,
+                    "wall",
+                    f"{motion} {verb_wall} wall {_wall_text(wall)}; "
+                    "add a waypoint (another GoTo) to go around it",
+                    labelled=True,
+                )
+        for oid, shape in self.resting(prev):
+            if overlaps(shape, area):
+                position = prev.objects[oid].position
+                self.add(
+                    k,
+                    "object-collision",
+                    f"{motion} {verb_obj} {oid}, resting at {_point(position)} "
+                    f"(size {_fmt(self.scene.objects[oid].size)}); go around it or request it away "
+                    f"with Req({oid})",
+                    labelled=True,
+                )
+
+    def reach(
+        self, k: int, oid: str, robot: State, where: Iterable[float], skip: Iterable[Wall] = ()
+    ) -> None:
+        """The gripper must not reach through a wall: robot and object squares on its two sides."""
+        x, y, _ = robot.robot
+        reach = square(x, y, self.side).union(square(*where, self.scene.objects[oid].size))
+        skipped = set(skip)
+        for wall, line in self.walls:
+            if wall not in skipped and overlaps(line, reach):
+                self.add(
+                    k,
+                    "wall",
+                    f"the robot at {_point((x, y))} and {oid} at {_point(where)} are on the two sides of "
+                    f"wall {_wall_text(wall)}; the gripper cannot reach through it",
+                )
+
+    def pickup(self, k: int, step: Step, prev: State, cur: State) -> None:
+        oid = step.object
+        self.robot_static(k, prev, cur)
+        self.heading_zero(k, cur, "pick-pose", "picked up")
+        ox, oy = prev.objects[oid].position
+        d = self.gap(oid)
+        x, y, _ = cur.robot
+        if not (_eq(x, ox - d) and _eq(y, oy)):
+            self.add(
+                k,
+                "pick-pose",
+                f"the robot is at {_point((x, y))}, but picking {oid} at {_point((ox, oy))} requires "
+                f"standing in front of it at {_point((ox - d, oy))} (d = {_fmt(d)} mm)",
+            )
+        else:
+            self.reach(k, oid, cur, (ox, oy))
+        carried_before = [o for o, s in prev.objects.items() if s.carried]
+        if carried_before:
+            self.add(
+                k,
+                "carried",
+                f"the robot already carries {', '.join(carried_before)} at instant {k - 1}; "
+                "drop it off before picking up another object",
+            )
+        if prev.objects[oid].away:
+            self.add(
+                k,
+                "away",
+                f"{oid} has been moved away by another robot (away at instant {k - 1}); it cannot be picked",
+            )
+        if not cur.objects[oid].carried:
+            self.add(k, "carried", f"{oid} is not marked carried after PickUp({oid})")
+        others = [o for o, s in cur.objects.items() if s.carried and o != oid]
+        if others:
+            self.add(
+                k, "carried", f"after PickUp({oid}) only {oid} may be carried, but {', '.join(others)} is too"
+            )
+        self.positions_static(k, prev, cur)
+        self.flags_static(k, prev, cur, "away")
+
+    def dropoff(self, k: int, step: Step, prev: State, cur: State) -> None:
+        oid = step.object
+        self.robot_static(k, prev, cur)
+        self.heading_zero(k, cur, "drop-pose", "dropped off")
+        if not prev.objects[oid].carried:
+            self.add(
+                k, "carried", f"{oid} is not carried at instant {k - 1}, so there is nothing to drop off"
+            )
+        others = [o for o, s in prev.objects.items() if s.carried and o != oid]
+        if others:
+            self.add(
+                k, "carried", f"the robot carries {', '.join(others)} as well as {oid} at instant {k - 1}"
+            )
+        still = [o for o, s in cur.objects.items() if s.carried]
+        if still:
+            self.add(k, "carried", f"{', '.join(still)} is still marked carried after DropOff({oid})")
+        d = self.gap(oid)
+        x, y, _ = cur.robot
+        where = cur.objects[oid].position
+        in_front = _points_eq(where, (x + d, y))
+        if not in_front:
+            self.add(
+                k,
+                "drop-pose",
+                f"{oid} is put at {_point(where)}, but a robot at {_point((x, y))} puts it in front of "
+                f"itself at {_point((x + d, y))} (d = {_fmt(d)} mm)",
+            )
+        self.positions_static(k, prev, cur, moved=oid)
+        self.flags_static(k, prev, cur, "away")
+        shape = square(where[0], where[1], self.scene.objects[oid].size)
+        crossed = []
+        for wall, line in self.walls:
+            if overlaps(line, shape):
+                crossed.append(wall)
+                self.add(
+                    k,
+                    "wall",
+                    f"{oid} dropped at {_point(where)} overlaps wall {_wall_text(wall)}; drop it elsewhere",
+                )
+        if in_front:
+            self.reach(k, oid, cur, where, skip=crossed)
+        for other, other_shape in self.resting(cur, exclude=oid):
+            if overlaps(other_shape, shape):
+                self.add(
+                    k,
+                    "object-collision",
+                    f"{oid} dropped at {_point(where)} overlaps {other}, resting at "
+                    f"{_point(cur.objects[other].position)}; drop it elsewhere",
+                )
+
+    def req(self, k: int, step: Step, prev: State, cur: State) -> None:
+        oid = step.object
+        self.robot_static(k, prev, cur)
+        self.positions_static(k, prev, cur)
+        self.flags_static(k, prev, cur, "carried")
+        self.flags_static(k, prev, cur, "away", changed=oid)
+        if prev.objects[oid].away:
+            self.add(k, "away", f"{oid} is already away at instant {k - 1}; request it only once")
+        if not cur.objects[oid].away:
+            self.add(k, "away", f"{oid} is not marked away after Req({oid})")
+        ox, oy = prev.objects[oid].position
+        d = self.gap(oid)
+        x, y, _ = cur.robot
+        if overlaps(square(x, y, self.side), square(ox - d, oy, self.side)):
+            self.add(
+                k,
+                "req-room",
+                f"the requester at {_point((x, y))} stands in the way of a robot picking {oid} from "
+                f"{_point((ox - d, oy))}; request from a pose that leaves that square free",
+            )
+
+    def res(self, k: int, step: Step, prev: State, cur: State) -> None:
+        oid = step.object
+        self.robot_static(k, prev, cur)
+        self.positions_static(k, prev, cur)
+        self.flags_static(k, prev, cur, "carried")
+        self.flags_static(k, prev, cur, "away")
+        if not prev.objects[oid].carried or not cur.objects[oid].carried:
+            self.add(
+                k,
+                "carried",
+                f"Res({oid}) tells the requester that {oid} has been moved away, so the robot must carry "
+                f"{oid} at instants {k - 1} and {k}; pick it up first",
+            )
+
+    # -- mission -----------------------------------------------------------------------------
+
+    def mission(self) -> None:
+        events: list[Event] = []
+        for name in self.plan.mission:
+            try:
+                event = parse_event(name)
+            except EventSyntaxError as err:  # only for plans built around the constructor
+                self.add(None, "mission", str(err))
+                return
+            if self.robot_id not in event.owners:
+                self.add(
+                    None,
+                    "mission",
+                    f"the mission lists {event.name}, an event of {' and '.join(sorted(event.owners))}; "
+                    "a robot's plan realises only its own events",
+                )
+                return
+            if event.kind == "drop" and event.workspace not in self.scene.workspaces:
+                self.add(
+                    None,
+                    "mission",
+                    f"{event.name} names workspace {event.workspace}, which is not in the scene "
+                    f"({', '.join(self.scene.workspaces) or 'none'})",
+                )
+                return
+            events.append(event)
+        last: int | None = None
+        for n, event in enumerate(events, 1):
+            start = 0 if last is None else last + 1
+            found = next((i for i in range(start, self.plan.horizon + 1) if self.holds(event, i)), None)
+            if found is None:
+                self.add(None, "mission", self.unmatched(event, n, len(events), last, events))
+                return
+            last = found
+
+    def holds(self, event: Event, i: int) -> bool:
+        if event.kind == "return":
+            return _pose_eq(self.states[i].robot, self.initial.robot)
+        if i == 0:
+            return False
+        step = self.plan.steps[i - 1]
+        if event.kind == "pick":
+            return step.primitive == "PickUp" and step.object == event.obj
+        if event.kind == "drop":
+            if step.primitive != "DropOff" or step.object != event.obj:
+                return False
+            obj = step.objects.get(event.obj)
+            return obj is not None and self.scene.workspaces[event.workspace].contains(
+                *obj.position, TOLERANCE
+            )
+        primitive = "Req" if self.robot_id == event.robot else "Res"
+        return step.primitive == primitive and step.object == event.obj
+
+    def expectation(self, event: Event) -> str:
+        if event.kind == "pick":
+            return f"PickUp({event.obj})"
+        if event.kind == "drop":
+            return f"DropOff({event.obj}) that leaves {event.obj} in {event.workspace}"
+        return f"{'Req' if self.robot_id == event.robot else 'Res'}({event.obj})"
+
+    def unmatched(self, event: Event, n: int, total: int, last: int | None, events: list[Event]) -> str:
+        after = "anywhere in the plan" if last is None else f"after instant {last} ({events[n - 2].name})"
+        head = f"mission event {event.name} ({_nth(n)} of {total}) is not realised"
+        if event.kind == "return":
+            text = f"{head}: the robot is never at its initial pose {_pose(self.initial.robot)} {after}"
+        else:
+            text = f"{head}: there is no {self.expectation(event)} {after}"
+        earlier = []
+        if last is not None and event.kind != "return":  # a return holds trivially at instant 0
+            earlier = [i for i in range(last + 1) if self.holds(event, i)]
+        if earlier:
+            text += (
+                f"; it holds only at instant {', '.join(map(str, earlier))}, before {events[n - 2].name}: "
+                "the events are out of order"
+            )
+        elif event.kind == "drop":
+            for i in range(1 if last is None else last + 1, self.plan.horizon + 1):
+                step = self.plan.steps[i - 1]
+                if step.primitive == "DropOff" and step.object == event.obj and event.obj in step.objects:
+                    text += (
+                        f"; DropOff({event.obj}) at instant {i} leaves it at "
+                        f"{_point(step.objects[event.obj].position)}, "
+                        f"outside {_workspace_text(self.scene, event.workspace)}"
+                    )
+        elif event.kind == "return" and self.plan.horizon:
+            text += f"; the last pose is {_pose(self.states[-1].robot)}: add a GoTo back to the initial pose"
+        remaining = [e.name for e in events[n:]]
+        if remaining:
+            text += f" (so {', '.join(remaining)} cannot be matched either)"
+        return text
+
+
+def _workspace_text(scene: Scene, wid: str) -> str:
+    ws = scene.workspaces[wid]
+    if ws.point is not None:
+        return f"{wid} (the point {_point(ws.point)})"
+    return f"{wid} (x in [{_fmt(ws.x[0])}, {_fmt(ws.x[1])}], y in [{_fmt(ws.y[0])}, {_fmt(ws.y[1])}])"
+
+
+def check_robot_plan(scene: Scene, robot_id: str, plan: RobotPlan) -> list[Violation]:
+    """Check one robot's plan against the scene: every transition, and the plan's own mission.
+
+    Parameters
+    ----------
+    scene : Scene
+        Walls, robots, objects and workspaces (mm, degrees).
+    robot_id : str
+        The robot whose plan it is; instant 0 is its initial pose and the scenario's objects.
+    plan : RobotPlan
+        The plan.
+
+    Returns
+    -------
+    list of Violation
+        Empty if the plan is sound: first the transitions' violations by instant, then the
+        first mission event that cannot be matched (if any).
+    """
+    if robot_id not in scene.robots:
+        return [
+            Violation(
+                robot_id,
+                None,
+                "robot",
+                f"{robot_id}: there is no robot {robot_id} in the scene "
+                f"({', '.join(scene.robots) or 'none'})",
+            )
+        ]
+    return _RobotChecker(scene, robot_id, plan).run()
+
+
+# ----------------------------------------------------------------------------------------------
+# The plan set
+# ----------------------------------------------------------------------------------------------
+
+
+def check_plan(scenario: Scenario, plan: PlanSet) -> CheckReport:
+    """Check a plan set against its scenario.
+
+    Every robot plan is checked with :func:`check_robot_plan`. The plan set as a whole must
+    also name the scenario; when the mission is given as task lists and the plan is feasible,
+    every robot with tasks has a plan whose mission contains its tasks in order, with only
+    ``away`` events added; every ``away`` event of a mission has its coordination pair, and
+    every pair appears in the missions of the requester and the responder.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The scenario the plan is for.
+    plan : PlanSet
+        The plans.
+
+    Returns
+    -------
+    CheckReport
+        ``ok`` when there is no violation; ``checked_steps`` counts the steps of the robots of
+        the scene.
+    """
+    scene = scenario.scene
+    violations: list[Violation] = []
+    if plan.scenario != scenario.name:
+        violations.append(
+            Violation(
+                None,
+                None,
+                "scenario",
+                f"the plan is for scenario {plan.scenario!r}, but the scenario is {scenario.name!r}",
+            )
+        )
+    checked = 0
+    for robot_id, robot_plan in plan.robots.items():
+        violations.extend(check_robot_plan(scene, robot_id, robot_plan))
+        if robot_id in scene.robots:
+            checked += robot_plan.horizon
+    tasks = scenario.mission.tasks
+    if tasks is not None and plan.feasible:
+        for robot_id, sequence in tasks.items():
+            violations.extend(_check_tasks(robot_id, sequence, plan.robots.get(robot_id)))
+    violations.extend(_check_coordination(plan))
+    return CheckReport(not violations, tuple(violations), checked)
+
+
+def _parsed(plan: RobotPlan) -> list[Event] | None:
+    try:
+        return list(plan.events)
+    except EventSyntaxError:
+        return None  # reported by check_robot_plan
+
+
+def _check_tasks(robot_id: str, sequence: tuple[Event, ...], plan: RobotPlan | None) -> list[Violation]:
+    if not sequence:
+        return []
+    tasks = ", ".join(e.name for e in sequence)
+    if plan is None:
+        return [
+            Violation(
+                robot_id,
+                None,
+                "mission",
+                f"{robot_id}: the scenario gives {robot_id} the tasks {tasks}, "
+                f"but the plan has no plan for {robot_id}",
+            )
+        ]
+    events = _parsed(plan)
+    if events is None:
+        return []
+    matched: set[int] = set()
+    position = 0
+    for task in sequence:
+        while position < len(events) and events[position] != task:
+            position += 1
+        if position == len(events):
+            return [
+                Violation(
+                    robot_id,
+                    None,
+                    "mission",
+                    f"{robot_id}: the plan's mission ({', '.join(plan.mission) or 'empty'}) does not contain "
+                    f"the scenario's tasks ({tasks}) in order; {task.name} is missing",
+                )
+            ]
+        matched.add(position)
+        position += 1
+    added = [e.name for i, e in enumerate(events) if i not in matched and e.kind != "away"]
+    if added:
+        return [
+            Violation(
+                robot_id,
+                None,
+                "mission",
+                f"{robot_id}: the plan's mission adds {', '.join(added)}, which the scenario's tasks "
+                f"({tasks}) do not have; only away events may be added",
+            )
+        ]
+    return []
+
+
+def _check_coordination(plan: PlanSet) -> list[Violation]:
+    violations = []
+    pairs = {pair.event for pair in plan.coordination}
+    for robot_id, robot_plan in plan.robots.items():
+        for event in _parsed(robot_plan) or ():
+            if event.kind == "away" and robot_id in event.owners and event not in pairs:
+                violations.append(
+                    Violation(
+                        robot_id,
+                        None,
+                        "coordination",
+                        f"{robot_id}: the mission has {event.name}, but the plan's coordination list "
+                        f"has no pair {{object: {event.obj}, requester: {event.robot}, "
+                        f"responder: {event.responder}}}",
+                    )
+                )
+    for pair in plan.coordination:
+        event = pair.event
+        for role, robot_id in (("requester", pair.requester), ("responder", pair.responder)):
+            robot_plan = plan.robots.get(robot_id)
+            if robot_plan is None:
+                if plan.feasible:
+                    violations.append(
+                        Violation(
+                            robot_id,
+                            None,
+                            "coordination",
+                            f"{robot_id}: the coordination pair {event.name} names {robot_id} as {role}, "
+                            f"but the plan has no plan for {robot_id}",
+                        )
+                    )
+            elif event.name not in robot_plan.mission:
+                primitive = "Req" if role == "requester" else "Res"
+                violations.append(
+                    Violation(
+                        robot_id,
+                        None,
+                        "coordination",
+                        f"{robot_id}: the coordination pair {event.name} names {robot_id} as {role}, but its "
+                        f"mission does not include {event.name} (realised by {primitive}({pair.object}))",
+                    )
+                )
+    return violations

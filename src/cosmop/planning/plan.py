@@ -1,0 +1,878 @@
+"""Plans: the plan file ``cosmop.plan/1`` and its immutable Python form.
+
+A plan set holds, for every robot, a sequence of motion primitives and the states they lead to
+(the paper's trace :math:`q(1), \\dots, q(K)`; instant 0 is the scenario)::
+
+    {
+      "format": "cosmop.plan/1",
+      "scenario": "warehouse-2x2",
+      "feasible": true,
+      "robots": {
+        "R1": {
+          "mission": ["away(O2,R1,R2)", "pick(R1,O1)", "drop(R1,O1,W1)", "return(R1)"],
+          "horizon": 7,
+          "steps": [
+            {"primitive": "Req", "object": "O2", "robot": [-2000, -1000, 0],
+             "objects": {"O1": {"position": [2000, -1000], "carried": false, "away": false},
+                         "O2": {"position": [1900, -1000], "carried": false, "away": true}}},
+            ...
+          ]
+        }
+      },
+      "coordination": [{"object": "O2", "requester": "R1", "responder": "R2"}]
+    }
+
+``steps[k-1]`` is instant *k*: the primitive taken between *k-1* and *k* and the whole state
+*after* it, as this robot's model sees it (robot pose ``[x, y, heading]`` in mm and degrees;
+every object's centre in mm, whether this robot carries it, and whether it has been moved away
+by another robot). ``primitive`` is one of ``GoTo``, ``PickUp``, ``DropOff``, ``Req`` (the
+paper's ``?ObjAway``) and ``Res`` (``!ObjAway``); all but ``GoTo`` name their ``object``.
+An infeasible scenario still has a plan file, with ``"feasible": false`` and a ``"reason"``.
+
+:func:`load_plan` and :meth:`PlanSet.from_dict` validate the shape of a plan and raise
+:class:`PlanError` naming the file, the field (e.g. ``robots.R1.steps[3].primitive``) and what
+was expected. Whether a plan is *sound* for a scene (walls, poses, flags, mission) is the
+business of :mod:`cosmop.planning.checker`. :func:`initial_state` gives instant 0 of a robot's
+plan, and :func:`successor` / :func:`plan_from_actions` build steps by applying the primitives'
+nominal effects (handy for hand-made plans and for decoding a solver's model).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import re
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import MappingProxyType
+from typing import TYPE_CHECKING, Any
+
+from cosmop.errors import CosmopInputError, EventSyntaxError
+from cosmop.io import write_atomic
+from cosmop.missions.events import ID_PATTERN, Event, parse_event
+
+if TYPE_CHECKING:
+    from cosmop.scenario import Scene
+
+__all__ = [
+    "OBJECT_PRIMITIVES",
+    "PLAN_FORMAT",
+    "PRIMITIVES",
+    "Coordination",
+    "ObjectState",
+    "PlanError",
+    "PlanSet",
+    "RobotPlan",
+    "State",
+    "Step",
+    "initial_state",
+    "load_plan",
+    "plan_from_actions",
+    "successor",
+]
+
+PLAN_FORMAT = "cosmop.plan/1"
+"""The value of the ``format`` field of the plan files this module reads and writes."""
+
+PRIMITIVES = ("GoTo", "PickUp", "DropOff", "Req", "Res")
+"""The motion primitives, in the paper's order :math:`\\pi^1, \\dots, \\pi^5`."""
+
+OBJECT_PRIMITIVES = frozenset({"PickUp", "DropOff", "Req", "Res"})
+"""The primitives that act on an object (every primitive but ``GoTo``)."""
+
+_ID_RE = re.compile(rf"{ID_PATTERN}\Z")
+
+Pose = tuple[float, float, float]
+Point = tuple[float, float]
+
+
+class PlanError(CosmopInputError):
+    """A plan file (or plan mapping) that cannot be read or does not have the expected shape."""
+
+
+# ----------------------------------------------------------------------------------------------
+# Values
+# ----------------------------------------------------------------------------------------------
+
+
+def _floats(values: Iterable[Any], n: int, what: str) -> tuple[float, ...]:
+    result = tuple(float(v) for v in values)
+    if len(result) != n:
+        raise ValueError(f"{what} needs {n} numbers, got {len(result)}")
+    if not all(math.isfinite(v) for v in result):
+        raise ValueError(f"{what} must be finite, got {result}")
+    return result
+
+
+def _object_map(objects: Mapping[str, ObjectState]) -> Mapping[str, ObjectState]:
+    for name, state in objects.items():
+        if not isinstance(state, ObjectState):
+            raise TypeError(f"object {name!r}: expected an ObjectState, got {type(state).__name__}")
+    if isinstance(objects, MappingProxyType):
+        return objects
+    return MappingProxyType(dict(objects))
+
+
+@dataclass(frozen=True)
+class ObjectState:
+    """The state of one movable object at one instant, as a robot's plan sees it.
+
+    Parameters
+    ----------
+    position : tuple of float
+        Centre ``(x, y)`` of the object's square, mm. A carried object keeps the position where
+        it was picked up until it is dropped off (the paper's :math:`\\phi_{carry}`).
+    carried : bool
+        Whether this robot carries the object (the paper's :math:`q_b.p`).
+    away : bool
+        Whether another robot has moved the object away on request (the paper's :math:`q_b.a`).
+    """
+
+    position: Point
+    carried: bool = False
+    away: bool = False
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "position", _floats(self.position, 2, "an object position"))
+        object.__setattr__(self, "carried", bool(self.carried))
+        object.__setattr__(self, "away", bool(self.away))
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON form: ``{"position": [x, y], "carried": bool, "away": bool}``."""
+        return {"position": [_num(v) for v in self.position], "carried": self.carried, "away": self.away}
+
+
+@dataclass(frozen=True)
+class State:
+    """The state of a robot's model at one instant: its pose and every object's state.
+
+    Parameters
+    ----------
+    robot : tuple of float
+        The robot's pose ``(x, y, heading)``: centre in mm, heading in degrees.
+    objects : Mapping[str, ObjectState]
+        Every object of the scene, by id (read-only).
+    """
+
+    robot: Pose
+    objects: Mapping[str, ObjectState]
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "robot", _floats(self.robot, 3, "a robot pose"))
+        object.__setattr__(self, "objects", _object_map(self.objects))
+
+
+def initial_state(scene: Scene, robot_id: str) -> State:
+    """Instant 0 of a robot's plan: the scenario.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene the plan is for.
+    robot_id : str
+        The robot whose plan it is.
+
+    Returns
+    -------
+    State
+        The robot at its initial pose (mm, degrees); every object at its scenario position, not
+        carried and not away.
+
+    Raises
+    ------
+    KeyError
+        If the scene has no robot `robot_id`.
+    """
+    robot = scene.robots[robot_id]
+    return State(
+        robot=robot.pose,
+        objects={
+            oid: ObjectState(obj.position, carried=False, away=False) for oid, obj in scene.objects.items()
+        },
+    )
+
+
+Action = tuple[str, Any] | tuple[str]
+"""A primitive to apply: ``("GoTo", (x, y, heading))``, ``("PickUp", "O1")``, ... (see :func:`successor`)."""
+
+
+def successor(
+    scene: Scene,
+    robot_id: str,
+    state: State,
+    primitive: str,
+    obj: str | None = None,
+    to: tuple[float, float, float] | None = None,
+) -> Step:
+    """The step that applies a primitive's nominal effect to `state` (no rule is checked).
+
+    ``GoTo`` moves the robot to `to`; ``PickUp(O)`` marks O carried; ``DropOff(O)`` puts O at
+    :math:`(x + d, y)` in front of the robot, :math:`d = (l + b)/2`, and marks it not carried;
+    ``Req(O)`` marks O away; ``Res(O)`` changes nothing. Whether the step is allowed is the
+    business of :func:`cosmop.planning.checker.check_robot_plan`.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene (for the sizes).
+    robot_id : str
+        The robot taking the step.
+    state : State
+        The state before the step.
+    primitive : {"GoTo", "PickUp", "DropOff", "Req", "Res"}
+        The primitive.
+    obj : str, optional
+        The object, for every primitive but ``GoTo``.
+    to : tuple of float, optional
+        The target pose ``(x, y, heading)`` (mm, degrees), for ``GoTo`` only.
+
+    Returns
+    -------
+    Step
+    """
+    robot = state.robot
+    objects = dict(state.objects)
+    if primitive == "GoTo":
+        if to is None:
+            raise ValueError("GoTo needs a target pose `to`")
+        robot = to
+    elif to is not None:
+        raise ValueError(f"{primitive} does not move the robot; give no target pose")
+    elif primitive == "PickUp":
+        objects[obj] = ObjectState(objects[obj].position, carried=True, away=objects[obj].away)
+    elif primitive == "DropOff":
+        gap = (scene.robots[robot_id].size + scene.objects[obj].size) / 2.0
+        objects[obj] = ObjectState((robot[0] + gap, robot[1]), carried=False, away=objects[obj].away)
+    elif primitive == "Req":
+        objects[obj] = ObjectState(objects[obj].position, carried=objects[obj].carried, away=True)
+    return Step(primitive, obj, robot, objects)
+
+
+def plan_from_actions(
+    scene: Scene, robot_id: str, mission: Iterable[str | Event], actions: Iterable[Action]
+) -> RobotPlan:
+    """A robot plan from a list of primitives, each applied with :func:`successor`.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene; instant 0 is :func:`initial_state`.
+    robot_id : str
+        The robot.
+    mission : iterable of str or Event
+        The mission the plan is meant to realise.
+    actions : iterable of tuple
+        ``("GoTo", (x, y, heading))`` or ``(primitive, object)`` for the others.
+
+    Returns
+    -------
+    RobotPlan
+
+    Examples
+    --------
+    >>> plan = plan_from_actions(scene, "R2", ["pick(R2,O2)"],
+    ...                          [("GoTo", (1650, -1000, 0)), ("PickUp", "O2")])  # doctest: +SKIP
+    """
+    state = initial_state(scene, robot_id)
+    steps = []
+    for action in actions:
+        primitive, *rest = action
+        arg = rest[0] if rest else None
+        if primitive == "GoTo":
+            step = successor(scene, robot_id, state, primitive, to=arg)
+        else:
+            step = successor(scene, robot_id, state, primitive, obj=arg)
+        steps.append(step)
+        state = step.state
+    return RobotPlan.from_steps(mission, steps)
+
+
+@dataclass(frozen=True)
+class Step:
+    """Instant *k* of a robot's plan: the primitive taken between *k-1* and *k*, and the state after it.
+
+    Parameters
+    ----------
+    primitive : {"GoTo", "PickUp", "DropOff", "Req", "Res"}
+        The motion primitive.
+    object : str or None
+        The object the primitive acts on; ``None`` exactly for ``GoTo``.
+    robot : tuple of float
+        The robot's pose after the step, ``(x, y, heading)`` in mm and degrees.
+    objects : Mapping[str, ObjectState]
+        Every object's state after the step, by id (read-only).
+
+    Raises
+    ------
+    ValueError
+        If the primitive is unknown, or `object` is missing (or given, for ``GoTo``).
+    """
+
+    primitive: str
+    object: str | None
+    robot: Pose
+    objects: Mapping[str, ObjectState]
+
+    def __post_init__(self) -> None:
+        if self.primitive not in PRIMITIVES:
+            raise ValueError(f"unknown primitive {self.primitive!r}; expected one of {', '.join(PRIMITIVES)}")
+        if self.primitive in OBJECT_PRIMITIVES and not self.object:
+            raise ValueError(f"{self.primitive} needs the object it acts on")
+        if self.primitive == "GoTo" and self.object is not None:
+            raise ValueError(f"GoTo acts on no object, got {self.object!r}")
+        object.__setattr__(self, "robot", _floats(self.robot, 3, "a robot pose"))
+        object.__setattr__(self, "objects", _object_map(self.objects))
+
+    @property
+    def label(self) -> str:
+        """The primitive with its object, e.g. ``PickUp(O1)``, or ``GoTo``."""
+        return self.primitive if self.object is None else f"{self.primitive}({self.object})"
+
+    @property
+    def state(self) -> State:
+        """The state after the step (pose and objects, without the primitive)."""
+        return State(self.robot, self.objects)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON form of the step (``object`` is ``null`` for ``GoTo``)."""
+        return {
+            "primitive": self.primitive,
+            "object": self.object,
+            "robot": [_num(v) for v in self.robot],
+            "objects": {oid: state.to_dict() for oid, state in self.objects.items()},
+        }
+
+    def to_text(self) -> str:
+        """The step as one line: primitive, robot pose, and what is carried, dropped or away."""
+        x, y, heading = self.robot
+        notes = []
+        carried = [oid for oid, s in self.objects.items() if s.carried]
+        if carried:
+            notes.append("carrying " + ", ".join(carried))
+        if self.primitive == "DropOff" and self.object in self.objects:
+            notes.append(f"{self.object} at {_point(self.objects[self.object].position)}")
+        away = [oid for oid, s in self.objects.items() if s.away]
+        if away:
+            notes.append("away: " + ", ".join(away))
+        text = f"{self.label:<12} robot ({_fmt(x)}, {_fmt(y)}, {_fmt(heading)}°)"
+        return f"{text}  {'; '.join(notes)}" if notes else text
+
+
+@dataclass(frozen=True)
+class RobotPlan:
+    """One robot's plan: the mission it realises and its steps, instants 1 to K.
+
+    Parameters
+    ----------
+    mission : tuple of str
+        The events the plan realises, in order, as canonical names (``pick(R1,O1)``,
+        ``drop(R1,O1,W1)``, ``return(R1)``, ``away(O2,R1,R2)``). :class:`~cosmop.missions.events.Event`
+        values and the paper's compact names are accepted and stored canonically.
+    horizon : int
+        K, the number of steps.
+    steps : tuple of Step
+        ``steps[k-1]`` is instant *k*.
+
+    Raises
+    ------
+    ValueError
+        If `horizon` differs from the number of steps or a mission event cannot be parsed.
+    """
+
+    mission: tuple[str, ...]
+    horizon: int
+    steps: tuple[Step, ...]
+
+    def __post_init__(self) -> None:
+        names = []
+        for item in self.mission:
+            if isinstance(item, Event):
+                names.append(item.name)
+            else:
+                try:
+                    names.append(parse_event(item).name)
+                except EventSyntaxError as err:
+                    raise ValueError(str(err)) from None
+        object.__setattr__(self, "mission", tuple(names))
+        object.__setattr__(self, "steps", tuple(self.steps))
+        if isinstance(self.horizon, bool) or not isinstance(self.horizon, int):
+            raise ValueError(f"the horizon must be an integer, got {self.horizon!r}")
+        if self.horizon != len(self.steps):
+            raise ValueError(f"the horizon {self.horizon} differs from the number of steps {len(self.steps)}")
+
+    @classmethod
+    def from_steps(cls, mission: Iterable[str | Event], steps: Iterable[Step]) -> RobotPlan:
+        """A plan whose horizon is the number of `steps`."""
+        steps = tuple(steps)
+        return cls(tuple(mission), len(steps), steps)
+
+    @property
+    def events(self) -> tuple[Event, ...]:
+        """The mission as :class:`~cosmop.missions.events.Event` values."""
+        return tuple(parse_event(name) for name in self.mission)
+
+    def state(self, k: int, initial: State | None = None) -> State:
+        """The state at instant `k`.
+
+        Parameters
+        ----------
+        k : int
+            The instant, ``0 <= k <= horizon``.
+        initial : State, optional
+            Instant 0 (see :func:`initial_state`); required only for ``k == 0``.
+
+        Returns
+        -------
+        State
+            `initial` for ``k == 0``, else the state after ``steps[k-1]``.
+
+        Raises
+        ------
+        IndexError
+            If `k` is out of range.
+        ValueError
+            If ``k == 0`` and `initial` is not given.
+        """
+        if not 0 <= k <= self.horizon:
+            raise IndexError(f"instant {k} is outside 0..{self.horizon}")
+        if k == 0:
+            if initial is None:
+                raise ValueError("instant 0 is the scenario: pass initial=initial_state(scene, robot_id)")
+            return initial
+        return self.steps[k - 1].state
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON form: ``{"mission": [...], "horizon": K, "steps": [...]}``."""
+        return {
+            "mission": list(self.mission),
+            "horizon": self.horizon,
+            "steps": [step.to_dict() for step in self.steps],
+        }
+
+    def to_text(self) -> str:
+        """The plan for people: one line per step, ``k  primitive  robot (x, y, heading°)  notes``."""
+        width = len(str(self.horizon))
+        return "\n".join(f"{k:>{width}}  {step.to_text()}" for k, step in enumerate(self.steps, 1))
+
+
+@dataclass(frozen=True)
+class Coordination:
+    """A request/response pair: `responder` moves `object` away for `requester`.
+
+    The pair is the shared event ``away(object, requester, responder)``: the requester's
+    ``Req(object)`` (the paper's ``?O Away``) and the responder's ``Res(object)`` (``!O Away``).
+    """
+
+    object: str
+    requester: str
+    responder: str
+
+    @property
+    def event(self) -> Event:
+        """The shared mission event ``away(O,A,B)``."""
+        return Event("away", self.requester, self.object, responder=self.responder)
+
+    def to_dict(self) -> dict[str, str]:
+        """The JSON form: ``{"object": ..., "requester": ..., "responder": ...}``."""
+        return {"object": self.object, "requester": self.requester, "responder": self.responder}
+
+
+@dataclass(frozen=True)
+class PlanSet:
+    """The plans of all robots for one scenario (the content of a ``cosmop.plan/1`` file).
+
+    Parameters
+    ----------
+    scenario : str
+        The scenario's name.
+    feasible : bool
+        Whether a plan was found; an infeasible plan set says why in `reason`.
+    robots : Mapping[str, RobotPlan]
+        Plans by robot id (read-only, in the order given).
+    coordination : tuple of Coordination
+        The request/response pairs the plans rely on.
+    reason : str, optional
+        Why no plan exists, in words a person can act on (required when not `feasible`).
+
+    Raises
+    ------
+    ValueError
+        If `feasible` is false and no `reason` is given.
+    """
+
+    scenario: str
+    feasible: bool
+    robots: Mapping[str, RobotPlan] = field(default_factory=dict)
+    coordination: tuple[Coordination, ...] = ()
+    reason: str | None = None
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.robots, MappingProxyType):
+            object.__setattr__(self, "robots", MappingProxyType(dict(self.robots)))
+        object.__setattr__(self, "coordination", tuple(self.coordination))
+        if not self.feasible and not self.reason:
+            raise ValueError("an infeasible plan set needs a reason")
+
+    @property
+    def horizon(self) -> int:
+        """The total number of steps over all robots."""
+        return sum(plan.horizon for plan in self.robots.values())
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON form of the plan file (``reason`` only when there is one)."""
+        data: dict[str, Any] = {
+            "format": PLAN_FORMAT,
+            "scenario": self.scenario,
+            "feasible": self.feasible,
+        }
+        if self.reason is not None:
+            data["reason"] = self.reason
+        data["robots"] = {robot: plan.to_dict() for robot, plan in self.robots.items()}
+        data["coordination"] = [pair.to_dict() for pair in self.coordination]
+        return data
+
+    @classmethod
+    def from_dict(cls, data: Any, file: str | os.PathLike[str] | None = None) -> PlanSet:
+        """Validate a plan file's content (parsed JSON) and build the plan set.
+
+        Parameters
+        ----------
+        data : Any
+            The parsed JSON.
+        file : str or os.PathLike, optional
+            The file it came from, for error messages.
+
+        Returns
+        -------
+        PlanSet
+
+        Raises
+        ------
+        PlanError
+            If the content does not have the shape of a ``cosmop.plan/1`` file; the error
+            names the file, the field and what was expected.
+        """
+        return _Reader(None if file is None else os.fspath(file)).plan_set(data)
+
+    def save(self, path: str | os.PathLike[str]) -> None:
+        """Write the plan file (JSON, UTF-8), atomically.
+
+        The JSON is indented, with every list or object that fits on one line kept on one
+        line (a step with few objects is one line).
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The destination; its directory must exist.
+        """
+        write_atomic(path, _pretty(self.to_dict()) + "\n")
+
+    def to_text(self) -> str:
+        """The plan set for people: per robot a header line and one line per step."""
+        lines = [f"plan for {self.scenario}: {'feasible' if self.feasible else 'infeasible'}"]
+        if self.reason:
+            lines.append(f"reason: {self.reason}")
+        for robot, plan in self.robots.items():
+            lines.append(f"{robot} ({plan.horizon} steps): {', '.join(plan.mission) or 'no mission'}")
+            lines.extend("  " + line for line in plan.to_text().splitlines())
+        for pair in self.coordination:
+            lines.append(f"coordination: {pair.responder} moves {pair.object} away for {pair.requester}")
+        return "\n".join(lines)
+
+
+def load_plan(path: str | os.PathLike[str]) -> PlanSet:
+    """Read and validate a plan file (``cosmop.plan/1``, JSON).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The plan file.
+
+    Returns
+    -------
+    PlanSet
+
+    Raises
+    ------
+    PlanError
+        If the file cannot be read, is not JSON (the line and column are given) or does not
+        have the shape of a plan file; the error names the file, the field and what was expected.
+    """
+    file = os.fspath(path)
+    try:
+        raw = Path(path).read_bytes()
+    except FileNotFoundError:
+        raise PlanError("file not found", file=file) from None
+    except IsADirectoryError:
+        raise PlanError("is a directory, expected a plan file", file=file) from None
+    except PermissionError:
+        raise PlanError("permission denied: cannot read the file", file=file) from None
+    except OSError as err:
+        raise PlanError(f"cannot read the file: {err.strerror or err}", file=file) from None
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError as err:
+        raise PlanError(
+            f"expected UTF-8 text, found an invalid byte at offset {err.start}", file=file
+        ) from None
+    if not text.strip():
+        raise PlanError("the file is empty; expected a cosmop.plan/1 JSON object", file=file)
+    try:
+        data = json.loads(text, object_pairs_hook=_no_duplicates, parse_constant=_no_constant)
+    except json.JSONDecodeError as err:
+        raise PlanError(f"invalid JSON: {err.msg}", file=file, line=err.lineno, column=err.colno) from None
+    except _JsonContentError as err:
+        raise PlanError(f"invalid JSON: {err}", file=file) from None
+    return PlanSet.from_dict(data, file=file)
+
+
+# ----------------------------------------------------------------------------------------------
+# Reading: shape validation with field paths
+# ----------------------------------------------------------------------------------------------
+
+
+class _JsonContentError(ValueError):
+    pass
+
+
+def _no_duplicates(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    result: dict[str, Any] = {}
+    for key, value in pairs:
+        if key in result:
+            raise _JsonContentError(f"duplicate key {key!r}; every key and id must appear once in its object")
+        result[key] = value
+    return result
+
+
+def _no_constant(name: str) -> Any:
+    raise _JsonContentError(f"{name} is not a number; coordinates must be finite")
+
+
+def _describe(value: Any) -> str:
+    names = {dict: "an object", list: "a list", str: "a string", bool: "a boolean", type(None): "null"}
+    if type(value) in names:
+        text = names[type(value)]
+        return f"{text} {value!r}" if isinstance(value, str | bool) else text
+    if isinstance(value, int | float):
+        return f"the number {value!r}"
+    return type(value).__name__
+
+
+_Path = tuple[str | int, ...]
+
+
+def _format_path(path: _Path) -> str | None:
+    """``("robots", "R1", "steps", 3, "primitive")`` -> ``robots.R1.steps[3].primitive``."""
+    text = ""
+    for part in path:
+        if isinstance(part, int):
+            text += f"[{part}]"
+        elif re.fullmatch(r"[A-Za-z0-9_-]+", part):
+            text += f".{part}" if text else part
+        else:
+            text += f"[{part!r}]"
+    return text or None
+
+
+class _Reader:
+    """Builds a PlanSet from parsed JSON, raising PlanError with the file and field path."""
+
+    def __init__(self, file: str | None) -> None:
+        self.file = file
+
+    def fail(self, path: _Path, expected: str) -> PlanError:
+        return PlanError(expected, file=self.file, field=_format_path(path))
+
+    def mapping(self, value: Any, path: _Path, required: tuple[str, ...], optional: tuple[str, ...] = ()):
+        if not isinstance(value, dict):
+            raise self.fail(path, f"expected a JSON object, got {_describe(value)}")
+        for key in required:
+            if key not in value:
+                raise self.fail(path, f"missing field {key!r}")
+        allowed = required + optional
+        for key in value:
+            if key not in allowed:
+                raise self.fail(
+                    (*path, key), f"unknown field {key!r}; expected {', '.join(repr(k) for k in allowed)}"
+                )
+        return value
+
+    def string(self, value: Any, path: _Path, what: str = "text") -> str:
+        if not isinstance(value, str):
+            raise self.fail(path, f"expected {what}, got {_describe(value)}")
+        return value
+
+    def ident(self, value: Any, path: _Path, what: str) -> str:
+        text = self.string(value, path, f"{what} id")
+        if not _ID_RE.match(text):
+            raise self.fail(path, f"{text!r} is not a valid {what} id (expected {ID_PATTERN})")
+        return text
+
+    def boolean(self, value: Any, path: _Path) -> bool:
+        if not isinstance(value, bool):
+            raise self.fail(path, f"expected true or false, got {_describe(value)}")
+        return value
+
+    def number(self, value: Any, path: _Path) -> float:
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise self.fail(path, f"expected a number, got {_describe(value)}")
+        if not math.isfinite(value):
+            raise self.fail(path, f"expected a finite number, got {value!r}")
+        return float(value)
+
+    def numbers(self, value: Any, path: _Path, names: tuple[str, ...], units: str) -> tuple[float, ...]:
+        wanted = f"a list [{', '.join(names)}] ({units})"
+        if not isinstance(value, list):
+            raise self.fail(path, f"expected {wanted}, got {_describe(value)}")
+        if len(value) != len(names):
+            raise self.fail(path, f"expected {wanted}, got {len(value)} number(s)")
+        return tuple(self.number(item, (*path, i)) for i, item in enumerate(value))
+
+    def plan_set(self, data: Any) -> PlanSet:
+        if isinstance(data, dict) and "format" in data and data["format"] != PLAN_FORMAT:
+            # another format (version) first: its other fields may legitimately differ
+            raise self.fail(("format",), f"unknown format {data['format']!r}; expected {PLAN_FORMAT!r}")
+        root = self.mapping(
+            data, (), ("format", "scenario", "feasible", "robots"), ("coordination", "reason")
+        )
+        scenario = self.string(root["scenario"], ("scenario",), "the scenario's name as text")
+        feasible = self.boolean(root["feasible"], ("feasible",))
+        reason = root.get("reason")
+        if reason is not None:
+            reason = self.string(reason, ("reason",), "text or null")
+        if not feasible and not reason:
+            raise self.fail(("reason",), "an infeasible plan needs a reason a person can act on")
+        robots_data = root["robots"]
+        if not isinstance(robots_data, dict):
+            raise self.fail(
+                ("robots",), f"expected a JSON object of plans by robot id, got {_describe(robots_data)}"
+            )
+        robots = {}
+        for robot, plan in robots_data.items():
+            self.ident(robot, ("robots", robot), "robot")
+            robots[robot] = self.robot_plan(plan, ("robots", robot), robot)
+        pairs_data = root.get("coordination", [])
+        if not isinstance(pairs_data, list):
+            raise self.fail(("coordination",), f"expected a list, got {_describe(pairs_data)}")
+        pairs = tuple(self.coordination(item, ("coordination", i)) for i, item in enumerate(pairs_data))
+        return PlanSet(scenario, feasible, robots, pairs, reason)
+
+    def coordination(self, value: Any, path: _Path) -> Coordination:
+        item = self.mapping(value, path, ("object", "requester", "responder"))
+        obj = self.ident(item["object"], (*path, "object"), "object")
+        requester = self.ident(item["requester"], (*path, "requester"), "robot")
+        responder = self.ident(item["responder"], (*path, "responder"), "robot")
+        if requester == responder:
+            raise self.fail(
+                (*path, "responder"), f"the responder must differ from the requester {requester!r}"
+            )
+        return Coordination(obj, requester, responder)
+
+    def robot_plan(self, value: Any, path: _Path, robot: str) -> RobotPlan:
+        item = self.mapping(value, path, ("mission", "horizon", "steps"))
+        mission_data = item["mission"]
+        if not isinstance(mission_data, list):
+            raise self.fail((*path, "mission"), f"expected a list of events, got {_describe(mission_data)}")
+        mission = []
+        for i, text in enumerate(mission_data):
+            event_path = (*path, "mission", i)
+            self.string(text, event_path, "an event such as 'pick(R1,O1)'")
+            try:
+                mission.append(parse_event(text, robot=robot).name)
+            except EventSyntaxError as err:
+                raise self.fail(event_path, str(err)) from None
+        horizon = item["horizon"]
+        if isinstance(horizon, bool) or not isinstance(horizon, int) or horizon < 0:
+            raise self.fail((*path, "horizon"), f"expected a non-negative integer, got {_describe(horizon)}")
+        steps_data = item["steps"]
+        if not isinstance(steps_data, list):
+            raise self.fail((*path, "steps"), f"expected a list of steps, got {_describe(steps_data)}")
+        if horizon != len(steps_data):
+            raise self.fail(
+                (*path, "horizon"),
+                f"the horizon is {horizon} but there are {len(steps_data)} steps; they must be equal",
+            )
+        steps = tuple(self.step(s, (*path, "steps", i)) for i, s in enumerate(steps_data))
+        return RobotPlan(tuple(mission), horizon, steps)
+
+    def step(self, value: Any, path: _Path) -> Step:
+        item = self.mapping(value, path, ("primitive", "robot", "objects"), ("object",))
+        primitive = item["primitive"]
+        if primitive not in PRIMITIVES:
+            raise self.fail(
+                (*path, "primitive"),
+                f"unknown primitive {_describe(primitive)}; expected one of {', '.join(PRIMITIVES)}",
+            )
+        obj = item.get("object")
+        if primitive == "GoTo":
+            if obj is not None:
+                raise self.fail(
+                    (*path, "object"), f"GoTo acts on no object; expected null, got {_describe(obj)}"
+                )
+        else:
+            if obj is None:
+                raise self.fail((*path, "object"), f"{primitive} needs the id of the object it acts on")
+            self.ident(obj, (*path, "object"), "object")
+        robot = self.numbers(item["robot"], (*path, "robot"), ("x", "y", "heading"), "mm, mm, degrees")
+        objects_data = item["objects"]
+        if not isinstance(objects_data, dict):
+            raise self.fail(
+                (*path, "objects"),
+                f"expected a JSON object of object states by id, got {_describe(objects_data)}",
+            )
+        objects = {}
+        for oid, state in objects_data.items():
+            state_path = (*path, "objects", oid)
+            self.ident(oid, state_path, "object")
+            fields = self.mapping(state, state_path, ("position", "carried", "away"))
+            objects[oid] = ObjectState(
+                self.numbers(fields["position"], (*state_path, "position"), ("x", "y"), "mm"),
+                self.boolean(fields["carried"], (*state_path, "carried")),
+                self.boolean(fields["away"], (*state_path, "away")),
+            )
+        if obj is not None and obj not in objects:
+            listed = ", ".join(objects) or "none"
+            raise self.fail((*path, "object"), f"{obj!r} is not among the step's objects ({listed})")
+        return Step(primitive, obj, robot, objects)
+
+
+# ----------------------------------------------------------------------------------------------
+# Formatting
+# ----------------------------------------------------------------------------------------------
+
+
+def _pretty(value: Any, level: int = 0, width: int = 100) -> str:
+    """JSON indented by two spaces, with every value that fits in `width` columns on one line."""
+    compact = json.dumps(value, ensure_ascii=False, separators=(", ", ": "))
+    if not isinstance(value, dict | list) or not value or len(compact) + 2 * level <= width:
+        return compact
+    pad, end = "  " * (level + 1), "  " * level
+    if isinstance(value, dict):
+        items = [
+            f"{pad}{json.dumps(key, ensure_ascii=False)}: {_pretty(item, level + 1, width)}"
+            for key, item in value.items()
+        ]
+        return "{\n" + ",\n".join(items) + "\n" + end + "}"
+    items = [pad + _pretty(item, level + 1, width) for item in value]
+    return "[\n" + ",\n".join(items) + "\n" + end + "]"
+
+
+def _num(value: float) -> int | float:
+    """A JSON number: integral values as integers (``-2000``, not ``-2000.0``)."""
+    if float(value).is_integer() and abs(value) < 2**53:
+        return int(value)
+    return float(value)
+
+
+def _fmt(value: float) -> str:
+    """A coordinate for people: ``-2000``, ``12.5`` (integers without a point, others exactly)."""
+    value = float(value)
+    if value.is_integer():
+        return str(int(value))
+    return repr(value)
+
+
+def _point(point: Iterable[float]) -> str:
+    return "(" + ", ".join(_fmt(v) for v in point) + ")"

@@ -1,0 +1,397 @@
+"""CoSMoP: one robot's safe motion primitives and local mission as CLTLB(D) formulas.
+
+Section IV of the paper.  The state at instant ``k`` (Section IV-C) is the robot's pose
+:math:`q_r = (x, y, \\alpha)`, every object's :math:`q_b^j = (x, y, p, a)` (position, carried,
+away) and the primitive :math:`\\pi` taken between ``k-1`` and ``k`` (``NONE`` at instant 0).
+Positions are integers in mm, headings integers in degrees, as in the paper.
+
+Each primitive is a small object with a name and an ``effect``: the constraint relating
+:math:`q` and :math:`\\bigcirc q` when :math:`\\bigcirc\\pi` is that primitive.  The
+specification is :math:`\\Box(\\bigcirc(\\pi = \\text{prim}) \\rightarrow \\text{effect})` for
+every primitive and object it applies to.  Adding a primitive means adding such an object;
+the solver does not change.  GoTo uses the sound region constraints of
+:mod:`cosmop.planning.regions` (never a wall or resting object overlapped, touching allowed).
+
+The local mission, a sequence of events :math:`e_1 \\dots e_m`, is the nested until
+:math:`a_1 \\mathbf{U} (g_1 \\wedge \\bigcirc(a_2 \\mathbf{U} (g_2 \\wedge \\cdots
+\\bigcirc(a_m \\mathbf{U} (g_m \\wedge \\neg\\bigcirc true)))))`.  Here :math:`g_i` is the
+event's goal (e.g. :math:`\\pi = \\text{PickUp}_j`) and :math:`a_i` the primitives allowed
+before it (GoTo, and requests for objects the robot neither carries, places nor must pick).
+This is the paper's encoding with its typo fixed (pick ends with PickUp, not DropOff), and it
+ends the trace at the last event.
+
+The specification is a list of *named parts* (the initial state, each primitive, each wall
+and object constraint of GoTo and DropOff, the mission), so an unsat core names what blocks a
+mission.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from fractions import Fraction
+from types import MappingProxyType
+
+from cosmop.logic import FALSE, TRUE, Always, Formula, Implies, Next, Not, Until, Var, conj, disj, eq
+from cosmop.missions.events import Event
+from cosmop.planning.regions import HalfPlane, wall_regions
+from cosmop.scenario import Scene
+
+NONE = 0
+PRIMITIVE_NAMES = ("GoTo", "PickUp", "DropOff", "Req", "Res")
+
+
+def _num(value: float) -> Fraction:
+    return Fraction(value).limit_denominator(10**6)
+
+
+@dataclass(frozen=True)
+class ObjectVars:
+    """CLTLB(D) variables of one object: position (int mm), carried and away (bool)."""
+
+    x: Var
+    y: Var
+    carried: Var
+    away: Var
+
+    @classmethod
+    def named(cls, obj: str) -> ObjectVars:
+        return cls(
+            Var(f"{obj}.x", "int"), Var(f"{obj}.y", "int"), Var(f"{obj}.p", "bool"), Var(f"{obj}.a", "bool")
+        )
+
+
+@dataclass(frozen=True)
+class Action:
+    """A primitive applied to an object (``None`` for GoTo), with its code in :math:`\\pi`."""
+
+    primitive: str
+    obj: str | None
+    code: int
+
+
+@dataclass(frozen=True)
+class RobotProblem:
+    """Everything one robot's plan is about: scene, robot, local mission, allowed actions.
+
+    Parameters
+    ----------
+    scene : Scene
+    robot : str
+    mission : tuple of Event
+        The local mission as a sequence of events (pick, drop, return, away).
+    requests : bool
+        Whether the robot may ask for objects to be moved away (Req).
+
+    Notes
+    -----
+    PickUp and DropOff are offered for the objects the mission picks; Req for every other
+    object (never one the robot carries, has placed or must pick, DESIGN.md); Res for the
+    objects of the ``away`` events the robot answers.
+    """
+
+    scene: Scene
+    robot: str
+    mission: tuple[Event, ...]
+    requests: bool = True
+    actions: tuple[Action, ...] = field(init=False)
+
+    def __post_init__(self) -> None:
+        own = [e.obj for e in self.mission if e.kind in ("pick", "drop") and e.obj]
+        answers = [e.obj for e in self.mission if e.kind == "away" and e.responder == self.robot and e.obj]
+        acts: list[tuple[str, str | None]] = [("GoTo", None)]
+        for obj in self.scene.objects:
+            if obj in own:
+                acts += [("PickUp", obj), ("DropOff", obj)]
+            elif self.requests:
+                acts.append(("Req", obj))
+            if obj in answers:
+                acts.append(("Res", obj))
+        object.__setattr__(self, "mission", tuple(self.mission))
+        object.__setattr__(self, "actions", tuple(Action(p, o, i + 1) for i, (p, o) in enumerate(acts)))
+
+    # -- variables -----------------------------------------------------------------------------
+    @property
+    def x(self) -> Var:
+        return Var("x", "int")
+
+    @property
+    def y(self) -> Var:
+        return Var("y", "int")
+
+    @property
+    def h(self) -> Var:
+        return Var("heading", "int")
+
+    @property
+    def pi(self) -> Var:
+        return Var("pi", "int")
+
+    def obj(self, obj: str) -> ObjectVars:
+        return ObjectVars.named(obj)
+
+    @property
+    def side(self) -> Fraction:
+        return _num(self.scene.robots[self.robot].size)
+
+    def code(self, primitive: str, obj: str | None = None) -> int | None:
+        """Code of an action in :math:`\\pi`, or ``None`` if the robot may not take it."""
+        for a in self.actions:
+            if a.primitive == primitive and a.obj == obj:
+                return a.code
+        return None
+
+    def is_action(self, primitive: str, obj: str | None = None) -> Formula:
+        code = self.code(primitive, obj)
+        return self.pi.eq(code) if code is not None else FALSE
+
+    def requests_except(self, obj: str | None) -> Formula:
+        """:math:`\\pi` is GoTo or a request for an object other than ``obj``."""
+        return disj(
+            [
+                self.pi.eq(a.code)
+                for a in self.actions
+                if a.primitive == "GoTo" or (a.primitive == "Req" and a.obj != obj)
+            ]
+        )
+
+    def clearance(self, obj: str) -> Fraction:
+        """:math:`d = (l_b + l_r)/2`, the centre distance when robot and object touch."""
+        return (_num(self.scene.objects[obj].size) + self.side) / 2
+
+
+def _static(*vars_: Var) -> Formula:
+    return conj(v.next().eq(v) if v.sort != "bool" else eq(v.next(), v) for v in vars_)
+
+
+def _half_plane(h: HalfPlane, x, y) -> Formula:
+    return h.a * x + h.b * y >= h.c
+
+
+class Primitive:
+    """A safe motion primitive: its name and the constraint between :math:`q` and :math:`\\bigcirc q`.
+
+    Subclasses set ``name`` and implement :meth:`parts`, returning named formulas that hold
+    whenever :math:`\\bigcirc \\pi` is this primitive applied to ``obj``.
+    """
+
+    name = ""
+
+    def parts(self, p: RobotProblem, obj: str | None) -> list[tuple[str, Formula]]:
+        raise NotImplementedError
+
+
+def _robot_static(p: RobotProblem) -> Formula:
+    return _static(p.x, p.y, p.h)
+
+
+def _objects_static(
+    p: RobotProblem, *, positions=True, carried=True, away=True, skip: str | None = None
+) -> Formula:
+    out = []
+    for o in p.scene.objects:
+        if o == skip:
+            continue
+        v = p.obj(o)
+        out += [v.x, v.y] if positions else []
+        out += [v.carried] if carried else []
+        out += [v.away] if away else []
+    return _static(*out)
+
+
+class GoTo(Primitive):
+    """Move in a straight line; never overlap a wall or a resting object (touching allowed)."""
+
+    name = "GoTo"
+
+    def parts(self, p, obj):
+        x, y = p.x, p.y
+        out = [("GoTo keeps the objects", _objects_static(p))]
+        for i, wall in enumerate(p.scene.obstacles):
+            regions = wall_regions(wall.start, wall.end, p.side, f"wall {i}")
+            out.append(
+                (
+                    f"wall {i} {[list(wall.start), list(wall.end)]}",
+                    disj(_half_plane(h, x, y) & _half_plane(h, x.next(), y.next()) for h in regions),
+                )
+            )
+        for o in p.scene.objects:
+            v, d = p.obj(o), p.clearance(o)
+            clear = disj(
+                [
+                    (x <= v.x - d) & (x.next() <= v.x - d),
+                    (x >= v.x + d) & (x.next() >= v.x + d),
+                    (y <= v.y - d) & (y.next() <= v.y - d),
+                    (y >= v.y + d) & (y.next() >= v.y + d),
+                ]
+            )
+            out.append((f"object {o}", Implies(~v.carried & ~v.away, clear)))
+        return out
+
+
+class PickUp(Primitive):
+    """Pick ``obj`` up from in front of it, facing it (heading 0), carrying nothing."""
+
+    name = "PickUp"
+
+    def parts(self, p, obj):
+        v, d = p.obj(obj), p.clearance(obj)
+        carry = conj(
+            [~p.obj(o).carried for o in p.scene.objects]
+            + [p.obj(o).carried.next() if o == obj else ~p.obj(o).carried.next() for o in p.scene.objects]
+        )
+        pose = p.h.eq(0) & p.y.eq(v.y) & p.x.eq(v.x - d) & ~v.away
+        return [(f"PickUp {obj}", _robot_static(p) & carry & pose & _objects_static(p, carried=False))]
+
+
+class DropOff(Primitive):
+    """Leave the carried ``obj`` in front of the robot, never onto a wall or another object."""
+
+    name = "DropOff"
+
+    def parts(self, p, obj):
+        v, d = p.obj(obj), p.clearance(obj)
+        held = conj(p.obj(o).carried if o == obj else ~p.obj(o).carried for o in p.scene.objects)
+        released = conj(~p.obj(o).carried.next() for o in p.scene.objects)
+        place = p.h.eq(0) & v.x.next().eq(p.x + d) & v.y.next().eq(p.y)
+        rest = _objects_static(p, carried=False, skip=obj) & _static(v.away)
+        out = [(f"DropOff {obj}", _robot_static(p) & held & released & place & rest)]
+        side = _num(p.scene.objects[obj].size)
+        for i, wall in enumerate(p.scene.obstacles):
+            regions = wall_regions(wall.start, wall.end, side, f"wall {i}")
+            out.append(
+                (
+                    f"{obj} dropped clear of wall {i}",
+                    disj(_half_plane(h, v.x.next(), v.y.next()) for h in regions),
+                )
+            )
+        for o in p.scene.objects:
+            if o == obj:
+                continue
+            w = p.obj(o)
+            gap = (side + _num(p.scene.objects[o].size)) / 2
+            apart = disj(
+                [
+                    v.x.next() <= w.x - gap,
+                    v.x.next() >= w.x + gap,
+                    v.y.next() <= w.y - gap,
+                    v.y.next() >= w.y + gap,
+                ]
+            )
+            out.append((f"{obj} dropped clear of {o}", Implies(~w.carried & ~w.away, apart)))
+        return out
+
+
+class Req(Primitive):
+    """Ask for ``obj`` to be moved away and wait; stand clear of the pose that picks it."""
+
+    name = "Req"
+
+    def parts(self, p, obj):
+        v, d, side = p.obj(obj), p.clearance(obj), p.side
+        flags = (
+            ~v.away
+            & v.away.next()
+            & _objects_static(p, away=False)
+            & _objects_static(p, positions=False, carried=False, skip=obj)
+        )
+        room = disj([p.x <= v.x - d - side, p.x >= v.x - d + side, p.y <= v.y - side, p.y >= v.y + side])
+        return [(f"Req {obj}", _robot_static(p) & flags & room)]
+
+
+class Res(Primitive):
+    """Answer that ``obj`` (carried) has been moved away."""
+
+    name = "Res"
+
+    def parts(self, p, obj):
+        return [(f"Res {obj}", _robot_static(p) & _objects_static(p) & p.obj(obj).carried)]
+
+
+PRIMITIVES: Mapping[str, Primitive] = MappingProxyType(
+    {c.name: c() for c in (GoTo, PickUp, DropOff, Req, Res)}
+)
+
+
+def _goal(p: RobotProblem, event: Event) -> tuple[Formula, Formula]:
+    """(allowed primitives before the event, the event's goal at its instant)."""
+    if event.kind == "pick":
+        return p.requests_except(event.obj), p.is_action("PickUp", event.obj)
+    if event.kind == "drop":
+        v = p.obj(event.obj)
+        ws = p.scene.workspaces[event.workspace]
+        if ws.point is not None:
+            inside = v.x.eq(_num(ws.point[0])) & v.y.eq(_num(ws.point[1]))
+        else:
+            inside = conj(
+                [v.x >= _num(ws.x[0]), v.x <= _num(ws.x[1]), v.y >= _num(ws.y[0]), v.y <= _num(ws.y[1])]
+            )
+        return p.requests_except(event.obj), p.is_action("DropOff", event.obj) & inside
+    if event.kind == "return":
+        x0, y0, h0 = p.scene.robots[p.robot].pose
+        home = p.x.eq(_num(x0)) & p.y.eq(_num(y0)) & p.h.eq(_num(h0))
+        return p.requests_except(None), home & (p.requests_except(None) | p.pi.eq(NONE))
+    if event.kind == "away":
+        if event.robot == p.robot:  # the requester
+            return p.requests_except(event.obj), p.is_action("Req", event.obj)
+        return p.requests_except(event.obj), p.is_action("Res", event.obj)
+    raise ValueError(f"unknown event kind {event.kind!r}")
+
+
+def mission_formula(p: RobotProblem, events: Sequence[Event] | None = None) -> Formula:
+    """The local mission as nested until, ending the trace at its last event."""
+    events = p.mission if events is None else tuple(events)
+    if not events:
+        return Not(Next(TRUE))
+    tail: Formula = Not(Next(TRUE))  # after the last event the trace ends
+    phase: Formula = tail
+    for event in reversed(events):
+        allowed, goal = _goal(p, event)
+        phase = Until(allowed | p.pi.eq(NONE), goal & tail)
+        tail = Next(phase)
+    return phase
+
+
+def initial_state(p: RobotProblem) -> Formula:
+    """Instant 0: the scenario's poses and positions, nothing carried or away, no primitive."""
+    x0, y0, h0 = p.scene.robots[p.robot].pose
+    parts = [p.x.eq(_num(x0)), p.y.eq(_num(y0)), p.h.eq(_num(h0)), p.pi.eq(NONE)]
+    for o, spec in p.scene.objects.items():
+        v = p.obj(o)
+        parts += [v.x.eq(_num(spec.position[0])), v.y.eq(_num(spec.position[1])), ~v.carried, ~v.away]
+    return conj(parts)
+
+
+def specification(p: RobotProblem, events: Sequence[Event] | None = None) -> list[tuple[str, Formula]]:
+    """The named parts of :math:`\\phi_{\\mathcal{P}}(\\mathcal{M}) \\wedge \\phi_{K}` for one robot.
+
+    Every part holds at instant 0 of a plan; their conjunction is the whole specification.
+    """
+    codes = [a.code for a in p.actions]
+    parts: list[tuple[str, Formula]] = [
+        ("initial state", initial_state(p)),
+        ("one primitive per step", Always(Implies(Next(TRUE), Next(disj(p.pi.eq(c) for c in codes))))),
+    ]
+    for action in p.actions:
+        for name, effect in PRIMITIVES[action.primitive].parts(p, action.obj):
+            parts.append((name, Always(Implies(Next(p.pi.eq(action.code)), effect))))
+    parts.append(("mission", mission_formula(p, events)))
+    return parts
+
+
+def request_codes(p: RobotProblem) -> dict[int, str]:
+    """Codes of the Req actions, with their objects."""
+    return {a.code: a.obj for a in p.actions if a.primitive == "Req" and a.obj is not None}
+
+
+def decode(p: RobotProblem, code: int) -> Action:
+    for a in p.actions:
+        if a.code == code:
+            return a
+    raise ValueError(f"no action has code {code}")
+
+
+def events_of(mission: Iterable[Event | str]) -> tuple[Event, ...]:
+    from cosmop.missions.events import parse_event
+
+    return tuple(e if isinstance(e, Event) else parse_event(e) for e in mission)

@@ -1,0 +1,661 @@
+"""The exact plan checker on hand-made plans for the 2x2 warehouse (paper, Example 1).
+
+Robots are squares of side 400 mm, objects of side 100 mm, so d = (400 + 100)/2 = 250 mm: a robot
+picks O1 (2000, -1000) from (1750, -1000), where its square overlaps O2 (1900, -1000) unless O2
+has been moved away -- hence R1's Req(O2). Each rule test makes one small edit to a valid plan
+and expects exactly the violation that edit causes.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from shapely.geometry import LineString, box
+
+from cosmop.planning import (
+    RULES,
+    CheckReport,
+    Coordination,
+    ObjectState,
+    PlanSet,
+    RobotPlan,
+    Step,
+    Violation,
+    check_plan,
+    check_robot_plan,
+    overlaps,
+    plan_from_actions,
+    square,
+    swept_square,
+)
+from cosmop.scenario import load_scenario, parse_scenario
+
+EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "01_warehouse_2x2" / "scenario.yaml"
+SCENARIO = load_scenario(EXAMPLE)
+SCENE = SCENARIO.scene
+
+R1_MISSION = ["away(O2,R1,R2)", "pick(R1,O1)", "drop(R1,O1,W1)", "return(R1)"]
+R1_ACTIONS = [
+    ("Req", "O2"),
+    ("GoTo", (1750, -1000, 0)),  # the pick pose of O1: touches O1, would overlap O2 were it not away
+    ("PickUp", "O1"),
+    ("GoTo", (-1500, -200, 0)),  # below the gap between the left wall and the inner wall
+    ("GoTo", (-1500, 2000, 0)),  # up through the gap
+    ("DropOff", "O1"),  # O1 at (-1250, 2000), inside W1
+    ("GoTo", (-2000, -1000, 0)),  # home
+]
+R2_MISSION = ["pick(R2,O2)", "drop(R2,O2,W2)", "return(R2)"]
+R2_ACTIONS = [
+    ("GoTo", (1650, -1000, 0)),  # the pick pose of O2
+    ("PickUp", "O2"),
+    ("GoTo", (1230, 2000, 0)),  # right of the inner wall's end (1000, 0)
+    ("DropOff", "O2"),  # O2 at (1480, 2000), inside W2
+    ("GoTo", (1230, -2000, 0)),  # straight down: moving right would sweep over O2
+    ("GoTo", (-2000, -2000, 0)),  # home
+]
+R2_RES_MISSION = ["pick(R2,O2)", "away(O2,R1,R2)", "drop(R2,O2,W2)", "return(R2)"]
+R2_RES_ACTIONS = [*R2_ACTIONS[:2], ("Res", "O2"), *R2_ACTIONS[2:]]
+
+
+def r1_plan(actions=R1_ACTIONS, mission=R1_MISSION) -> RobotPlan:
+    return plan_from_actions(SCENE, "R1", mission, actions)
+
+
+def r2_plan(actions=R2_ACTIONS, mission=R2_MISSION) -> RobotPlan:
+    return plan_from_actions(SCENE, "R2", mission, actions)
+
+
+def coordinated() -> PlanSet:
+    return PlanSet(
+        "warehouse-2x2",
+        True,
+        {"R1": r1_plan(), "R2": r2_plan(R2_RES_ACTIONS, R2_RES_MISSION)},
+        (Coordination("O2", "R1", "R2"),),
+    )
+
+
+def replaced(actions, index: int, action) -> list:
+    """The actions with ``actions[index]`` (step ``index + 1``) replaced."""
+    result = list(actions)
+    result[index] = action
+    return result
+
+
+def edit_step(plan: RobotPlan, k: int, **changes) -> RobotPlan:
+    """The plan with fields of step ``k`` (1-based) changed."""
+    steps = list(plan.steps)
+    steps[k - 1] = dataclasses.replace(steps[k - 1], **changes)
+    return RobotPlan(plan.mission, plan.horizon, tuple(steps))
+
+
+def edit_object(plan: RobotPlan, k: int, oid: str, **changes) -> RobotPlan:
+    """The plan with the state of object `oid` in step ``k`` changed."""
+    objects = dict(plan.steps[k - 1].objects)
+    objects[oid] = dataclasses.replace(objects[oid], **changes)
+    return edit_step(plan, k, objects=objects)
+
+
+def only(violations: list[Violation], rule: str, instant: int | None) -> Violation:
+    assert len(violations) == 1, "\n".join(v.message for v in violations)
+    (violation,) = violations
+    assert (violation.rule, violation.instant) == (rule, instant), violation.message
+    assert violation.rule in RULES
+    return violation
+
+
+# ----------------------------------------------------------------------------------------------
+# The valid plans
+# ----------------------------------------------------------------------------------------------
+
+
+def test_r1_plan_with_request_is_valid() -> None:
+    plan = r1_plan()
+    assert plan.horizon == 7
+    assert [s.label for s in plan.steps] == [
+        "Req(O2)",
+        "GoTo",
+        "PickUp(O1)",
+        "GoTo",
+        "GoTo",
+        "DropOff(O1)",
+        "GoTo",
+    ]
+    assert plan.steps[5].objects["O1"].position == (-1250.0, 2000.0)
+    assert check_robot_plan(SCENE, "R1", plan) == []
+
+
+def test_r2_plan_alone_is_valid_with_two_gotos_home() -> None:
+    plan = r2_plan()
+    assert plan.horizon == 6
+    assert plan.steps[3].objects["O2"].position == (1480.0, 2000.0)
+    assert check_robot_plan(SCENE, "R2", plan) == []
+
+
+def test_coordinated_plan_set_is_valid() -> None:
+    report = check_plan(SCENARIO, coordinated())
+    assert report == CheckReport(True, (), 14)
+    assert report.to_dict() == {"ok": True, "checked_steps": 14, "violations": []}
+
+
+def test_instant_zero_is_the_scenario() -> None:
+    # a return at instant 0 is realised by the initial pose itself
+    plan = plan_from_actions(SCENE, "R1", ["return(R1)"], [])
+    assert check_robot_plan(SCENE, "R1", plan) == []
+
+
+# ----------------------------------------------------------------------------------------------
+# GoTo
+# ----------------------------------------------------------------------------------------------
+
+
+def test_goto_crossing_a_wall() -> None:
+    # the waypoint below the gap moved right, under the inner wall: going up from there crosses it
+    plan = r1_plan(replaced(R1_ACTIONS, 3, ("GoTo", (-900, -200, 0))))
+    v = only(check_robot_plan(SCENE, "R1", plan), "wall", 5)
+    assert v.robot == "R1"
+    assert v.message.startswith("R1 at instant 5: GoTo from (-900, -200) to (-1500, 2000) crosses wall ")
+    assert "[[-1000,0],[1000,0]]" in v.message
+
+
+def test_goto_crossing_the_wall_by_a_tenth_of_a_millimetre() -> None:
+    # R2 goes home past the inner wall's end (1000, 0); 0.1 mm further left and its square cuts it
+    actions = [(p, (1199.9, *x[1:])) if p == "GoTo" and x[0] == 1230 else (p, x) for p, x in R2_ACTIONS]
+    v = only(check_robot_plan(SCENE, "R2", r2_plan(actions)), "wall", 5)
+    assert "GoTo from (1199.9, 2000) to (1199.9, -2000) crosses wall [[-1000,0],[1000,0]]" in v.message
+
+
+def test_touching_a_wall_exactly_is_allowed() -> None:
+    # R2's square passes the inner wall's end point with its left edge exactly on it (x = 1000),
+    # and slides along the bottom wall (its lower edge on y = -2500) on the way home.
+    actions = [(p, (1200, *x[1:])) if p == "GoTo" and x[0] == 1230 else (p, x) for p, x in R2_ACTIONS]
+    actions = [*actions[:-1], ("GoTo", (-2000, -2300, 0)), ("GoTo", (-2300, -2300, 0)), actions[-1]]
+    plan = r2_plan(actions)
+    assert plan.steps[3].objects["O2"].position == (1450.0, 2000.0)
+    assert check_robot_plan(SCENE, "R2", plan) == []
+
+
+def test_touching_a_wall_along_an_edge_at_the_end_of_a_goto() -> None:
+    # the waypoint's top edge lies on the inner wall (y = 0): allowed; the next GoTo then crosses it
+    plan = r1_plan(replaced(R1_ACTIONS, 3, ("GoTo", (-800, -200, 0))))
+    only(check_robot_plan(SCENE, "R1", plan), "wall", 5)
+
+
+def test_goto_clipping_a_resting_object() -> None:
+    # without the request, going to O1's pick pose sweeps over O2 (and so does leaving it)
+    plan = r1_plan(R1_ACTIONS[1:], R1_MISSION[1:])
+    violations = check_robot_plan(SCENE, "R1", plan)
+    assert [(v.instant, v.rule) for v in violations] == [(1, "object-collision"), (3, "object-collision")]
+    assert violations[0].message == (
+        "R1 at instant 1: GoTo from (-2000, -1000) to (1750, -1000) sweeps over O2, resting at "
+        "(1900, -1000) (size 100); go around it or request it away with Req(O2)"
+    )
+
+
+def test_goto_sweep_between_two_clear_squares_hits_an_object() -> None:
+    # both end squares are clear of O1; the swept area between them is not
+    plan = r1_plan([("Req", "O2"), ("GoTo", (1700, -1500, 0)), ("GoTo", (2300, -700, 0))], ["away(O2,R1,R2)"])
+    assert not overlaps(square(1700, -1500, 400), square(2000, -1000, 100))
+    assert not overlaps(square(2300, -700, 400), square(2000, -1000, 100))
+    v = only(check_robot_plan(SCENE, "R1", plan), "object-collision", 3)
+    assert "sweeps over O1" in v.message
+
+
+def test_goto_touching_a_resting_object_is_allowed() -> None:
+    # R2's pick pose: its square touches O2 along an edge
+    plan = r2_plan(R2_ACTIONS[:1], [])
+    assert check_robot_plan(SCENE, "R2", plan) == []
+
+
+def test_goto_must_not_change_flags() -> None:
+    plan = edit_object(r1_plan(), 4, "O1", carried=False)
+    violations = check_robot_plan(SCENE, "R1", plan)
+    # instant 4 drops the carried flag by GoTo, instant 5 (a GoTo too) raises it again
+    assert [(v.instant, v.rule) for v in violations] == [(4, "carried"), (5, "carried")]
+    assert "the carried flag of O1 changes from true to false" in violations[0].message
+
+
+def test_goto_may_turn_the_robot() -> None:
+    plan = r1_plan(replaced(R1_ACTIONS, 3, ("GoTo", (-1500, -200, 90))))
+    assert check_robot_plan(SCENE, "R1", plan) == []
+
+
+def test_carried_object_keeps_its_pick_position() -> None:
+    # moving O1 along with the robot contradicts phi_carry: positions change only on DropOff
+    plan = r1_plan()
+    plan = edit_object(plan, 4, "O1", position=(-1250, 2000))
+    plan = edit_object(plan, 5, "O1", position=(-1250, 2000))
+    v = only(check_robot_plan(SCENE, "R1", plan), "position", 4)
+    assert "O1 moves from (2000, -1000) to (-1250, 2000)" in v.message
+    assert "a carried object stays where it was picked up" in v.message
+
+
+# ----------------------------------------------------------------------------------------------
+# PickUp
+# ----------------------------------------------------------------------------------------------
+
+
+def test_picking_from_the_wrong_pose() -> None:
+    actions = replaced(R1_ACTIONS, 1, ("GoTo", (1740, -1000, 0)))
+    v = only(check_robot_plan(SCENE, "R1", r1_plan(actions)), "pick-pose", 3)
+    assert v.message == (
+        "R1 at instant 3, PickUp(O1): the robot is at (1740, -1000), but picking O1 at (2000, -1000) "
+        "requires standing in front of it at (1750, -1000) (d = 250 mm)"
+    )
+
+
+def test_picking_at_the_wrong_heading() -> None:
+    actions = replaced(R1_ACTIONS, 1, ("GoTo", (1750, -1000, 90)))
+    v = only(check_robot_plan(SCENE, "R1", r1_plan(actions)), "pick-pose", 3)
+    assert "heading is 90°" in v.message
+
+
+def test_headings_compare_modulo_360_and_positions_within_tolerance() -> None:
+    actions = replaced(R1_ACTIONS, 1, ("GoTo", (1750, -1000 + 5e-7, 360)))
+    assert check_robot_plan(SCENE, "R1", r1_plan(actions)) == []
+    actions = replaced(R1_ACTIONS, 1, ("GoTo", (1750 - 1e-4, -1000, 0)))
+    v = only(check_robot_plan(SCENE, "R1", r1_plan(actions)), "pick-pose", 3)
+    assert "the robot is at (1749.9999, -1000)" in v.message
+
+
+def test_geometry_is_exact_not_within_tolerance() -> None:
+    # 0.5 micrometre into O1 is an overlap, although poses compare within 1 micrometre
+    actions = replaced(R1_ACTIONS, 1, ("GoTo", (1750 + 5e-7, -1000, 0)))
+    v = only(check_robot_plan(SCENE, "R1", r1_plan(actions)), "object-collision", 2)
+    assert "to (1750.0000005, -1000) sweeps over O1" in v.message
+
+
+def test_picking_while_carrying() -> None:
+    actions = [*R2_ACTIONS[:2], ("GoTo", (1750, -1000, 0)), ("PickUp", "O1")]
+    violations = check_robot_plan(SCENE, "R2", r2_plan(actions, ["pick(R2,O2)"]))
+    assert [(v.instant, v.rule) for v in violations] == [(4, "carried"), (4, "carried")]
+    assert "already carries O2" in violations[0].message
+
+
+def test_picking_an_object_moved_away() -> None:
+    plan = r1_plan([("Req", "O2"), ("GoTo", (1650, -1000, 0)), ("PickUp", "O2")], ["away(O2,R1,R2)"])
+    v = only(check_robot_plan(SCENE, "R1", plan), "away", 3)
+    assert "O2 has been moved away" in v.message
+
+
+def test_pickup_must_mark_the_object_carried() -> None:
+    plan = r1_plan()
+    for k in range(3, 6):
+        plan = edit_object(plan, k, "O1", carried=False)
+    violations = check_robot_plan(SCENE, "R1", plan)
+    assert [(v.instant, v.rule) for v in violations] == [(3, "carried"), (6, "carried")]
+    assert violations[0].message == "R1 at instant 3, PickUp(O1): O1 is not marked carried after PickUp(O1)"
+
+
+def test_robot_must_not_move_while_picking() -> None:
+    plan = edit_step(r1_plan(), 3, robot=(1750, -1000, 0))  # unchanged: valid
+    assert check_robot_plan(SCENE, "R1", plan) == []
+    plan = edit_step(r1_plan(), 1, robot=(-2000, -900, 0))  # Req(O2) moves the robot
+    v = only(check_robot_plan(SCENE, "R1", plan), "robot-static", 1)
+    assert "the robot moves from (-2000, -1000, 0°) to (-2000, -900, 0°)" in v.message
+
+
+# ----------------------------------------------------------------------------------------------
+# DropOff
+# ----------------------------------------------------------------------------------------------
+
+
+def test_dropping_onto_an_object() -> None:
+    actions = [*R2_ACTIONS[:2], ("GoTo", (1700, -1000, 0)), ("DropOff", "O2")]
+    v = only(check_robot_plan(SCENE, "R2", r2_plan(actions, ["pick(R2,O2)"])), "object-collision", 4)
+    assert v.message == (
+        "R2 at instant 4, DropOff(O2): O2 dropped at (1950, -1000) overlaps O1, resting at (2000, -1000); "
+        "drop it elsewhere"
+    )
+
+
+def test_dropping_onto_a_wall() -> None:
+    actions = [*R2_ACTIONS[:2], ("GoTo", (1650, -1500, 0)), ("GoTo", (2250, -1500, 0)), ("DropOff", "O2")]
+    v = only(check_robot_plan(SCENE, "R2", r2_plan(actions, ["pick(R2,O2)"])), "wall", 5)
+    assert "O2 dropped at (2500, -1500) overlaps wall [[2500,-2500],[2500,2500]]" in v.message
+
+
+def test_dropping_through_a_wall() -> None:
+    # the robot touches the right wall and would put O2 on its far side, touching it
+    actions = [*R2_ACTIONS[:2], ("GoTo", (1650, -1500, 0)), ("GoTo", (2300, -1500, 0)), ("DropOff", "O2")]
+    v = only(check_robot_plan(SCENE, "R2", r2_plan(actions, ["pick(R2,O2)"])), "wall", 5)
+    assert "on the two sides of wall [[2500,-2500],[2500,2500]]" in v.message
+
+
+def test_dropping_outside_the_workspace() -> None:
+    # drop pose 70 mm further right: O2 lands at x = 1550 > 1500
+    actions = replaced(R2_ACTIONS, 2, ("GoTo", (1300, 2000, 0)))
+    v = only(check_robot_plan(SCENE, "R2", r2_plan(actions)), "mission", None)
+    assert v.message == (
+        "R2: mission event drop(R2,O2,W2) (2nd of 3) is not realised: there is no DropOff(O2) that "
+        "leaves O2 in W2 after instant 2 (pick(R2,O2)); DropOff(O2) at instant 4 leaves it at "
+        "(1550, 2000), outside W2 (x in [1000, 1500], y in [2000, 2500]) "
+        "(so return(R2) cannot be matched either)"
+    )
+
+
+def test_dropping_on_the_workspace_boundary_counts() -> None:
+    actions = replaced(R2_ACTIONS, 2, ("GoTo", (1250, 2000, 0)))
+    actions = replaced(actions, 4, ("GoTo", (1250, -2000, 0)))
+    plan = r2_plan(actions)
+    assert plan.steps[3].objects["O2"].position == (1500.0, 2000.0)
+    assert check_robot_plan(SCENE, "R2", plan) == []
+
+
+def test_dropping_at_a_point_workspace() -> None:
+    data = {
+        "name": "points",
+        "scene": {
+            "obstacles": [[[-2500, -2500], [2500, -2500]]],
+            "robots": {"R1": {"size": 400, "pose": [0, 0, 0]}},
+            "objects": {"O1": {"size": 100, "position": [1000, 0]}},
+            "workspaces": {"W1": {"point": [1250, 500]}},
+        },
+        "mission": {"tasks": {"R1": ["pick O1", "drop O1 at W1"]}},
+    }
+    scenario = parse_scenario(data)
+    mission = ["pick(R1,O1)", "drop(R1,O1,W1)"]
+    good = plan_from_actions(
+        scenario.scene,
+        "R1",
+        mission,
+        [("GoTo", (750, 0, 0)), ("PickUp", "O1"), ("GoTo", (1000, 500, 0)), ("DropOff", "O1")],
+    )
+    assert check_robot_plan(scenario.scene, "R1", good) == []
+    bad = plan_from_actions(
+        scenario.scene,
+        "R1",
+        mission,
+        [("GoTo", (750, 0, 0)), ("PickUp", "O1"), ("GoTo", (1000, 501, 0)), ("DropOff", "O1")],
+    )
+    v = only(check_robot_plan(scenario.scene, "R1", bad), "mission", None)
+    assert "outside W1 (the point (1250, 500))" in v.message
+
+
+def test_picking_through_a_wall() -> None:
+    # the robot's front edge and the object's back edge both touch a short wall between them
+    data = {
+        "name": "behind-a-wall",
+        "scene": {
+            "obstacles": [[[1200, -500], [1200, 500]]],
+            "robots": {"R1": {"size": 400, "pose": [0, 0, 0]}},
+            "objects": {"O1": {"size": 100, "position": [1250, 0]}},
+            "workspaces": {},
+        },
+        "mission": {"tasks": {"R1": ["pick O1"]}},
+    }
+    scene = parse_scenario(data).scene
+    plan = plan_from_actions(scene, "R1", ["pick(R1,O1)"], [("GoTo", (1000, 0, 0)), ("PickUp", "O1")])
+    v = only(check_robot_plan(scene, "R1", plan), "wall", 2)
+    assert v.message == (
+        "R1 at instant 2, PickUp(O1): the robot at (1000, 0) and O1 at (1250, 0) are on the two sides of "
+        "wall [[1200,-500],[1200,500]]; the gripper cannot reach through it"
+    )
+
+
+def test_dropoff_must_put_the_object_in_front_of_the_robot() -> None:
+    plan = r1_plan()
+    plan = edit_object(plan, 6, "O1", position=(-1250, 2010))
+    plan = edit_object(plan, 7, "O1", position=(-1250, 2010))
+    v = only(check_robot_plan(SCENE, "R1", plan), "drop-pose", 6)
+    assert "O1 is put at (-1250, 2010), but a robot at (-1500, 2000) puts it" in v.message
+
+
+def test_dropping_what_is_not_carried() -> None:
+    plan = r2_plan([("GoTo", (1650, -1000, 0)), ("DropOff", "O2")], [])
+    v = only(check_robot_plan(SCENE, "R2", plan), "carried", 2)
+    assert "O2 is not carried at instant 1" in v.message
+
+
+# ----------------------------------------------------------------------------------------------
+# Req and Res
+# ----------------------------------------------------------------------------------------------
+
+
+def test_request_while_standing_in_the_pick_pose() -> None:
+    actions = [("GoTo", (1650, -1000, 0)), *R1_ACTIONS]
+    v = only(check_robot_plan(SCENE, "R1", r1_plan(actions)), "req-room", 2)
+    assert v.message == (
+        "R1 at instant 2, Req(O2): the requester at (1650, -1000) stands in the way of a robot picking O2 "
+        "from (1650, -1000); request from a pose that leaves that square free"
+    )
+
+
+@pytest.mark.parametrize(
+    ("x", "y", "ok"),
+    [
+        (1250, -1000, True),
+        (1250.5, -1000, False),
+        (1300, -1000, False),
+        (1650, -1400, True),
+        (1650, -1399, False),
+    ],
+)
+def test_request_room_touching_is_allowed(x: float, y: float, ok: bool) -> None:
+    # the pick pose of O2 is (1650, -1000), square x 1450..1850, y -1200..-800
+    actions = [("GoTo", (x, y, 0)), *R1_ACTIONS]
+    violations = [v for v in check_robot_plan(SCENE, "R1", r1_plan(actions)) if v.instant == 2]
+    assert [v.rule for v in violations] == ([] if ok else ["req-room"])
+
+
+def test_request_twice() -> None:
+    actions = [("Req", "O2"), *R1_ACTIONS]
+    violations = check_robot_plan(SCENE, "R1", r1_plan(actions))
+    assert [(v.instant, v.rule) for v in violations] == [(2, "away")]
+    assert "O2 is already away at instant 1; request it only once" in violations[0].message
+
+
+def test_request_must_mark_the_object_away() -> None:
+    plan = edit_object(r1_plan(), 1, "O2", away=False)
+    violations = check_robot_plan(SCENE, "R1", plan)
+    # then GoTo sets the flag, and sweeps over O2 which is not away at instant 1
+    assert [(v.instant, v.rule) for v in violations] == [(1, "away"), (2, "away"), (2, "object-collision")]
+    assert "O2 is not marked away after Req(O2)" in violations[0].message
+
+
+def test_response_needs_the_object_carried() -> None:
+    plan = r2_plan([("Res", "O2")], [])
+    v = only(check_robot_plan(SCENE, "R2", plan), "carried", 1)
+    assert "the robot must carry O2 at instants 0 and 1" in v.message
+
+
+def test_response_changes_nothing() -> None:
+    plan = edit_object(r2_plan(R2_RES_ACTIONS, R2_RES_MISSION), 3, "O1", away=True)
+    violations = check_robot_plan(SCENE, "R2", plan)
+    assert [(v.instant, v.rule) for v in violations] == [(3, "away"), (4, "away")]
+
+
+# ----------------------------------------------------------------------------------------------
+# The mission
+# ----------------------------------------------------------------------------------------------
+
+
+def test_missing_return() -> None:
+    v = only(check_robot_plan(SCENE, "R2", r2_plan(R2_ACTIONS[:-1])), "mission", None)
+    assert v.message == (
+        "R2: mission event return(R2) (3rd of 3) is not realised: the robot is never at its initial pose "
+        "(-2000, -2000, 0°) after instant 4 (drop(R2,O2,W2)); the last pose is (1230, -2000, 0°): add a "
+        "GoTo back to the initial pose"
+    )
+
+
+def test_return_needs_the_initial_heading() -> None:
+    actions = replaced(R2_ACTIONS, 5, ("GoTo", (-2000, -2000, 180)))
+    only(check_robot_plan(SCENE, "R2", r2_plan(actions)), "mission", None)
+
+
+def test_events_out_of_order() -> None:
+    mission = [R1_MISSION[0], R1_MISSION[2], R1_MISSION[1], R1_MISSION[3]]
+    v = only(check_robot_plan(SCENE, "R1", r1_plan(mission=mission)), "mission", None)
+    assert v.message == (
+        "R1: mission event pick(R1,O1) (3rd of 4) is not realised: there is no PickUp(O1) after instant 6 "
+        "(drop(R1,O1,W1)); it holds only at instant 3, before drop(R1,O1,W1): the events are out of order "
+        "(so return(R1) cannot be matched either)"
+    )
+
+
+def test_request_event_needs_a_req_step() -> None:
+    plan = r1_plan(replaced(R1_ACTIONS, 0, ("GoTo", (-2000, -1000, 0))), R1_MISSION)
+    violations = check_robot_plan(SCENE, "R1", plan)
+    assert [v.rule for v in violations] == ["object-collision", "object-collision", "mission"]
+    assert "mission event away(O2,R1,R2) (1st of 4) is not realised: there is no Req(O2) anywhere" in (
+        violations[-1].message
+    )
+
+
+def test_response_event_needs_a_res_step() -> None:
+    v = only(check_robot_plan(SCENE, "R2", r2_plan(R2_ACTIONS, R2_RES_MISSION)), "mission", None)
+    assert "there is no Res(O2) after instant 2 (pick(R2,O2))" in v.message
+
+
+def test_mission_event_of_another_robot() -> None:
+    v = only(check_robot_plan(SCENE, "R1", r1_plan(mission=["pick(R2,O2)"])), "mission", None)
+    assert "pick(R2,O2), an event of R2" in v.message
+
+
+def test_mission_with_unknown_workspace() -> None:
+    v = only(check_robot_plan(SCENE, "R1", r1_plan(mission=["drop(R1,O1,W9)"])), "mission", None)
+    assert "workspace W9, which is not in the scene (W1, W2)" in v.message
+
+
+# ----------------------------------------------------------------------------------------------
+# Malformed states
+# ----------------------------------------------------------------------------------------------
+
+
+def test_step_missing_an_object() -> None:
+    plan = r1_plan()
+    objects = dict(plan.steps[3].objects)
+    del objects["O2"]
+    plan = edit_step(plan, 4, objects=objects)
+    v = only(check_robot_plan(SCENE, "R1", plan), "objects", 4)
+    assert "every step must list every object of the scene (O1, O2); missing O2" in v.message
+
+
+def test_step_naming_an_unknown_object() -> None:
+    plan = r1_plan()
+    state = plan.steps[0]
+    bad = Step("Req", "O9", state.robot, {**state.objects, "O9": ObjectState((0, 0), False, True)})
+    plan = RobotPlan(plan.mission, plan.horizon, (bad, *plan.steps[1:]))
+    violations = check_robot_plan(SCENE, "R1", plan)
+    assert [(v.instant, v.rule) for v in violations] == [(1, "objects"), (1, "objects"), (None, "mission")]
+    assert "O9 not in the scene" in violations[0].message
+    assert "O9 is not an object of the scene (O1, O2)" in violations[1].message
+
+
+def test_unknown_robot() -> None:
+    v = only(check_robot_plan(SCENE, "R9", r1_plan()), "robot", None)
+    assert v.message == "R9: there is no robot R9 in the scene (R1, R2)"
+
+
+# ----------------------------------------------------------------------------------------------
+# The plan set
+# ----------------------------------------------------------------------------------------------
+
+
+def test_plan_for_another_scenario() -> None:
+    report = check_plan(SCENARIO, dataclasses.replace(coordinated(), scenario="other"))
+    assert not report.ok
+    (v,) = report.violations
+    assert (v.robot, v.instant, v.rule) == (None, None, "scenario")
+    assert report.to_dict()["violations"][0]["robot"] is None
+
+
+def test_missing_robot_plan() -> None:
+    plans = PlanSet("warehouse-2x2", True, {"R2": r2_plan()})
+    (v,) = check_plan(SCENARIO, plans).violations
+    assert (v.robot, v.rule) == ("R1", "mission")
+    assert "the plan has no plan for R1" in v.message
+
+
+def test_plan_mission_must_contain_the_tasks() -> None:
+    plans = PlanSet("warehouse-2x2", True, {"R1": r1_plan(R1_ACTIONS[:-1], R1_MISSION[:-1]), "R2": r2_plan()})
+    plans = dataclasses.replace(plans, coordination=(Coordination("O2", "R1", "R2"),))
+    violations = check_plan(SCENARIO, plans).violations
+    assert [(v.robot, v.rule) for v in violations] == [("R1", "mission"), ("R2", "coordination")]
+    assert "return(R1) is missing" in violations[0].message
+    assert "names R2 as responder, but its mission does not include away(O2,R1,R2)" in violations[1].message
+
+
+def test_plan_mission_may_add_only_away_events() -> None:
+    extra = r2_plan([*R2_ACTIONS, ("GoTo", (1650, -1000, 0)), ("PickUp", "O1")], [*R2_MISSION, "pick(R2,O1)"])
+    plans = PlanSet("warehouse-2x2", True, {"R1": r1_plan(), "R2": extra}, (Coordination("O2", "R1", "R2"),))
+    violations = [v for v in check_plan(SCENARIO, plans).violations if v.rule == "mission"]
+    assert len(violations) == 1
+    assert "adds pick(R2,O1)" in violations[0].message
+
+
+def test_away_event_needs_a_coordination_pair() -> None:
+    plans = dataclasses.replace(coordinated(), coordination=())
+    violations = check_plan(SCENARIO, plans).violations
+    assert [(v.robot, v.rule) for v in violations] == [("R1", "coordination"), ("R2", "coordination")]
+
+
+def test_infeasible_plan_set_checks_nothing() -> None:
+    plans = PlanSet("warehouse-2x2", False, {}, reason="no shortest plan within the horizon bound")
+    assert check_plan(SCENARIO, plans) == CheckReport(True, (), 0)
+
+
+# ----------------------------------------------------------------------------------------------
+# Geometry
+# ----------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("segment", "expected"),
+    [
+        (((0, -10), (0, 10)), True),  # through the middle
+        (((-1, 1), (1, 1)), False),  # along the top edge
+        (((1, -5), (1, 5)), False),  # along the right edge, longer than it
+        (((1, 0), (5, 0)), False),  # ends on the right edge
+        (((0.999, 0), (5, 0)), True),  # reaches inside by 1 micrometre
+        (((2, 2), (3, 3)), False),  # apart
+        (((1, 1), (3, 3)), False),  # touches a corner
+    ],
+)
+def test_segment_overlap_means_interiors(segment, expected: bool) -> None:
+    assert overlaps(LineString(segment), box(-1, -1, 1, 1)) is expected
+
+
+def test_squares_sharing_an_edge_do_not_overlap() -> None:
+    assert not overlaps(square(0, 0, 2), square(2, 0, 2))
+    assert not overlaps(square(0, 0, 2), square(2, 2, 2))
+    assert overlaps(square(0, 0, 2), square(1.999, 0, 2))
+
+
+@settings(max_examples=60)
+@given(
+    st.integers(-3000, 3000),
+    st.integers(-3000, 3000),
+    st.integers(-3000, 3000),
+    st.integers(1, 1000),
+    st.booleans(),
+)
+def test_axis_aligned_sweep_is_the_bounding_box(
+    x0: int, y0: int, delta: int, side: int, vertical: bool
+) -> None:
+    start, end = (x0, y0), ((x0, y0 + delta) if vertical else (x0 + delta, y0))
+    area = swept_square(start, end, side)
+    half = side / 2
+    expected = box(
+        min(start[0], end[0]) - half,
+        min(start[1], end[1]) - half,
+        max(start[0], end[0]) + half,
+        max(start[1], end[1]) + half,
+    )
+    assert area.symmetric_difference(expected).area == pytest.approx(0, abs=1e-6)
+
+
+@settings(max_examples=60)
+@given(
+    st.tuples(st.integers(-2000, 2000), st.integers(-2000, 2000)),
+    st.tuples(st.integers(-2000, 2000), st.integers(-2000, 2000)),
+    st.floats(0, 1),
+)
+def test_sweep_covers_every_intermediate_square(start, end, t: float) -> None:
+    area = swept_square(start, end, 400)
+    middle = (start[0] + t * (end[0] - start[0]), start[1] + t * (end[1] - start[1]))
+    assert area.buffer(1e-6).contains(square(*middle, 400))

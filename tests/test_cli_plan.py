@@ -1,0 +1,59 @@
+"""``cosmop plan``: plan file + PNG, exit 0 / 1 (file still written) / 2 (nothing written)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import yaml
+from typer.testing import CliRunner
+
+from cosmop.cli import app
+from cosmop.planning.checker import check_plan
+from cosmop.planning.plan import load_plan
+from cosmop.scenario import load_scenario
+
+ROOT = Path(__file__).resolve().parents[1]
+TASKS_FILE = ROOT / "examples" / "01_warehouse_2x2" / "scenario.yaml"
+runner = CliRunner()
+
+
+def test_plan_writes_a_checked_plan_and_a_png(tmp_path):
+    out, png = tmp_path / "plan.json", tmp_path / "plan.png"
+    result = runner.invoke(app, ["plan", str(TASKS_FILE), "-o", str(out), "--png", str(png)])
+    assert result.exit_code == 0, result.output
+    plans = load_plan(out)
+    assert plans.feasible and plans.robots["R1"].horizon == 7 and plans.robots["R2"].horizon == 6
+    assert check_plan(load_scenario(TASKS_FILE), plans).ok
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert "R1" in result.stdout and "O2" in result.stdout and "all valid" in result.stdout
+
+
+def test_infeasible_robot_exits_1_and_still_writes_the_file(tmp_path):
+    data = yaml.safe_load(TASKS_FILE.read_text())
+    # box R2 in: four walls tight around its square
+    data["scene"]["obstacles"] += [
+        [[-2300, -2300], [-1700, -2300]],
+        [[-1700, -2300], [-1700, -1700]],
+        [[-1700, -1700], [-2300, -1700]],
+        [[-2300, -1700], [-2300, -2300]],
+    ]
+    scenario = tmp_path / "boxed.yaml"
+    scenario.write_text(yaml.safe_dump(data))
+    out = tmp_path / "plan.json"
+    result = runner.invoke(app, ["plan", str(scenario), "-o", str(out), "--max-horizon", "8"])
+    assert result.exit_code == 1, result.output
+    written = json.loads(out.read_text())
+    assert written["feasible"] is False
+    assert "R2" in written["reason"] and "pick(R2,O2)" in written["reason"] and "wall" in written["reason"]
+    assert set(written["robots"]) == {"R1"}
+
+
+def test_bad_input_exits_2_and_writes_nothing(tmp_path):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(TASKS_FILE.read_text().replace("size: 400", "size: -1", 1))
+    out = tmp_path / "plan.json"
+    result = runner.invoke(app, ["plan", str(bad), "-o", str(out)])
+    assert result.exit_code == 2
+    assert "size" in result.stderr and "Traceback" not in result.output
+    assert not out.exists()
