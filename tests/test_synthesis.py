@@ -99,3 +99,42 @@ def test_incremental_and_fresh_search_agree(small):
         b = synthesize(small.scene, robot, small.mission.tasks[robot], incremental=False)
         assert (a.horizon, sorted(a.requests)) == (b.horizon, sorted(b.requests))
         assert check_robot_plan(small.scene, robot, b.plan) == []
+
+
+def test_minimality_evidence(small):
+    res = synthesize(small.scene, "R1", small.mission.tasks["R1"])
+    assert res.unsat_horizons == tuple(range(2, res.horizon))  # 2 non-return events: K >= 2
+
+
+def _one_robot_scene(extra_walls):
+    from cosmop.scenario import parse_scenario
+
+    return parse_scenario(
+        {
+            "name": "gripper",
+            "scene": {
+                "obstacles": [
+                    [[-2000, -2000], [2000, -2000]],
+                    [[2000, -2000], [2000, 2000]],
+                    [[2000, 2000], [-2000, 2000]],
+                    [[-2000, 2000], [-2000, -2000]],
+                    *extra_walls,
+                ],
+                "robots": {"R1": {"size": 400, "pose": [-1000, 0, 0]}},
+                "objects": {"O1": {"size": 100, "position": [1000, 0]}},
+                "workspaces": {"W1": {"x": [-1500, -500], "y": [1000, 1500]}},
+            },
+            "mission": {"tasks": {"R1": ["pick O1", "drop O1 at W1", "return"]}},
+        }
+    )
+
+
+def test_no_pick_through_a_wall():
+    open_scene = _one_robot_scene([])
+    res = synthesize(open_scene.scene, "R1", open_scene.mission.tasks["R1"], max_horizon=8)
+    assert res.feasible and check_robot_plan(open_scene.scene, "R1", res.plan) == []
+    # a short wall exactly on the object's left edge, between the pick pose and the object
+    walled = _one_robot_scene([[[950, -40], [950, 40]]])
+    blocked = synthesize(walled.scene, "R1", walled.mission.tasks["R1"], max_horizon=8)
+    assert not blocked.feasible
+    assert any(name.startswith("gripper clear of wall 4") for name in blocked.blocking), blocked.blocking

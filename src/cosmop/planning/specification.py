@@ -82,33 +82,48 @@ class RobotProblem:
         The local mission as a sequence of events (pick, drop, return, away).
     requests : bool
         Whether the robot may ask for objects to be moved away (Req).
+    primitives : Mapping[str, Primitive], optional
+        The primitive library (default :data:`PRIMITIVES`); each primitive says which objects
+        it applies to (:meth:`Primitive.targets`), and the actions are all such pairs.
 
     Notes
     -----
-    PickUp and DropOff are offered for the objects the mission picks; Req for every other
-    object (never one the robot carries, has placed or must pick, DESIGN.md); Res for the
-    objects of the ``away`` events the robot answers.
+    With the default library PickUp and DropOff apply to the objects the mission picks, Req to
+    every other object (never one the robot carries, has placed or must pick, DESIGN.md), Res
+    to the objects of the ``away`` events the robot answers.
     """
 
     scene: Scene
     robot: str
     mission: tuple[Event, ...]
     requests: bool = True
+    primitives: Mapping[str, Primitive] | None = None
     actions: tuple[Action, ...] = field(init=False)
 
     def __post_init__(self) -> None:
-        own = [e.obj for e in self.mission if e.kind in ("pick", "drop") and e.obj]
-        answers = [e.obj for e in self.mission if e.kind == "away" and e.responder == self.robot and e.obj]
-        acts: list[tuple[str, str | None]] = [("GoTo", None)]
-        for obj in self.scene.objects:
-            if obj in own:
-                acts += [("PickUp", obj), ("DropOff", obj)]
-            elif self.requests:
-                acts.append(("Req", obj))
-            if obj in answers:
-                acts.append(("Res", obj))
         object.__setattr__(self, "mission", tuple(self.mission))
-        object.__setattr__(self, "actions", tuple(Action(p, o, i + 1) for i, (p, o) in enumerate(acts)))
+        primitives = PRIMITIVES if self.primitives is None else self.primitives
+        object.__setattr__(self, "primitives", MappingProxyType(dict(primitives)))
+        acts = [(prim.name, obj) for prim in self.primitives.values() for obj in prim.targets(self)]
+        object.__setattr__(self, "actions", tuple(Action(name, o, i + 1) for i, (name, o) in enumerate(acts)))
+
+    @property
+    def own_objects(self) -> tuple[str, ...]:
+        """Objects the mission picks or drops (never requested: the robot handles them)."""
+        return tuple(
+            o
+            for o in self.scene.objects
+            if any(e.obj == o and e.kind in ("pick", "drop") for e in self.mission)
+        )
+
+    @property
+    def answered_objects(self) -> tuple[str, ...]:
+        """Objects of the ``away`` events this robot answers."""
+        return tuple(
+            o
+            for o in self.scene.objects
+            if any(e.kind == "away" and e.obj == o and e.responder == self.robot for e in self.mission)
+        )
 
     # -- variables -----------------------------------------------------------------------------
     @property
@@ -171,14 +186,40 @@ def _half_plane(h: HalfPlane, x, y) -> Formula:
 class Primitive:
     """A safe motion primitive: its name and the constraint between :math:`q` and :math:`\\bigcirc q`.
 
-    Subclasses set ``name`` and implement :meth:`parts`, returning named formulas that hold
-    whenever :math:`\\bigcirc \\pi` is this primitive applied to ``obj``.
+    Subclasses set ``name`` and implement :meth:`targets` (the objects it applies to, ``None``
+    for a primitive without object) and :meth:`parts` (named formulas that hold whenever
+    :math:`\\bigcirc \\pi` is this primitive applied to ``obj``).  A new primitive is a new
+    subclass added to the library passed to :class:`RobotProblem`; the solver does not change.
     """
 
     name = ""
 
+    def targets(self, p: RobotProblem) -> tuple[str | None, ...]:
+        raise NotImplementedError
+
     def parts(self, p: RobotProblem, obj: str | None) -> list[tuple[str, Formula]]:
         raise NotImplementedError
+
+
+def _gripper_clear(p: RobotProblem, obj: str, ox, oy) -> list[tuple[str, Formula]]:
+    """Robot and object squares in one region of every wall: no wall between them (the gripper).
+
+    The regions of one wall computed for the two sizes are the same half-planes shifted by each
+    square's support, so both squares in the i-th of them put their union on one side.
+    """
+    side = _num(p.scene.objects[obj].size)
+    out = []
+    for i, wall in enumerate(p.scene.obstacles):
+        pairs = zip(
+            wall_regions(wall.start, wall.end, p.side), wall_regions(wall.start, wall.end, side), strict=True
+        )
+        out.append(
+            (
+                f"gripper clear of wall {i}",
+                disj(_half_plane(a, p.x, p.y) & _half_plane(b, ox, oy) for a, b in pairs),
+            )
+        )
+    return out
 
 
 def _robot_static(p: RobotProblem) -> Formula:
@@ -203,6 +244,9 @@ class GoTo(Primitive):
     """Move in a straight line; never overlap a wall or a resting object (touching allowed)."""
 
     name = "GoTo"
+
+    def targets(self, p):
+        return (None,)
 
     def parts(self, p, obj):
         x, y = p.x, p.y
@@ -234,6 +278,9 @@ class PickUp(Primitive):
 
     name = "PickUp"
 
+    def targets(self, p):
+        return p.own_objects
+
     def parts(self, p, obj):
         v, d = p.obj(obj), p.clearance(obj)
         carry = conj(
@@ -241,13 +288,17 @@ class PickUp(Primitive):
             + [p.obj(o).carried.next() if o == obj else ~p.obj(o).carried.next() for o in p.scene.objects]
         )
         pose = p.h.eq(0) & p.y.eq(v.y) & p.x.eq(v.x - d) & ~v.away
-        return [(f"PickUp {obj}", _robot_static(p) & carry & pose & _objects_static(p, carried=False))]
+        out = [(f"PickUp {obj}", _robot_static(p) & carry & pose & _objects_static(p, carried=False))]
+        return out + _gripper_clear(p, obj, v.x, v.y)
 
 
 class DropOff(Primitive):
     """Leave the carried ``obj`` in front of the robot, never onto a wall or another object."""
 
     name = "DropOff"
+
+    def targets(self, p):
+        return p.own_objects
 
     def parts(self, p, obj):
         v, d = p.obj(obj), p.clearance(obj)
@@ -256,6 +307,7 @@ class DropOff(Primitive):
         place = p.h.eq(0) & v.x.next().eq(p.x + d) & v.y.next().eq(p.y)
         rest = _objects_static(p, carried=False, skip=obj) & _static(v.away)
         out = [(f"DropOff {obj}", _robot_static(p) & held & released & place & rest)]
+        out += _gripper_clear(p, obj, v.x.next(), v.y.next())
         side = _num(p.scene.objects[obj].size)
         for i, wall in enumerate(p.scene.obstacles):
             regions = wall_regions(wall.start, wall.end, side, f"wall {i}")
@@ -287,6 +339,9 @@ class Req(Primitive):
 
     name = "Req"
 
+    def targets(self, p):
+        return tuple(o for o in p.scene.objects if o not in p.own_objects) if p.requests else ()
+
     def parts(self, p, obj):
         v, d, side = p.obj(obj), p.clearance(obj), p.side
         flags = (
@@ -303,6 +358,9 @@ class Res(Primitive):
     """Answer that ``obj`` (carried) has been moved away."""
 
     name = "Res"
+
+    def targets(self, p):
+        return p.answered_objects
 
     def parts(self, p, obj):
         return [(f"Res {obj}", _robot_static(p) & _objects_static(p) & p.obj(obj).carried)]
@@ -373,7 +431,7 @@ def specification(p: RobotProblem, events: Sequence[Event] | None = None) -> lis
         ("one primitive per step", Always(Implies(Next(TRUE), Next(disj(p.pi.eq(c) for c in codes))))),
     ]
     for action in p.actions:
-        for name, effect in PRIMITIVES[action.primitive].parts(p, action.obj):
+        for name, effect in p.primitives[action.primitive].parts(p, action.obj):
             parts.append((name, Always(Implies(Next(p.pi.eq(action.code)), effect))))
     parts.append(("mission", mission_formula(p, events)))
     return parts

@@ -59,6 +59,10 @@ class Synthesis:
     solve_s : float
     checks : int
         Solver calls made.
+    unsat_horizons : tuple of int
+        The horizons proved unsatisfiable before the plan was found (evidence that ``horizon``
+        is minimal: every shorter length is among them or below the lower bound, one step per
+        non-return event).
     """
 
     robot: str
@@ -70,6 +74,7 @@ class Synthesis:
     blocking: tuple[str, ...] = ()
     solve_s: float = 0.0
     checks: int = field(default=0, repr=False)
+    unsat_horizons: tuple[int, ...] = ()
 
 
 def _solver(rlimit: int, ctx: z3.Context) -> z3.Solver:
@@ -168,6 +173,7 @@ def synthesize(
     checks = 0
     lower = sum(1 for e in events if e.kind != "return")  # each such event takes a step
     grow: IncrementalUnrolling | None = None
+    unsat: list[int] = []
     for K in range(lower, max_horizon + 1):
         if incremental:  # one solver; the horizon grows under the assumption ``end``
             if grow is None:
@@ -188,6 +194,7 @@ def synthesize(
         if verdict == z3.unknown:
             raise RuntimeError(f"Z3 gave up at K={K} for {robot} ({s.reason_unknown()}); raise rlimit")
         if verdict != z3.sat:
+            unsat.append(K)
             continue
         model = s.model()
         if request_codes(p):
@@ -204,7 +211,16 @@ def synthesize(
                 best = model.eval(count, model_completion=True).as_long()
                 s.pop()
         plan, asked = _plan(p, u, model)
-        return Synthesis(robot, True, plan, K, asked, solve_s=time.perf_counter() - t0, checks=checks)
+        return Synthesis(
+            robot,
+            True,
+            plan,
+            K,
+            asked,
+            solve_s=time.perf_counter() - t0,
+            checks=checks,
+            unsat_horizons=tuple(unsat),
+        )
     reason, blocking = _explain(p, events, max_horizon, rlimit)
     return Synthesis(
         robot,
@@ -215,6 +231,7 @@ def synthesize(
         blocking=blocking,
         solve_s=time.perf_counter() - t0,
         checks=checks,
+        unsat_horizons=tuple(unsat),
     )
 
 
@@ -239,7 +256,9 @@ def _explain(p: RobotProblem, events: tuple[Event, ...], K: int, rlimit: int) ->
     if s.check() == z3.unsat:
         core = [names[str(c)] for c in s.unsat_core()]
         # obstacles only: the primitives' own effects and the mission are in every core
-        blocking = tuple(n for n in core if n.startswith(("wall", "object")) or " dropped clear of " in n)
+        blocking = tuple(
+            n for n in core if n.startswith(("wall", "object", "gripper")) or " dropped clear of " in n
+        )
     what = ", ".join(blocking) if blocking else "the primitives' constraints"
     return (
         f"{p.robot} cannot reach {events[i - 1].name} (event {i} of its mission) within {K} steps; "
