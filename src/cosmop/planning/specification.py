@@ -20,6 +20,10 @@ before it (GoTo, and requests for objects the robot neither carries, places nor 
 This is the paper's encoding with its typo fixed (pick ends with PickUp, not DropOff), and it
 ends the trace at the last event.
 
+The paper's :math:`\\phi_{carry}` (an object's position changes only when it is dropped) is
+part of every primitive's frame condition: GoTo, PickUp, Req and Res keep every position,
+and DropOff moves only the object it drops.
+
 The specification is a list of *named parts* (the initial state, each primitive, each wall
 and object constraint of GoTo and DropOff, the mission), so an unsat core names what blocks a
 mission.
