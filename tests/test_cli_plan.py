@@ -57,3 +57,14 @@ def test_bad_input_exits_2_and_writes_nothing(tmp_path):
     assert result.exit_code == 2
     assert "size" in result.stderr and "Traceback" not in result.output
     assert not out.exists()
+
+
+def test_png_without_matplotlib_is_a_clear_error(tmp_path, monkeypatch):
+    import cosmop.viz
+
+    monkeypatch.setattr(cosmop.viz, "available", lambda: False)
+    out = tmp_path / "plan.json"
+    result = runner.invoke(app, ["plan", str(TASKS_FILE), "-o", str(out), "--png", str(tmp_path / "p.png")])
+    assert result.exit_code == 2
+    assert "matplotlib" in result.stderr and "Traceback" not in result.output
+    assert not out.exists()

@@ -273,6 +273,12 @@ def plan(
     from cosmop.planning.team import plan_robots
 
     loaded = _load(scenario)
+    if png is not None:
+        from cosmop.viz import available
+
+        if not available():  # say so before any work is done or anything is written
+            typer.echo("error: --png needs matplotlib: pip install 'cosmop[viz]'", err=True)
+            raise typer.Exit(EXIT_INPUT_ERROR)
     err = Console(file=sys.stderr, highlight=False)
     with Progress(
         TextColumn("planning"),

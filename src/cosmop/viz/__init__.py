@@ -1,5 +1,5 @@
 """Plots of scenes and plans (matplotlib, the optional ``viz`` extra)."""
 
-from cosmop.viz.plans import draw_plan, save_plan_png
+from cosmop.viz.plans import available, draw_plan, save_plan_png
 
-__all__ = ["draw_plan", "save_plan_png"]
+__all__ = ["available", "draw_plan", "save_plan_png"]

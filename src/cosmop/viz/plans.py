@@ -17,6 +17,13 @@ from cosmop.scenario import Scene
 _LABELS = {"PickUp": "P", "DropOff": "D", "Req": "?", "Res": "!"}
 
 
+def available() -> bool:
+    """Whether matplotlib can be imported (the ``viz`` extra is installed)."""
+    import importlib.util
+
+    return importlib.util.find_spec("matplotlib") is not None
+
+
 def _pyplot() -> Any:
     try:
         import matplotlib
