@@ -38,27 +38,14 @@ EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "01_warehouse_2x2" 
 SCENARIO = load_scenario(EXAMPLE)
 SCENE = SCENARIO.scene
 
-R1_MISSION = ["away(O2,R1,R2)", "pick(R1,O1)", "drop(R1,O1,W1)", "return(R1)"]
-R1_ACTIONS = [
-    ("Req", "O2"),
-    ("GoTo", (1750, -1000, 0)),  # the pick pose of O1: touches O1, would overlap O2 were it not away
-    ("PickUp", "O1"),
-    ("GoTo", (-1500, -200, 0)),  # below the gap between the left wall and the inner wall
-    ("GoTo", (-1500, 2000, 0)),  # up through the gap
-    ("DropOff", "O1"),  # O1 at (-1250, 2000), inside W1
-    ("GoTo", (-2000, -1000, 0)),  # home
-]
-R2_MISSION = ["pick(R2,O2)", "drop(R2,O2,W2)", "return(R2)"]
-R2_ACTIONS = [
-    ("GoTo", (1650, -1000, 0)),  # the pick pose of O2
-    ("PickUp", "O2"),
-    ("GoTo", (1230, 2000, 0)),  # right of the inner wall's end (1000, 0)
-    ("DropOff", "O2"),  # O2 at (1480, 2000), inside W2
-    ("GoTo", (1230, -2000, 0)),  # straight down: moving right would sweep over O2
-    ("GoTo", (-2000, -2000, 0)),  # home
-]
-R2_RES_MISSION = ["pick(R2,O2)", "away(O2,R1,R2)", "drop(R2,O2,W2)", "return(R2)"]
-R2_RES_ACTIONS = [*R2_ACTIONS[:2], ("Res", "O2"), *R2_ACTIONS[2:]]
+from handmade_plans import (  # noqa: E402 - the shared hand-made plans
+    R1_ACTIONS,
+    R1_MISSION,
+    R2_ACTIONS,
+    R2_MISSION,
+    R2_RES_ACTIONS,
+    R2_RES_MISSION,
+)
 
 
 def r1_plan(actions=R1_ACTIONS, mission=R1_MISSION) -> RobotPlan:

@@ -17,26 +17,9 @@ SCENE = load_scenario(EXAMPLE).scene
 
 runner = CliRunner()
 
-R1_MISSION = ["away(O2,R1,R2)", "pick(R1,O1)", "drop(R1,O1,W1)", "return(R1)"]
-R1_ACTIONS = [
-    ("Req", "O2"),
-    ("GoTo", (1750, -1000, 0)),
-    ("PickUp", "O1"),
-    ("GoTo", (-1500, -200, 0)),
-    ("GoTo", (-1500, 2000, 0)),
-    ("DropOff", "O1"),
-    ("GoTo", (-2000, -1000, 0)),
-]
-R2_MISSION = ["pick(R2,O2)", "away(O2,R1,R2)", "drop(R2,O2,W2)", "return(R2)"]
-R2_ACTIONS = [
-    ("GoTo", (1650, -1000, 0)),
-    ("PickUp", "O2"),
-    ("Res", "O2"),
-    ("GoTo", (1230, 2000, 0)),
-    ("DropOff", "O2"),
-    ("GoTo", (1230, -2000, 0)),
-    ("GoTo", (-2000, -2000, 0)),
-]
+from handmade_plans import R1_ACTIONS, R1_MISSION  # noqa: E402
+from handmade_plans import R2_RES_ACTIONS as R2_ACTIONS  # noqa: E402
+from handmade_plans import R2_RES_MISSION as R2_MISSION  # noqa: E402
 
 
 def write_plan(tmp_path: Path, r1_actions=R1_ACTIONS, name: str = "plan.json") -> Path:

@@ -7,6 +7,8 @@ import os
 import secrets
 from pathlib import Path
 
+from cosmop.errors import CosmopInputError
+
 __all__ = ["write_atomic"]
 
 
@@ -81,3 +83,36 @@ def _fsync_directory(directory: Path) -> None:
             os.fsync(fd)
     finally:
         os.close(fd)
+
+
+def read_text(path: str | os.PathLike[str], error: type[CosmopInputError], kind: str) -> str:
+    """Read a UTF-8 input file; every failure raises ``error`` naming the file.
+
+    Parameters
+    ----------
+    path : path-like
+    error : type of CosmopInputError
+        The error to raise (e.g. ``ScenarioError``), constructed as ``error(message, file=...)``.
+    kind : str
+        What the file should be (``"a scenario file"``), for the messages.
+
+    Returns
+    -------
+    str
+        The text, without a UTF-8 byte-order mark.
+    """
+    file = os.fspath(path)
+    try:
+        raw = Path(path).read_bytes()
+    except FileNotFoundError:
+        raise error("file not found", file=file) from None
+    except IsADirectoryError:
+        raise error(f"is a directory, expected {kind}", file=file) from None
+    except PermissionError:
+        raise error("permission denied: cannot read the file", file=file) from None
+    except OSError as err:
+        raise error(f"cannot read the file: {err.strerror or err}", file=file) from None
+    try:
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError as err:
+        raise error(f"expected UTF-8 text, found an invalid byte at offset {err.start}", file=file) from None

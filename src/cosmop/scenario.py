@@ -36,6 +36,7 @@ import yaml
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError
 
 from cosmop.errors import EventSyntaxError, ScenarioError
+from cosmop.io import read_text
 from cosmop.missions.events import ID_PATTERN, Event, parse_event
 
 __all__ = [
@@ -898,21 +899,6 @@ def load_scenario(path: str | os.PathLike[str]) -> Scenario:
         not a valid scenario; the error names the file, the field and what was expected.
     """
     file = os.fspath(path)
-    try:
-        raw = Path(path).read_bytes()
-    except FileNotFoundError:
-        raise ScenarioError("file not found", file=file) from None
-    except IsADirectoryError:
-        raise ScenarioError("is a directory, expected a scenario file", file=file) from None
-    except PermissionError:
-        raise ScenarioError("permission denied: cannot read the file", file=file) from None
-    except OSError as err:
-        raise ScenarioError(f"cannot read the file: {err.strerror or err}", file=file) from None
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError as err:
-        raise ScenarioError(
-            f"expected UTF-8 text, found an invalid byte at offset {err.start}", file=file
-        ) from None
+    text = read_text(path, ScenarioError, "a scenario file")
     data, marks = _load_yaml(text, file)
     return _Builder(data, file, marks).build(Path(path))

@@ -45,12 +45,11 @@ import os
 import re
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
-from pathlib import Path
 from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
 from cosmop.errors import CosmopInputError, EventSyntaxError
-from cosmop.io import write_atomic
+from cosmop.io import read_text, write_atomic
 from cosmop.missions.events import ID_PATTERN, Event, parse_event
 
 if TYPE_CHECKING:
@@ -601,22 +600,7 @@ def load_plan(path: str | os.PathLike[str]) -> PlanSet:
         have the shape of a plan file; the error names the file, the field and what was expected.
     """
     file = os.fspath(path)
-    try:
-        raw = Path(path).read_bytes()
-    except FileNotFoundError:
-        raise PlanError("file not found", file=file) from None
-    except IsADirectoryError:
-        raise PlanError("is a directory, expected a plan file", file=file) from None
-    except PermissionError:
-        raise PlanError("permission denied: cannot read the file", file=file) from None
-    except OSError as err:
-        raise PlanError(f"cannot read the file: {err.strerror or err}", file=file) from None
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError as err:
-        raise PlanError(
-            f"expected UTF-8 text, found an invalid byte at offset {err.start}", file=file
-        ) from None
+    text = read_text(path, PlanError, "a plan file")
     if not text.strip():
         raise PlanError("the file is empty; expected a cosmop.plan/1 JSON object", file=file)
     try:
