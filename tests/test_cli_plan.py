@@ -23,10 +23,15 @@ def test_plan_writes_a_checked_plan_and_a_png(tmp_path):
     result = runner.invoke(app, ["plan", str(TASKS_FILE), "-o", str(out), "--png", str(png)])
     assert result.exit_code == 0, result.output
     plans = load_plan(out)
-    assert plans.feasible and plans.robots["R1"].horizon == 7 and plans.robots["R2"].horizon == 6
+    # the paper's Example 1 after coordination: R1 7 steps with Req(O2), R2 7 with Res(O2)
+    assert plans.feasible and plans.robots["R1"].horizon == 7 and plans.robots["R2"].horizon == 7
+    assert [(c.object, c.requester, c.responder) for c in plans.coordination] == [("O2", "R1", "R2")]
+    assert plans.robots["R1"].mission[0] == "away(O2,R1,R2)"
+    assert plans.robots["R2"].mission[:2] == ("pick(R2,O2)", "away(O2,R1,R2)")
+    assert "Res(O2)" in [s.label for s in plans.robots["R2"].steps]
     assert check_plan(load_scenario(TASKS_FILE), plans).ok
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    assert "R1" in result.stdout and "O2" in result.stdout and "all valid" in result.stdout
+    assert "O2 to R1" in result.stdout and "deadlock-free" in result.stdout and "all valid" in result.stdout
 
 
 def test_infeasible_robot_exits_1_and_still_writes_the_file(tmp_path):

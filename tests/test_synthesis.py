@@ -138,3 +138,8 @@ def test_no_pick_through_a_wall():
     blocked = synthesize(walled.scene, "R1", walled.mission.tasks["R1"], max_horizon=8)
     assert not blocked.feasible
     assert any(name.startswith("gripper clear of wall 4") for name in blocked.blocking), blocked.blocking
+
+
+def test_a_robot_without_a_mission_gets_an_empty_plan(small):
+    res = synthesize(small.scene, "R2", [])
+    assert res.feasible and res.horizon == 0 and res.plan.steps == ()

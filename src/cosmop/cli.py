@@ -261,16 +261,18 @@ def plan(
     ] = None,
     max_horizon: Annotated[int, typer.Option(help="Longest plan tried per robot (steps).", min=0)] = 16,
 ) -> None:
-    """Plan each robot's shortest safe sequence of motion primitives (paper, Section IV).
+    """Plan, coordinate and verify the team (paper, Fig. "Overall framework").
 
-    Each robot is planned on its own; every plan is checked by the exact plan checker before
-    it is written.  The file is written even when a robot is infeasible (``"feasible": false``
-    and a reason naming the robot and the event).  Exit status 0 feasible, 1 infeasible, 2 bad
-    input.
+    Each robot's shortest safe sequence of motion primitives is synthesised; every request
+    (Req) becomes an ``away(O, requester, responder)`` pair placed so that the team cannot
+    deadlock; the robots whose missions changed are re-planned; the coordinated missions are
+    verified against the global mission, and every plan passes the exact checker before it is
+    written.  The file is written even when infeasible (``"feasible": false`` and a reason).
+    Exit status 0 feasible, 1 infeasible, 2 bad input.
     """
-    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+    from rich.progress import Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
 
-    from cosmop.planning.team import plan_robots
+    from cosmop.pipeline import plan_team
 
     loaded = _load(scenario)
     if png is not None:
@@ -281,18 +283,19 @@ def plan(
             raise typer.Exit(EXIT_INPUT_ERROR)
     err = Console(file=sys.stderr, highlight=False)
     with Progress(
-        TextColumn("planning"),
-        BarColumn(),
-        TextColumn("{task.completed}/{task.total} robots {task.description}"),
+        SpinnerColumn(),
+        TextColumn("{task.description}"),
         TimeElapsedColumn(),
         console=err,
         transient=True,
     ) as progress:
-        task = progress.add_task("", total=len(loaded.scene.robots))
-        result = plan_robots(
+        task = progress.add_task("planning", total=None)
+        result = plan_team(
             loaded,
             max_horizon=max_horizon,
-            on_robot=lambda robot, _: progress.update(task, advance=1, description=robot),
+            on_robot=lambda robot, res: progress.update(
+                task, description=f"planned {robot} ({res.horizon} steps)"
+            ),
         )
     result.plans.save(output)
     if png is not None:
@@ -301,21 +304,36 @@ def plan(
         save_plan_png(loaded.scene, result.plans, png)
     console = _stdout()
     table = Table(title=Text(f"plans for {loaded.name}"), header_style="bold")
-    for column in ("robot", "feasible", "horizon", "requests", "solve time"):
+    for column in ("robot", "feasible", "horizon", "requests", "responses", "solve time"):
         table.add_column(column)
     for robot, res in result.results.items():
+        answers = [c.object + " to " + c.requester for c in result.plans.coordination if c.responder == robot]
         table.add_row(
             robot,
             "yes" if res.feasible else Text("no", style="red"),
             str(res.horizon) if res.horizon is not None else "-",
             Text(", ".join(res.requests) or "-"),
+            Text(", ".join(answers) or "-"),
             f"{res.solve_s:.2f} s",
         )
     console.print(table)
-    verdict = f"{result.report.checked_steps} steps checked, all valid; written to {output}"
-    console.print(Text(verdict, style="green"))
-    if not result.plans.feasible:
-        console.print(Text(f"infeasible: {result.plans.reason}", style="red"))
+    if result.verification is not None:
+        v = result.verification
+        console.print(
+            Text(
+                f"coordination: {len(result.plans.coordination)} pair(s), deadlock-free; "
+                f"verification: {'holds' if v.holds else 'fails'} ({v.method})",
+                style="green" if v.holds else "red",
+            )
+        )
+    if result.plans.feasible:
+        console.print(
+            Text(
+                f"{result.report.checked_steps} steps checked, all valid; written to {output}", style="green"
+            )
+        )
+    else:
+        console.print(Text(f"infeasible: {result.plans.reason}; written to {output}", style="red"))
     raise typer.Exit(0 if result.plans.feasible else 1)
 
 

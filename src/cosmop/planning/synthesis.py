@@ -197,7 +197,7 @@ def synthesize(
             unsat.append(K)
             continue
         model = s.model()
-        if request_codes(p):
+        if K > 0 and request_codes(p):  # at K = 0 there is no step to count
             count = _count_requests(p, u)
             best = model.eval(count, model_completion=True).as_long()
             while best > 0:
