@@ -36,3 +36,10 @@ def test_a_blocking_object_nobody_picks_is_refused():
         "R1 needs O2 moved away" in result.plans.reason
         and "no robot's mission picks O2" in result.plans.reason
     )
+
+
+def test_worker_processes_do_not_change_the_result():
+    scenario = load_scenario(EXAMPLE)
+    one = plan_team(scenario, workers=1)
+    two = plan_team(scenario, workers=2)
+    assert one.plans.to_dict() == two.plans.to_dict()

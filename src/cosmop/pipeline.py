@@ -15,8 +15,11 @@ reason naming the object and who needed it; re-allocating the task of moving it 
 
 from __future__ import annotations
 
+import multiprocessing
+import os
 import time
 from collections.abc import Callable, Mapping
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from types import MappingProxyType
 
@@ -75,6 +78,7 @@ def plan_team(
     max_horizon: int = 16,
     rlimit: int = DEFAULT_RLIMIT,
     max_iterations: int = 5,
+    workers: int | None = None,
     on_robot: Callable[[str, Synthesis], None] | None = None,
 ) -> TeamResult:
     """Plan, coordinate and verify the whole team (see the module docstring).
@@ -86,6 +90,9 @@ def plan_team(
         Passed to :func:`cosmop.planning.synthesis.synthesize`.
     max_iterations : int
         Cap on coordinate/re-synthesize rounds.
+    workers : int, optional
+        Worker processes for the robots' syntheses (default: one per core, at most one per
+        robot; 1 plans in this process).  The result does not depend on it.
     on_robot : callable, optional
         Called after every synthesis (progress display).
 
@@ -99,16 +106,59 @@ def plan_team(
     base = local_sequences(scenario)
     phases["decompose"] = time.perf_counter() - t
 
-    def plan(robot: str, events: tuple[Event, ...]) -> Synthesis:
-        t0 = time.perf_counter()
-        res = synthesize(scenario.scene, robot, events, max_horizon=max_horizon, rlimit=rlimit)
-        phases["synthesize"] += time.perf_counter() - t0
-        if on_robot is not None:
-            on_robot(robot, res)
-        return res
+    n_workers = min(os.cpu_count() or 1, len(base)) if workers is None else max(1, workers)
+    pool = _pool(n_workers) if n_workers > 1 else None
 
+    def plan_all(jobs: dict[str, tuple[Event, ...]]) -> dict[str, Synthesis]:
+        t0 = time.perf_counter()
+        out: dict[str, Synthesis] = {}
+        if pool is None or len(jobs) < 2:
+            for robot, events in jobs.items():
+                out[robot] = _synthesize((scenario.scene, robot, events, max_horizon, rlimit))
+                if on_robot is not None:
+                    on_robot(robot, out[robot])
+        else:
+            futures = {
+                pool.submit(_synthesize, (scenario.scene, robot, events, max_horizon, rlimit)): robot
+                for robot, events in jobs.items()
+            }
+            for future in as_completed(futures):
+                out[futures[future]] = future.result()
+                if on_robot is not None:
+                    on_robot(futures[future], out[futures[future]])
+        phases["synthesize"] += time.perf_counter() - t0
+        return {robot: out[robot] for robot in jobs}  # team order, whatever finished first
+
+    try:
+        return _loop(scenario, base, plan_all, phases, max_iterations)
+    finally:
+        if pool is not None:
+            pool.shutdown()
+
+
+def _synthesize(job: tuple) -> Synthesis:
+    """One robot's synthesis (module level, so worker processes can run it)."""
+    scene, robot, events, max_horizon, rlimit = job
+    return synthesize(scene, robot, events, max_horizon=max_horizon, rlimit=rlimit)
+
+
+def _pool(workers: int) -> ProcessPoolExecutor:
+    """Worker processes (forked where the platform allows: no re-import of the package)."""
+    methods = multiprocessing.get_all_start_methods()
+    context = multiprocessing.get_context("fork" if "fork" in methods else "spawn")
+    return ProcessPoolExecutor(max_workers=workers, mp_context=context)
+
+
+def _loop(
+    scenario: Scenario,
+    base: dict[str, tuple[Event, ...]],
+    plan_all: Callable[[dict[str, tuple[Event, ...]]], dict[str, Synthesis]],
+    phases: dict[str, float],
+    max_iterations: int,
+) -> TeamResult:
+    """Coordinate, re-plan, verify and check (steps 3-6 of the module docstring)."""
     current = dict(base)
-    results = {robot: plan(robot, events) for robot, events in base.items()}
+    results = plan_all(dict(base))
     requests: dict[str, list[tuple[str, int]]] = {r: [] for r in base}
     coordinated: Coordinated | None = None
     reasons: list[str] = []
@@ -147,10 +197,9 @@ def plan_team(
             )
         if reasons:
             break
-        for robot, events in coordinated.sequences.items():
-            if events != current[robot]:
-                current[robot] = events
-                results[robot] = plan(robot, events)
+        changed = {r: events for r, events in coordinated.sequences.items() if events != current[r]}
+        current.update(changed)
+        results.update(plan_all(changed))
     verification = None
     if not reasons:
         t0 = time.perf_counter()

@@ -35,6 +35,7 @@ from typing import Annotated, Any, Literal, NoReturn, Union, get_args, get_origi
 import yaml
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError
 
+from cosmop._frozen import reduce_frozen
 from cosmop.errors import EventSyntaxError, ScenarioError
 from cosmop.io import read_text
 from cosmop.missions.events import ID_PATTERN, Event, parse_event
@@ -196,6 +197,8 @@ class Scene:
         Workspaces by id.
     """
 
+    __reduce__ = reduce_frozen  # picklable for worker processes
+
     obstacles: tuple[Wall, ...]
     robots: Mapping[str, Robot]
     objects: Mapping[str, MovableObject] = field(default_factory=dict)
@@ -245,6 +248,8 @@ class Mission:
     dfa : DfaSpec, optional
         The global mission automaton.
     """
+
+    __reduce__ = reduce_frozen  # picklable for worker processes
 
     tasks: Mapping[str, tuple[Event, ...]] | None = None
     dfa: DfaSpec | None = None

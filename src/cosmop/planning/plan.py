@@ -48,6 +48,7 @@ from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
+from cosmop._frozen import reduce_frozen
 from cosmop.errors import CosmopInputError, EventSyntaxError
 from cosmop.io import read_text, write_atomic
 from cosmop.missions.events import ID_PATTERN, Event, parse_event
@@ -154,6 +155,8 @@ class State:
     objects : Mapping[str, ObjectState]
         Every object of the scene, by id (read-only).
     """
+
+    __reduce__ = reduce_frozen  # picklable for worker processes
 
     robot: Pose
     objects: Mapping[str, ObjectState]
@@ -308,6 +311,8 @@ class Step:
     ValueError
         If the primitive is unknown, or `object` is missing (or given, for ``GoTo``).
     """
+
+    __reduce__ = reduce_frozen  # picklable for worker processes
 
     primitive: str
     object: str | None
@@ -500,6 +505,8 @@ class PlanSet:
     ValueError
         If `feasible` is false and no `reason` is given.
     """
+
+    __reduce__ = reduce_frozen  # picklable for worker processes
 
     scenario: str
     feasible: bool
