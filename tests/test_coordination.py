@@ -86,6 +86,11 @@ def test_ten_by_ten_coordination_structure_is_the_papers(ten):
     # R3 answers both of its requesters, each with its own event, right after picking O3
     r3 = [e.name for e in result.sequences["R3"]]
     assert r3[0] == "pick(R3,O3)" and set(r3[1:3]) == {"away(O3,R1,R3)", "away(O3,R2,R3)"}
+    # a responder that others wait on is answered first: when R1 waits for R2 (O2) before R3,
+    # R3 must answer R2 before R1 (the order of the paper's figures)
+    r1 = [e.name for e in result.sequences["R1"]]
+    if r1.index("away(O2,R1,R2)") < r1.index("away(O3,R1,R3)"):
+        assert r3[1:3] == ["away(O3,R2,R3)", "away(O3,R1,R3)"]
 
 
 def test_ten_by_ten_coordinated_plans_are_checked_and_verified(ten):
