@@ -29,7 +29,7 @@ from cosmop.automata import DFA
 from cosmop.errors import CosmopInputError, EventSyntaxError
 from cosmop.io import write_atomic
 from cosmop.missions.decomposition import decompose as run_decompose
-from cosmop.missions.mission import GlobalMission
+from cosmop.missions.mission import GlobalMission, sequence_of
 from cosmop.missions.verification import verify as run_verify
 from cosmop.planning.checker import check_plan
 from cosmop.planning.plan import load_plan
@@ -119,17 +119,10 @@ class Method(StrEnum):
 
 def _sequence_text(dfa: DFA) -> str:
     """A local mission as ``a -> b -> c`` when it is one sequence, else its size."""
-    rows = dfa.delta
-    q, seq = dfa.initial, []
-    while len(seq) <= dfa.n_states:
-        out = [j for j in range(dfa.n_events) if rows[q, j] >= 0]
-        if not out:
-            return " -> ".join(seq) if seq else "(no events)"
-        if len(out) > 1:
-            break
-        seq.append(dfa.alphabet[out[0]])
-        q = int(rows[q, out[0]])
-    return f"{dfa.n_states} states, {dfa.n_transitions} transitions"
+    seq = sequence_of(dfa)
+    if seq is None:
+        return f"{dfa.n_states} states, {dfa.n_transitions} transitions"
+    return " -> ".join(seq) if seq else "(no events)"
 
 
 @app.command()

@@ -29,6 +29,7 @@ from cosmop.automata import DFA, parallel
 from cosmop.automata.composition import _clusters, shortest_word
 from cosmop.automata.operations import coaccessible_mask
 from cosmop.missions.events import Event
+from cosmop.missions.mission import sequence_automaton
 
 
 @dataclass(frozen=True)
@@ -95,18 +96,6 @@ def requests_by_phase(
     return out
 
 
-def _sequence_dfa(events: Sequence[Event]) -> DFA:
-    """The sequence as a DFA marked only when complete (so blocking is visible)."""
-    names = [e.name for e in events]
-    n = len(names)
-    return DFA.from_transitions(
-        "s0",
-        [(f"s{k}", e, f"s{k + 1}") for k, e in enumerate(names)],
-        marked=[f"s{n}"],
-        states=[f"s{k}" for k in range(n + 1)],
-    )
-
-
 def blocking_word(sequences: Mapping[str, Sequence[Event]]) -> tuple[str, ...] | None:
     """A shortest word into a deadlock, or ``None`` when the robots can always all complete.
 
@@ -116,7 +105,7 @@ def blocking_word(sequences: Mapping[str, Sequence[Event]]) -> tuple[str, ...] |
     different clusters cannot block each other.
     """
     robots = list(sequences)
-    dfas = [_sequence_dfa(sequences[r]) for r in robots]
+    dfas = [sequence_automaton([e.name for e in sequences[r]], closed=False) for r in robots]
     for members in _clusters(dfas):
         if len(members) == 1:
             continue

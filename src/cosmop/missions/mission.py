@@ -21,16 +21,33 @@ from cosmop.missions.events import Event, parse_event
 from cosmop.scenario import Mission, Scenario
 
 
-def sequence_automaton(events: Sequence[str]) -> DFA:
-    """Prefix-closed DFA of one sequence of events: states ``s0 .. sk``, all marked.
+def sequence_automaton(events: Sequence[str], *, closed: bool = True) -> DFA:
+    """DFA of one sequence of events :math:`\\sigma_1 \\sigma_2 \\cdots \\sigma_k`.
 
-    Its marked language is :math:`\\overline{\\sigma_1 \\sigma_2 \\cdots \\sigma_k}`.
+    With ``closed=True`` (a mission) every state is marked, so the marked language is the
+    prefix-closure :math:`\\overline{\\sigma_1 \\cdots \\sigma_k}`; with ``closed=False`` only
+    the complete sequence is marked (used to see whether robots can all finish).
     """
-    return DFA.from_transitions(
-        "s0",
-        [(f"s{k}", event, f"s{k + 1}") for k, event in enumerate(events)],
-        states=[f"s{k}" for k in range(len(events) + 1)],
-    )
+    return DFA.from_word(tuple(events), closed=closed)
+
+
+def sequence_of(dfa: DFA) -> tuple[str, ...] | None:
+    """The events of a linear DFA (one path, no branching, no cycle), or ``None``.
+
+    The inverse of :func:`sequence_automaton`: a local mission that is one sequence of events.
+    """
+    q, seq, seen = dfa.initial, [], {dfa.initial}
+    while True:
+        out = [j for j in range(dfa.n_events) if dfa.delta[q, j] >= 0]
+        if not out:
+            return tuple(seq)
+        if len(out) > 1:
+            return None
+        seq.append(dfa.alphabet[out[0]])
+        q = int(dfa.delta[q, out[0]])
+        if q in seen:
+            return None
+        seen.add(q)
 
 
 def local_alphabets(events: Iterable[Event], robots: Iterable[str]) -> dict[str, tuple[str, ...]]:

@@ -7,28 +7,11 @@ team is planned, coordinated and checked by :func:`cosmop.pipeline.plan_team`.
 
 from __future__ import annotations
 
-from cosmop.automata import DFA
 from cosmop.errors import ScenarioError
 from cosmop.missions.decomposition import decompose
 from cosmop.missions.events import Event
-from cosmop.missions.mission import GlobalMission
+from cosmop.missions.mission import GlobalMission, sequence_of
 from cosmop.scenario import Scenario
-
-
-def sequence_of(dfa: DFA) -> tuple[str, ...] | None:
-    """The events of a linear DFA (one path, no branching), or ``None``."""
-    q, seq, seen = dfa.initial, [], {dfa.initial}
-    while True:
-        out = [j for j in range(dfa.n_events) if dfa.delta[q, j] >= 0]
-        if not out:
-            return tuple(seq)
-        if len(out) > 1:
-            return None
-        seq.append(dfa.alphabet[out[0]])
-        q = int(dfa.delta[q, out[0]])
-        if q in seen:
-            return None
-        seen.add(q)
 
 
 def local_sequences(scenario: Scenario) -> dict[str, tuple[Event, ...]]:
