@@ -85,7 +85,7 @@ class Composition:
         return project_composition(self.components, events, log=log)
 
 
-def _clusters(components: Sequence[DFA]) -> list[list[int]]:
+def clusters(components: Sequence[DFA]) -> list[list[int]]:
     """Groups of components connected by shared events (union-find), in index order."""
     parent = list(range(len(components)))
 
@@ -149,7 +149,7 @@ def project_composition(
     target = set(events)
     observe = log.observe if log else (lambda d: d)
     parts: list[DFA] = []
-    for members in _clusters(components):
+    for members in clusters(components):
         touches = any(target & set(components[i].alphabet) for i in members)
         if not touches and all(components[i].marked[components[i].initial] for i in members):
             continue  # contributes {ε}: the empty word is in every factor, so the cluster is not empty
@@ -201,7 +201,7 @@ def lift_word(
     if not set(word) <= known:
         return None
     pinned = DFA.from_word(tuple(word), known, closed=False)
-    groups = _clusters([pinned, *components])
+    groups = clusters([pinned, *components])
     head: tuple[str, ...] = ()
     tail: list[str] = []
     for members in groups:

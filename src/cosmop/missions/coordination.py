@@ -26,7 +26,7 @@ from dataclasses import dataclass
 from types import MappingProxyType
 
 from cosmop.automata import DFA, parallel
-from cosmop.automata.composition import _clusters, shortest_word
+from cosmop.automata.composition import clusters, shortest_word
 from cosmop.automata.operations import coaccessible_mask
 from cosmop.missions.events import Event
 from cosmop.missions.mission import sequence_automaton
@@ -106,7 +106,7 @@ def blocking_word(sequences: Mapping[str, Sequence[Event]]) -> tuple[str, ...] |
     """
     robots = list(sequences)
     dfas = [sequence_automaton([e.name for e in sequences[r]], closed=False) for r in robots]
-    for members in _clusters(dfas):
+    for members in clusters(dfas):
         if len(members) == 1:
             continue
         product = parallel(*(dfas[i] for i in members))

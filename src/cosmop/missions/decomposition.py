@@ -57,23 +57,34 @@ def project_locally(
     }
 
 
+def factor_counterexample(modules: list[DFA], factor: DFA, log: SizeLog | None = None) -> Word | None:
+    """A word of :math:`\\|_i M_i` whose projection onto :math:`\\Sigma(T)` is not in ``factor``.
+
+    :math:`u \\in P_{\\Sigma(T)}(\\|_i M_i) \\setminus T` is a shortest violation of the factor
+    (the projection is computed compositionally), lifted to a word of the product that
+    projects onto it; ``None`` when the factor holds.
+    """
+    view = project_composition(modules, factor.alphabet, log=log)
+    u = inclusion_counterexample(view, factor)
+    if u is None:
+        return None
+    word = lift_word(modules, u, factor.alphabet)
+    if word is None:  # cannot happen: u is a word of the projection
+        raise AssertionError("counterexample does not lift to the product")
+    return word
+
+
 def separability_counterexample(
     mission: Composition, local: Mapping[str, DFA], log: SizeLog | None = None
 ) -> Word | None:
     """A word of :math:`\\|_i K^i` outside :math:`K`, or ``None`` when :math:`\\|_i K^i \\subseteq K`.
 
-    Factor by factor: :math:`u \\in P_{\\Sigma(T_j)}(\\|_i K^i) \\setminus T_j` is a shortest
-    violation of factor ``j`` (the first violated factor in order), lifted to a word of the
-    product :math:`\\|_i K^i` that projects onto it.
+    Factor by factor (:func:`factor_counterexample`); the first violated factor gives the word.
     """
     modules = list(local.values())
     for factor in mission.components:
-        view = project_composition(modules, factor.alphabet, log=log)
-        u = inclusion_counterexample(view, factor)
-        if u is not None:
-            word = lift_word(modules, u, factor.alphabet)
-            if word is None:  # cannot happen: u is a word of the projection
-                raise AssertionError("counterexample does not lift to the product")
+        word = factor_counterexample(modules, factor, log)
+        if word is not None:
             return word
     return None
 

@@ -53,7 +53,8 @@ from cosmop.automata import (
     project_composition,
     satisfaction_counterexample,
 )
-from cosmop.automata.composition import SizeLog, lift_word
+from cosmop.automata.composition import SizeLog, clusters, lift_word
+from cosmop.missions.decomposition import factor_counterexample
 from cosmop.missions.mission import GlobalMission
 
 Word = tuple[str, ...]
@@ -352,18 +353,15 @@ def _learn_assumption(
     return holds, teacher.last, None, sul.num_queries + counts["membership"], counts["equivalence"]
 
 
-def _cluster(start: set[str], alphabets: Mapping[str, set[str]]) -> list[str]:
-    """Robots reachable from ``start`` through shared events, in team order."""
-    members = set(start)
-    changed = True
-    while changed:
-        changed = False
-        events = set().union(*(alphabets[r] for r in members)) if members else set()
-        for robot, sigma in alphabets.items():
-            if robot not in members and sigma & events:
-                members.add(robot)
-                changed = True
-    return [r for r in alphabets if r in members]
+def _cluster(start: set[str], local: Mapping[str, DFA]) -> list[str]:
+    """Robots linked to ``start`` through shared events (directly or not), in team order."""
+    robots = list(local)
+    members: set[str] = set()
+    for group in clusters(list(local.values())):
+        names = {robots[i] for i in group}
+        if names & start:
+            members |= names
+    return [r for r in robots if r in members]
 
 
 def verify(
@@ -407,7 +405,7 @@ def verify(
         sigma = set(factor.alphabet)
         # the guarantor is the robot owning most of the factor's events (team order breaks ties)
         owners = sorted((r for r in local if alphabets[r] & sigma), key=lambda r: -len(alphabets[r] & sigma))
-        cluster = _cluster(set(owners), alphabets)
+        cluster = _cluster(set(owners), local)
         modules = [local[r] for r in cluster]
         environment_robots = [r for r in cluster if owners and r != owners[0]]
         interface: tuple[str, ...] = ()
@@ -444,11 +442,10 @@ def verify(
             if violation is not None:
                 counterexample = lift_word(modules, violation, alphabets[owners[0]] | set(interface))
         if holds is None:  # direct check: by method, or because L* stopped at its round cap
-            view = project_composition(modules, factor.alphabet, log=log)
-            u = inclusion_counterexample(view, factor)
-            holds = u is None
-            if u is not None:
-                counterexample = lift_word(modules, u, factor.alphabet)
+            word = factor_counterexample(modules, factor, log)
+            holds = word is None
+            if word is not None:
+                counterexample = word
             method_used = "direct" if not use_ag else "direct (L* round cap)"
         else:
             method_used = "assume-guarantee"
