@@ -475,9 +475,9 @@ RULES: list[tuple[str, Callable[[dict[str, Any]], object], str, tuple[str, ...]]
     ("missing mission", lambda d: d.pop("mission"), "mission", ("missing required key 'mission'",)),
     (
         "unknown scene key",
-        lambda d: d["scene"].__setitem__("humans", []),
-        "scene.humans",
-        ("unknown key 'humans'", "robots"),
+        lambda d: d["scene"].__setitem__("lights", []),
+        "scene.lights",
+        ("unknown key 'lights'", "robots"),
     ),
     ("no robots", lambda d: d["scene"].__setitem__("robots", {}), "scene.robots", ("non-empty mapping",)),
     (

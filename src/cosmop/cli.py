@@ -330,6 +330,131 @@ def plan(
     raise typer.Exit(0 if result.plans.feasible else 1)
 
 
+@app.command()
+def simulate(
+    scenario: ScenarioArgument,
+    plan_file: Annotated[
+        Path | None,
+        typer.Option(
+            "--plan",
+            help="Plan file to execute (cosmop.plan/1); planned first if absent.",
+            show_default=False,
+        ),
+    ] = None,
+    seed: Annotated[int, typer.Option(help="Seed of the people's random walks.")] = 0,
+    summary: Annotated[
+        Path | None, typer.Option(help="Write the summary (cosmop.sim/1 JSON) here.", show_default=False)
+    ] = None,
+    trace: Annotated[
+        Path | None,
+        typer.Option(help="Write the trace, every cycle (cosmop.trace/1 JSON).", show_default=False),
+    ] = None,
+    gif: Annotated[Path | None, typer.Option(help="Write an animation (GIF).", show_default=False)] = None,
+    mp4: Annotated[Path | None, typer.Option(help="Write an animation (MP4).", show_default=False)] = None,
+    max_time: Annotated[float, typer.Option(help="Simulated seconds before giving up.", min=1.0)] = 900.0,
+    replan: Annotated[bool, typer.Option(help="Stalled robots replan their remaining mission.")] = True,
+) -> None:
+    """Execute the plans: passive-safe DWA, docking, messages, people walking through.
+
+    Every cycle each robot drives (GoTo), docks (PickUp, DropOff), waits for an answer (Req) or
+    sends one (Res); a monitor records every contact and whether the robot was moving then.
+    Exit status 0 when every robot finished with no contact while moving, 1 otherwise, 2 on bad
+    input.
+    """
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+    from cosmop.planning.plan import PlanSet
+    from cosmop.sim import SimSettings
+    from cosmop.sim import simulate as run_simulate
+
+    loaded = _load(scenario)
+    for path, check_video in ((gif, False), (mp4, True)):
+        if path is None:
+            continue
+        from cosmop.viz import available, video_available
+
+        if not available() or (check_video and not video_available()):  # before any work
+            extra = "video" if check_video else "viz"
+            typer.echo(f"error: --{path.suffix[1:]} needs pip install 'cosmop[{extra}]'", err=True)
+            raise typer.Exit(EXIT_INPUT_ERROR)
+    err = Console(file=sys.stderr, highlight=False)
+    if plan_file is not None:
+        plans: PlanSet = load_plan(plan_file)
+        report = check_plan(loaded, plans)
+        if not plans.feasible or not report.ok:
+            why = plans.reason if not plans.feasible else report.violations[0].message
+            typer.echo(
+                f"error: {plan_file}: expected a feasible plan valid for {loaded.name}: {why}", err=True
+            )
+            raise typer.Exit(EXIT_INPUT_ERROR)
+    else:
+        from cosmop.pipeline import plan_team
+
+        with Progress(TextColumn("planning"), TimeElapsedColumn(), console=err, transient=True) as progress:
+            progress.add_task("planning", total=None)
+            plans = plan_team(loaded).plans
+        if not plans.feasible:
+            _stdout().print(Text(f"infeasible: {plans.reason}", style="red"))
+            raise typer.Exit(1)
+    settings = SimSettings(max_time=max_time, replan=replan)
+    with Progress(
+        TextColumn("simulating"),
+        BarColumn(),
+        TextColumn("{task.fields[done]}/{task.fields[robots]} robots done, t = {task.completed:.0f} s"),
+        TimeElapsedColumn(),
+        console=err,
+        transient=True,
+    ) as progress:
+        task = progress.add_task("simulating", total=max_time, done=0, robots=len(loaded.scene.robots))
+        result = run_simulate(
+            loaded,
+            plans,
+            seed=seed,
+            settings=settings,
+            on_cycle=lambda t, done, robots: progress.update(task, completed=t, done=done),
+        )
+    if summary is not None:
+        result.save_summary(summary)
+    if trace is not None:
+        result.save_trace(trace)
+    for path in (gif, mp4):
+        if path is not None:
+            from cosmop.viz import save_animation
+
+            with Progress(
+                TextColumn(f"drawing {path.name}"), TimeElapsedColumn(), console=err, transient=True
+            ) as p:
+                p.add_task("drawing", total=None)
+                save_animation(loaded.scene, result.trace(), path, plans=plans)
+    console = _stdout()
+    table = Table(title=Text(f"simulation of {loaded.name} (seed {seed})"), header_style="bold")
+    for column in ("robot", "pose [mm, deg]", "distance", "finished"):
+        table.add_column(column)
+    finished = result.finished
+    for rid, (pose, dist) in result.robots.items():
+        table.add_row(
+            rid,
+            f"{pose[0]:.0f}, {pose[1]:.0f}, {pose[2]:.0f}",
+            f"{dist / 1000:.1f} m",
+            "yes" if finished[rid] else Text("no", style="red"),
+        )
+    console.print(table)
+    delivered = result.objects_in_workspaces(loaded, plans)
+    ok = result.completed and result.contacts_while_moving == 0
+    speed = result.sim_time_s / max(result.wall_time_s, 1e-9)
+    console.print(
+        Text(
+            f"{'completed' if result.completed else 'not completed'} in {result.sim_time_s:.1f} s simulated "
+            f"({result.wall_time_s:.1f} s, {speed:.0f}x real time); "
+            f"objects in place {sum(delivered.values())}/{len(delivered)}; contacts {len(result.contacts)}, "
+            f"while moving {result.contacts_while_moving}; messages {len(result.messages)}; "
+            f"replans {result.replans}",
+            style="green" if ok else "red",
+        )
+    )
+    raise typer.Exit(0 if ok else 1)
+
+
 def _summary_table(scenario: Scenario) -> Table:
     """A table with one row per part of the scenario."""
     scene, mission = scenario.scene, scenario.mission

@@ -1,19 +1,30 @@
-"""Scenarios: the scene (walls, robots, movable objects, workspaces) and the mission.
+"""Scenarios: the scene (walls, robots, movable objects, workspaces, people) and the mission.
 
 A scenario file (format version 1) is YAML::
 
     name: warehouse-2x2
     scene:
       obstacles: [[[-2500, -2500], [2500, -2500]], ...]   # wall segments [[x1, y1], [x2, y2]]
+      dynamics:   {max_speed: 750, acceleration: 300, braking: 500, turn_rate: 100, cycle: 0.1}
       robots:     {R1: {size: 400, pose: [-2000, -1000, 0]}, ...}   # x, y, heading
       objects:    {O1: {size: 100, position: [2000, -1000]}, ...}
       workspaces: {W1: {x: [-1500, -1000], y: [2000, 2500]}, W3: {point: [-4250, 4000]}}
+      humans:     {H1: {size: 400, speed: 600, path: [[0, -1500], [0, -2200, 5]]}, ...}
     mission:
       tasks: {R1: [pick O1, drop O1 at W1, return], ...}   # or: dfa: {initial, transitions, ...}
 
-Lengths are millimetres and angles degrees; robots and objects are axis-aligned squares of
-side ``size``. :func:`load_scenario` reads such a file and :func:`parse_scenario` validates
-an already-parsed mapping; both return an immutable :class:`Scenario` or raise
+Lengths are millimetres, angles degrees and times seconds; robots, objects and people are
+axis-aligned squares of side ``size``. The optional ``dynamics`` (any subset of its keys) are
+the unicycle limits of every robot; a robot may override them field by field with its own
+``dynamics`` key, e.g. ``R1: {size: 400, pose: [0, 0, 0], dynamics: {max_speed: 500}}``, but
+all robots share one control ``cycle``. The optional ``humans`` are people the robots do not
+control: each walks along its ``path`` of points ``[x, y]`` or ``[x, y, dwell]`` (standing
+``dwell`` seconds on arriving there) and repeats it, unless ``loop: false``; a person given a
+``walk: {x: [lo, hi], y: [lo, hi]}`` area roams there at random once its path ends (at once,
+if the path is only its start point).
+
+:func:`load_scenario` reads such a file and :func:`parse_scenario` validates an already-parsed
+mapping; both return an immutable :class:`Scenario` or raise
 :class:`~cosmop.errors.ScenarioError` naming the file, the field and what was expected.
 
 The YAML dialect is close to YAML 1.2's core schema: only ``true``/``false`` are booleans
@@ -26,14 +37,15 @@ from __future__ import annotations
 import math
 import os
 import re
+from collections import Counter
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from types import MappingProxyType, NoneType, UnionType
 from typing import Annotated, Any, Literal, NoReturn, Union, get_args, get_origin
 
 import yaml
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError, field_validator
 
 from cosmop._frozen import reduce_frozen
 from cosmop.errors import EventSyntaxError, ScenarioError
@@ -43,6 +55,8 @@ from cosmop.missions.events import ID_PATTERN, Event, parse_event
 __all__ = [
     "SCENARIO_VERSION",
     "DfaSpec",
+    "Dynamics",
+    "Human",
     "Mission",
     "MovableObject",
     "Robot",
@@ -65,6 +79,53 @@ Point = tuple[float, float]
 
 
 @dataclass(frozen=True)
+class Dynamics:
+    """The unicycle limits of a robot, as used by the simulator and its safety check.
+
+    These are the parameters of the passive-safety condition (the paper's corollary, after
+    Mitsch et al.): a robot that brakes at `braking` as soon as it must can always stop before
+    reaching anything that moves at most a known speed, given that within one control `cycle`
+    it may still accelerate at `acceleration`. The defaults are those of a Pioneer P3-DX-class
+    robot used indoors: its spec sheet tops out at 1.2 m/s, and these are moderate indoor
+    settings within those limits.
+
+    Parameters
+    ----------
+    max_speed : float, optional
+        Top translational speed, mm/s (> 0; default 750).
+    acceleration : float, optional
+        Translational acceleration ``A``, mm/s^2 (> 0; default 300).
+    braking : float, optional
+        Braking deceleration ``b``, mm/s^2 (> 0; default 500).
+    turn_rate : float, optional
+        Top turning rate ``Omega``, degrees/s (> 0; default 100).
+    cycle : float, optional
+        Control cycle ``epsilon``: the longest time between two control decisions, s
+        (> 0; default 0.1).
+
+    Raises
+    ------
+    ValueError
+        If a field is not a finite positive number.
+    """
+
+    max_speed: float = 750.0
+    acceleration: float = 300.0
+    braking: float = 500.0
+    turn_rate: float = 100.0
+    cycle: float = 0.1
+
+    def __post_init__(self) -> None:
+        for item in fields(self):
+            value = getattr(self, item.name)
+            if isinstance(value, bool) or not isinstance(value, int | float):
+                raise ValueError(f"dynamics: {item.name} must be a number, got {value!r}")
+            if not (math.isfinite(value) and value > 0):
+                raise ValueError(f"dynamics: {item.name} must be a finite positive number, got {value!r}")
+            object.__setattr__(self, item.name, float(value))
+
+
+@dataclass(frozen=True)
 class Robot:
     """A mobile robot: an axis-aligned square.
 
@@ -76,11 +137,16 @@ class Robot:
         Side of the square footprint, mm (> 0).
     pose : tuple of float
         Initial pose ``(x, y, heading)``: centre in mm, heading in degrees.
+    dynamics : Dynamics, optional
+        The robot's limits (speeds in mm/s, degrees/s; accelerations in mm/s^2; cycle in s);
+        by default :class:`Dynamics`' defaults. A loaded scenario gives every robot the
+        defaults, overridden by ``scene.dynamics``, overridden by the robot's own ``dynamics``.
     """
 
     id: str
     size: float
     pose: tuple[float, float, float]
+    dynamics: Dynamics = Dynamics()
 
 
 @dataclass(frozen=True)
@@ -161,6 +227,73 @@ class Workspace:
 
 
 @dataclass(frozen=True)
+class Human:
+    """A person: an uncontrolled mover, an axis-aligned square.
+
+    The person starts at the first point of `path` and walks straight from each point to the
+    next at `speed`, standing still ``dwell`` seconds on arriving at a point (for the first
+    point, also at the start). After the last point the person walks back to the first and
+    repeats the path if `loop`, or stays at the last point otherwise. If `walk` is given, a
+    person whose path ends (``loop`` false, or a path of only the start point) then roams
+    forever to random points of that rectangle, drawn by the simulation from its seed; with
+    `walk`, the path may be just the start point.
+
+    Parameters
+    ----------
+    id : str
+        The person's id, e.g. ``"H1"``.
+    size : float
+        Side of the square footprint, mm (> 0).
+    speed : float
+        Walking speed, mm/s (> 0): the most the person ever moves.
+    path : tuple of (float, float, float)
+        Waypoints ``(x, y, dwell)``: position in mm, dwell in seconds (>= 0). Points given as
+        ``(x, y)`` get dwell 0. At least two points unless `walk` is given.
+    loop : bool, optional
+        Whether to repeat the path (default true).
+    walk : tuple of (float, float), optional
+        The roaming area ``((xlo, xhi), (ylo, yhi))``, mm, with ``lo <= hi``.
+
+    Raises
+    ------
+    ValueError
+        If a size, speed, dwell or range is out of bounds, or the path is too short.
+    """
+
+    id: str
+    size: float
+    speed: float
+    path: tuple[tuple[float, float, float], ...]
+    loop: bool = True
+    walk: tuple[Point, Point] | None = None
+
+    def __post_init__(self) -> None:
+        if not (self.size > 0 and self.speed > 0):
+            raise ValueError(f"human {self.id}: size and speed must be positive")
+        if any(len(point) not in (2, 3) for point in self.path):
+            raise ValueError(f"human {self.id}: path points are (x, y) or (x, y, dwell)")
+        path = tuple(
+            (float(point[0]), float(point[1]), float(point[2]) if len(point) > 2 else 0.0)
+            for point in self.path
+        )
+        if any(dwell < 0 for _, _, dwell in path):
+            raise ValueError(f"human {self.id}: dwell times must be >= 0")
+        if len(path) < (1 if self.walk is not None else 2):
+            raise ValueError(f"human {self.id}: a path needs two points, or one point and a walk area")
+        object.__setattr__(self, "path", path)
+        if self.walk is not None:
+            (xlo, xhi), (ylo, yhi) = self.walk
+            if xlo > xhi or ylo > yhi:
+                raise ValueError(f"human {self.id}: walk ranges must be [lo, hi] with lo <= hi")
+            object.__setattr__(self, "walk", ((float(xlo), float(xhi)), (float(ylo), float(yhi))))
+
+    @property
+    def start(self) -> Point:
+        """Where the person starts: the first point of the path ``(x, y)``, mm."""
+        return self.path[0][:2]
+
+
+@dataclass(frozen=True)
 class Wall:
     """A wall: the straight segment from `start` to `end` (mm; the end points differ)."""
 
@@ -181,7 +314,7 @@ def _frozen_mapping(mapping: Mapping[str, Any]) -> Mapping[str, Any]:
 
 @dataclass(frozen=True)
 class Scene:
-    """The physical scene: walls, robots, movable objects and workspaces.
+    """The physical scene: walls, robots, movable objects, workspaces and people.
 
     The mappings are read-only and keep the order of the scenario file.
 
@@ -195,6 +328,11 @@ class Scene:
         Movable objects by id.
     workspaces : Mapping[str, Workspace]
         Workspaces by id.
+    humans : Mapping[str, Human]
+        People (uncontrolled movers) by id; by default none.
+    dynamics : Dynamics, optional
+        The scene-wide robot limits as given in the file (:class:`Dynamics`' defaults
+        overridden by ``scene.dynamics``); each robot's own are in ``Robot.dynamics``.
     """
 
     __reduce__ = reduce_frozen  # picklable for worker processes
@@ -203,10 +341,12 @@ class Scene:
     robots: Mapping[str, Robot]
     objects: Mapping[str, MovableObject] = field(default_factory=dict)
     workspaces: Mapping[str, Workspace] = field(default_factory=dict)
+    humans: Mapping[str, Human] = field(default_factory=dict)
+    dynamics: Dynamics = Dynamics()
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "obstacles", tuple(self.obstacles))
-        for name in ("robots", "objects", "workspaces"):
+        for name in ("robots", "objects", "workspaces", "humans"):
             object.__setattr__(self, name, _frozen_mapping(getattr(self, name)))
 
 
@@ -284,7 +424,7 @@ class Scenario:
     name : str
         The scenario's name.
     scene : Scene
-        Walls, robots, objects and workspaces.
+        Walls, robots, objects, workspaces and people.
     mission : Mission
         The global mission.
     source : pathlib.Path, optional
@@ -449,9 +589,31 @@ class _Model(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
 
 
+class _DynamicsModel(_Model):
+    """Any subset of the :class:`Dynamics` fields; an absent field is inherited."""
+
+    max_speed: _Positive | None = None
+    acceleration: _Positive | None = None
+    braking: _Positive | None = None
+    turn_rate: _Positive | None = None
+    cycle: _Positive | None = None
+
+    @field_validator("*", mode="before")
+    @classmethod
+    def _given_means_a_number(cls, value: Any) -> Any:
+        if value is None:  # "cycle: null" is a mistake, not "inherit"
+            raise ValueError("expected a number, got null")
+        return value
+
+    def overrides(self) -> dict[str, float]:
+        """The fields given, by name."""
+        return self.model_dump(exclude_none=True)
+
+
 class _RobotModel(_Model):
     size: _Positive
     pose: tuple[_Number, _Number, _Number]
+    dynamics: _DynamicsModel | None = None
 
 
 class _ObjectModel(_Model):
@@ -465,11 +627,26 @@ class _WorkspaceModel(_Model):
     point: _Pair | None = None
 
 
+class _AreaModel(_Model):
+    x: _Pair
+    y: _Pair
+
+
+class _HumanModel(_Model):
+    size: _Positive
+    speed: _Positive
+    path: Annotated[list[Annotated[list[_Number], Field(min_length=2, max_length=3)]], Field(min_length=1)]
+    loop: Annotated[bool, Field(strict=True)] = True
+    walk: _AreaModel | None = None
+
+
 class _SceneModel(_Model):
     obstacles: Annotated[list[tuple[_Pair, _Pair]], _none_to([])] = []
     robots: Annotated[dict[_Text, _RobotModel], Field(min_length=1)]
     objects: Annotated[dict[_Text, _ObjectModel], _none_to({})] = {}
     workspaces: Annotated[dict[_Text, _WorkspaceModel], _none_to({})] = {}
+    humans: Annotated[dict[_Text, _HumanModel], _none_to({})] = {}
+    dynamics: _DynamicsModel | None = None
 
 
 class _DfaModel(_Model):
@@ -494,6 +671,15 @@ class _ScenarioModel(_Model):
 _WALL = "a wall [[x1, y1], [x2, y2]]: two points of two numbers each (mm)"
 _RANGE = "a range [lo, hi] of two numbers with lo <= hi (mm)"
 _STATE = "a state name"
+_DYNAMICS = "a mapping with any of the keys max_speed, acceleration, braking, turn_rate, cycle"
+_DYNAMICS_FIELDS = {
+    "max_speed": "a positive number (top translational speed, mm/s)",
+    "acceleration": "a positive number (translational acceleration, mm/s^2)",
+    "braking": "a positive number (braking deceleration, mm/s^2)",
+    "turn_rate": "a positive number (top turning rate, degrees/s)",
+    "cycle": "a positive number (control cycle, s)",
+}
+_WAYPOINT = "a point [x, y] or [x, y, dwell]: two or three numbers (mm, mm, seconds)"
 # What is expected at a field; "*" stands for any id, "#" for any list index.
 _EXPECTED: dict[tuple[str, ...], str] = {
     ("version",): f"{SCENARIO_VERSION}, the scenario format version",
@@ -511,6 +697,19 @@ _EXPECTED: dict[tuple[str, ...], str] = {
     ("scene", "workspaces", "*", "x"): _RANGE,
     ("scene", "workspaces", "*", "y"): _RANGE,
     ("scene", "workspaces", "*", "point"): "a point [x, y]: two numbers (mm)",
+    ("scene", "humans"): "a mapping from human ids to {size, speed, path}",
+    ("scene", "humans", "*", "size"): "a positive number (side of the square person, mm)",
+    ("scene", "humans", "*", "speed"): "a positive number (walking speed, mm/s)",
+    ("scene", "humans", "*", "path"): f"a non-empty list of waypoints, each {_WAYPOINT}",
+    ("scene", "humans", "*", "path", "#"): _WAYPOINT,
+    ("scene", "humans", "*", "loop"): "true or false (whether to repeat the path)",
+    ("scene", "humans", "*", "walk"): "an area {x: [lo, hi], y: [lo, hi]} (mm) to roam in",
+    ("scene", "humans", "*", "walk", "x"): _RANGE,
+    ("scene", "humans", "*", "walk", "y"): _RANGE,
+    ("scene", "dynamics"): _DYNAMICS,
+    ("scene", "robots", "*", "dynamics"): _DYNAMICS,
+    **{("scene", "dynamics", key): text for key, text in _DYNAMICS_FIELDS.items()},
+    **{("scene", "robots", "*", "dynamics", key): text for key, text in _DYNAMICS_FIELDS.items()},
     ("mission",): "exactly one of tasks: {robot: [steps]} or dfa: {initial, transitions}",
     ("mission", "tasks"): "a mapping from robot ids to lists of task steps",
     ("mission", "tasks", "*"): "a list of task steps such as [pick O1, drop O1 at W1, return]",
@@ -696,8 +895,13 @@ class _Builder:
 
     def build_scene(self, model: _SceneModel) -> Scene:
         owner_of_id: dict[str, _Path] = {}
-        kinds = {"robots": "a robot", "objects": "an object", "workspaces": "a workspace"}
-        for group in ("robots", "objects", "workspaces"):
+        kinds = {
+            "robots": "a robot",
+            "objects": "an object",
+            "workspaces": "a workspace",
+            "humans": "a human",
+        }
+        for group in kinds:
             for ident in getattr(model, group):
                 path = ("scene", group, ident)
                 if not re.fullmatch(ID_PATTERN, ident):
@@ -707,7 +911,7 @@ class _Builder:
                     self.fail(
                         path,
                         f"id {ident!r} is already used by {kinds[other[1]]} ({_format_path(other)}); "
-                        "ids must be unique across robots, objects and workspaces",
+                        "ids must be unique across robots, objects, workspaces and humans",
                     )
                 owner_of_id[ident] = path
 
@@ -720,10 +924,73 @@ class _Builder:
                 )
             walls.append(Wall(start, end))
 
-        robots = {ident: Robot(ident, r.size, r.pose) for ident, r in model.robots.items()}
+        dynamics = Dynamics() if model.dynamics is None else replace(Dynamics(), **model.dynamics.overrides())
+        robots = {
+            ident: Robot(
+                ident,
+                r.size,
+                r.pose,
+                dynamics if r.dynamics is None else replace(dynamics, **r.dynamics.overrides()),
+            )
+            for ident, r in model.robots.items()
+        }
+        self.check_cycles(robots, dynamics)
         objects = {ident: MovableObject(ident, o.size, o.position) for ident, o in model.objects.items()}
         workspaces = {ident: self.build_workspace(ident, w) for ident, w in model.workspaces.items()}
-        return Scene(obstacles=tuple(walls), robots=robots, objects=objects, workspaces=workspaces)
+        humans = {ident: self.build_human(ident, h) for ident, h in model.humans.items()}
+        return Scene(
+            obstacles=tuple(walls),
+            robots=robots,
+            objects=objects,
+            workspaces=workspaces,
+            humans=humans,
+            dynamics=dynamics,
+        )
+
+    def check_cycles(self, robots: Mapping[str, Robot], default: Dynamics) -> None:
+        """All robots share one control cycle: report the first robot off the most common one."""
+        counts = Counter(robot.dynamics.cycle for robot in robots.values())
+        if len(counts) <= 1:
+            return
+        # the cycle most robots use; on a tie the scene-wide one, else the first in file order
+        common = max(counts, key=lambda cycle: (counts[cycle], cycle == default.cycle))
+        odd = next(robot for robot in robots.values() if robot.dynamics.cycle != common)
+        users = [robot.id for robot in robots.values() if robot.dynamics.cycle == common]
+        if len(users) == len(robots) - 1:
+            others = "the others use"
+        elif len(users) == 1:
+            others = f"{users[0]} uses"
+        else:
+            shown = ", ".join(users[:3]) + (f" and {len(users) - 3} more" if len(users) > 3 else "")
+            others = f"{shown} use"
+        self.fail(
+            ("scene", "robots", odd.id, "dynamics", "cycle"),
+            "every robot must share one control cycle (the simulation steps all robots with one "
+            f"clock); this robot's is {odd.dynamics.cycle:g} s, {others} {common:g} s",
+        )
+
+    def build_human(self, ident: str, model: _HumanModel) -> Human:
+        path = ("scene", "humans", ident)
+        for index, point in enumerate(model.path):
+            if len(point) == 3 and point[2] < 0:
+                self.fail(
+                    (*path, "path", index, 2), f"expected a dwell time >= 0 (seconds), got {point[2]:g}"
+                )
+        if len(model.path) < 2 and model.walk is None:
+            self.fail(
+                (*path, "path"),
+                "expected at least two waypoints to walk between, or a walk area "
+                "{x: [lo, hi], y: [lo, hi]} to roam in from the start point; got one point",
+            )
+        walk = None
+        if model.walk is not None:
+            for axis in ("x", "y"):
+                lo, hi = getattr(model.walk, axis)
+                if lo > hi:
+                    self.fail((*path, "walk", axis), f"expected {_RANGE}, got lo = {lo:g} > hi = {hi:g}")
+            walk = (model.walk.x, model.walk.y)
+        points = tuple((p[0], p[1], p[2] if len(p) == 3 else 0.0) for p in model.path)
+        return Human(ident, model.size, model.speed, points, loop=model.loop, walk=walk)
 
     def build_workspace(self, ident: str, model: _WorkspaceModel) -> Workspace:
         path = ("scene", "workspaces", ident)

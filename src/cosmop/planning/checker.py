@@ -252,12 +252,13 @@ def _nth(n: int) -> str:
 class _RobotChecker:
     """Checks one robot's plan; collects violations."""
 
-    def __init__(self, scene: Scene, robot_id: str, plan: RobotPlan) -> None:
+    def __init__(self, scene: Scene, robot_id: str, plan: RobotPlan, start: State | None = None) -> None:
         self.scene = scene
         self.robot_id = robot_id
         self.plan = plan
         self.side = scene.robots[robot_id].size
-        self.initial = initial_state(scene, robot_id)
+        self.initial = initial_state(scene, robot_id) if start is None else start
+        self.home = scene.robots[robot_id].pose
         self.states: list[State] = [self.initial, *(step.state for step in plan.steps)]
         self.walls = [(wall, _wall_line(wall)) for wall in scene.obstacles]
         self.violations: list[Violation] = []
@@ -602,7 +603,7 @@ class _RobotChecker:
 
     def holds(self, event: Event, i: int) -> bool:
         if event.kind == "return":
-            return _pose_eq(self.states[i].robot, self.initial.robot)
+            return _pose_eq(self.states[i].robot, self.home)
         if i == 0:
             return False
         step = self.plan.steps[i - 1]
@@ -629,7 +630,7 @@ class _RobotChecker:
         after = "anywhere in the plan" if last is None else f"after instant {last} ({events[n - 2].name})"
         head = f"mission event {event.name} ({_nth(n)} of {total}) is not realised"
         if event.kind == "return":
-            text = f"{head}: the robot is never at its initial pose {_pose(self.initial.robot)} {after}"
+            text = f"{head}: the robot is never at its initial pose {_pose(self.home)} {after}"
         else:
             text = f"{head}: there is no {self.expectation(event)} {after}"
         earlier = []
@@ -664,7 +665,9 @@ def _workspace_text(scene: Scene, wid: str) -> str:
     return f"{wid} (x in [{_fmt(ws.x[0])}, {_fmt(ws.x[1])}], y in [{_fmt(ws.y[0])}, {_fmt(ws.y[1])}])"
 
 
-def check_robot_plan(scene: Scene, robot_id: str, plan: RobotPlan) -> list[Violation]:
+def check_robot_plan(
+    scene: Scene, robot_id: str, plan: RobotPlan, start: State | None = None
+) -> list[Violation]:
     """Check one robot's plan against the scene: every transition, and the plan's own mission.
 
     Parameters
@@ -675,6 +678,9 @@ def check_robot_plan(scene: Scene, robot_id: str, plan: RobotPlan) -> list[Viola
         The robot whose plan it is; instant 0 is its initial pose and the scenario's objects.
     plan : RobotPlan
         The plan.
+    start : State, optional
+        Instant 0 when it is not the scenario (a plan made mid-mission, :mod:`cosmop.sim`);
+        ``return`` still means the scenario's initial pose.
 
     Returns
     -------
@@ -692,7 +698,7 @@ def check_robot_plan(scene: Scene, robot_id: str, plan: RobotPlan) -> list[Viola
                 f"({', '.join(scene.robots) or 'none'})",
             )
         ]
-    return _RobotChecker(scene, robot_id, plan).run()
+    return _RobotChecker(scene, robot_id, plan, start).run()
 
 
 # ----------------------------------------------------------------------------------------------

@@ -38,6 +38,7 @@ from types import MappingProxyType
 
 from cosmop.logic import FALSE, TRUE, Always, Formula, Implies, Next, Not, Until, Var, conj, disj, eq
 from cosmop.missions.events import Event
+from cosmop.planning.plan import State
 from cosmop.planning.regions import HalfPlane, wall_regions
 from cosmop.scenario import Scene
 
@@ -89,6 +90,10 @@ class RobotProblem:
     primitives : Mapping[str, Primitive], optional
         The primitive library (default :data:`PRIMITIVES`); each primitive says which objects
         it applies to (:meth:`Primitive.targets`), and the actions are all such pairs.
+    start : State, optional
+        Instant 0 when it is not the scenario: a robot that replans mid-mission starts where it
+        is (integer mm and degrees), with the objects as it knows them; ``return`` still means
+        the scenario's initial pose.
 
     Notes
     -----
@@ -102,6 +107,7 @@ class RobotProblem:
     mission: tuple[Event, ...]
     requests: bool = True
     primitives: Mapping[str, Primitive] | None = None
+    start: State | None = None
     actions: tuple[Action, ...] = field(init=False)
 
     def __post_init__(self) -> None:
@@ -415,7 +421,18 @@ def mission_formula(p: RobotProblem, events: Sequence[Event] | None = None) -> F
 
 
 def initial_state(p: RobotProblem) -> Formula:
-    """Instant 0: the scenario's poses and positions, nothing carried or away, no primitive."""
+    """Instant 0: the scenario's poses and positions, nothing carried or away, no primitive.
+
+    With ``p.start`` (a replan mid-mission) instant 0 is that state instead.
+    """
+    if p.start is not None:
+        x0, y0, h0 = p.start.robot
+        parts = [p.x.eq(_num(x0)), p.y.eq(_num(y0)), p.h.eq(_num(h0)), p.pi.eq(NONE)]
+        for o, state in p.start.objects.items():
+            v = p.obj(o)
+            parts += [v.x.eq(_num(state.position[0])), v.y.eq(_num(state.position[1]))]
+            parts += [v.carried if state.carried else ~v.carried, v.away if state.away else ~v.away]
+        return conj(parts)
     x0, y0, h0 = p.scene.robots[p.robot].pose
     parts = [p.x.eq(_num(x0)), p.y.eq(_num(y0)), p.h.eq(_num(h0)), p.pi.eq(NONE)]
     for o, spec in p.scene.objects.items():

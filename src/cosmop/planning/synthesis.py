@@ -24,7 +24,7 @@ import z3
 
 from cosmop.logic import IncrementalUnrolling, Signature, Unrolling, conj
 from cosmop.missions.events import Event
-from cosmop.planning.plan import ObjectState, RobotPlan, Step
+from cosmop.planning.plan import ObjectState, RobotPlan, State, Step
 from cosmop.planning.specification import (
     NONE,
     RobotProblem,
@@ -142,6 +142,7 @@ def synthesize(
     max_horizon: int = 16,
     rlimit: int = DEFAULT_RLIMIT,
     incremental: bool = True,
+    start: State | None = None,
 ) -> Synthesis:
     """The shortest safe plan of motion primitives for one robot's local mission.
 
@@ -160,6 +161,8 @@ def synthesize(
     incremental : bool
         Search K with one solver whose unrolling grows (:class:`cosmop.logic.IncrementalUnrolling`,
         the default: 2.5x faster on the 10x10 example) instead of a fresh solver per K.
+    start : State, optional
+        Instant 0 if not the scenario (replanning mid-mission; integer mm and degrees).
 
     Returns
     -------
@@ -167,7 +170,7 @@ def synthesize(
     """
     t0 = time.perf_counter()
     events = events_of(mission)
-    p = RobotProblem(scene, robot, events, requests)
+    p = RobotProblem(scene, robot, events, requests, start=start)
     formula = conj(f for _, f in specification(p))
     signature = Signature.of(formula)
     checks = 0

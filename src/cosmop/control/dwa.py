@@ -1,0 +1,414 @@
+"""The extended Dynamic Window Approach: passive-safe arcs towards a global path.
+
+Every control cycle :math:`\\varepsilon` each driving robot (Fox, Burgard and Thrun's DWA, as
+extended in the paper):
+
+1. measures the L-infinity gap to every sensed obstacle -- walls and resting objects
+   (:math:`V_o = 0`), other robots and people (their top speeds);
+2. decides passive safety (:mod:`cosmop.control.safety`): if ``safe`` holds it may pick any
+   acceleration in :math:`[-b, A]`; otherwise it may take only arcs whose own worst case
+   (held for a cycle, then braking along the arc) provably keeps clear of every obstacle --
+   typically arcs leading away -- and else brakes with :math:`-b` along its current arc;
+3. samples arcs :math:`(v, \\omega)` in the dynamic window
+   :math:`[v - b\\varepsilon, \\min(v + A\\varepsilon, v_{top})] \\times [-\\Omega, \\Omega]`
+   (only :math:`v - b\\varepsilon` when braking), predicts each for ``horizon`` seconds, and
+4. scores them by progress towards a look-ahead point on the global path, heading towards it,
+   clearance along the arc (moving obstacles pessimistically grown by :math:`V_o t`) and speed.
+
+The safety of step 2 does not depend on the score: the score only chooses *where* to go among
+arcs the safety rule admits.  Everything is vectorised over robots, arcs and obstacles.
+Units: mm, mm/s, radians and rad/s inside; degrees at the interfaces of :mod:`cosmop.sim`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from cosmop.control.geometry import box_gaps, point_segment_linf
+from cosmop.control.safety import obstacle_speed
+
+__all__ = ["DwaCommand", "DwaSettings", "dwa_commands", "robot_gaps"]
+
+
+@dataclass(frozen=True)
+class DwaSettings:
+    """Tuning of the dynamic window's search (not of its safety, which has no parameters).
+
+    Attributes
+    ----------
+    speeds, turns : int
+        Samples of :math:`v` and :math:`\\omega` in the window.
+    horizon : float
+        Prediction time of an arc, s.
+    samples : int
+        Points checked along a predicted arc.
+    lookahead : float
+        Distance of the target point ahead on the global path, mm.
+    clearance : float
+        Gap to walls and objects beyond which more room does not score, mm.
+    personal_space : float
+        The same for robots and people, mm: robots keep their distance from movers.
+    standoff : float
+        Extra gap (mm) that ``safe`` keeps from robots and people.  Passive safety alone lets a
+        robot come arbitrarily close to a standing robot, and two robots that touch can never
+        both move again; with a standoff they stop apart, and the per-arc check then lets them
+        leave without closing in.
+    turn_in_place : float
+        Heading error (degrees) above which the robot turns on the spot instead of driving.
+    """
+
+    speeds: int = 5
+    turns: int = 9
+    horizon: float = 1.0
+    samples: int = 3
+    lookahead: float = 500.0
+    clearance: float = 60.0
+    personal_space: float = 300.0
+    standoff: float = 100.0
+    turn_in_place: float = 50.0
+    progress_weight: float = 1.0
+    heading_weight: float = 0.5
+    clearance_weight: float = 0.4
+    speed_weight: float = 0.05
+
+
+@dataclass(frozen=True)
+class DwaCommand:
+    """The commands of one cycle for a batch of robots (arrays of shape ``(R,)``).
+
+    Attributes
+    ----------
+    v : ndarray
+        Translational speed to reach at the end of the cycle, mm/s (acceleration
+        :math:`(v - v_0)/\\varepsilon \\in [-b, A]`).
+    w : ndarray
+        Turn rate, rad/s.
+    safe : ndarray of bool
+        Whether ``safe`` held (False: the robot brakes).
+    gap : ndarray
+        Smallest L-infinity gap to any obstacle, mm.
+    """
+
+    v: np.ndarray
+    w: np.ndarray
+    safe: np.ndarray
+    gap: np.ndarray
+
+
+def robot_gaps(
+    centres: np.ndarray, half: np.ndarray, walls: np.ndarray, boxes: np.ndarray, ignore: np.ndarray | None
+) -> tuple[np.ndarray, np.ndarray]:
+    """L-infinity gaps of robot squares to walls ``(R, W)`` and to boxes ``(R, M)``.
+
+    `ignore` (shape ``(R, M)``) masks boxes a robot does not sense as obstacles (itself, the
+    object in its gripper); their gap is ``inf``.
+    """
+    wall_gap = (
+        point_segment_linf(centres, walls) - half[:, None] if len(walls) else np.zeros((len(centres), 0))
+    )
+    box_gap = box_gaps(centres, half[:, None], boxes) if len(boxes) else np.zeros((len(centres), 0))
+    if ignore is not None and box_gap.size:
+        box_gap = np.where(ignore, np.inf, box_gap)
+    return wall_gap, box_gap
+
+
+def dwa_commands(
+    pose: np.ndarray,
+    v: np.ndarray,
+    half: np.ndarray,
+    limits: np.ndarray,
+    target: np.ndarray,
+    stop_distance: np.ndarray,
+    walls: np.ndarray,
+    boxes: np.ndarray,
+    box_speed: np.ndarray,
+    ignore: np.ndarray | None,
+    settings: DwaSettings = DwaSettings(),
+    grip: np.ndarray | None = None,
+    box_velocity: np.ndarray | None = None,
+    room_cap: np.ndarray | None = None,
+    box_accel: np.ndarray | None = None,
+    w_now: np.ndarray | None = None,
+    agents: np.ndarray | None = None,
+) -> DwaCommand:
+    """One cycle of the extended DWA for `R` robots at once.
+
+    Parameters
+    ----------
+    pose : ndarray, shape (R, 3)
+        ``x, y`` (mm) and heading (rad).
+    v : ndarray, shape (R,)
+        Translational speeds now, mm/s.
+    half : ndarray, shape (R,)
+        Half sides of the robots, mm.
+    limits : ndarray, shape (R, 5)
+        Per robot: top speed (mm/s), :math:`A`, :math:`b` (mm/s²), :math:`\\Omega` (rad/s),
+        :math:`\\varepsilon` (s).
+    target : ndarray, shape (R, 2)
+        The look-ahead point on each robot's global path, mm.
+    stop_distance : ndarray, shape (R,)
+        Distance left to the goal along the path (mm): the speed is capped so that the robot
+        can stop there with half its braking.
+    walls : ndarray, shape (W, 4)
+    boxes : ndarray, shape (M, 3)
+        Other obstacles (objects, robots, people) as ``x, y, half side``.
+    box_speed : ndarray, shape (M,)
+        :math:`V_o` of each box, mm/s.
+    ignore : ndarray of bool, shape (R, M), optional
+        Boxes each robot does not treat as obstacles (itself).
+    settings : DwaSettings
+    grip : ndarray of bool, shape (R, M), optional
+        The object each robot touches with its gripper (just docked or just dropped): it does
+        not count for ``safe`` (the robot touches it by design) but arcs into it score as
+        touching, so the robot leaves it.
+    box_velocity : ndarray, shape (M, 2), optional
+        Current velocities of the boxes (mm/s), to extrapolate them along a predicted arc
+        when scoring (the safety rule assumes the worst, :math:`V_o`, instead).
+    box_accel : ndarray, shape (M,), optional
+        Acceleration limits of the boxes (mm/s²; ``inf`` for people, 0 for objects): with
+        their current speeds (from `box_velocity`) they tighten :math:`V_o` to
+        :func:`~cosmop.control.safety.obstacle_speed` over each robot's stopping horizon.
+    w_now : ndarray, shape (R,), optional
+        Current turn rates (rad/s): a robot with no admissible arc brakes along its arc.
+    agents : ndarray of bool, shape (M,), optional
+        Which boxes are robots or people, kept at the standoff (default: those that move).
+    room_cap : ndarray, shape (R,), optional
+        Per robot, the most clearance that scores (mm; default ``settings.clearance``).  Set
+        it to the gap at the goal so that a goal close to an obstacle (a docking pose) does
+        not repel its own robot.
+
+    Returns
+    -------
+    DwaCommand
+    """
+    R = len(pose)
+    top, acc, brk, omega, eps = (limits[:, i] for i in range(5))
+    xy, theta = pose[:, :2], pose[:, 2]
+    skip = ignore if grip is None else (grip if ignore is None else ignore | grip)
+    wall_gap, box_gap = robot_gaps(xy, half, walls, boxes, skip)
+
+    # Passive safety: v < v_max for every obstacle (paper's safe, per-obstacle V).
+    movers = box_speed > 0 if agents is None else agents
+    gap_all = np.concatenate([wall_gap, box_gap - settings.standoff * movers[None, :]], axis=1)
+    speed_all = np.concatenate([np.zeros(wall_gap.shape[1]), box_speed])
+    margin = (acc / brk + 1)[:, None] * (acc[:, None] / 2 * eps[:, None] ** 2 + eps[:, None] * v[:, None])
+    margin = margin + (v * v / (2 * brk))[:, None]
+    horizon = eps + (v + acc * eps) / brk  # (R,): the stopping horizon T
+    if box_accel is not None and box_velocity is not None and len(boxes):
+        now = np.hypot(box_velocity[:, 0], box_velocity[:, 1])
+        bound = obstacle_speed(horizon[:, None], box_speed[None, :], now[None, :], box_accel[None, :])
+        speeds = np.concatenate([np.zeros((R, wall_gap.shape[1])), bound], axis=1)
+    else:
+        speeds = np.broadcast_to(speed_all[None, :], gap_all.shape)
+    margin = margin + speeds * horizon[:, None]
+    safe = np.all(gap_all > margin, axis=1)
+    min_gap = (
+        np.concatenate([wall_gap, box_gap], axis=1).min(axis=1) if gap_all.shape[1] else np.full(R, np.inf)
+    )
+
+    # The dynamic window.
+    low = np.maximum(0.0, v - brk * eps)
+    high = np.minimum(v + acc * eps, top)
+    high = np.minimum(high, np.sqrt(np.maximum(brk * stop_distance, 0.0)))  # stop at the goal
+    high = np.maximum(high, low)
+    to_target = np.arctan2(target[:, 1] - xy[:, 1], target[:, 0] - xy[:, 0])
+    error = np.angle(np.exp(1j * (to_target - theta)))
+    turning = np.abs(error) > np.radians(settings.turn_in_place)
+    high = np.where(turning, low, high)
+
+    s = np.linspace(0.0, 1.0, settings.speeds)
+    vs = low[:, None] + (high - low)[:, None] * s[None, :]  # (R, Nv)
+    ws = omega[:, None] * np.linspace(-1.0, 1.0, settings.turns)[None, :]
+    aim = np.clip(error / max(settings.horizon / 2, eps.max()), -omega, omega)
+    ws = np.concatenate([ws, aim[:, None]], axis=1)  # (R, Nw)
+    V = np.repeat(vs[:, :, None], ws.shape[1], axis=2).reshape(R, -1)  # (R, K)
+    W = np.repeat(ws[:, None, :], vs.shape[1], axis=1).reshape(R, -1)
+
+    if not safe.all() and len(boxes):
+        # Not safe: head away from the nearest box along the axis of its L-infinity gap first,
+        # out of the standoff; the path is taken up again once safe holds.
+        rows = np.flatnonzero(~safe)
+        near = np.argmin(np.where(np.isinf(box_gap[rows]), np.inf, box_gap[rows]), axis=1)
+        close = box_gap[rows, near] < settings.standoff
+        delta = xy[rows] - boxes[near, :2]
+        along_x = np.abs(delta[:, 0]) >= np.abs(delta[:, 1])
+        away = np.where(along_x[:, None], [[1.0, 0.0]], [[0.0, 1.0]]) * np.sign(delta).clip(-1, 1)
+        away[np.all(away == 0, axis=1)] = [1.0, 0.0]
+        retreat = xy[rows] + away * (settings.standoff * 2)
+        target = target.copy()
+        target[rows[close]] = retreat[close]
+        to_target = np.arctan2(target[:, 1] - xy[:, 1], target[:, 0] - xy[:, 0])
+        error = np.angle(np.exp(1j * (to_target - theta)))
+        turning = np.abs(error) > np.radians(settings.turn_in_place)
+        high = np.where(turning, low, np.maximum(np.minimum(v + acc * eps, top), low))
+        s_ = np.linspace(0.0, 1.0, settings.speeds)
+        vs = low[:, None] + (high - low)[:, None] * s_[None, :]
+        ws = omega[:, None] * np.linspace(-1.0, 1.0, settings.turns)[None, :]
+        aim = np.clip(error / max(settings.horizon / 2, eps.max()), -omega, omega)
+        ws = np.concatenate([ws, aim[:, None]], axis=1)
+        V = np.repeat(vs[:, :, None], ws.shape[1], axis=2).reshape(R, -1)
+        W = np.repeat(ws[:, None, :], vs.shape[1], axis=1).reshape(R, -1)
+
+    # Predicted arcs: positions at t_k, k = 1..S, with (v, w) held.
+    t = settings.horizon * np.arange(1, settings.samples + 1) / settings.samples  # (S,)
+    th = theta[:, None, None] + W[:, :, None] * t[None, None, :]
+    straight = np.abs(W) < 1e-6
+    w_safe = np.where(straight, 1.0, W)[:, :, None]
+    px = np.where(
+        straight[:, :, None],
+        V[:, :, None] * t * np.cos(theta)[:, None, None],
+        V[:, :, None] / w_safe * (np.sin(th) - np.sin(theta)[:, None, None]),
+    )
+    py = np.where(
+        straight[:, :, None],
+        V[:, :, None] * t * np.sin(theta)[:, None, None],
+        -V[:, :, None] / w_safe * (np.cos(th) - np.cos(theta)[:, None, None]),
+    )
+    pts = np.stack([xy[:, 0, None, None] + px, xy[:, 1, None, None] + py], axis=-1)  # (R, K, S, 2)
+
+    # Clearance along each arc; moving obstacles grown by V t (pessimistic).
+    flat = pts.reshape(R, -1, 2)
+    clear = np.full(flat.shape[:2], np.inf)
+    if len(walls):
+        clear = (point_segment_linf(flat, walls) - half[:, None, None]).min(axis=-1)
+    if len(boxes):
+        tk = np.tile(t, V.shape[1])  # (K*S,): the time of each predicted point
+        if box_velocity is None:
+            bg = box_gaps(flat, half[:, None, None], boxes)  # (R, K*S, M)
+        else:
+            moved = boxes[None, :, :2] + tk[:, None, None] * box_velocity[None, :, :]  # (K*S, M, 2)
+            d = np.maximum(
+                np.abs(flat[:, :, None, 0] - moved[None, :, :, 0]),
+                np.abs(flat[:, :, None, 1] - moved[None, :, :, 1]),
+            )
+            bg = d - half[:, None, None] - boxes[None, None, :, 2]
+        if ignore is not None:
+            bg = np.where(ignore[:, None, :], np.inf, bg)
+        if movers.any():
+            mover_clear = bg[:, :, movers].min(axis=-1).reshape(R, V.shape[1], settings.samples).min(axis=-1)
+        if (~movers).any():
+            clear = np.minimum(clear, bg[:, :, ~movers].min(axis=-1))
+        clear = np.minimum(clear, bg.min(axis=-1))
+    clear = clear.reshape(R, V.shape[1], settings.samples).min(axis=-1)
+    if not len(boxes) or not movers.any():
+        mover_clear = np.full_like(clear, np.inf)
+
+    end = pts[:, :, -1, :]
+    end_heading = th[:, :, -1]
+    d_now = np.hypot(target[:, 0] - xy[:, 0], target[:, 1] - xy[:, 1])
+    d_end = np.hypot(target[:, None, 0] - end[..., 0], target[:, None, 1] - end[..., 1])
+    # Progress relative to the best the window allows, so that it also decides at low speed.
+    progress = (d_now[:, None] - d_end) / np.maximum(high * settings.horizon, 1.0)[:, None]
+    bearing = np.arctan2(target[:, None, 1] - end[..., 1], target[:, None, 0] - end[..., 0])
+    heading = 1.0 - np.abs(np.angle(np.exp(1j * (bearing - end_heading)))) / np.pi
+    heading = np.where(d_end < 1.0, 1.0, heading)
+    cap = np.full(R, settings.clearance) if room_cap is None else np.minimum(room_cap, settings.clearance)
+    cap = np.maximum(cap, 0.0)[:, None]
+    room = np.where(cap > 0, np.minimum(clear, cap) / np.maximum(cap, 1e-9), 1.0)
+    room = np.minimum(room, np.clip(mover_clear / settings.personal_space, 0.0, 1.0))
+    score = (
+        settings.progress_weight * progress
+        + settings.heading_weight * heading
+        + settings.clearance_weight * room
+        + settings.speed_weight * V / np.maximum(top, 1.0)[:, None]
+    )
+    # An arc that would touch something within the horizon is taken only if every arc would.
+    score = np.where(clear > 0, score, score - 1e3 + clear / 1e3)
+    w_out = np.zeros(R)
+    if not safe.all():
+        # Not safe: only arcs whose own braking path provably keeps clear (checked below), else
+        # brake along the previous arc -- the one the last cycle's check covered.
+        rows = np.flatnonzero(~safe)
+        # Inside the standoff of a mover, an escape arc may not end closer to it than now.
+        # (a few mm of slack per cycle, down to half the standoff, so that it can slide along)
+        near = box_gap[rows]
+        floor = np.minimum(near, np.maximum(near - 2.0, settings.standoff / 2))
+        keep = np.where(movers[None, :] & (near < settings.standoff), floor, -np.inf)
+        ok = _escape_ok(
+            pose[rows],
+            v[rows],
+            V[rows],
+            W[rows],
+            half[rows],
+            limits[rows],
+            walls,
+            boxes,
+            box_speed,
+            None if ignore is None else skip[rows],
+            box_velocity,
+            box_accel,
+            keep,
+        )
+        score[rows] = np.where(ok, score[rows], -np.inf)
+        none = ~ok.any(axis=1)
+        w_prev = np.zeros(R) if w_now is None else w_now
+        fallback = rows[none]
+        score[fallback] = -np.inf
+        w_out[fallback] = w_prev[fallback]
+    best = np.argmax(score, axis=1)
+    rows_all = np.arange(R)
+    v_out = V[rows_all, best]
+    w_out = np.where(np.isfinite(score[rows_all, best]), W[rows_all, best], w_out)
+    v_out = np.where(np.isfinite(score[rows_all, best]), v_out, low)
+    return DwaCommand(v=v_out, w=w_out, safe=safe, gap=min_gap)
+
+
+def _escape_ok(
+    pose, v, V, W, half, limits, walls, boxes, box_speed, skip, box_velocity, box_accel, keep, steps: int = 8
+):
+    """Whether each arc's worst case keeps clear: held for one cycle, then braking to a stop.
+
+    The robot reaches speed ``V`` linearly within :math:`\varepsilon`, then brakes with
+    :math:`-b` with the turn rate held; at every sampled instant :math:`t` its square must be
+    farther from each obstacle than :math:`V_o t` plus the distance it covers between samples.
+    This is passive safety checked directly along one arc, used when ``safe`` (which covers
+    every arc at once) fails, so that a robot standing close to something can still leave.
+    ``keep`` (shape ``(U, M)``, mm): the gap to each box may not end below it (``-inf``: no
+    such rule), so that a robot inside another's standoff only leaves or slides along.
+    """
+    U, K = V.shape
+    _top, _acc, brk, _omega, eps = (limits[:, i] for i in range(5))
+    total = eps[:, None] + V / brk[:, None]  # (U, K): time until standing still
+    dt = total / steps
+    t = dt[:, :, None] * np.arange(1, steps + 1)[None, None, :]  # (U, K, n)
+    e = eps[:, None, None]
+    speed = np.where(
+        t <= e,
+        v[:, None, None] + (V[:, :, None] - v[:, None, None]) * t / e,
+        np.maximum(V[:, :, None] - brk[:, None, None] * (t - e), 0.0),
+    )
+    theta = pose[:, 2, None, None] + W[:, :, None] * t
+    step = speed * dt[:, :, None]
+    x = pose[:, 0, None, None] + np.cumsum(step * np.cos(theta), axis=2)
+    y = pose[:, 1, None, None] + np.cumsum(step * np.sin(theta), axis=2)
+    slack = step.max(axis=2, initial=0.0)[:, :, None]
+    pts = np.stack([x, y], axis=-1).reshape(U, -1, 2)
+    ok = np.ones((U, K), dtype=bool)
+    if len(walls):
+        gap = (point_segment_linf(pts, walls) - half[:, None, None]).reshape(U, K, steps, -1)
+        now_gap = point_segment_linf(pose[:, :2], walls) - half[:, None]  # (U, W)
+        fine = (gap > slack[..., None]) | ((gap >= now_gap[:, None, None, :] - 1e-9) & (gap > 0))
+        ok &= fine.all(axis=(2, 3))
+    if len(boxes):
+        gap = box_gaps(pts, half[:, None, None], boxes).reshape(U, K, steps, -1)
+        if box_accel is not None and box_velocity is not None:
+            now = np.hypot(box_velocity[:, 0], box_velocity[:, 1])
+            bound = obstacle_speed(
+                total.max(axis=1)[:, None], box_speed[None, :], now[None, :], box_accel[None, :]
+            )
+        else:
+            bound = np.broadcast_to(box_speed[None, :], (U, len(boxes)))
+        reach = t[..., None] * bound[:, None, None, :]
+        fine = gap > reach + slack[..., None]
+        # From a box that stands still (V = 0), moving away never closes the gap: an arc whose
+        # sampled gaps never fall below the gap now (and open up at once) needs no slack.
+        now_gap = box_gaps(pose[:, :2], half[:, None], boxes)  # (U, M)
+        away = (gap >= now_gap[:, None, None, :] - 1e-9) & (gap > 0)
+        fine |= away & (bound[:, None, None, :] == 0)
+        fine[:, :, -1, :] &= gap[:, :, -1, :] >= keep[:, None, :] - 1e-9
+        if skip is not None:
+            fine |= skip[:, None, None, :]
+        ok &= fine.all(axis=(2, 3))
+    return ok

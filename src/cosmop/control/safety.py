@@ -1,0 +1,109 @@
+"""Passive safety of the extended Dynamic Window Approach (the paper's ``safe`` and Corollary).
+
+A robot with translational speed :math:`v \\ge 0`, acceleration at most :math:`A`, braking
+:math:`b` and control cycle :math:`\\varepsilon` may start a new arc only when, for every
+obstacle :math:`o` that moves at most :math:`V_o` fast,
+
+.. math::
+
+    \\lVert p_r - p_o \\rVert_\\infty > \\Big(\\frac{A}{b} + 1\\Big)\\Big(\\frac{A}{2}\\varepsilon^2
+    + \\varepsilon v\\Big) + \\frac{v^2}{2b} + V_o\\Big(\\varepsilon + \\frac{v + A\\varepsilon}{b}\\Big);
+
+otherwise it brakes with :math:`-b` (Mitsch et al., Theorem 2 of the journal version; the
+paper's ``safe``).  Then the robot is never moving when it touches an obstacle: it can always
+stop before the gap closes, even if the obstacle runs towards it at :math:`V_o`.  Solving the
+condition for :math:`v` gives the paper's Corollary,
+
+.. math::
+
+    v_{max} = b\\sqrt{\\Big(\\frac{A}{b} + 1\\Big)\\varepsilon^2 + \\Big(\\frac{V}{b}\\Big)^2 +
+    \\frac{2\\lVert p_r - p_o \\rVert_\\infty}{b}} - b\\,\\varepsilon\\Big(\\frac{A}{b} + 1\\Big) - V,
+
+and ``safe`` holds exactly when :math:`v < v_{max}`.  The paper uses one :math:`V` for all
+obstacles; the condition holds obstacle by obstacle, so walls and resting objects use
+:math:`V_o = 0` and people their top speed.
+
+In the condition :math:`V_o` only bounds how far the obstacle can come during the robot's
+stopping horizon :math:`T = \varepsilon + (v + A\varepsilon)/b`: the term is
+:math:`V_o T`.  Another robot of the team shares its speed :math:`v_o` and acceleration
+limit :math:`A_o` (the robots talk over the message bus), so within :math:`T` it moves at most
+:math:`v_o T + A_o T^2/2`; :func:`obstacle_speed` gives the matching
+:math:`V_o = \\min(v^{top}_o, v_o + A_o T/2)`, which is still a sound bound and lets two
+robots that stand close start again (with the top speed alone they could block each other
+for ever).  Units: mm, mm/s, mm/s², s.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from cosmop.scenario import Dynamics
+
+__all__ = ["admissible_speed", "is_safe", "obstacle_speed", "stopping_horizon", "stopping_margin"]
+
+
+def stopping_margin(v, speed_bound, dynamics: Dynamics):
+    """The right-hand side of ``safe``: the gap (mm) a robot at speed `v` needs.
+
+    Parameters
+    ----------
+    v : float or ndarray
+        Translational speed now, mm/s (>= 0).
+    speed_bound : float or ndarray
+        :math:`V_o`, the most the obstacle moves, mm/s.
+    dynamics : Dynamics
+        :math:`A`, :math:`b`, :math:`\\varepsilon`.
+    """
+    a, b, eps = dynamics.acceleration, dynamics.braking, dynamics.cycle
+    return (
+        (a / b + 1.0) * (a / 2.0 * eps**2 + eps * v)
+        + v * v / (2.0 * b)
+        + speed_bound * (eps + (v + a * eps) / b)
+    )
+
+
+def stopping_horizon(v, dynamics: Dynamics):
+    """:math:`T = \varepsilon + (v + A\varepsilon)/b`: the latest time a robot at `v` stands still, s."""
+    a, b, eps = dynamics.acceleration, dynamics.braking, dynamics.cycle
+    return eps + (v + a * eps) / b
+
+
+def obstacle_speed(horizon, top, speed_now, acceleration):
+    r"""The speed bound :math:`V_o = \min(v^{top}_o, v_o + A_o T/2)` of an obstacle over `horizon`.
+
+    Parameters
+    ----------
+    horizon : float or ndarray
+        :math:`T`, s (see :func:`stopping_horizon`).
+    top : float or ndarray
+        The obstacle's top speed, mm/s (``inf`` acceleration: a person, bounded by this alone).
+    speed_now : float or ndarray
+        Its current speed, mm/s.
+    acceleration : float or ndarray
+        Its acceleration limit, mm/s² (``inf`` when unknown).
+
+    Returns
+    -------
+    float or ndarray
+        A speed whose product with `horizon` bounds the obstacle's displacement, mm/s.
+    """
+    with np.errstate(invalid="ignore"):
+        reach = np.asarray(speed_now) + np.asarray(acceleration) * np.asarray(horizon) / 2.0
+    return np.minimum(top, np.where(np.isnan(reach), np.inf, reach))
+
+
+def is_safe(gap, v, speed_bound, dynamics: Dynamics):
+    """The paper's ``safe``: ``gap > stopping_margin(v, V)`` (elementwise)."""
+    return np.asarray(gap) > stopping_margin(v, speed_bound, dynamics)
+
+
+def admissible_speed(gap, speed_bound, dynamics: Dynamics):
+    """The Corollary's :math:`v_{max}`: ``safe`` holds exactly for ``0 <= v < v_max``.
+
+    Negative when not even a standing robot may start (the gap is below
+    :math:`(A/b + 1) A\\varepsilon^2/2 + V_o\\varepsilon(1 + A/b)`).
+    """
+    a, b, eps = dynamics.acceleration, dynamics.braking, dynamics.cycle
+    gap = np.asarray(gap, dtype=float)
+    root = np.sqrt(np.maximum((a / b + 1.0) * eps**2 + (speed_bound / b) ** 2 + 2.0 * gap / b, 0.0))
+    return b * root - b * eps * (a / b + 1.0) - speed_bound

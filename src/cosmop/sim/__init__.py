@@ -1,0 +1,32 @@
+"""Executing plans in a multi-robot world: robots, people, messages, safety monitor, replanning.
+
+:func:`simulate` runs a ``cosmop.plan/1`` plan set in the scenario's world
+(:mod:`cosmop.sim.simulation`); people walk their paths (:mod:`cosmop.sim.humans`); a stalled
+robot replans its remaining mission from where it is (:mod:`cosmop.sim.replan`).  The result
+carries the ``cosmop.sim/1`` summary and the ``cosmop.trace/1`` trace.
+"""
+
+from cosmop.sim.replan import replan, sensed_scene
+from cosmop.sim.simulation import (
+    SIM_FORMAT,
+    TRACE_FORMAT,
+    Contact,
+    Message,
+    SimResult,
+    SimSettings,
+    simulate,
+    wait_in_place,
+)
+
+__all__ = [
+    "SIM_FORMAT",
+    "TRACE_FORMAT",
+    "Contact",
+    "Message",
+    "SimResult",
+    "SimSettings",
+    "replan",
+    "sensed_scene",
+    "simulate",
+    "wait_in_place",
+]

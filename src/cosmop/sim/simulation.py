@@ -1,0 +1,1149 @@
+"""Executing plans: a multi-robot world with messages, people and a safety monitor.
+
+Every robot executes its ``cosmop.plan/1`` plan step by step, all robots in lock step with one
+control cycle :math:`\\varepsilon` (the scenario's ``dynamics.cycle``):
+
+``GoTo``
+    drives with the passive-safe dynamic window (:mod:`cosmop.control.dwa`) along a global path
+    (:mod:`cosmop.control.paths`) to the step's waypoint.  A waypoint followed by another
+    ``GoTo`` is passed within ``pass_tolerance``; the last one of a run is reached within
+    ``goal_tolerance`` and turned to its heading within ``heading_tolerance``.
+``PickUp`` / ``DropOff``
+    dock: the docking pose (the object's x minus :math:`d = (l_r + l_o)/2`, its y, heading 0;
+    or the plan's pose for a drop) is closed at ``dock_speed`` by the docking controller (a
+    fine alignment of at most ``dock_tolerance``, which the unicycle model abstracts), then the
+    gripper works for ``handling_time``.  After a drop the robot turns away from the object
+    and backs off ``release_gap`` straight, so that it never drives along an object it touches.
+    A carried object rides on its robot, inside the robot's square, as in the plan model where
+    a carried object takes no room.
+``Req``
+    stops and waits for the responder's message; ``Res`` stops and sends it (the message bus
+    logs every message).
+
+Robots are unicycles: each cycle the robot holds an acceleration in :math:`[-b, A]` and a turn
+rate in :math:`[-\\Omega, \\Omega]`.  The footprint is the scenario's axis-aligned square, so a
+turn on the spot moves no part of it; *moving* means a translational speed above zero.
+
+The safety monitor records every contact -- a robot's square touching a wall, a resting
+object, another robot or a person -- and whether the robot was moving then.  Passive safety
+guarantees that it never is (a person may walk into a standing robot).  A robot that makes no
+progress for ``stall_time`` replans its remaining mission from where it is, with the robots and
+people it senses added to the scene (:mod:`cosmop.sim.replan`).  Units: mm, mm/s, degrees at
+the interfaces, seconds.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from cosmop.control.dwa import DwaSettings, dwa_commands
+from cosmop.control.geometry import box_gaps, point_segment_linf, segment_array
+from cosmop.control.paths import GlobalPath, plan_path
+from cosmop.control.safety import is_safe, obstacle_speed, stopping_horizon, stopping_margin
+from cosmop.io import write_atomic
+from cosmop.missions.events import Event, parse_event
+from cosmop.planning.checker import check_robot_plan
+from cosmop.planning.plan import ObjectState, PlanSet, RobotPlan, State, Step, plan_from_actions
+from cosmop.scenario import Scenario
+from cosmop.sim.humans import Walker
+from cosmop.sim.replan import replan
+
+__all__ = [
+    "SIM_FORMAT",
+    "TRACE_FORMAT",
+    "Contact",
+    "Message",
+    "SimResult",
+    "SimSettings",
+    "simulate",
+    "wait_in_place",
+]
+
+SIM_FORMAT = "cosmop.sim/1"
+"""The ``format`` of a simulation summary (``summary.json``)."""
+
+TRACE_FORMAT = "cosmop.trace/1"
+"""The ``format`` of a simulation trace (``trace.json``)."""
+
+_PRIMITIVES = (None, "GoTo", "PickUp", "DropOff", "Req", "Res")
+_TOUCH = 1e-6  # mm: squares closer than this touch
+
+
+@dataclass(frozen=True)
+class SimSettings:
+    """How the simulation runs (the robots' limits come from the scenario's ``dynamics``).
+
+    Attributes
+    ----------
+    max_time : float
+        Simulated seconds after which an unfinished run stops (``completed`` false).
+    goal_tolerance, pass_tolerance : float
+        Distance (mm) within which a final / intermediate GoTo waypoint counts as reached.
+    heading_tolerance : float
+        Degrees within which a final waypoint's heading counts as reached.
+    dock_tolerance : float
+        Largest offset (mm) from a docking pose that the docking controller closes; farther
+        away, the robot first drives there.
+    dock_speed : float
+        Speed of the docking controller, mm/s (at most one cycle's braking, :math:`b\varepsilon`).
+    reach : float
+        How far (mm) the gripper reaches: docking blocked closer than this to its pose still
+        picks up or drops off; a drop puts the object where the plan puts it.
+    handling_time : float
+        Seconds the gripper needs to pick up or drop off.
+    release_gap : float
+        How far (mm) a robot backs off from an object it has dropped before it drives on.
+    detour_time : float
+        Seconds without progress after which a driving robot plans its global path again,
+        around the robots that block it and have the right of way (less path left).
+    stall_time : float
+        Seconds without ``stall_progress`` mm of progress after which a driving robot replans.
+    stall_progress : float
+        Progress (mm of path) that resets the stall clock.
+    replan : bool
+        Whether stalled robots replan (else they keep trying).
+    wait_in_place : bool
+        Issue requests before driving to where the plan waits (:func:`wait_in_place`).
+    sense_range : float
+        Robots and people within this gap (mm) of a stalled robot are added to its scene.
+    max_horizon, rlimit : int
+        Bounds of the solver when replanning.
+    dwa : DwaSettings
+        The dynamic window's search.
+    """
+
+    max_time: float = 900.0
+    goal_tolerance: float = 15.0
+    pass_tolerance: float = 150.0
+    heading_tolerance: float = 2.0
+    dock_tolerance: float = 80.0
+    dock_speed: float = 50.0
+    reach: float = 20.0
+    handling_time: float = 1.0
+    release_gap: float = 30.0
+    detour_time: float = 3.0
+    stall_time: float = 12.0
+    stall_progress: float = 50.0
+    replan: bool = True
+    wait_in_place: bool = True
+    sense_range: float = 800.0
+    max_horizon: int = 12
+    rlimit: int = 50_000_000
+    dwa: DwaSettings = field(default_factory=DwaSettings)
+
+
+@dataclass(frozen=True)
+class Message:
+    """A message on the bus: ``sender`` answers ``receiver``'s request about ``object``."""
+
+    t: float
+    sender: str
+    receiver: str
+    object: str
+    event: str
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "t": self.t,
+            "from": self.sender,
+            "to": self.receiver,
+            "object": self.object,
+            "event": self.event,
+        }
+
+
+@dataclass(frozen=True)
+class Contact:
+    """A contact episode: `robot`'s square touched `other` from time `t` on.
+
+    ``moving`` is true if the robot had a translational speed above zero at any cycle of the
+    episode -- what passive safety rules out.
+    """
+
+    t: float
+    robot: str
+    other: str
+    moving: bool
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"t": self.t, "robot": self.robot, "other": self.other, "moving": self.moving}
+
+
+@dataclass(frozen=True)
+class SimResult:
+    """The outcome of :func:`simulate`: status, statistics, and the whole trace.
+
+    Attributes
+    ----------
+    scenario : str
+    completed : bool
+        Every robot executed its whole plan before ``max_time``.
+    sim_time_s, wall_time_s : float
+        Simulated and real seconds.
+    cycles : int
+    dt : float
+        The control cycle, s.
+    contacts : tuple of Contact
+    replans, replan_attempts : int
+        Successful replans and all attempts.
+    messages : tuple of Message
+    objects : Mapping[str, tuple]
+        Final ``(position (x, y), carried_by or None)`` of every object.
+    robots : Mapping[str, tuple]
+        Final ``(pose (x, y, heading deg), distance_mm)`` of every robot.
+    finished : Mapping[str, bool]
+        Whether each robot executed its whole plan.
+    frames : Mapping[str, ndarray]
+        Per cycle arrays: ``t`` (n,), ``pose`` (n, R, 3; degrees), ``v`` (n, R), ``w``
+        (n, R; deg/s), ``carrying`` (n, R; object index or -1), ``primitive`` (n, R; index in
+        ``(None, GoTo, PickUp, DropOff, Req, Res)``), ``waiting`` (n, R), ``humans`` (n, H, 2),
+        ``objects`` (n, O, 2).
+    robot_ids, human_ids, object_ids : tuple of str
+    """
+
+    scenario: str
+    completed: bool
+    sim_time_s: float
+    wall_time_s: float
+    cycles: int
+    dt: float
+    contacts: tuple[Contact, ...]
+    replans: int
+    replan_attempts: int
+    messages: tuple[Message, ...]
+    objects: Mapping[str, tuple]
+    robots: Mapping[str, tuple]
+    frames: Mapping[str, np.ndarray] = field(repr=False)
+    finished: Mapping[str, bool] = field(default_factory=dict)
+    robot_ids: tuple[str, ...] = ()
+    human_ids: tuple[str, ...] = ()
+    object_ids: tuple[str, ...] = ()
+
+    @property
+    def contacts_while_moving(self) -> int:
+        """Contact episodes in which the robot was moving (0 under passive safety)."""
+        return sum(1 for c in self.contacts if c.moving)
+
+    def summary(self) -> dict[str, Any]:
+        """The ``cosmop.sim/1`` summary (what ``--summary`` writes)."""
+        return {
+            "format": SIM_FORMAT,
+            "scenario": self.scenario,
+            "completed": self.completed,
+            "sim_time_s": round(self.sim_time_s, 6),
+            "wall_time_s": round(self.wall_time_s, 6),
+            "cycles": self.cycles,
+            "contacts": len(self.contacts),
+            "contacts_while_moving": self.contacts_while_moving,
+            "replans": self.replans,
+            "replan_attempts": self.replan_attempts,
+            "messages": [m.to_dict() for m in self.messages],
+            "objects": {
+                oid: {"position": [round(p[0], 3), round(p[1], 3)], "carried_by": by}
+                for oid, (p, by) in self.objects.items()
+            },
+            "robots": {
+                rid: {"pose": [round(v, 3) for v in pose], "distance_mm": round(dist, 3)}
+                for rid, (pose, dist) in self.robots.items()
+            },
+            "contact_log": [c.to_dict() for c in self.contacts],
+        }
+
+    def trace(self) -> dict[str, Any]:
+        """The ``cosmop.trace/1`` trace: one frame per cycle (what ``--trace`` writes)."""
+        f = self.frames
+        frames = []
+        for n in range(len(f["t"])):
+            robots = {}
+            for i, rid in enumerate(self.robot_ids):
+                carry = int(f["carrying"][n, i])
+                robots[rid] = {
+                    "pose": [round(float(x), 3) for x in f["pose"][n, i]],
+                    "v": round(float(f["v"][n, i]), 3),
+                    "w": round(float(f["w"][n, i]), 3),
+                    "carrying": self.object_ids[carry] if carry >= 0 else None,
+                    "primitive": _PRIMITIVES[int(f["primitive"][n, i])],
+                    "waiting": bool(f["waiting"][n, i]),
+                }
+            frames.append(
+                {
+                    "t": round(float(f["t"][n]), 6),
+                    "robots": robots,
+                    "humans": {
+                        hid: [round(float(x), 3) for x in f["humans"][n, j]]
+                        for j, hid in enumerate(self.human_ids)
+                    },
+                    "objects": {
+                        oid: [round(float(x), 3) for x in f["objects"][n, j]]
+                        for j, oid in enumerate(self.object_ids)
+                    },
+                }
+            )
+        return {
+            "format": TRACE_FORMAT,
+            "scenario": self.scenario,
+            "dt": self.dt,
+            "frames": frames,
+            "messages": [m.to_dict() for m in self.messages],
+        }
+
+    def save_summary(self, path: str | os.PathLike[str]) -> None:
+        """Write :meth:`summary` as JSON, atomically."""
+        write_atomic(path, json.dumps(self.summary(), indent=2) + "\n")
+
+    def save_trace(self, path: str | os.PathLike[str]) -> None:
+        """Write :meth:`trace` as JSON, atomically."""
+        write_atomic(path, json.dumps(self.trace(), separators=(",", ":")) + "\n")
+
+    def objects_in_workspaces(self, scenario: Scenario, plans: PlanSet) -> dict[str, bool]:
+        """For every drop event of the plans' missions: is its object in its workspace now?"""
+        out = {}
+        for plan in plans.robots.values():
+            for event in plan.events:
+                if event.kind == "drop":
+                    (x, y), by = self.objects[event.obj]
+                    ws = scenario.scene.workspaces[event.workspace]
+                    out[event.obj] = by is None and ws.contains(x, y, 1e-6)
+        return out
+
+
+# ----------------------------------------------------------------------------------------------
+# The world
+# ----------------------------------------------------------------------------------------------
+
+
+class _Agent:
+    """One robot's executor: where it is in its plan and what it is doing (mutable)."""
+
+    def __init__(self, rid: str, index: int, steps: tuple[Step, ...], mission: tuple[Event, ...]) -> None:
+        self.id = rid
+        self.index = index
+        self.steps = list(steps)
+        self.mission = list(mission)
+        self.k = 0  # the step being executed
+        self.phase = "start"  # of driving: start, drive, turn
+        self.stage: str | None = None  # of docking: approach, dock, handle
+        self.path: GlobalPath | None = None
+        self.goal: tuple[float, float, float] | None = None
+        self.timer = 0.0
+        self.grip: int | None = None  # object index touched by the gripper
+        self.best = math.inf  # path left at the last progress
+        self.room = math.inf  # clearance of the current goal
+        self.left = 0.0  # path left while driving (0 otherwise: the right of way)
+        self.detour_until = 0.0
+        self.since = 0.0  # time of the last progress
+        self.waiting = False
+        self.answered: dict[str, int] = {}  # Res sent per object
+
+    @property
+    def done(self) -> bool:
+        return self.k >= len(self.steps)
+
+    @property
+    def step(self) -> Step:
+        return self.steps[self.k]
+
+
+class _World:
+    """The state of a running simulation; :func:`simulate` drives it."""
+
+    def __init__(self, scenario: Scenario, plans: PlanSet, seed: int, settings: SimSettings) -> None:
+        scene = scenario.scene
+        self.scenario = scenario
+        self.settings = settings
+        self.rids = tuple(scene.robots)
+        self.oids = tuple(scene.objects)
+        humans = getattr(scene, "humans", {})
+        self.hids = tuple(humans)
+        R = len(self.rids)
+        self.walls = segment_array([(w.start, w.end) for w in scene.obstacles])
+        robots = [scene.robots[r] for r in self.rids]
+        self.half = np.array([r.size / 2.0 for r in robots])
+        dyn = [r.dynamics for r in robots]
+        self.dynamics = dyn
+        cycles = {d.cycle for d in dyn}
+        if len(cycles) != 1:
+            raise ValueError("every robot must share one control cycle")
+        self.dt = cycles.pop()
+        self.limits = np.array(
+            [[d.max_speed, d.acceleration, d.braking, math.radians(d.turn_rate), d.cycle] for d in dyn]
+        ).reshape(R, 5)
+        self.pose = np.array([[r.pose[0], r.pose[1], math.radians(r.pose[2])] for r in robots]).reshape(R, 3)
+        self.v = np.zeros(R)
+        self.w = np.zeros(R)
+        self.distance = np.zeros(R)
+        self.obj_pos = np.array([scene.objects[o].position for o in self.oids], dtype=float).reshape(-1, 2)
+        self.obj_half = np.array([scene.objects[o].size / 2.0 for o in self.oids])
+        self.carried_by = np.full(len(self.oids), -1)
+        rng = np.random.default_rng(seed)
+        self.walkers = [Walker(humans[h], self.walls, rng) for h in self.hids]
+        self.human_half = np.array([w.half for w in self.walkers])
+        self.human_speed = np.array([humans[h].speed for h in self.hids])
+        self.robot_speed = self.limits[:, 0].copy()
+        self.agents = []
+        for i, rid in enumerate(self.rids):
+            plan = plans.robots.get(rid)
+            if plan is not None and settings.wait_in_place:
+                plan = wait_in_place(scene, rid, plan)
+            steps = plan.steps if plan is not None else ()
+            events = plan.events if plan is not None else ()
+            self.agents.append(_Agent(rid, i, steps, events))
+        self.inbox: set[tuple[str, str]] = set()  # (object, receiver)
+        self.messages: list[Message] = []
+        self.contacts: list[Contact] = []
+        self.touching: dict[tuple[int, str], int] = {}  # pair -> index in contacts
+        self.replans = 0
+        self.replan_attempts = 0
+        self.detours = 0
+        self.t = 0.0
+
+    # -- obstacles ---------------------------------------------------------------------------
+
+    def boxes(self) -> tuple[np.ndarray, np.ndarray, list[str]]:
+        """Resting objects, robots and people as boxes ``x, y, half``, their speed bounds, names."""
+        resting = np.flatnonzero(self.carried_by < 0)
+        parts = [
+            np.column_stack([self.obj_pos[resting], self.obj_half[resting]]),
+            np.column_stack([self.pose[:, :2], self.half]),
+        ]
+        speeds = [np.zeros(len(resting)), np.where(self.parked(), 0.0, self.robot_speed)]
+        names = [self.oids[j] for j in resting] + list(self.rids)
+        if self.walkers:
+            parts.append(np.column_stack([np.array([w.position for w in self.walkers]), self.human_half]))
+            speeds.append(self.human_speed)
+            names += list(self.hids)
+        return np.vstack(parts).reshape(-1, 3), np.concatenate(speeds), names
+
+    def parked(self) -> np.ndarray:
+        """Which robots are parked: standing and promising not to move (their V is 0).
+
+        A robot that has finished, waits for a message or lets its gripper work stands still,
+        and it leaves that state only when no other robot is within the standoff
+        (:meth:`crowded`).  The others may therefore treat it like a wall: come close, dock
+        beside it, and leave again -- two robots that touch could otherwise never part.
+        """
+        return np.array(
+            [(a.done or a.waiting or a.stage == "handle") and self.v[a.index] == 0 for a in self.agents],
+            dtype=bool,
+        )
+
+    def crowded(self, i: int) -> bool:
+        """Whether another robot is within the standoff of robot `i` (it stays parked then)."""
+        gaps = box_gaps(self.pose[i, :2], self.half[i], np.column_stack([self.pose[:, :2], self.half]))
+        gaps[i] = np.inf
+        return bool((gaps < self.settings.dwa.standoff).any())
+
+    def box_velocity(self, names: list[str]) -> np.ndarray:
+        """Current velocities (mm/s) of the boxes of :meth:`boxes`: sensed, for prediction only."""
+        vel = np.zeros((len(names), 2))
+        n_obj = len(names) - len(self.rids) - len(self.walkers)
+        heading = self.pose[:, 2]
+        vel[n_obj : n_obj + len(self.rids)] = np.column_stack(
+            [self.v * np.cos(heading), self.v * np.sin(heading)]
+        )
+        for k, walker in enumerate(self.walkers):
+            vel[n_obj + len(self.rids) + k] = walker.velocity
+        return vel
+
+    def box_accel(self, names: list[str]) -> np.ndarray:
+        """Acceleration limits of the boxes of :meth:`boxes` (objects 0, people unknown: inf)."""
+        acc = np.zeros(len(names))
+        n_obj = len(names) - len(self.rids) - len(self.walkers)
+        acc[n_obj : n_obj + len(self.rids)] = np.where(self.parked(), 0.0, self.limits[:, 1])
+        acc[n_obj + len(self.rids) :] = np.inf
+        return acc
+
+    def static_gap(self, point: tuple[float, ...], half: float) -> float:
+        """L-infinity gap (mm) of a square at `point` to the walls and resting objects."""
+        gap = math.inf
+        p = np.array(point[:2], dtype=float)
+        if len(self.walls):
+            gap = float((point_segment_linf(p, self.walls) - half).min())
+        keep = self.carried_by < 0
+        if keep.any():
+            boxes = np.column_stack([self.obj_pos[keep], self.obj_half[keep]])
+            gap = min(gap, float(box_gaps(p, half, boxes).min()))
+        return gap
+
+    def static_boxes(self, robot: int, goal: tuple[float, ...] | None = None) -> np.ndarray:
+        """What the global path of robot `robot` avoids: resting objects and parked robots.
+
+        A robot that waits for a message, docks, handles an object or has finished stands
+        still for a while, so the others plan around it instead of queueing behind it.
+        """
+        keep = self.carried_by < 0
+        boxes = [np.column_stack([self.obj_pos[keep], self.obj_half[keep]])]
+        parked = [
+            a.index
+            for a in self.agents
+            if a.index != robot and (a.done or a.waiting or a.stage is not None) and self.v[a.index] == 0
+        ]
+        if parked:
+            half = self.half[parked].copy()
+            if goal is not None:
+                # A parked robot stops up to the goal tolerance from its own goal, so a goal
+                # planned right beside it may lie a little inside: shrink that one, so that
+                # the goal stays reachable (the path is a guide; the dynamic window keeps the
+                # real distance).
+                reach = np.abs(self.pose[parked, :2] - np.asarray(goal[:2])).max(axis=1)
+                inside = reach < half + self.half[robot]
+                half[inside] = np.minimum(half[inside], np.maximum(reach[inside] - self.half[robot], 1.0))
+            boxes.append(np.column_stack([self.pose[parked, :2], half]))
+        return np.vstack(boxes).reshape(-1, 3)
+
+    # -- messages ----------------------------------------------------------------------------
+
+    def send(self, agent: _Agent, obj: str) -> None:
+        """Answer the next request about `obj`: the k-th Res(obj) answers the k-th such event."""
+        sender = agent.id
+        requesters = [
+            e.robot for e in agent.mission if e.kind == "away" and e.obj == obj and e.robot != sender
+        ]
+        sent = agent.answered.get(obj, 0)
+        agent.answered[obj] = sent + 1
+        receiver = requesters[min(sent, len(requesters) - 1)]
+        event = f"away({obj},{receiver},{sender})"
+        self.messages.append(Message(round(self.t, 6), sender, receiver, obj, event))
+        self.inbox.add((obj, receiver))
+
+
+def wait_in_place(scene, robot: str, plan: RobotPlan) -> RobotPlan:
+    """The plan with every run of requests issued before the drive that precedes it.
+
+    A plan may drive somewhere and then wait there for another robot's answer (``GoTo``,
+    ``Req``).  Where a robot waits does not matter to the mission, but a robot parked next to
+    the objects can stand in the way of the very robot it waits for.  Requests are therefore
+    moved before the drive when the reordered plan still passes the exact plan checker (the
+    drive then meets fewer objects: the requested ones are away); otherwise the plan is kept.
+    """
+    actions: list[tuple] = [
+        ("GoTo", st.robot) if st.primitive == "GoTo" else (st.primitive, st.object) for st in plan.steps
+    ]
+    k, changed = 0, False
+    while k < len(actions):
+        if actions[k][0] == "Req" and k > 0 and actions[k - 1][0] == "GoTo":
+            b = k - 1
+            while b > 0 and actions[b - 1][0] == "GoTo":
+                b -= 1
+            e = k
+            while e + 1 < len(actions) and actions[e + 1][0] == "Req":
+                e += 1
+            actions = actions[:b] + actions[k : e + 1] + actions[b:k] + actions[e + 1 :]
+            changed = True
+            k = e + 1
+        else:
+            k += 1
+    if not changed:
+        return plan
+    reordered = plan_from_actions(scene, robot, plan.mission, actions)
+    return reordered if not check_robot_plan(scene, robot, reordered) else plan
+
+
+def _wrap(angle: np.ndarray | float) -> np.ndarray | float:
+    return (np.asarray(angle) + math.pi) % (2 * math.pi) - math.pi
+
+
+# ----------------------------------------------------------------------------------------------
+# The executor: one cycle's decision per robot
+# ----------------------------------------------------------------------------------------------
+
+
+def _decide(world: _World, agent: _Agent) -> tuple[str, Any]:
+    """What `agent` does this cycle: ``("drive", (target, stop))``, ``("move", (v, w))`` or
+    ``("dock", pose)``."""
+    i = agent.index
+    brake = ("move", (max(0.0, world.v[i] - world.limits[i, 2] * world.dt), 0.0))
+    while not agent.done:
+        step = agent.step
+        prim = step.primitive
+        if prim == "GoTo":
+            action = _goto(world, agent, step)
+        elif prim in ("PickUp", "DropOff"):
+            action = _handle(world, agent, step)
+        elif prim == "Req":
+            agent.waiting = True
+            if world.v[i] > 0:
+                return brake
+            if (step.object, agent.id) in world.inbox and not world.crowded(i):
+                agent.waiting = False
+                action = None
+            else:
+                return brake
+        else:  # Res
+            if world.v[i] > 0:
+                return brake
+            world.send(agent, step.object)
+            action = None
+        if action is not None:
+            return action
+        agent.k += 1  # the step is done
+        agent.left = 0.0
+        agent.phase = "start"
+        agent.stage = None
+        agent.waiting = False
+        agent.path = None
+    return brake
+
+
+def _goto(world: _World, agent: _Agent, step: Step) -> tuple[str, Any] | None:
+    final = agent.k + 1 >= len(agent.steps) or agent.steps[agent.k + 1].primitive != "GoTo"
+    goal = step.robot
+    return _drive(world, agent, goal, final, heading=final)
+
+
+def _drive(
+    world: _World, agent: _Agent, goal: tuple[float, float, float], final: bool, heading: bool
+) -> tuple[str, Any] | None:
+    """Drive towards `goal`; ``None`` once it is reached (and turned to, if `heading`)."""
+    s = world.settings
+    i = agent.index
+    xy = world.pose[i, :2]
+    fresh = agent.phase == "start" or agent.path is None
+    if fresh:
+        agent.path = plan_path(
+            (float(xy[0]), float(xy[1])),
+            (goal[0], goal[1]),
+            float(world.half[i]),
+            world.walls,
+            world.static_boxes(i, goal),
+        ) or GlobalPath(((float(xy[0]), float(xy[1])), (goal[0], goal[1])), 0.0)
+        agent.phase = "drive"
+        agent.room = world.static_gap(goal, float(world.half[i]))
+        agent.best = math.inf
+        agent.since = world.t
+    dist = math.hypot(goal[0] - xy[0], goal[1] - xy[1])
+    tolerance = s.goal_tolerance if final else s.pass_tolerance
+    if agent.phase == "drive" and dist <= tolerance:
+        if not final:
+            return None
+        agent.phase = "turn"
+    if agent.phase == "turn":
+        if world.v[i] > 0:
+            return ("move", (max(0.0, world.v[i] - world.limits[i, 2] * world.dt), 0.0))
+        if not heading:
+            return None
+        error = float(_wrap(math.radians(goal[2]) - world.pose[i, 2]))
+        if abs(math.degrees(error)) <= s.heading_tolerance:
+            return None
+        w = max(-world.limits[i, 3], min(world.limits[i, 3], error / world.dt))
+        return ("move", (0.0, w))
+    target, left = agent.path.lookahead((float(xy[0]), float(xy[1])), s.dwa.lookahead)
+    agent.left = left
+    if left < agent.best - s.stall_progress:
+        agent.best = left
+        agent.since = world.t
+    elif world.t - agent.since > s.detour_time and world.t >= agent.detour_until:
+        _detour(world, agent, goal)
+    elif world.t - agent.since > s.stall_time:
+        _stalled(world, agent)
+        agent.since = world.t
+        agent.best = math.inf
+        if agent.phase == "start":
+            return _decide(world, agent)
+    stop = left if final else math.inf
+    return ("drive", (target, stop, agent.room))
+
+
+def _detour(world: _World, agent: _Agent, goal: tuple[float, float, float]) -> None:
+    """Plan the global path again, around the robots that block this one and have the right of way.
+
+    Two driving robots can block each other for ever, each waiting for the other to clear
+    its path.  The one with more path left yields: it plans its global path around the other
+    (as if that one stood still) for a while.  Ties go to the robot listed first.  Without
+    such blockers the path is simply planned again (parked robots come and go).
+    """
+    s = world.settings
+    i = agent.index
+    agent.detour_until = world.t + s.detour_time
+    gaps = box_gaps(world.pose[i, :2], world.half[i], np.column_stack([world.pose[:, :2], world.half]))
+    parked = world.parked()  # (already in the static boxes)
+    blockers = [
+        j
+        for j, other in enumerate(world.agents)
+        if j != i
+        and not parked[j]
+        and gaps[j] < s.sense_range
+        and (other.left < agent.left or (other.left == agent.left and j < i))
+    ]
+    xy = (float(world.pose[i, 0]), float(world.pose[i, 1]))
+    boxes = np.vstack(
+        [world.static_boxes(i, goal), np.column_stack([world.pose[blockers, :2], world.half[blockers]])]
+    )
+    path = plan_path(xy, (goal[0], goal[1]), float(world.half[i]), world.walls, boxes)
+    if path is None:
+        return
+    world.detours += int(bool(blockers))
+    agent.path = path
+    agent.best = path.length
+
+
+def _handle(world: _World, agent: _Agent, step: Step) -> tuple[str, Any] | None:
+    """PickUp or DropOff: dock, then let the gripper work."""
+    s = world.settings
+    i = agent.index
+    j = world.oids.index(step.object)
+    gap = world.half[i] + world.obj_half[j]
+    if step.primitive == "PickUp":
+        ox, oy = world.obj_pos[j]
+        dock = (float(ox - gap), float(oy), 0.0)
+    else:
+        dock = (float(step.robot[0]), float(step.robot[1]), 0.0)
+    if agent.stage is None:
+        offset = math.hypot(dock[0] - world.pose[i, 0], dock[1] - world.pose[i, 1])
+        agent.stage = "dock" if offset <= s.dock_tolerance else "approach"
+    if agent.stage == "approach":  # not where the plan said: drive to the docking pose first
+        action = _drive(world, agent, dock, final=True, heading=True)
+        if action is not None:
+            return action
+        agent.stage = "dock"
+    if agent.stage == "dock":
+        if step.primitive == "PickUp":
+            agent.grip = j
+        if world.v[i] > 0:
+            return ("move", (max(0.0, world.v[i] - world.limits[i, 2] * world.dt), 0.0))
+        offset = math.hypot(dock[0] - world.pose[i, 0], dock[1] - world.pose[i, 1])
+        error = abs(float(_wrap(-world.pose[i, 2])))
+        there = offset < 1e-9 and error < 1e-9
+        if not there and _dock_safe(world, i, agent):
+            return ("dock", dock)
+        if not there and (offset > s.reach or error > math.radians(s.heading_tolerance)):
+            return ("move", (0.0, 0.0))  # blocked: wait (the gripper cannot reach from here)
+        if step.primitive == "DropOff" and not _drop_clear(world, i, j, _drop_spot(world, agent, step, j)):
+            return ("move", (0.0, 0.0))
+        agent.stage = "handle"
+        agent.timer = s.handling_time
+    if agent.stage == "handle":
+        agent.timer -= world.dt
+        if agent.timer > 1e-9 or world.crowded(i):
+            return ("move", (0.0, 0.0))
+        if step.primitive == "PickUp":
+            world.carried_by[j] = i
+            agent.grip = None
+            return None
+        world.obj_pos[j] = _drop_spot(world, agent, step, j)
+        world.carried_by[j] = -1
+        agent.grip = j  # touching it until the robot has backed off
+        agent.stage = "release"
+    if agent.stage == "release":
+        return _release(world, agent, j)
+    return ("move", (0.0, 0.0))
+
+
+def _release(world: _World, agent: _Agent, j: int) -> tuple[str, Any] | None:
+    """Leave a dropped object: turn away from it (it lies at +x) and back off straight.
+
+    Driving in -x strictly widens the gap to an object at +x, so the gripper's contact ends
+    without the robot ever moving towards it; every other obstacle is checked as in docking.
+    """
+    s = world.settings
+    i = agent.index
+    sep = box_gaps(world.pose[i, :2], world.half[i], np.array([[*world.obj_pos[j], world.obj_half[j]]]))
+    brake = ("move", (max(0.0, world.v[i] - world.limits[i, 2] * world.dt), 0.0))
+    if float(sep[0]) >= s.release_gap:
+        if world.v[i] > 0:
+            return brake
+        agent.grip = None
+        return None
+    error = float(_wrap(math.pi - world.pose[i, 2]))
+    if abs(error) > 1e-6:
+        if world.v[i] > 0:
+            return brake
+        return ("move", (0.0, max(-world.limits[i, 3], min(world.limits[i, 3], error / world.dt))))
+    if not _dock_safe(world, i, agent):
+        return brake
+    return ("move", (s.dock_speed, 0.0))
+
+
+def _drop_spot(world: _World, agent: _Agent, step: Step, j: int) -> np.ndarray:
+    """Where the gripper puts object `j` down: where the plan puts it (within reach of the robot)."""
+    planned = step.objects.get(world.oids[j])
+    if planned is not None:
+        return np.array(planned.position, dtype=float)
+    i = agent.index
+    return np.array([world.pose[i, 0] + world.half[i] + world.obj_half[j], world.pose[i, 1]])
+
+
+def _drop_clear(world: _World, i: int, j: int, spot: np.ndarray) -> bool:
+    """Whether object `j` may be put at `spot` by robot `i` now.
+
+    A new object must not appear inside another robot's stopping distance (that robot could
+    no longer brake in time: passive safety assumes resting obstacles stay where they are) nor
+    on a person.
+    """
+    others = [k for k in range(len(world.rids)) if k != i]
+    if others:
+        gaps = box_gaps(
+            world.pose[others, :2], world.half[others][:, None], np.array([[*spot, world.obj_half[j]]])
+        )
+        need = [
+            stopping_margin(world.v[k], 0.0, world.dynamics[k]) + world.settings.dwa.standoff for k in others
+        ]
+        if (gaps[:, 0] <= np.array(need)).any():
+            return False
+    if world.walkers:
+        people = np.column_stack([np.array([w.position for w in world.walkers]), world.human_half])
+        if (box_gaps(spot, world.obj_half[j], people) <= _TOUCH).any():
+            return False
+    return True
+
+
+def _stalled(world: _World, agent: _Agent) -> None:
+    """Receding horizon: replan the remaining mission with the sensed robots and people."""
+    s = world.settings
+    if not s.replan:
+        return
+    i = agent.index
+    world.replan_attempts += 1
+    boxes, _, names = world.boxes()
+    gaps = box_gaps(world.pose[i, :2], world.half[i], boxes)
+    sensed = [
+        (float(b[0]), float(b[1]), float(b[2]) + 10.0)
+        for b, n, g in zip(boxes, names, gaps, strict=True)
+        if n != agent.id and n not in world.oids and g < s.sense_range
+    ]
+    done_steps = agent.steps[: agent.k]
+    remaining = _remaining_events(agent.mission, done_steps, agent.id)
+    objects = {}
+    for j, oid in enumerate(world.oids):
+        carried = world.carried_by[j] == i
+        away = world.carried_by[j] >= 0 and not carried
+        away = away or any(st.primitive == "Req" and st.object == oid for st in done_steps)
+        pos = world.obj_pos[j]
+        objects[oid] = ObjectState(
+            (round(float(pos[0])), round(float(pos[1]))), carried=bool(carried), away=away
+        )
+    x, y, h = world.pose[i]
+    start = State((round(float(x)), round(float(y)), round(math.degrees(float(h)))), objects)
+    plan = replan(
+        world.scenario.scene,
+        agent.id,
+        remaining,
+        start,
+        sensed,
+        max_horizon=s.max_horizon,
+        rlimit=s.rlimit,
+    )
+    if plan is None:
+        return
+    world.replans += 1
+    agent.steps = done_steps + list(plan.steps)
+    agent.phase = "start"
+    agent.stage = None
+    agent.path = None
+
+
+def _remaining_events(mission: list[Event], done: list[Step], robot: str) -> list[Event]:
+    """The mission events that the executed steps have not realised yet, in order."""
+    k = 0
+    for n, event in enumerate(mission):
+        if event.kind == "return":
+            if n == len(mission) - 1:
+                return mission[n:]
+            continue
+        want = {"pick": "PickUp", "drop": "DropOff"}.get(event.kind)
+        if want is None:
+            want = "Req" if event.robot == robot else "Res"
+        while k < len(done) and not (done[k].primitive == want and done[k].object == event.obj):
+            k += 1
+        if k >= len(done):
+            return mission[n:]
+        k += 1
+    return []
+
+
+# ----------------------------------------------------------------------------------------------
+# One cycle of physics and monitoring
+# ----------------------------------------------------------------------------------------------
+
+
+def _integrate(world: _World, v_cmd: np.ndarray, w_cmd: np.ndarray, docks: dict[int, tuple]) -> np.ndarray:
+    """Move every robot for one cycle: constant acceleration towards `v_cmd` and turn rate.
+
+    Returns each robot's translational speed at the end of the cycle, mm/s: what the monitor
+    calls moving.  A docking creep is a stop-and-go no faster than one cycle's braking, so the
+    robot is at rest at the start of every docking cycle and moving until it is on the pose.
+    """
+    dt = world.dt
+    acc, brk = world.limits[:, 1], world.limits[:, 2]
+    v0 = world.v
+    v1 = np.clip(v_cmd, np.maximum(0.0, v0 - brk * dt), v0 + acc * dt)
+    v1 = np.minimum(v1, world.limits[:, 0])
+    start = world.pose[:, :2].copy()
+    n = 4
+    for k in range(n):  # midpoint rule on sub-steps: exact enough for 0.1 s cycles
+        tm = (k + 0.5) / n
+        v = v0 + (v1 - v0) * tm
+        theta = world.pose[:, 2] + w_cmd * dt / (2 * n)
+        world.pose[:, 0] += v * np.cos(theta) * dt / n
+        world.pose[:, 1] += v * np.sin(theta) * dt / n
+        world.pose[:, 2] += w_cmd * dt / n
+    world.pose[:, 2] = _wrap(world.pose[:, 2])
+    world.v = v1
+    world.w = w_cmd.copy()
+    moving = v1.copy()
+    for i, dock in docks.items():  # the docking controller: straight, slow, exact at the end
+        x, y, h = world.pose[i]
+        dx, dy = dock[0] - x, dock[1] - y
+        dist = math.hypot(dx, dy)
+        # Creep no faster than the robot can stop within one cycle: it halts exactly on the pose.
+        step = min(world.settings.dock_speed, world.limits[i, 2] * dt) * dt
+        if dist <= step:
+            world.pose[i, 0], world.pose[i, 1] = dock[0], dock[1]
+        else:
+            world.pose[i, 0] += dx * step / dist
+            world.pose[i, 1] += dy * step / dist
+        error = float(_wrap(math.radians(dock[2]) - h))
+        turn = world.limits[i, 3] * dt
+        world.pose[i, 2] = math.radians(dock[2]) if abs(error) <= turn else h + math.copysign(turn, error)
+        world.v[i] = 0.0
+        world.w[i] = 0.0
+        moving[i] = 0.0 if dist <= step else step / dt
+    world.distance += np.hypot(*(world.pose[:, :2] - start).T)
+    return moving
+
+
+def _monitor(world: _World, moving_speed: np.ndarray) -> None:
+    """Record contacts: new touching pairs, and whether the robot moves while touching."""
+    boxes, _, names = world.boxes()
+    R = len(world.rids)
+    wall_gap = (
+        point_segment_linf(world.pose[:, :2], world.walls) - world.half[:, None]
+        if len(world.walls)
+        else np.zeros((R, 0))
+    )
+    box_gap = box_gaps(world.pose[:, :2], world.half[:, None], boxes) if len(boxes) else np.zeros((R, 0))
+    now: set[tuple[int, str]] = set()
+    for i, agent in enumerate(world.agents):
+        for w in np.flatnonzero(wall_gap[i] <= _TOUCH):
+            now.add((i, f"wall {int(w)}"))
+        for b in np.flatnonzero(box_gap[i] <= _TOUCH):
+            name = names[b]
+            if name == agent.id:
+                continue
+            gripped = agent.grip is not None and name == world.oids[agent.grip]
+            if gripped and box_gap[i, b] >= -_TOUCH:
+                continue  # the gripper's contact with its own object
+            now.add((i, name))
+        if agent.grip is not None and world.carried_by[agent.grip] < 0 and agent.stage is None:
+            j = agent.grip
+            sep = box_gaps(
+                world.pose[i, :2], world.half[i], np.array([[*world.obj_pos[j], world.obj_half[j]]])
+            )
+            if float(sep[0]) > 1.0:
+                agent.grip = None
+    for pair in list(world.touching):
+        if pair not in now:
+            del world.touching[pair]
+    for pair in now:
+        moving = bool(moving_speed[pair[0]] > 0)
+        if pair not in world.touching:
+            world.touching[pair] = len(world.contacts)
+            world.contacts.append(Contact(round(world.t, 6), world.rids[pair[0]], pair[1], moving))
+        elif moving and not world.contacts[world.touching[pair]].moving:
+            c = world.contacts[world.touching[pair]]
+            world.contacts[world.touching[pair]] = Contact(c.t, c.robot, c.other, True)
+
+
+# ----------------------------------------------------------------------------------------------
+# The entry point
+# ----------------------------------------------------------------------------------------------
+
+
+def simulate(
+    scenario: Scenario,
+    plans: PlanSet,
+    *,
+    seed: int = 0,
+    settings: SimSettings | None = None,
+    on_cycle: Callable[[float, int, int], None] | None = None,
+) -> SimResult:
+    """Execute a plan set in the scenario's world with moving people; monitor safety.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The scene (walls, robots with their ``dynamics``, objects, workspaces, ``humans``).
+    plans : PlanSet
+        A feasible ``cosmop.plan/1`` plan set for the scenario (with its coordination pairs).
+    seed : int
+        Seeds the people's random walks; the run is deterministic given the seed.
+    settings : SimSettings, optional
+    on_cycle : callable, optional
+        Called every cycle with ``(t, robots done, robots)`` (the CLI's progress bar).
+
+    Returns
+    -------
+    SimResult
+    """
+    settings = settings or SimSettings()
+    if not plans.feasible:
+        raise ValueError(f"the plan set is infeasible: {plans.reason}")
+    wall0 = time.perf_counter()
+    world = _World(scenario, plans, seed, settings)
+    R, H, n_obj = len(world.rids), len(world.walkers), len(world.oids)
+    n_max = math.ceil(settings.max_time / world.dt)
+    rec: dict[str, list] = {
+        k: [] for k in ("t", "pose", "v", "w", "carrying", "primitive", "waiting", "humans", "objects")
+    }
+    completed = False
+    cycles = 0
+    self_mask = None
+    _record(world, rec)
+    for _ in range(n_max):
+        boxes, speeds, names = world.boxes()
+        if self_mask is None or self_mask.shape[1] != len(names):
+            self_mask = np.array([[n == rid for n in names] for rid in world.rids]).reshape(R, len(names))
+        v_cmd = world.v.copy()
+        w_cmd = np.zeros(R)
+        docks: dict[int, tuple] = {}
+        driving, targets, stops, caps = [], [], [], []
+        for agent in world.agents:
+            kind, arg = _decide(world, agent)
+            i = agent.index
+            if kind == "drive":
+                driving.append(i)
+                targets.append(arg[0])
+                stops.append(arg[1])
+                caps.append(arg[2])
+            elif kind == "dock":
+                docks[i] = arg
+            else:
+                v_cmd[i], w_cmd[i] = arg
+        if driving:
+            idx = np.array(driving)
+            grip = np.zeros((len(idx), len(names)), dtype=bool)
+            for row, i in enumerate(driving):
+                g = world.agents[i].grip
+                if g is not None and world.oids[g] in names:  # (a drop this cycle is sensed next cycle)
+                    grip[row, names.index(world.oids[g])] = True
+            cmd = dwa_commands(
+                world.pose[idx],
+                world.v[idx],
+                world.half[idx],
+                world.limits[idx],
+                np.array(targets, dtype=float),
+                np.array(stops, dtype=float),
+                world.walls,
+                boxes,
+                speeds,
+                self_mask[idx],
+                settings.dwa,
+                grip=grip,
+                box_velocity=world.box_velocity(names),
+                room_cap=np.array(caps, dtype=float),
+                box_accel=world.box_accel(names),
+                w_now=world.w[idx],
+                agents=np.array([n in world.rids or n in world.hids for n in names], dtype=bool),
+            )
+            v_cmd[idx] = cmd.v
+            w_cmd[idx] = cmd.w
+        moving = _integrate(world, v_cmd, w_cmd, docks)
+        for walker in world.walkers:
+            walker.step(world.dt)
+        world.t += world.dt
+        cycles += 1
+        _monitor(world, moving)
+        _record(world, rec)
+        done = sum(a.done for a in world.agents)
+        if on_cycle is not None:
+            on_cycle(world.t, done, R)
+        if done == R and not world.v.any():
+            completed = True
+            break
+    frames = {k: np.array(v) for k, v in rec.items()}
+    n = len(frames["t"])
+    frames["pose"] = frames["pose"].reshape(n, R, 3)
+    frames["humans"] = frames["humans"].reshape(n, H, 2)
+    frames["objects"] = frames["objects"].reshape(n, n_obj, 2)
+    return SimResult(
+        scenario=scenario.name,
+        completed=completed,
+        sim_time_s=world.t,
+        wall_time_s=time.perf_counter() - wall0,
+        cycles=cycles,
+        dt=world.dt,
+        contacts=tuple(world.contacts),
+        replans=world.replans,
+        replan_attempts=world.replan_attempts,
+        messages=tuple(world.messages),
+        objects={
+            oid: (
+                tuple(float(x) for x in _object_position(world, j)),
+                world.rids[world.carried_by[j]] if world.carried_by[j] >= 0 else None,
+            )
+            for j, oid in enumerate(world.oids)
+        },
+        robots={
+            rid: (
+                (float(world.pose[i, 0]), float(world.pose[i, 1]), math.degrees(float(world.pose[i, 2]))),
+                float(world.distance[i]),
+            )
+            for i, rid in enumerate(world.rids)
+        },
+        frames=frames,
+        finished={a.id: a.done for a in world.agents},
+        robot_ids=world.rids,
+        human_ids=world.hids,
+        object_ids=world.oids,
+    )
+
+
+def _dock_safe(world: _World, i: int, agent: _Agent) -> bool:
+    """Passive safety of a slow docking or release move, with the gripper's object left out."""
+    boxes, speeds, names = world.boxes()
+    skip = {agent.id}
+    if agent.grip is not None:
+        skip.add(world.oids[agent.grip])
+    keep = [b for b, n in enumerate(names) if n not in skip]
+    dyn = world.dynamics[i]
+    speed = min(world.settings.dock_speed, world.limits[i, 2] * world.dt)
+    gaps = box_gaps(world.pose[i, :2], world.half[i], boxes[keep]) if keep else np.zeros(0)
+    now = np.hypot(*world.box_velocity(names)[keep].T) if keep else np.zeros(0)
+    bound = obstacle_speed(stopping_horizon(speed, dyn), speeds[keep], now, world.box_accel(names)[keep])
+    ok = bool(np.all(is_safe(gaps, speed, bound, dyn)))
+    if len(world.walls):
+        wall_gap = point_segment_linf(world.pose[i, :2], world.walls) - world.half[i]
+        ok = ok and bool(np.all(is_safe(wall_gap, speed, 0.0, dyn)))
+    return ok
+
+
+def _object_position(world: _World, j: int) -> np.ndarray:
+    carrier = world.carried_by[j]
+    return world.pose[carrier, :2] if carrier >= 0 else world.obj_pos[j]
+
+
+def _record(world: _World, rec: dict[str, list]) -> None:
+    rec["t"].append(world.t)
+    pose = world.pose.copy()
+    pose[:, 2] = np.degrees(pose[:, 2])
+    rec["pose"].append(pose)
+    rec["v"].append(world.v.copy())
+    rec["w"].append(np.degrees(world.w))
+    carrying = np.full(len(world.rids), -1)
+    for j, r in enumerate(world.carried_by):
+        if r >= 0:
+            carrying[r] = j
+    rec["carrying"].append(carrying)
+    rec["primitive"].append(
+        np.array([0 if a.done else _PRIMITIVES.index(a.step.primitive) for a in world.agents])
+    )
+    rec["waiting"].append(np.array([a.waiting for a in world.agents]))
+    rec["humans"].append(np.array([w.position for w in world.walkers]).reshape(-1, 2))
+    positions = world.obj_pos.copy()
+    for j, r in enumerate(world.carried_by):
+        if r >= 0:
+            positions[j] = world.pose[r, :2]
+    rec["objects"].append(positions)
+
+
+def parse_plan_events(names: tuple[str, ...]) -> tuple[Event, ...]:
+    """Mission event names as events (helper for callers holding raw plan files)."""
+    return tuple(parse_event(n) for n in names)
