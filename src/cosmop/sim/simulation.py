@@ -95,8 +95,9 @@ class SimSettings:
     dock_speed : float
         Speed of the docking controller, mm/s (at most one cycle's braking, :math:`b\varepsilon`).
     reach : float
-        How far (mm) the gripper reaches: docking blocked closer than this to its pose still
-        picks up or drops off; a drop puts the object where the plan puts it.
+        How far (mm) the gripper reaches: a pick-up whose docking is blocked closer than this
+        to its pose still picks the object up.  A drop waits for the exact pose: the object
+        goes exactly where the plan puts it (in its workspace).
     handling_time : float
         Seconds the gripper needs to pick up or drop off.
     release_gap : float
@@ -342,6 +343,7 @@ class _Agent:
         self.since = 0.0  # time of the last progress
         self.waiting = False
         self.answered: dict[str, int] = {}  # Res sent per object
+        self.leave: float | None = None  # heading that backs off from a dropped object
 
     @property
     def done(self) -> bool:
@@ -712,9 +714,10 @@ def _handle(world: _World, agent: _Agent, step: Step) -> tuple[str, Any] | None:
         offset = math.hypot(dock[0] - world.pose[i, 0], dock[1] - world.pose[i, 1])
         error = abs(float(_wrap(-world.pose[i, 2])))
         there = offset < 1e-9 and error < 1e-9
-        if not there and _dock_safe(world, i, agent):
+        if not there and _dock_safe(world, i, agent, dock):
             return ("dock", dock)
-        if not there and (offset > s.reach or error > math.radians(s.heading_tolerance)):
+        reach = s.reach if step.primitive == "PickUp" else 0.0  # a drop goes exactly where planned
+        if not there and (offset > reach or error > math.radians(s.heading_tolerance)):
             return ("move", (0.0, 0.0))  # blocked: wait (the gripper cannot reach from here)
         if step.primitive == "DropOff" and not _drop_clear(world, i, j, _drop_spot(world, agent, step, j)):
             return ("move", (0.0, 0.0))
@@ -738,10 +741,12 @@ def _handle(world: _World, agent: _Agent, step: Step) -> tuple[str, Any] | None:
 
 
 def _release(world: _World, agent: _Agent, j: int) -> tuple[str, Any] | None:
-    """Leave a dropped object: turn away from it (it lies at +x) and back off straight.
+    """Leave a dropped object: turn away from it and back off straight.
 
-    Driving in -x strictly widens the gap to an object at +x, so the gripper's contact ends
-    without the robot ever moving towards it; every other obstacle is checked as in docking.
+    The heading is chosen once, among those facing away from the object (it lies at +x), as the
+    straight move that opens the gap to every wall and resting object it touches fastest (a
+    drop pose may touch a wall as well), so the robot never slides along anything it touches;
+    robots and people are checked as in docking.
     """
     s = world.settings
     i = agent.index
@@ -751,15 +756,48 @@ def _release(world: _World, agent: _Agent, j: int) -> tuple[str, Any] | None:
         if world.v[i] > 0:
             return brake
         agent.grip = None
+        agent.leave = None
         return None
-    error = float(_wrap(math.pi - world.pose[i, 2]))
+    if agent.leave is None:
+        agent.leave = _leave_heading(world, i)
+    error = float(_wrap(agent.leave - world.pose[i, 2]))
     if abs(error) > 1e-6:
         if world.v[i] > 0:
             return brake
         return ("move", (0.0, max(-world.limits[i, 3], min(world.limits[i, 3], error / world.dt))))
-    if not _dock_safe(world, i, agent):
+    if not _dock_safe(world, i, agent, _ahead(world, i, s.release_gap + 10.0)):
         return brake
     return ("move", (s.dock_speed, 0.0))
+
+
+def _static_gap_at(world: _World, i: int, points: np.ndarray) -> np.ndarray:
+    """Smallest gap (mm) of robot `i`'s square at `points` to walls and resting objects."""
+    gap = np.full(len(points), np.inf)
+    if len(world.walls):
+        gap = np.minimum(gap, (point_segment_linf(points, world.walls) - world.half[i]).min(axis=1))
+    keep = world.carried_by < 0
+    if keep.any():
+        boxes = np.column_stack([world.obj_pos[keep], world.obj_half[keep]])
+        gap = np.minimum(gap, box_gaps(points, world.half[i], boxes).min(axis=1))
+    return gap
+
+
+def _leave_heading(world: _World, i: int) -> float:
+    """The heading (rad) away from +x whose straight move opens the static gaps best."""
+    headings = np.radians(np.arange(95.0, 270.0, 5.0))
+    units = np.column_stack([np.cos(headings), np.sin(headings)])
+    xy = world.pose[i, :2]
+    near = _static_gap_at(world, i, xy[None, :] + 2.0 * units)
+    far = _static_gap_at(world, i, xy[None, :] + 40.0 * units)
+    now = float(_static_gap_at(world, i, xy[None, :])[0])
+    score = np.where(near > now - 1e-9, far, -np.inf)  # opening at once, then as wide as possible
+    return float(headings[int(np.argmax(score))])
+
+
+def _ahead(world: _World, i: int, distance: float) -> tuple[float, float, float]:
+    """The pose `distance` mm straight ahead of robot `i`."""
+    x, y, h = world.pose[i]
+    return (float(x + distance * math.cos(h)), float(y + distance * math.sin(h)), 0.0)
 
 
 def _drop_spot(world: _World, agent: _Agent, step: Step, j: int) -> np.ndarray:
@@ -1096,23 +1134,47 @@ def simulate(
     )
 
 
-def _dock_safe(world: _World, i: int, agent: _Agent) -> bool:
-    """Passive safety of a slow docking or release move, with the gripper's object left out."""
+def _dock_safe(world: _World, i: int, agent: _Agent, target: tuple | None = None) -> bool:
+    """Passive safety of a slow docking or release move, with the gripper's object left out.
+
+    Moving obstacles (robots, people) need the paper's ``safe`` at the creep speed.  Towards a
+    docking `target` the creep is a straight move that stops exactly on it, so walls and
+    resting objects only need to stay clear of that short segment (touching allowed: a
+    docking pose may touch a wall, as the plan allows).
+    """
     boxes, speeds, names = world.boxes()
     skip = {agent.id}
     if agent.grip is not None:
         skip.add(world.oids[agent.grip])
-    keep = [b for b, n in enumerate(names) if n not in skip]
+    movers = [
+        b
+        for b, n in enumerate(names)
+        if n not in skip and (speeds[b] > 0 or n in world.rids or n in world.hids)
+    ]
+    still = [b for b, n in enumerate(names) if n not in skip and b not in movers]
     dyn = world.dynamics[i]
     speed = min(world.settings.dock_speed, world.limits[i, 2] * world.dt)
-    gaps = box_gaps(world.pose[i, :2], world.half[i], boxes[keep]) if keep else np.zeros(0)
-    now = np.hypot(*world.box_velocity(names)[keep].T) if keep else np.zeros(0)
-    bound = obstacle_speed(stopping_horizon(speed, dyn), speeds[keep], now, world.box_accel(names)[keep])
-    ok = bool(np.all(is_safe(gaps, speed, bound, dyn)))
+    xy = world.pose[i, :2]
+    if movers:
+        gaps = box_gaps(xy, world.half[i], boxes[movers])
+        now = np.hypot(*world.box_velocity(names)[movers].T)
+        bound = obstacle_speed(
+            stopping_horizon(speed, dyn), speeds[movers], now, world.box_accel(names)[movers]
+        )
+        if not np.all(is_safe(gaps, speed, bound, dyn)):
+            return False
+    if target is None:
+        if still and not np.all(is_safe(box_gaps(xy, world.half[i], boxes[still]), speed, 0.0, dyn)):
+            return False
+        if len(world.walls):
+            return bool(np.all(is_safe(point_segment_linf(xy, world.walls) - world.half[i], speed, 0.0, dyn)))
+        return True
+    path = xy[None, :] + np.linspace(0.0, 1.0, 12)[:, None] * (np.asarray(target[:2]) - xy)[None, :]
+    if still and (box_gaps(path, world.half[i], boxes[still]) < -1e-6).any():
+        return False
     if len(world.walls):
-        wall_gap = point_segment_linf(world.pose[i, :2], world.walls) - world.half[i]
-        ok = ok and bool(np.all(is_safe(wall_gap, speed, 0.0, dyn)))
-    return ok
+        return bool((point_segment_linf(path, world.walls) - world.half[i] >= -1e-6).all())
+    return True
 
 
 def _object_position(world: _World, j: int) -> np.ndarray:

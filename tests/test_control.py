@@ -1,0 +1,126 @@
+"""Passive safety, L-infinity geometry, global paths and people's walks."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+from shapely.geometry import LineString
+
+from cosmop.control import admissible_speed, is_safe, plan_path, point_segment_linf, segment_array
+from cosmop.planning import overlaps, swept_square
+from cosmop.planning.checker import square
+from cosmop.scenario import Dynamics, Human
+from cosmop.sim.humans import Walker
+
+DYN = Dynamics()
+
+
+@given(
+    gap=st.floats(0.0, 5000.0),
+    v=st.floats(0.0, 750.0),
+    speed=st.floats(0.0, 1500.0),
+)
+def test_corollary_speed_is_the_bound_of_safe(gap, v, speed):
+    bound = float(admissible_speed(gap, speed, DYN))
+    if abs(v - bound) > 1e-6:
+        assert bool(is_safe(gap, v, speed, DYN)) == (v < bound)
+
+
+def test_safe_keeps_stopping_distance():
+    # Braking from any admissible speed with an obstacle closing at V never closes the gap.
+    a, b, eps = DYN.acceleration, DYN.braking, DYN.cycle
+    for gap in (50.0, 300.0, 1500.0):
+        for V in (0.0, 600.0):
+            v = float(admissible_speed(gap, V, DYN)) - 1e-6
+            if v <= 0:
+                continue
+            # worst case: accelerate for one cycle, then brake; the obstacle runs at V meanwhile
+            v1 = v + a * eps
+            travel = v * eps + a * eps**2 / 2 + v1**2 / (2 * b)
+            closing = V * (eps + v1 / b)
+            assert travel + closing < gap
+
+
+@given(
+    px=st.floats(-3000, 3000),
+    py=st.floats(-3000, 3000),
+    seg=st.tuples(*[st.floats(-3000, 3000)] * 4),
+)
+def test_linf_distance_to_segment_matches_sampling(px, py, seg):
+    x1, y1, x2, y2 = seg
+    exact = float(point_segment_linf(np.array([px, py]), np.array([seg]))[0])
+    t = np.linspace(0.0, 1.0, 20001)
+    sampled = np.maximum(np.abs(x1 + t * (x2 - x1) - px), np.abs(y1 + t * (y2 - y1) - py)).min()
+    assert exact <= sampled + 1e-6
+    assert exact >= sampled - np.hypot(x2 - x1, y2 - y1) / 20000 - 1e-6
+
+
+WALLS_2X2 = [
+    ((-2500, -2500), (2500, -2500)),
+    ((2500, -2500), (2500, 2500)),
+    ((2500, 2500), (-2500, 2500)),
+    ((-2500, 2500), (-2500, -2500)),
+    ((0, 0), (0, 2500)),
+    ((-1000, 0), (1000, 0)),
+]
+
+
+@pytest.mark.parametrize(
+    ("start", "goal"),
+    [((-2000, -1000), (-1300, 2000)), ((1250, 2000), (-2000, -2000)), ((1650, -1000), (1250, 2000))],
+)
+def test_global_path_never_crosses_a_wall(start, goal):
+    walls = segment_array(WALLS_2X2)
+    boxes = np.array([[1900.0, -1000.0, 50.0]])
+    path = plan_path(start, goal, 200.0, walls, boxes)
+    assert path is not None and path.points[0] == start and path.points[-1] == goal
+    for a, b in zip(path.points, path.points[1:], strict=False):
+        swept = swept_square(a, b, 400.0)
+        for (x1, y1), (x2, y2) in WALLS_2X2:
+            assert not overlaps(LineString([(x1, y1), (x2, y2)]), swept)
+        assert not overlaps(square(1900, -1000, 100), swept)
+
+
+def test_global_path_reports_no_way():
+    walls = segment_array(
+        [
+            ((-1000, -1000), (1000, -1000)),
+            ((1000, -1000), (1000, 1000)),
+            ((1000, 1000), (-1000, 1000)),
+            ((-1000, 1000), (-1000, -1000)),
+        ]
+    )
+    assert plan_path((0, 0), (3000, 0), 200.0, walls, np.zeros((0, 3))) is None
+
+
+def test_walker_follows_its_path_and_stands():
+    person = Human("H1", 400, 500, ((0, 0, 0), (1000, 0, 2.0), (1000, 1000, 0)), loop=True)
+    walker = Walker(person, np.zeros((0, 4)), np.random.default_rng(0))
+    for _ in range(20):  # 2 s at 500 mm/s: at the second point
+        walker.step(0.1)
+    assert walker.position == pytest.approx([1000, 0])
+    for _ in range(20):  # standing there for 2 s
+        walker.step(0.1)
+    assert walker.position == pytest.approx([1000, 0])
+    speeds = []
+    for _ in range(100):
+        before = walker.position.copy()
+        walker.step(0.1)
+        speeds.append(np.hypot(*(walker.position - before)) / 0.1)
+    assert max(speeds) <= 500 + 1e-6
+
+
+def test_random_walk_is_seeded_and_stays_in_its_area():
+    person = Human("H1", 400, 600, ((0, 0, 0),), walk=((-1000, 1000), (-500, 500)))
+    runs = []
+    for seed in (1, 1, 2):
+        walker = Walker(person, np.zeros((0, 4)), np.random.default_rng(seed))
+        track = []
+        for _ in range(300):
+            walker.step(0.1)
+            track.append(walker.position.copy())
+        runs.append(np.array(track))
+    assert np.array_equal(runs[0], runs[1]) and not np.array_equal(runs[0], runs[2])
+    assert (np.abs(runs[0][:, 0]) <= 1000 + 1e-9).all() and (np.abs(runs[0][:, 1]) <= 500 + 1e-9).all()

@@ -1,0 +1,207 @@
+"""The simulator: the examples complete, people never meet a moving robot, files, CLI."""
+
+from __future__ import annotations
+
+import json
+import multiprocessing
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from cosmop.cli import app
+from cosmop.pipeline import plan_team
+from cosmop.planning import check_robot_plan
+from cosmop.scenario import load_scenario
+from cosmop.sim import SIM_FORMAT, TRACE_FORMAT, SimSettings, simulate, wait_in_place
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+runner = CliRunner()
+
+
+def _planned(name: str):
+    scenario = load_scenario(EXAMPLES / name / "scenario.yaml")
+    return scenario, plan_team(scenario).plans
+
+
+@pytest.fixture(scope="module")
+def warehouse_2x2():
+    return _planned("01_warehouse_2x2")
+
+
+@pytest.fixture(scope="module")
+def people_2x2():
+    return _planned("03_people_2x2")
+
+
+def _assert_done(result, scenario, plans) -> None:
+    assert result.completed, result.finished
+    assert all(result.finished.values())
+    assert result.contacts_while_moving == 0
+    delivered = result.objects_in_workspaces(scenario, plans)
+    assert delivered and all(delivered.values()), delivered
+    for rid, (pose, _) in result.robots.items():  # every mission ends with return
+        home = scenario.scene.robots[rid].pose
+        assert abs(pose[0] - home[0]) <= 20 and abs(pose[1] - home[1]) <= 20, (rid, pose)
+
+
+def test_2x2_completes_with_its_message(warehouse_2x2):
+    scenario, plans = warehouse_2x2
+    result = simulate(scenario, plans)
+    _assert_done(result, scenario, plans)
+    assert [m.event for m in result.messages] == ["away(O2,R1,R2)"]
+    assert result.contacts == ()  # nobody else walks here: no contact at all
+    # R1 asked first and waited: it cannot leave home before R2 answered.
+    i = result.robot_ids.index("R1")
+    left = result.frames["t"][np.argmax(np.any(result.frames["v"][:, [i]] > 0, axis=1))]
+    assert left >= result.messages[0].t
+
+
+def test_10x10_completes():
+    scenario, plans = _planned("02_warehouse_10x10")
+    result = simulate(scenario, plans)
+    _assert_done(result, scenario, plans)
+    assert len(result.messages) == len(plans.coordination)
+    assert {(m.object, m.receiver, m.sender) for m in result.messages} == {
+        (c.object, c.requester, c.responder) for c in plans.coordination
+    }
+
+
+def _run_seed(job):
+    scenario, plans, seed = job
+    result = simulate(scenario, plans, seed=seed, settings=SimSettings(max_time=600))
+    delivered = result.objects_in_workspaces(scenario, plans)
+    return result.completed, result.contacts_while_moving, all(delivered.values()), len(result.contacts)
+
+
+def test_200_seeded_runs_with_people_crossing(people_2x2):
+    scenario, plans = people_2x2
+    jobs = [(scenario, plans, seed) for seed in range(200)]
+    with multiprocessing.get_context("fork").Pool(2) as pool:
+        outcomes = pool.map(_run_seed, jobs)
+    assert all(completed for completed, _, _, _ in outcomes)
+    assert sum(moving for _, moving, _, _ in outcomes) == 0
+    assert all(delivered for _, _, delivered, _ in outcomes)
+    # The people did meet the robots (they walk into standing ones): the test is not vacuous.
+    assert sum(contacts for _, _, _, contacts in outcomes) > 200
+
+
+def test_person_in_the_doorway_makes_r1_wait():
+    scenario, plans = _planned("04_doorway_2x2")
+    result = simulate(scenario, plans)
+    _assert_done(result, scenario, plans)
+    frames, i = result.frames, result.robot_ids.index("R1")
+    entered = frames["t"][np.argmax(frames["pose"][:, i, 1] > 0)]  # into the left room, above y = 0
+    stands = scenario.scene.humans["H1"].path[0][2]
+    assert entered >= stands  # only once the person has left the doorway
+    assert result.replan_attempts >= 1  # it stalled and looked for another way (there is none)
+    free, free_plans = _planned("01_warehouse_2x2")
+    plain = simulate(free, free_plans)
+    plain_entered = plain.frames["t"][np.argmax(plain.frames["pose"][:, i, 1] > 0)]
+    assert entered - plain_entered > 20  # it waited
+
+
+def test_same_seed_same_run(people_2x2):
+    scenario, plans = people_2x2
+    a = simulate(scenario, plans, seed=7, settings=SimSettings(max_time=40))
+    b = simulate(scenario, plans, seed=7, settings=SimSettings(max_time=40))
+    c = simulate(scenario, plans, seed=8, settings=SimSettings(max_time=40))
+    assert np.array_equal(a.frames["pose"], b.frames["pose"])
+    assert np.array_equal(a.frames["humans"], b.frames["humans"])
+    assert not np.array_equal(a.frames["humans"], c.frames["humans"])
+
+
+def test_summary_and_trace_files(tmp_path, people_2x2):
+    scenario, plans = people_2x2
+    result = simulate(scenario, plans, seed=3, settings=SimSettings(max_time=30))
+    result.save_summary(tmp_path / "s.json")
+    result.save_trace(tmp_path / "t.json")
+    summary = json.loads((tmp_path / "s.json").read_text())
+    assert summary["format"] == SIM_FORMAT
+    for key, kind in {
+        "completed": bool,
+        "sim_time_s": float,
+        "wall_time_s": float,
+        "contacts": int,
+        "contacts_while_moving": int,
+        "replans": int,
+    }.items():
+        assert isinstance(summary[key], kind), key
+    assert summary["completed"] is False and summary["sim_time_s"] == pytest.approx(30.0)
+    assert set(summary["objects"]) == {"O1", "O2"}
+    assert set(summary["objects"]["O1"]) == {"position", "carried_by"}
+    assert set(summary["robots"]["R1"]) == {"pose", "distance_mm"}
+    trace = json.loads((tmp_path / "t.json").read_text())
+    assert trace["format"] == TRACE_FORMAT and trace["dt"] == pytest.approx(0.1)
+    assert len(trace["frames"]) == result.cycles + 1  # instant 0 and every cycle
+    frame = trace["frames"][-1]
+    assert set(frame) == {"t", "robots", "humans", "objects"}
+    assert set(frame["robots"]["R1"]) >= {"pose", "v", "w", "carrying"}
+    assert set(frame["humans"]) == {"H1", "H2"}
+
+
+def test_waiting_in_place_keeps_the_plan_sound():
+    scenario, plans = _planned("02_warehouse_10x10")
+    moved = 0
+    for rid, plan in plans.robots.items():
+        reordered = wait_in_place(scenario.scene, rid, plan)
+        assert not check_robot_plan(scenario.scene, rid, reordered)
+        assert sorted(s.primitive for s in reordered.steps) == sorted(s.primitive for s in plan.steps)
+        moved += reordered != plan
+        for k, step in enumerate(reordered.steps[:-1]):  # no request right after a drive any more
+            assert (
+                not (step.primitive == "GoTo" and reordered.steps[k + 1].primitive == "Req")
+                or reordered == plan
+            )
+    assert moved >= 1
+
+
+def test_cli_simulate(tmp_path, warehouse_2x2):
+    _, plans = warehouse_2x2
+    plans.save(tmp_path / "plan.json")
+    result = runner.invoke(
+        app,
+        [
+            "simulate",
+            str(EXAMPLES / "01_warehouse_2x2" / "scenario.yaml"),
+            "--plan",
+            str(tmp_path / "plan.json"),
+            "--summary",
+            str(tmp_path / "summary.json"),
+        ],
+        env={"COLUMNS": "200"},
+    )
+    assert result.exit_code == 0, result.output
+    assert "completed" in result.output
+    assert json.loads((tmp_path / "summary.json").read_text())["completed"] is True
+
+
+def test_cli_simulate_rejects_a_plan_for_another_scenario(tmp_path, warehouse_2x2):
+    _, plans = warehouse_2x2
+    plans.save(tmp_path / "plan.json")
+    result = runner.invoke(
+        app,
+        [
+            "simulate",
+            str(EXAMPLES / "02_warehouse_10x10" / "scenario.yaml"),
+            "--plan",
+            str(tmp_path / "plan.json"),
+            "--summary",
+            str(tmp_path / "summary.json"),
+        ],
+    )
+    assert result.exit_code == 2
+    assert "plan.json" in result.output and "Traceback" not in result.output
+    assert len(result.output.strip().splitlines()) == 1
+    assert not (tmp_path / "summary.json").exists()
+
+
+def test_cli_simulate_bad_plan_file(tmp_path):
+    bad = tmp_path / "plan.json"
+    bad.write_text('{"format": "cosmop.plan/1", "robots": 3}')
+    result = runner.invoke(
+        app, ["simulate", str(EXAMPLES / "01_warehouse_2x2" / "scenario.yaml"), "--plan", str(bad)]
+    )
+    assert result.exit_code == 2
+    assert result.output.startswith("error: ") and "Traceback" not in result.output
