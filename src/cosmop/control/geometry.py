@@ -27,7 +27,8 @@ def point_segment_linf(points: np.ndarray, segments: np.ndarray) -> np.ndarray:
     :math:`d_\\infty(p, [a, b]) = \\min_{t \\in [0, 1]} \\max(|a_x + t d_x - p_x|, |a_y + t d_y -
     p_y|)` with :math:`d = b - a`.  The function of `t` is convex and piecewise linear, so its
     minimum lies at an end point or a break point: where either term is zero or where the two
-    terms are equal; all six candidates are evaluated.
+    terms are equal; all six candidates are evaluated.  An axis-parallel segment is a
+    degenerate box, for which the distance is the larger of the two interval distances.
 
     Parameters
     ----------
@@ -41,6 +42,28 @@ def point_segment_linf(points: np.ndarray, segments: np.ndarray) -> np.ndarray:
     ndarray, shape (..., m)
         Distances (mm).
     """
+    segments = np.asarray(segments, dtype=float)
+    straight = (segments[:, 0] == segments[:, 2]) | (segments[:, 1] == segments[:, 3])
+    if straight.all():
+        return _axis_aligned(points, segments)
+    if straight.any():
+        out = np.empty((*np.shape(points)[:-1], len(segments)))
+        out[..., straight] = _axis_aligned(points, segments[straight])
+        out[..., ~straight] = _general(points, segments[~straight])
+        return out
+    return _general(points, segments)
+
+
+def _axis_aligned(points: np.ndarray, segments: np.ndarray) -> np.ndarray:
+    """An axis-parallel segment is a degenerate box: the larger of the two interval distances."""
+    p = np.asarray(points, dtype=float)[..., None, :]
+    lo = np.minimum(segments[:, :2], segments[:, 2:])
+    hi = np.maximum(segments[:, :2], segments[:, 2:])
+    d = np.maximum(np.maximum(lo - p, p - hi), 0.0)
+    return np.maximum(d[..., 0], d[..., 1])
+
+
+def _general(points: np.ndarray, segments: np.ndarray) -> np.ndarray:
     p = np.asarray(points, dtype=float)[..., None, :]
     ax = segments[:, 0] - p[..., 0]
     ay = segments[:, 1] - p[..., 1]
@@ -50,7 +73,7 @@ def point_segment_linf(points: np.ndarray, segments: np.ndarray) -> np.ndarray:
     best = np.maximum(np.abs(ax), np.abs(ay))
     end = np.maximum(np.abs(ax + dx), np.abs(ay + dy))
     np.minimum(best, end, out=best)
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         for num, den in ((-ax, dx), (-ay, dy), (ay - ax, dx - dy), (-(ax + ay), dx + dy)):
             t = np.where(den != 0, num / np.where(den != 0, den, 1.0), 0.0)
             np.clip(t, 0.0, 1.0, out=t)

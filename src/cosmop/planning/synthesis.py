@@ -143,6 +143,7 @@ def synthesize(
     rlimit: int = DEFAULT_RLIMIT,
     incremental: bool = True,
     start: State | None = None,
+    explain: bool = True,
 ) -> Synthesis:
     """The shortest safe plan of motion primitives for one robot's local mission.
 
@@ -163,6 +164,9 @@ def synthesize(
         the default: 2.5x faster on the 10x10 example) instead of a fresh solver per K.
     start : State, optional
         Instant 0 if not the scenario (replanning mid-mission; integer mm and degrees).
+    explain : bool
+        When infeasible, search for the first unreachable event and an unsat core (the
+        ``reason``); a replan that only needs yes or no skips it.
 
     Returns
     -------
@@ -224,7 +228,10 @@ def synthesize(
             checks=checks,
             unsat_horizons=tuple(unsat),
         )
-    reason, blocking = _explain(p, events, max_horizon, rlimit)
+    if explain:
+        reason, blocking = _explain(p, events, max_horizon, rlimit)
+    else:
+        reason, blocking = f"no plan of at most {max_horizon} steps", ()
     return Synthesis(
         robot,
         False,

@@ -67,7 +67,14 @@ def replan(
     """
     world = sensed_scene(scene, sensed)
     result = synthesize(
-        world, robot, tuple(events), requests=False, max_horizon=max_horizon, rlimit=rlimit, start=start
+        world,
+        robot,
+        tuple(events),
+        requests=False,
+        max_horizon=max_horizon,
+        rlimit=rlimit,
+        start=start,
+        explain=False,
     )
     if not result.feasible or result.plan is None:
         return None

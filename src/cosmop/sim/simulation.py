@@ -137,7 +137,7 @@ class SimSettings:
     wait_in_place: bool = True
     sense_range: float = 800.0
     max_horizon: int = 12
-    rlimit: int = 50_000_000
+    rlimit: int = 10_000_000
     dwa: DwaSettings = field(default_factory=DwaSettings)
 
 
@@ -860,13 +860,16 @@ def _stalled(world: _World, agent: _Agent) -> None:
         )
     x, y, h = world.pose[i]
     start = State((round(float(x)), round(float(y)), round(math.degrees(float(h)))), objects)
+    # A replan should not be much longer than what is left of the plan: bound the search there
+    # (an infeasible replan -- a blocked doorway -- would otherwise search every horizon).
+    horizon = min(s.max_horizon, len(agent.steps) - agent.k + 4)
     plan = replan(
         world.scenario.scene,
         agent.id,
         remaining,
         start,
         sensed,
-        max_horizon=s.max_horizon,
+        max_horizon=horizon,
         rlimit=s.rlimit,
     )
     if plan is None:
