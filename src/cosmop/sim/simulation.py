@@ -49,7 +49,7 @@ from cosmop.control.geometry import box_gaps, point_segment_linf, segment_array
 from cosmop.control.paths import GlobalPath, plan_path
 from cosmop.control.safety import is_safe, obstacle_speed, stopping_horizon, stopping_margin
 from cosmop.io import write_atomic
-from cosmop.missions.events import Event, parse_event
+from cosmop.missions.events import Event
 from cosmop.planning.checker import check_robot_plan
 from cosmop.planning.plan import ObjectState, PlanSet, RobotPlan, State, Step, plan_from_actions
 from cosmop.scenario import Scenario
@@ -1207,8 +1207,3 @@ def _record(world: _World, rec: dict[str, list]) -> None:
         if r >= 0:
             positions[j] = world.pose[r, :2]
     rec["objects"].append(positions)
-
-
-def parse_plan_events(names: tuple[str, ...]) -> tuple[Event, ...]:
-    """Mission event names as events (helper for callers holding raw plan files)."""
-    return tuple(parse_event(n) for n in names)
