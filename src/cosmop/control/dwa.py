@@ -184,7 +184,7 @@ def dwa_commands(
     DwaCommand
     """
     R = len(pose)
-    top, acc, brk, omega, eps = (limits[:, i] for i in range(5))
+    top, acc, brk, eps = limits[:, 0], limits[:, 1], limits[:, 2], limits[:, 4]
     xy, theta = pose[:, :2], pose[:, 2]
     skip = ignore if grip is None else (grip if ignore is None else ignore | grip)
     wall_gap, box_gap = robot_gaps(xy, half, walls, boxes, skip)
@@ -208,23 +208,7 @@ def dwa_commands(
         np.concatenate([wall_gap, box_gap], axis=1).min(axis=1) if gap_all.shape[1] else np.full(R, np.inf)
     )
 
-    # The dynamic window.
-    low = np.maximum(0.0, v - brk * eps)
-    high = np.minimum(v + acc * eps, top)
-    high = np.minimum(high, np.sqrt(np.maximum(brk * stop_distance, 0.0)))  # stop at the goal
-    high = np.maximum(high, low)
-    to_target = np.arctan2(target[:, 1] - xy[:, 1], target[:, 0] - xy[:, 0])
-    error = np.angle(np.exp(1j * (to_target - theta)))
-    turning = np.abs(error) > np.radians(settings.turn_in_place)
-    high = np.where(turning, low, high)
-
-    s = np.linspace(0.0, 1.0, settings.speeds)
-    vs = low[:, None] + (high - low)[:, None] * s[None, :]  # (R, Nv)
-    ws = omega[:, None] * np.linspace(-1.0, 1.0, settings.turns)[None, :]
-    aim = np.clip(error / max(settings.horizon / 2, eps.max()), -omega, omega)
-    ws = np.concatenate([ws, aim[:, None]], axis=1)  # (R, Nw)
-    V = np.repeat(vs[:, :, None], ws.shape[1], axis=2).reshape(R, -1)  # (R, K)
-    W = np.repeat(ws[:, None, :], vs.shape[1], axis=1).reshape(R, -1)
+    low, high, V, W = _window(pose, v, limits, target, stop_distance, settings)
 
     if not safe.all() and len(boxes):
         # Not safe: head away from the nearest box along the axis of its L-infinity gap first,
@@ -239,17 +223,7 @@ def dwa_commands(
         retreat = xy[rows] + away * (settings.standoff * 2)
         target = target.copy()
         target[rows[close]] = retreat[close]
-        to_target = np.arctan2(target[:, 1] - xy[:, 1], target[:, 0] - xy[:, 0])
-        error = np.angle(np.exp(1j * (to_target - theta)))
-        turning = np.abs(error) > np.radians(settings.turn_in_place)
-        high = np.where(turning, low, np.maximum(np.minimum(v + acc * eps, top), low))
-        s_ = np.linspace(0.0, 1.0, settings.speeds)
-        vs = low[:, None] + (high - low)[:, None] * s_[None, :]
-        ws = omega[:, None] * np.linspace(-1.0, 1.0, settings.turns)[None, :]
-        aim = np.clip(error / max(settings.horizon / 2, eps.max()), -omega, omega)
-        ws = np.concatenate([ws, aim[:, None]], axis=1)
-        V = np.repeat(vs[:, :, None], ws.shape[1], axis=2).reshape(R, -1)
-        W = np.repeat(ws[:, None, :], vs.shape[1], axis=1).reshape(R, -1)
+        low, high, V, W = _window(pose, v, limits, target, np.full(R, np.inf), settings)
 
     # Predicted arcs: positions at t_k, k = 1..S, with (v, w) held.
     t = settings.horizon * np.arange(1, settings.samples + 1) / settings.samples  # (S,)
@@ -353,6 +327,49 @@ def dwa_commands(
     w_out = np.where(np.isfinite(score[rows_all, best]), W[rows_all, best], w_out)
     v_out = np.where(np.isfinite(score[rows_all, best]), v_out, low)
     return DwaCommand(v=v_out, w=w_out, safe=safe, gap=min_gap)
+
+
+def _window(
+    pose: np.ndarray,
+    v: np.ndarray,
+    limits: np.ndarray,
+    target: np.ndarray,
+    stop_distance: np.ndarray,
+    settings: DwaSettings,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    r"""The sampled arcs of the dynamic window of each robot, towards its `target`.
+
+    The speeds span :math:`[v - b\varepsilon, \min(v + A\varepsilon, v_{top},
+    \sqrt{b\,d})]` (:math:`d`: `stop_distance`, so that the robot can stop at its goal),
+    only the lower end when the target lies more than ``turn_in_place`` off the heading; the
+    turn rates span :math:`[-\Omega, \Omega]` plus the one that aims at the target.
+
+    Returns
+    -------
+    low, high : ndarray, shape (R,)
+        The window's speed range, mm/s.
+    V, W : ndarray, shape (R, K)
+        Every sampled pair of speed (mm/s) and turn rate (rad/s).
+    """
+    R = len(pose)
+    top, acc, brk, omega, eps = (limits[:, i] for i in range(5))
+    xy, theta = pose[:, :2], pose[:, 2]
+    low = np.maximum(0.0, v - brk * eps)
+    high = np.minimum(v + acc * eps, top)
+    high = np.minimum(high, np.sqrt(np.maximum(brk * stop_distance, 0.0)))
+    high = np.maximum(high, low)
+    to_target = np.arctan2(target[:, 1] - xy[:, 1], target[:, 0] - xy[:, 0])
+    error = np.angle(np.exp(1j * (to_target - theta)))
+    turning = np.abs(error) > np.radians(settings.turn_in_place)
+    high = np.where(turning, low, high)
+    s = np.linspace(0.0, 1.0, settings.speeds)
+    vs = low[:, None] + (high - low)[:, None] * s[None, :]  # (R, Nv)
+    ws = omega[:, None] * np.linspace(-1.0, 1.0, settings.turns)[None, :]
+    aim = np.clip(error / max(settings.horizon / 2, eps.max()), -omega, omega)
+    ws = np.concatenate([ws, aim[:, None]], axis=1)  # (R, Nw)
+    V = np.repeat(vs[:, :, None], ws.shape[1], axis=2).reshape(R, -1)  # (R, K)
+    W = np.repeat(ws[:, None, :], vs.shape[1], axis=1).reshape(R, -1)
+    return low, high, V, W
 
 
 def _escape_ok(

@@ -44,7 +44,7 @@ from typing import Any
 
 import numpy as np
 
-from cosmop.control.dwa import DwaSettings, dwa_commands
+from cosmop.control.dwa import DwaSettings, dwa_commands, robot_gaps
 from cosmop.control.geometry import box_gaps, point_segment_linf, segment_array
 from cosmop.control.paths import GlobalPath, plan_path
 from cosmop.control.safety import is_safe, obstacle_speed, stopping_horizon, stopping_margin
@@ -463,16 +463,16 @@ class _World:
         acc[n_obj + len(self.rids) :] = np.inf
         return acc
 
-    def static_gap(self, point: tuple[float, ...], half: float) -> float:
-        """L-infinity gap (mm) of a square at `point` to the walls and resting objects."""
-        gap = math.inf
-        p = np.array(point[:2], dtype=float)
+    def static_gaps(self, points: np.ndarray, half: float) -> np.ndarray:
+        """L-infinity gaps (mm) of squares of half side `half` at `points` to walls and resting objects."""
+        points = np.asarray(points, dtype=float).reshape(-1, 2)
+        gap = np.full(len(points), np.inf)
         if len(self.walls):
-            gap = float((point_segment_linf(p, self.walls) - half).min())
+            gap = np.minimum(gap, (point_segment_linf(points, self.walls) - half).min(axis=1))
         keep = self.carried_by < 0
         if keep.any():
             boxes = np.column_stack([self.obj_pos[keep], self.obj_half[keep]])
-            gap = min(gap, float(box_gaps(p, half, boxes).min()))
+            gap = np.minimum(gap, box_gaps(points, half, boxes).min(axis=1))
         return gap
 
     def static_boxes(self, robot: int, goal: tuple[float, ...] | None = None) -> np.ndarray:
@@ -562,7 +562,7 @@ def _decide(world: _World, agent: _Agent) -> tuple[str, Any]:
     """What `agent` does this cycle: ``("drive", (target, stop))``, ``("move", (v, w))`` or
     ``("dock", pose)``."""
     i = agent.index
-    brake = ("move", (max(0.0, world.v[i] - world.limits[i, 2] * world.dt), 0.0))
+    brake = _brake(world, i)
     while not agent.done:
         step = agent.step
         prim = step.primitive
@@ -595,6 +595,11 @@ def _decide(world: _World, agent: _Agent) -> tuple[str, Any]:
     return brake
 
 
+def _brake(world: _World, i: int) -> tuple[str, Any]:
+    """Robot `i`'s command to brake with :math:`-b` (the always-safe choice), not turning."""
+    return ("move", (max(0.0, world.v[i] - world.limits[i, 2] * world.dt), 0.0))
+
+
 def _goto(world: _World, agent: _Agent, step: Step) -> tuple[str, Any] | None:
     final = agent.k + 1 >= len(agent.steps) or agent.steps[agent.k + 1].primitive != "GoTo"
     goal = step.robot
@@ -618,7 +623,7 @@ def _drive(
             world.static_boxes(i, goal),
         ) or GlobalPath(((float(xy[0]), float(xy[1])), (goal[0], goal[1])), 0.0)
         agent.phase = "drive"
-        agent.room = world.static_gap(goal, float(world.half[i]))
+        agent.room = float(world.static_gaps(goal[:2], world.half[i])[0])
         agent.best = math.inf
         agent.since = world.t
     dist = math.hypot(goal[0] - xy[0], goal[1] - xy[1])
@@ -629,7 +634,7 @@ def _drive(
         agent.phase = "turn"
     if agent.phase == "turn":
         if world.v[i] > 0:
-            return ("move", (max(0.0, world.v[i] - world.limits[i, 2] * world.dt), 0.0))
+            return _brake(world, i)
         if not heading:
             return None
         error = float(_wrap(math.radians(goal[2]) - world.pose[i, 2]))
@@ -710,7 +715,7 @@ def _handle(world: _World, agent: _Agent, step: Step) -> tuple[str, Any] | None:
         if step.primitive == "PickUp":
             agent.grip = j
         if world.v[i] > 0:
-            return ("move", (max(0.0, world.v[i] - world.limits[i, 2] * world.dt), 0.0))
+            return _brake(world, i)
         offset = math.hypot(dock[0] - world.pose[i, 0], dock[1] - world.pose[i, 1])
         error = abs(float(_wrap(-world.pose[i, 2])))
         there = offset < 1e-9 and error < 1e-9
@@ -751,7 +756,7 @@ def _release(world: _World, agent: _Agent, j: int) -> tuple[str, Any] | None:
     s = world.settings
     i = agent.index
     sep = box_gaps(world.pose[i, :2], world.half[i], np.array([[*world.obj_pos[j], world.obj_half[j]]]))
-    brake = ("move", (max(0.0, world.v[i] - world.limits[i, 2] * world.dt), 0.0))
+    brake = _brake(world, i)
     if float(sep[0]) >= s.release_gap:
         if world.v[i] > 0:
             return brake
@@ -770,26 +775,14 @@ def _release(world: _World, agent: _Agent, j: int) -> tuple[str, Any] | None:
     return ("move", (s.dock_speed, 0.0))
 
 
-def _static_gap_at(world: _World, i: int, points: np.ndarray) -> np.ndarray:
-    """Smallest gap (mm) of robot `i`'s square at `points` to walls and resting objects."""
-    gap = np.full(len(points), np.inf)
-    if len(world.walls):
-        gap = np.minimum(gap, (point_segment_linf(points, world.walls) - world.half[i]).min(axis=1))
-    keep = world.carried_by < 0
-    if keep.any():
-        boxes = np.column_stack([world.obj_pos[keep], world.obj_half[keep]])
-        gap = np.minimum(gap, box_gaps(points, world.half[i], boxes).min(axis=1))
-    return gap
-
-
 def _leave_heading(world: _World, i: int) -> float:
     """The heading (rad) away from +x whose straight move opens the static gaps best."""
     headings = np.radians(np.arange(95.0, 270.0, 5.0))
     units = np.column_stack([np.cos(headings), np.sin(headings)])
     xy = world.pose[i, :2]
-    near = _static_gap_at(world, i, xy[None, :] + 2.0 * units)
-    far = _static_gap_at(world, i, xy[None, :] + 40.0 * units)
-    now = float(_static_gap_at(world, i, xy[None, :])[0])
+    near = world.static_gaps(xy[None, :] + 2.0 * units, world.half[i])
+    far = world.static_gaps(xy[None, :] + 40.0 * units, world.half[i])
+    now = float(world.static_gaps(xy, world.half[i])[0])
     score = np.where(near > now - 1e-9, far, -np.inf)  # opening at once, then as wide as possible
     return float(headings[int(np.argmax(score))])
 
@@ -954,13 +947,7 @@ def _integrate(world: _World, v_cmd: np.ndarray, w_cmd: np.ndarray, docks: dict[
 def _monitor(world: _World, moving_speed: np.ndarray) -> None:
     """Record contacts: new touching pairs, and whether the robot moves while touching."""
     boxes, _, names = world.boxes()
-    R = len(world.rids)
-    wall_gap = (
-        point_segment_linf(world.pose[:, :2], world.walls) - world.half[:, None]
-        if len(world.walls)
-        else np.zeros((R, 0))
-    )
-    box_gap = box_gaps(world.pose[:, :2], world.half[:, None], boxes) if len(boxes) else np.zeros((R, 0))
+    wall_gap, box_gap = robot_gaps(world.pose[:, :2], world.half, world.walls, boxes, None)
     now: set[tuple[int, str]] = set()
     for i, agent in enumerate(world.agents):
         for w in np.flatnonzero(wall_gap[i] <= _TOUCH):
