@@ -32,6 +32,8 @@ from cosmop.planning import (
     square,
     swept_square,
 )
+from cosmop.planning.plan import PlanMessage
+from cosmop.planning.teamsafety import make_team_safe
 from cosmop.scenario import load_scenario, parse_scenario
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "01_warehouse_2x2" / "scenario.yaml"
@@ -122,10 +124,66 @@ def test_r2_plan_alone_is_valid_with_two_gotos_home() -> None:
     assert check_robot_plan(SCENE, "R2", plan) == []
 
 
-def test_coordinated_plan_set_is_valid() -> None:
+def test_each_plan_is_valid_but_the_team_may_meet() -> None:
+    # R1 drives to (1750, -1000) as soon as R2 has answered, while R2 still stands at
+    # (1650, -1000) holding O2: each plan is sound alone, the two together are not
     report = check_plan(SCENARIO, coordinated())
-    assert report == CheckReport(True, (), 14)
-    assert report.to_dict() == {"ok": True, "checked_steps": 14, "violations": []}
+    assert not report.ok and {v.rule for v in report.violations} == {"conflict"}
+    first = report.violations[0].message
+    assert "R1" in first and "R2" in first and "no message orders them" in first
+
+
+def test_team_safe_plan_set_is_valid() -> None:
+    plans = coordinated()
+    safe = make_team_safe(SCENE, plans.robots)
+    assert safe.safe and safe.messages and safe.conflicts > safe.ordered_before
+    ordered = dataclasses.replace(plans, robots=safe.plans, messages=safe.messages)
+    report = check_plan(SCENARIO, ordered)
+    assert report == CheckReport(True, (), sum(p.horizon for p in safe.plans.values()))
+    assert report.to_dict()["violations"] == []
+
+
+def test_a_message_nobody_sends_is_a_violation() -> None:
+    plans = coordinated()
+    safe = make_team_safe(SCENE, plans.robots)
+    name = safe.messages[0].event
+    sender = safe.messages[0].sender
+    muted = dataclasses.replace(
+        safe.plans[sender],
+        steps=tuple(s for s in safe.plans[sender].steps if s.message != name),
+        horizon=safe.plans[sender].horizon - 1,
+        mission=tuple(e for e in safe.plans[sender].mission if e != name),
+    )
+    robots = dict(safe.plans) | {sender: muted}
+    report = check_plan(SCENARIO, dataclasses.replace(plans, robots=robots, messages=safe.messages))
+    rules = {v.rule for v in report.violations}
+    assert "message" in rules and "deadlock" in rules
+    assert any("never sends" in v.message for v in report.violations)
+
+
+def test_messages_that_wait_on_each_other_deadlock() -> None:
+    # R1 waits for R2's message before sending its own, R2 waits for R1's first: nobody moves
+    r1 = plans_with_messages("R1", [("Req", "msg(R2,R1,a)"), ("Res", "msg(R1,R2,b)")])
+    r2 = plans_with_messages("R2", [("Req", "msg(R1,R2,b)"), ("Res", "msg(R2,R1,a)")])
+    messages = (PlanMessage("msg(R2,R1,a)", "order", "test"), PlanMessage("msg(R1,R2,b)", "order", "test"))
+    scenario = parse_scenario(
+        {
+            "name": "two",
+            "scene": {
+                "robots": {"R1": {"size": 400, "pose": [0, 0, 0]}, "R2": {"size": 400, "pose": [2000, 0, 0]}}
+            },
+            "mission": {"tasks": {"R1": [], "R2": []}},
+        }
+    )
+    report = check_plan(scenario, PlanSet("two", True, {"R1": r1, "R2": r2}, messages=messages))
+    (v,) = report.violations
+    assert v.rule == "deadlock" and "R1 at instant 1" in v.message and "R2 at instant 1" in v.message
+
+
+def plans_with_messages(robot: str, steps) -> RobotPlan:
+    pose = (0, 0, 0) if robot == "R1" else (2000, 0, 0)
+    made = [Step(p, None, pose, {}, m) for p, m in steps]
+    return RobotPlan.from_steps([m for _, m in steps], made)
 
 
 def test_instant_zero_is_the_scenario() -> None:
@@ -581,9 +639,12 @@ def test_away_event_needs_a_coordination_pair() -> None:
     assert [(v.robot, v.rule) for v in violations] == [("R1", "coordination"), ("R2", "coordination")]
 
 
-def test_infeasible_plan_set_checks_nothing() -> None:
+def test_a_plan_file_marked_infeasible_is_not_valid() -> None:
     plans = PlanSet("warehouse-2x2", False, {}, reason="no shortest plan within the horizon bound")
-    assert check_plan(SCENARIO, plans) == CheckReport(True, (), 0)
+    report = check_plan(SCENARIO, plans)
+    assert not report.ok and report.checked_steps == 0
+    (v,) = report.violations
+    assert v.rule == "infeasible" and "no shortest plan" in v.message
 
 
 # ----------------------------------------------------------------------------------------------

@@ -65,19 +65,49 @@ def test_json_output_has_the_documented_shape():
     assert DFA.from_dict(r1).accepts(["pick(R1,O1)", "drop(R1,O1,W1)"])
 
 
-def test_not_separable_exits_1_with_counterexample_and_resynthesis(tmp_path):
+def test_not_separable_is_ordered_by_messages(tmp_path):
     path = ordered_scenario(tmp_path)
-    result = runner.invoke(app, ["decompose", str(path)])
-    assert result.exit_code == 1, result.output
+    result = runner.invoke(app, ["decompose", str(path)], env={"COLUMNS": "200"})
+    assert result.exit_code == 0, result.output
     assert "separable: no" in result.stdout
     assert "counterexample: pick(R2,O2)" in result.stdout
-    assert "re-synthesis: sound" in result.stdout
+    assert "ordered by 1 message(s) instead of removing tasks" in result.stdout
+    assert "R2 waits before pick(R2,O2) until R1 has done pick(R1,O1)" in result.stdout
     as_json = runner.invoke(app, ["decompose", str(path), "--json"])
-    assert as_json.exit_code == 1
+    assert as_json.exit_code == 0
     data = json.loads(as_json.stdout)
     assert data["separable"] is False and data["counterexample"] == ["pick(R2,O2)"]
+    assert data["resynthesis"] is None
+    (message,) = data["messages"]
+    assert message["sender"] == "R1" and message["receiver"] == "R2"
+    assert (message["after"], message["before"]) == ("pick(R1,O1)", "pick(R2,O2)")
+    assert data["coordinated_missions"]["R2"][0] == message["event"]
+    assert data["verification"]["holds"] is True and data["verification"]["deadlock_free"] is True
+
+
+def test_not_separable_and_not_orderable_exits_1_with_resynthesis(tmp_path):
+    # a choice between robots: either R1 or R2 picks O1, never both; no order can make the
+    # robots agree, so the paper's pruning runs and the verdict stays "not proven"
+    data = yaml.safe_load(DFA_FILE.read_text())
+    data["mission"] = {
+        "dfa": {
+            "initial": "q0",
+            "marked": ["q2"],
+            "transitions": [
+                ["q0", "pick(R1,O1)", "q1"],
+                ["q1", "drop(R1,O1,W1)", "q2"],
+                ["q0", "pick(R2,O1)", "q3"],
+                ["q3", "drop(R2,O1,W1)", "q2"],
+            ],
+        }
+    }
+    path = tmp_path / "choice.yaml"
+    path.write_text(yaml.safe_dump(data))
+    result = runner.invoke(app, ["decompose", str(path), "--json"])
+    assert result.exit_code == 1
+    data = json.loads(result.stdout)
+    assert data["separable"] is False and data["messages"] == []
     assert data["resynthesis"]["converged"] is True
-    assert data["verification"]["holds"] is False
 
 
 def test_dot_files_are_written(tmp_path):

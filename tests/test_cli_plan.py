@@ -20,14 +20,19 @@ runner = CliRunner()
 
 def test_plan_writes_a_checked_plan_and_a_png(tmp_path):
     out, png = tmp_path / "plan.json", tmp_path / "plan.png"
-    result = runner.invoke(app, ["plan", str(TASKS_FILE), "-o", str(out), "--png", str(png)])
+    result = runner.invoke(
+        app, ["plan", str(TASKS_FILE), "-o", str(out), "--png", str(png)], env={"COLUMNS": "200"}
+    )
     assert result.exit_code == 0, result.output
     plans = load_plan(out)
-    # the paper's Example 1 after coordination: R1 7 steps with Req(O2), R2 7 with Res(O2)
-    assert plans.feasible and plans.robots["R1"].horizon == 7 and plans.robots["R2"].horizon == 7
+    # the paper's Example 1 after coordination: R1 7 steps with Req(O2), R2 7 with Res(O2),
+    # then the messages that keep the two robots apart
+    assert plans.feasible and plans.messages
     assert [(c.object, c.requester, c.responder) for c in plans.coordination] == [("O2", "R1", "R2")]
     assert plans.robots["R1"].mission[0] == "away(O2,R1,R2)"
     assert plans.robots["R2"].mission[:2] == ("pick(R2,O2)", "away(O2,R1,R2)")
+    rows = {line.split("│")[1].strip(): line for line in result.stdout.splitlines() if line.count("│") > 5}
+    assert "│ 7 " in rows["R1"] and "│ 7 " in rows["R2"]  # the shortest plans have 7 steps
     assert "Res(O2)" in [s.label for s in plans.robots["R2"].steps]
     assert check_plan(load_scenario(TASKS_FILE), plans).ok
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

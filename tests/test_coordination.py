@@ -109,19 +109,31 @@ def test_ten_by_ten_coordinated_plans_are_checked_and_verified(ten):
 
 
 def test_a_circular_wait_is_found():
-    # R1 waits for R2's answer, R2 for R3's, R3 answers R1 first: nobody can move
+    # R1 waits for R2's answer before its pick, and R2 for R1's before its own: nobody can move
+    sequences = {
+        "R1": seq("away(O2,R1,R2)", "pick(R1,O1)", "away(O1,R2,R1)"),
+        "R2": seq("away(O1,R2,R1)", "pick(R2,O2)", "away(O2,R1,R2)"),
+    }
+    word = blocking_word(sequences)
+    assert word is not None and word[-2:] == (
+        "[R1 waits for away(O2,R1,R2)]",
+        "[R2 waits for away(O1,R2,R1)]",
+    )
+
+
+def test_answers_are_asynchronous_so_answer_order_cannot_block():
+    # R3 answers R1 before R2 while R1 first waits for R2: the answers are sent and R3 goes on
     sequences = {
         "R1": seq("away(O2,R1,R2)", "away(O3,R1,R3)", "pick(R1,O1)"),
         "R2": seq("away(O3,R2,R3)", "pick(R2,O2)", "away(O2,R1,R2)"),
         "R3": seq("pick(R3,O3)", "away(O3,R1,R3)", "away(O3,R2,R3)"),
     }
-    word = blocking_word(sequences)
-    assert word == ("pick(R3,O3)",)
-    # coordinate() orders R3's answers so that this cannot happen
+    assert blocking_word(sequences) is None
     requests = {"R1": [("O2", 0), ("O3", 0)], "R2": [("O3", 0)]}
     plain = {"R1": seq("pick(R1,O1)"), "R2": seq("pick(R2,O2)"), "R3": seq("pick(R3,O3)")}
     result = coordinate(plain, requests)
     assert result.deadlock_free
+    # those who wait least are answered first: R2 before R1
     assert [e.name for e in result.sequences["R3"]] == ["pick(R3,O3)", "away(O3,R2,R3)", "away(O3,R1,R3)"]
 
 

@@ -26,6 +26,7 @@ from cosmop.automata import (
 )
 from cosmop.missions.decomposition import decompose, resynthesize, separability_counterexample
 from cosmop.missions.mission import GlobalMission, local_alphabets, sequence_automaton
+from cosmop.missions.team import check_words, verify_team
 from cosmop.missions.verification import verify
 from cosmop.scenario import load_scenario
 
@@ -126,9 +127,25 @@ def test_ordered_picks_are_not_separable_with_a_true_counterexample(ordered):
     assert product_of_locals.accepts(v.counterexample) and not k.accepts(v.counterexample)
 
 
+def test_ordered_picks_are_kept_by_a_message_not_pruned(ordered):
+    result = decompose(ordered)
+    assert not result.separable and result.resynthesis is None
+    messaging = result.messaging
+    assert messaging is not None
+    ((name, ((a, i), (b, j))),) = messaging.messages
+    assert (a, i, b, j) == ("R1", 0, "R2", 0)  # R2 waits before its pick for R1's pick
+    assert messaging.words["R1"] == (R1[0], name, *R1[1:])
+    assert messaging.words["R2"] == (name, *R2)
+    verdict = verify_team(ordered, messaging.words)
+    assert verdict.holds and verdict.blocking is None
+    assert check_words(ordered, messaging.words).holds
+    assert not check_words(ordered, {"R1": R1, "R2": R2}).holds  # without the message: R2 may pick first
+    assert result.sound_local_missions is messaging.local_missions
+
+
 def test_resynthesised_local_missions_are_sound(ordered):
     result = decompose(ordered)
-    rs = result.resynthesis
+    rs = resynthesize(ordered, result.local_missions)
     assert rs is not None and rs.converged and rs.iterations >= 1
     k = ordered.automaton.components[0]
     for robot, local in rs.local_missions.items():
@@ -138,7 +155,6 @@ def test_resynthesised_local_missions_are_sound(ordered):
     assert verify(ordered, rs.local_missions, method="assume-guarantee").holds
     assert rs.lost_events["R2"] == tuple(sorted(R2))  # without messages R2 cannot know R1 picked
     assert rs.lost_events["R1"] == ()
-    assert result.sound_local_missions is rs.local_missions
 
 
 def test_resynthesis_cap_is_reported(ordered):

@@ -30,6 +30,7 @@ from cosmop.errors import CosmopInputError, EventSyntaxError
 from cosmop.io import write_atomic
 from cosmop.missions.decomposition import decompose as run_decompose
 from cosmop.missions.mission import GlobalMission, sequence_of
+from cosmop.missions.team import verify_team
 from cosmop.missions.verification import verify as run_verify
 from cosmop.planning.checker import check_plan
 from cosmop.planning.plan import load_plan
@@ -148,17 +149,32 @@ def decompose(
     loaded = _load(scenario)
     err = Console(file=sys.stderr, highlight=False)
     mission = GlobalMission.from_scenario(loaded)
+    team = None
     with err.status("decomposing by natural projection ...", spinner="dots") as status:
         result = run_decompose(mission)
         status.update("verifying (assume-guarantee) ...")
-        verification = run_verify(mission, result.local_missions, method=method.value)
+        if result.messaging is not None:  # the robots ordered by messages: verify them with their messages
+            team = verify_team(mission, result.messaging.words, method=method.value)
+            verification = (
+                team.safety if team.safety is not None else run_verify(mission, result.local_missions)
+            )
+        else:
+            verification = run_verify(mission, result.local_missions, method=method.value)
     if dot is not None:
         dot.mkdir(parents=True, exist_ok=True)
         for robot, dfa in result.local_missions.items():
             write_atomic(dot / f"{robot}.dot", dfa.to_dot(f"K_{robot}"))
-    ok = result.separable and verification.holds
+    holds = team.holds if team is not None else verification.holds
+    ok = (result.separable or result.messaging is not None) and holds
     if as_json:
-        data = result.to_dict() | {"verification": verification.to_dict()}
+        checked = verification.to_dict() | {"holds": holds}
+        if team is not None:
+            checked |= {
+                "deadlock_free": team.blocking is None,
+                "complete": None if team.completion is None else team.completion.to_dict(),
+                "counterexample": None if team.counterexample is None else list(team.counterexample),
+            }
+        data = result.to_dict() | {"verification": checked}
         typer.echo(json.dumps(data, indent=2))
         raise typer.Exit(0 if ok else 1)
     console = _stdout()
@@ -177,6 +193,17 @@ def decompose(
     )
     if result.counterexample is not None:
         console.print(Text(f"counterexample: {' '.join(result.counterexample)}", style="red"))
+    if result.messaging is not None:
+        console.print(
+            Text(f"ordered by {len(result.messaging.messages)} message(s) instead of removing tasks:")
+        )
+        for entry in result.messaging.to_dict(result._words()):
+            console.print(
+                Text(
+                    f"  {entry['event']}: {entry['receiver']} waits before {entry['before']} "
+                    f"until {entry['sender']} has done {entry['after']}"
+                )
+            )
     if result.resynthesis is not None:
         rs = result.resynthesis
         console.print(
@@ -192,15 +219,18 @@ def decompose(
     sizes = ", ".join(str(a.assumption.n_states if a.assumption else 0) for a in v.assumptions) or "-"
     console.print(
         Text(
-            f"verification: {'holds' if v.holds else 'fails'} ({v.method}; "
+            f"verification: {'holds' if holds else 'fails'} ({v.method}; "
             f"{v.membership_queries} membership / {v.equivalence_queries} equivalence queries; "
             f"assumption sizes {sizes}; "
             f"largest automaton {v.largest_automaton}; {v.time_s:.3f} s)",
-            style="green" if v.holds else "red",
+            style="green" if holds else "red",
         )
     )
-    if v.counterexample is not None:
-        console.print(Text(f"violation: {' '.join(v.counterexample)}", style="red"))
+    violation = team.reason() if team is not None else None
+    if violation is None and v.counterexample is not None:
+        violation = " ".join(v.counterexample)
+    if violation is not None:
+        console.print(Text(f"violation: {violation}", style="red"))
     raise typer.Exit(0 if ok else 1)
 
 
@@ -296,29 +326,26 @@ def plan(
 
         save_plan_png(loaded.scene, result.plans, png)
     console = _stdout()
-    table = Table(title=Text(f"plans for {loaded.name}"), header_style="bold")
-    for column in ("robot", "feasible", "horizon", "requests", "responses", "solve time"):
-        table.add_column(column)
-    for robot, res in result.results.items():
-        answers = [c.object + " to " + c.requester for c in result.plans.coordination if c.responder == robot]
-        table.add_row(
-            robot,
-            "yes" if res.feasible else Text("no", style="red"),
-            str(res.horizon) if res.horizon is not None else "-",
-            Text(", ".join(res.requests) or "-"),
-            Text(", ".join(answers) or "-"),
-            f"{res.solve_s:.2f} s",
-        )
-    console.print(table)
+    console.print(_plan_table(loaded, result))
     if result.verification is not None:
         v = result.verification
+        safety = result.safety
+        ordered = f"{safety.conflicts} conflict(s) between plans, " if safety is not None else ""
         console.print(
             Text(
-                f"coordination: {len(result.plans.coordination)} pair(s), deadlock-free; "
-                f"verification: {'holds' if v.holds else 'fails'} ({v.method})",
+                f"coordination: {len(result.plans.coordination)} pair(s), {len(result.plans.messages)} "
+                f"message(s) ({ordered}deadlock-free); verification: "
+                f"{'holds' if v.holds else 'fails'} ({v.method})",
                 style="green" if v.holds else "red",
             )
         )
+        if safety is not None and safety.makespan_alone > 0:
+            console.print(
+                Text(
+                    f"expected time to finish: {safety.makespan:.0f} s (each robot alone: at most "
+                    f"{safety.makespan_alone:.0f} s)"
+                )
+            )
     if result.plans.feasible:
         console.print(
             Text(
@@ -453,6 +480,29 @@ def simulate(
         )
     )
     raise typer.Exit(0 if ok else 1)
+
+
+def _plan_table(scenario: Scenario, result) -> Table:
+    """One row per robot: its plan's steps, K (the shortest plan), requests, answers, messages."""
+    table = Table(title=Text(f"plans for {scenario.name}"), header_style="bold")
+    for column in ("robot", "feasible", "steps", "K", "requests", "answers", "msgs out/in", "solve"):
+        table.add_column(column)
+    for robot, res in result.results.items():
+        plan = result.plans.robots.get(robot)
+        answers = [c.object + " to " + c.requester for c in result.plans.coordination if c.responder == robot]
+        sent = sum(1 for s in plan.steps if s.message is not None and s.primitive == "Res") if plan else 0
+        awaited = sum(1 for s in plan.steps if s.message is not None and s.primitive == "Req") if plan else 0
+        table.add_row(
+            robot,
+            "yes" if res.feasible else Text("no", style="red"),
+            str(plan.horizon) if plan is not None else "-",
+            str(res.horizon) if res.horizon is not None else "-",
+            Text(", ".join(res.requests) or "-"),
+            Text(", ".join(answers) or "-"),
+            f"{sent}/{awaited}" if sent or awaited else "-",
+            f"{res.solve_s:.2f} s",
+        )
+    return table
 
 
 def _summary_table(scenario: Scenario) -> Table:

@@ -1,37 +1,54 @@
 """The top-down ↔ bottom-up loop (the paper's Fig. "Overall framework").
 
-1. *Decompose* the global mission into local missions (sequences of events).
-2. *Synthesize* every robot's shortest plan.
-3. *Coordinate*: each Req(O) of robot A becomes the pair ``away(O, A, B)`` with B the robot whose
-   mission picks O, placed deadlock-free (:mod:`cosmop.missions.coordination`).
-4. *Re-synthesize* the robots whose missions changed (responders gain their Res).
-5. Repeat from 3 until no plan asks for anything new (capped; the cap is reported).
-6. *Verify*: the coordinated local missions satisfy the global mission (assume-guarantee over
-   the factors) and can always complete (no deadlock), and every plan passes the exact checker.
-
-A request that no robot's mission can answer (no mission picks the object) is refused with a
-reason naming the object and who needed it; re-allocating the task of moving it is not done.
+1. *Decompose* the global mission into local missions, one word of events per robot.  When the
+   mission is not separable because it orders different robots' events, the order is kept by
+   messages (:mod:`cosmop.missions.ordering`), never by dropping tasks; only when no placement
+   of messages can work are tasks pruned, and then the plan is infeasible and names them.
+2. *Synthesize* every robot's shortest plan (its messages are put in afterwards).
+3. *Coordinate requests*: each Req(O) of robot A becomes the message ``away(O, A, B)`` from the
+   robot B whose mission picks O (:mod:`cosmop.missions.coordination`); the responders are
+   re-planned; repeat until no plan asks for anything new (capped).  A request that nobody can
+   answer, or that would deadlock the team, is forbidden and the requester re-planned: its next
+   best plan asks for less, or is a step longer.
+4. *Make the plans team-safe* (:mod:`cosmop.planning.teamsafety`): every place two plans share is
+   ordered by a message.  A conflict that no order resolves (a robot parked for good where
+   another must pass) is resolved by re-planning one robot with the other's space as an
+   obstacle.
+5. *Verify*: the robots' words with all their messages cannot deadlock and do exactly what the
+   global mission asks (:func:`cosmop.missions.team.verify_team`); every plan set passes the
+   exact checker (:func:`cosmop.planning.checker.check_plan`).
 """
 
 from __future__ import annotations
 
+import itertools
 import multiprocessing
 import os
 import time
 from collections.abc import Callable, Mapping
-from concurrent.futures import ProcessPoolExecutor, as_completed
-from dataclasses import dataclass
+from concurrent.futures import Executor, ProcessPoolExecutor
+from dataclasses import dataclass, replace
 from types import MappingProxyType
 
-from cosmop.missions.coordination import Coordinated, coordinate, requests_by_phase
-from cosmop.missions.events import Event
-from cosmop.missions.mission import GlobalMission, sequence_automaton
-from cosmop.missions.verification import Verification, verify
+import shapely
+
+from cosmop.missions.coordination import Coordinated, coordinate
+from cosmop.missions.decomposition import decompose
+from cosmop.missions.events import Event, parse_event
+from cosmop.missions.mission import GlobalMission, sequence_of
+from cosmop.missions.team import TeamVerdict, blocking_word, check_words
 from cosmop.planning.checker import CheckReport, check_plan
-from cosmop.planning.plan import Coordination, PlanSet
+from cosmop.planning.conflicts import Conflict, ConflictSettings
+from cosmop.planning.plan import Coordination, PlanMessage, PlanSet, RobotPlan
+from cosmop.planning.realisation import event_instants
 from cosmop.planning.synthesis import DEFAULT_RLIMIT, Synthesis, synthesize
-from cosmop.planning.team import local_sequences
-from cosmop.scenario import Scenario
+from cosmop.planning.teamsafety import TeamSafety, make_team_safe
+from cosmop.scenario import Scenario, Scene, Wall
+
+__all__ = ["TeamResult", "plan_team"]
+
+PHASES = ("decompose", "synthesize", "coordinate", "conflicts", "verify", "check")
+"""The phases whose seconds :attr:`TeamResult.phases` records."""
 
 
 @dataclass(frozen=True)
@@ -41,12 +58,13 @@ class TeamResult:
     Attributes
     ----------
     plans : PlanSet
-        Every robot's plan and the coordination pairs (the plan file's content).
+        Every robot's plan, the request/response pairs and the messages (the plan file).
     results : Mapping[str, Synthesis]
         The last synthesis of each robot.
     coordination : Coordinated or None
-    verification : Verification or None
-        Whether the coordinated local missions satisfy the global mission.
+        The request/response pairs and the words with them.
+    verification : TeamVerdict or None
+        Whether the robots' words with their messages do exactly what the mission asks.
     report : CheckReport
         The exact checker's verdict on ``plans`` (always ok for a feasible result).
     iterations : int
@@ -54,22 +72,95 @@ class TeamResult:
     converged : bool
         False when the iteration cap stopped the loop.
     phases : Mapping[str, float]
-        Seconds spent in decompose, synthesize, coordinate, verify, check.
+        Seconds spent in each phase of :data:`PHASES`.
+    safety : TeamSafety or None
+        The conflicts between the plans and the messages that order them.
+    replans : tuple of str
+        Why robots were re-planned after their first plan (requests forbidden, conflicts).
     """
 
     plans: PlanSet
     results: Mapping[str, Synthesis]
     coordination: Coordinated | None
-    verification: Verification | None
+    verification: TeamVerdict | None
     report: CheckReport
     iterations: int
     converged: bool
     phases: Mapping[str, float]
+    safety: TeamSafety | None = None
+    replans: tuple[str, ...] = ()
 
 
-def _base_index(sequence: tuple[Event, ...], index: int) -> int:
-    """Index in the uncoordinated sequence of the event at ``index`` of a coordinated one."""
-    return sum(1 for e in sequence[:index] if e.kind != "away")
+@dataclass(frozen=True)
+class _Job:
+    """One robot's synthesis, as sent to a worker process."""
+
+    scene: Scene
+    robot: str
+    events: tuple[Event, ...]
+    max_horizon: int
+    rlimit: int
+    unrequestable: frozenset[str] = frozenset()
+
+
+def _synthesize(job: _Job) -> Synthesis:
+    """One robot's synthesis (module level, so worker processes can run it)."""
+    return synthesize(
+        job.scene,
+        job.robot,
+        job.events,
+        max_horizon=job.max_horizon,
+        rlimit=job.rlimit,
+        unrequestable=job.unrequestable,
+    )
+
+
+def _pool(workers: int) -> ProcessPoolExecutor:
+    """Worker processes (forked where the platform allows: no re-import of the package)."""
+    methods = multiprocessing.get_all_start_methods()
+    context = multiprocessing.get_context("fork" if "fork" in methods else "spawn")
+    return ProcessPoolExecutor(max_workers=workers, mp_context=context)
+
+
+class _Planner:
+    """Runs syntheses (in an executor when there is one) and keeps the phase times."""
+
+    def __init__(self, scenario, executor, on_robot, max_horizon, rlimit, phases) -> None:
+        self.scenario = scenario
+        self.executor = executor
+        self.on_robot = on_robot
+        self.max_horizon = max_horizon
+        self.rlimit = rlimit
+        self.phases = phases
+        self.forbidden: dict[str, frozenset[str]] = {}
+        self.obstacles: dict[str, tuple[Wall, ...]] = {}
+
+    def job(self, robot: str, events: tuple[Event, ...]) -> _Job:
+        scene = self.scenario.scene
+        extra = self.obstacles.get(robot, ())
+        if extra:
+            scene = replace(scene, obstacles=scene.obstacles + extra)
+        return _Job(
+            scene, robot, tuple(events), self.max_horizon, self.rlimit, self.forbidden.get(robot, frozenset())
+        )
+
+    def run(self, jobs: Mapping[str, tuple[Event, ...]]) -> dict[str, Synthesis]:
+        t0 = time.perf_counter()
+        work = {robot: self.job(robot, events) for robot, events in jobs.items()}
+        out: dict[str, Synthesis] = {}
+        if self.executor is None or len(work) < 2:
+            for robot, job in work.items():
+                out[robot] = _synthesize(job)
+                if self.on_robot is not None:
+                    self.on_robot(robot, out[robot])
+        else:
+            futures = {robot: self.executor.submit(_synthesize, job) for robot, job in work.items()}
+            for robot, future in futures.items():
+                out[robot] = future.result()
+                if self.on_robot is not None:
+                    self.on_robot(robot, out[robot])
+        self.phases["synthesize"] += time.perf_counter() - t0
+        return {robot: out[robot] for robot in jobs}
 
 
 def plan_team(
@@ -79,9 +170,11 @@ def plan_team(
     rlimit: int = DEFAULT_RLIMIT,
     max_iterations: int = 5,
     workers: int | None = None,
+    executor: Executor | None = None,
     on_robot: Callable[[str, Synthesis], None] | None = None,
+    conflicts: ConflictSettings | None = None,
 ) -> TeamResult:
-    """Plan, coordinate and verify the whole team (see the module docstring).
+    """Plan, coordinate, make team-safe and verify the whole team (see the module docstring).
 
     Parameters
     ----------
@@ -92,144 +185,296 @@ def plan_team(
         Cap on coordinate/re-synthesize rounds.
     workers : int, optional
         Worker processes for the robots' syntheses (default: one per core, at most one per
-        robot; 1 plans in this process).  The result does not depend on it.
+        robot; 1 plans in this process).  Ignored when `executor` is given.
+    executor : concurrent.futures.Executor, optional
+        Where to run the syntheses (any ``submit``/``result`` executor, e.g. a Dask
+        ``Client.get_executor()``).  The result does not depend on it.
     on_robot : callable, optional
         Called after every synthesis (progress display).
+    conflicts : ConflictSettings, optional
+        How conflicts between plans are found.
 
     Raises
     ------
     AssertionError
-        If a plan fails the exact checker (an encoding bug, never a user error).
+        If a plan set fails the exact checker (an encoding bug, never a user error).
     """
-    phases = dict.fromkeys(("decompose", "synthesize", "coordinate", "verify", "check"), 0.0)
+    phases = dict.fromkeys(PHASES, 0.0)
     t = time.perf_counter()
-    base = local_sequences(scenario)
+    mission = GlobalMission.from_scenario(scenario)
+    words, notes, reasons = _local_words(scenario, mission)
     phases["decompose"] = time.perf_counter() - t
-
-    n_workers = min(os.cpu_count() or 1, len(base)) if workers is None else max(1, workers)
-    pool = _pool(n_workers) if n_workers > 1 else None
-
-    def plan_all(jobs: dict[str, tuple[Event, ...]]) -> dict[str, Synthesis]:
-        t0 = time.perf_counter()
-        out: dict[str, Synthesis] = {}
-        if pool is None or len(jobs) < 2:
-            for robot, events in jobs.items():
-                out[robot] = _synthesize((scenario.scene, robot, events, max_horizon, rlimit))
-                if on_robot is not None:
-                    on_robot(robot, out[robot])
-        else:
-            futures = {
-                pool.submit(_synthesize, (scenario.scene, robot, events, max_horizon, rlimit)): robot
-                for robot, events in jobs.items()
-            }
-            for future in as_completed(futures):
-                out[futures[future]] = future.result()
-                if on_robot is not None:
-                    on_robot(futures[future], out[futures[future]])
-        phases["synthesize"] += time.perf_counter() - t0
-        return {robot: out[robot] for robot in jobs}  # team order, whatever finished first
-
+    pool = None
+    if executor is None:
+        n_workers = min(os.cpu_count() or 1, len(words)) if workers is None else max(1, workers)
+        pool = _pool(n_workers) if n_workers > 1 else None
+    planner = _Planner(scenario, executor or pool, on_robot, max_horizon, rlimit, phases)
     try:
-        return _loop(scenario, base, plan_all, phases, max_iterations)
+        return _loop(scenario, mission, words, notes, reasons, planner, max_iterations, conflicts)
     finally:
         if pool is not None:
             pool.shutdown()
 
 
-def _synthesize(job: tuple) -> Synthesis:
-    """One robot's synthesis (module level, so worker processes can run it)."""
-    scene, robot, events, max_horizon, rlimit = job
-    return synthesize(scene, robot, events, max_horizon=max_horizon, rlimit=rlimit)
-
-
-def _pool(workers: int) -> ProcessPoolExecutor:
-    """Worker processes (forked where the platform allows: no re-import of the package)."""
-    methods = multiprocessing.get_all_start_methods()
-    context = multiprocessing.get_context("fork" if "fork" in methods else "spawn")
-    return ProcessPoolExecutor(max_workers=workers, mp_context=context)
+def _local_words(
+    scenario: Scenario, mission: GlobalMission
+) -> tuple[dict[str, tuple[Event, ...]], dict[str, tuple[str, str]], list[str]]:
+    """Each robot's word, what each message in them is for, and why planning cannot start."""
+    robots = tuple(scenario.scene.robots)
+    notes: dict[str, tuple[str, str]] = {}
+    if scenario.mission.tasks is not None:
+        words = {r: tuple(scenario.mission.tasks.get(r, ())) for r in robots}
+        for r, word in words.items():
+            for e in word:
+                if e.kind == "msg" and e.sender == r:
+                    notes[e.name] = ("mission", f"the mission orders {e.receiver} to wait for {r} here")
+        return words, notes, []
+    result = decompose(mission)
+    if result.messaging is not None:
+        plain = {r: sequence_of(d) or () for r, d in result.local_missions.items()}
+        for name, ((a, i), (b, j)) in result.messaging.messages:
+            notes[name] = ("order", f"the mission orders {b}'s {plain[b][j]} after {a}'s {plain[a][i]}")
+        local = {r: tuple(w) for r, w in result.messaging.words.items()}
+    elif not result.separable and result.resynthesis is not None:
+        lost = {r: e for r, e in result.resynthesis.lost_events.items() if e}
+        named = "; ".join(f"{r} loses {', '.join(e)}" for r, e in lost.items())
+        why = "the mission is not separable and no messages can order it; pruning it loses tasks: "
+        return {r: () for r in robots}, notes, [why + (named or "none")]
+    else:
+        local = {r: sequence_of(d) for r, d in result.local_missions.items()}
+        branching = [r for r, seq in local.items() if seq is None]
+        if branching:
+            why = f"planning needs each local mission to be one sequence of events; {branching[0]}'s branches"
+            return {r: () for r in robots}, notes, [why]
+    words = {r: tuple(parse_event(e) for e in local.get(r) or ()) for r in robots}
+    return words, notes, []
 
 
 def _loop(
     scenario: Scenario,
+    mission: GlobalMission,
     base: dict[str, tuple[Event, ...]],
-    plan_all: Callable[[dict[str, tuple[Event, ...]]], dict[str, Synthesis]],
-    phases: dict[str, float],
+    notes: dict[str, tuple[str, str]],
+    reasons: list[str],
+    planner: _Planner,
     max_iterations: int,
+    settings: ConflictSettings | None,
 ) -> TeamResult:
-    """Coordinate, re-plan, verify and check (steps 3-6 of the module docstring)."""
-    current = dict(base)
-    results = plan_all(dict(base))
-    requests: dict[str, list[tuple[str, int]]] = {r: [] for r in base}
-    coordinated: Coordinated | None = None
-    reasons: list[str] = []
-    iterations, converged = 0, False
-    while not reasons:
-        infeasible = [r.reason for r in results.values() if not r.feasible]
-        if infeasible:
-            reasons += infeasible
-            break
-        t0 = time.perf_counter()
-        fresh = False
-        for robot, res in results.items():
-            known = {obj for obj, _ in requests[robot]}
-            steps = [(s.primitive, s.object) for s in res.plan.steps]
-            for obj, index in requests_by_phase(steps, current[robot]):
-                if obj not in known:
-                    requests[robot].append((obj, _base_index(current[robot], index)))
-                    known.add(obj)
-                    fresh = True
-        if not fresh:
-            phases["coordinate"] += time.perf_counter() - t0
-            converged = True
-            break
-        if iterations >= max_iterations:
-            phases["coordinate"] += time.perf_counter() - t0
-            reasons.append(f"coordination did not settle within {max_iterations} rounds")
-            break
-        iterations += 1
-        coordinated = coordinate(base, requests)
-        phases["coordinate"] += time.perf_counter() - t0
-        for obj, requester in coordinated.unanswered:
-            reasons.append(f"{requester} needs {obj} moved away, but no robot's mission picks {obj}")
-        if not coordinated.deadlock_free:
-            reasons.append(
-                f"the coordinated missions can deadlock after: {' '.join(coordinated.blocking or ())}"
-            )
-        if reasons:
-            break
-        changed = {r: events for r, events in coordinated.sequences.items() if events != current[r]}
-        current.update(changed)
-        results.update(plan_all(changed))
-    verification = None
+    """Coordinate requests, make the plans team-safe, verify and check (steps 2-5)."""
+    phases = planner.phases
+    replans: list[str] = []
+    results: dict[str, Synthesis] = {}
+    coordinated, current, iterations, converged = None, dict(base), 0, False
+    if not reasons:
+        results = planner.run(dict(base))
+        coordinated, current, iterations, converged = _coordinate_requests(
+            base, results, planner, max_iterations, reasons, replans
+        )
+    safety, plans = None, {r: res.plan for r, res in results.items() if res.plan is not None}
+    if not reasons:
+        safety = _make_safe(scenario, current, results, planner, settings, reasons, replans)
+        plans = dict(safety.plans)
+    verdict = None
     if not reasons:
         t0 = time.perf_counter()
-        local = {r: sequence_automaton([e.name for e in events]) for r, events in current.items()}
-        verification = verify(GlobalMission.from_scenario(scenario), local)
+        verdict = check_words(mission, {r: p.mission for r, p in plans.items()})
         phases["verify"] = time.perf_counter() - t0
-        if not verification.holds:
-            reasons.append(
-                f"the coordinated missions violate the global mission: {verification.counterexample}"
-            )
+        if not verdict.holds:
+            reasons.append(verdict.reason() or "the coordinated missions violate the global mission")
+    messages = _plan_messages(plans, notes) + (list(safety.messages) if safety is not None else [])
     pairs = coordinated.pairs if coordinated is not None else ()
-    plans = PlanSet(
+    plan_set = PlanSet(
         scenario=scenario.name,
         feasible=not reasons,
-        robots={r: res.plan for r, res in results.items() if res.plan is not None},
+        robots=plans,
         coordination=tuple(Coordination(p.obj, p.requester, p.responder) for p in pairs),
         reason="; ".join(reasons) if reasons else None,
+        messages=tuple(messages) if not reasons else (),
     )
     t0 = time.perf_counter()
-    report = check_plan(scenario, plans)
+    report = check_plan(scenario, plan_set)
     phases["check"] = time.perf_counter() - t0
-    if plans.feasible and not report.ok:
+    if plan_set.feasible and not report.ok:
         raise AssertionError(f"a synthesised plan failed the exact checker: {report.violations[0].message}")
     return TeamResult(
-        plans=plans,
+        plans=plan_set,
         results=MappingProxyType(results),
         coordination=coordinated,
-        verification=verification,
+        verification=verdict,
         report=report,
         iterations=iterations,
         converged=converged,
         phases=MappingProxyType(phases),
+        safety=safety,
+        replans=tuple(replans),
+    )
+
+
+def _plan_messages(plans: Mapping[str, RobotPlan], notes: Mapping[str, tuple[str, str]]) -> list[PlanMessage]:
+    """The plan file's entries for the messages of the mission (orders, user's messages)."""
+    out = []
+    for robot, plan in plans.items():
+        for name in plan.mission:
+            if name in notes and name.startswith("msg(") and name.split(",")[0][4:] == robot:
+                kind, text = notes[name]
+                out.append(PlanMessage(name, kind, text))
+    return out
+
+
+def _requests(
+    plan: RobotPlan, robot: str, scene: Scene, sequence: tuple[Event, ...]
+) -> list[tuple[str, int]]:
+    """Each Req(O) of `plan` with the index (in `sequence`) of the first event realised after it."""
+    instants = event_instants(plan, robot, scene, sequence)
+    out = []
+    for k, step in enumerate(plan.steps, 1):
+        if step.primitive == "Req" and step.object is not None:
+            index = next((n for n, t in enumerate(instants) if t is not None and t >= k), len(sequence))
+            out.append((step.object, index))
+    return out
+
+
+def _base_index(sequence: tuple[Event, ...], index: int) -> int:
+    """Index in the sequence without away events of the event at ``index`` of `sequence`."""
+    return sum(1 for e in sequence[:index] if e.kind != "away")
+
+
+def _coordinate_requests(
+    base: dict[str, tuple[Event, ...]],
+    results: dict[str, Synthesis],
+    planner: _Planner,
+    max_iterations: int,
+    reasons: list[str],
+    replans: list[str],
+) -> tuple[Coordinated | None, dict[str, tuple[Event, ...]], int, bool]:
+    """Turn requests into away messages until no plan asks for anything new (step 3)."""
+    scene = planner.scenario.scene
+    current, coordinated, iterations = dict(base), None, 0
+    asked: dict[str, list[tuple[str, int]]] = {r: [] for r in base}
+    while True:
+        if any(not res.feasible for res in results.values()):
+            reasons += [res.reason for res in results.values() if not res.feasible]
+            return coordinated, current, iterations, False
+        t0 = time.perf_counter()
+        requests = {
+            r: [(o, _base_index(current[r], i)) for o, i in _requests(res.plan, r, scene, current[r])]
+            for r, res in results.items()
+        }
+        if requests == asked:
+            planner.phases["coordinate"] += time.perf_counter() - t0
+            return coordinated, current, iterations, True
+        if iterations >= max_iterations:
+            reasons.append(f"coordination did not settle within {max_iterations} rounds")
+            return coordinated, current, iterations, False
+        iterations, asked = iterations + 1, requests
+        coordinated = coordinate(base, requests)
+        planner.phases["coordinate"] += time.perf_counter() - t0
+        forbid = _bad_requests(coordinated)
+        if forbid:
+            if not _forbid(forbid, base, results, planner, reasons, replans):
+                return coordinated, current, iterations, False
+            continue
+        changed = {r: events for r, events in coordinated.sequences.items() if events != current[r]}
+        current.update(changed)
+        results.update(planner.run(changed))
+
+
+def _bad_requests(coordinated: Coordinated) -> dict[str, dict[str, str]]:
+    """Requests to forbid, by robot and object, with why: nobody can answer, or they close a wait cycle."""
+    out: dict[str, dict[str, str]] = {}
+    for obj, requester in coordinated.unanswered:
+        out.setdefault(requester, {})[obj] = f"no robot's mission picks {obj}"
+    if not coordinated.deadlock_free:
+        words = {r: [e.name for e in seq] for r, seq in coordinated.sequences.items()}
+        for line in blocking_word(words) or ():
+            if line.startswith("[") and " waits for away(" in line:
+                robot, _, event = line[1:-1].partition(" waits for ")
+                obj = event[5:].split(",")[0]
+                out.setdefault(robot, {})[obj] = f"waiting for {obj} deadlocks the team ({event})"
+    return out
+
+
+def _forbid(
+    forbid: Mapping[str, Mapping[str, str]],
+    base: dict[str, tuple[Event, ...]],
+    results: dict[str, Synthesis],
+    planner: _Planner,
+    reasons: list[str],
+    replans: list[str],
+) -> bool:
+    """Re-plan each robot without the requests in `forbid`; False (with reasons) if one cannot."""
+    for robot, why in forbid.items():
+        planner.forbidden[robot] = planner.forbidden.get(robot, frozenset()) | frozenset(why)
+        replans.append(
+            f"{robot} re-planned without requesting {', '.join(sorted(why))}: {'; '.join(why.values())}"
+        )
+    fresh = planner.run({r: base[r] for r in forbid})
+    results.update(fresh)
+    for robot, res in fresh.items():
+        if not res.feasible:
+            for obj, why in sorted(forbid[robot].items()):
+                reasons.append(f"{robot} needs {obj} moved away, but {why}")
+            reasons.append(f"without that request: {res.reason}")
+    return not reasons
+
+
+def _make_safe(
+    scenario: Scenario,
+    current: dict[str, tuple[Event, ...]],
+    results: dict[str, Synthesis],
+    planner: _Planner,
+    settings: ConflictSettings | None,
+    reasons: list[str],
+    replans: list[str],
+    max_rounds: int = 6,
+) -> TeamSafety:
+    """Order every conflict by messages; re-plan around the ones no order resolves (step 4).
+
+    Each round, every robot that must give way in an unresolved conflict is re-planned with the
+    space of the other side as an obstacle (all of them at once), until the conflicts are
+    ordered or `max_rounds` rounds are spent.
+    """
+    settings = settings or ConflictSettings()
+    for n in range(max_rounds + 1):
+        plans = {r: res.plan for r, res in results.items()}
+        used = {name for p in plans.values() for name in p.mission if name.startswith("msg(")}
+        t0 = time.perf_counter()
+        safety = make_team_safe(scenario.scene, plans, settings=settings, used=used)
+        planner.phases["conflicts"] += time.perf_counter() - t0
+        if safety.safe:
+            return safety
+        detours: dict[str, list[Conflict]] = {}
+        for conflict in safety.unresolved:
+            options = safety.detours(conflict)
+            if not options or n == max_rounds:
+                reasons.append(
+                    f"no order or re-plan keeps {' and '.join(conflict.robots)} apart: {conflict.describe()}"
+                )
+                return safety
+            robot, keep = options[0]
+            planner.obstacles[robot] = planner.obstacles.get(robot, ()) + _walls_around(keep.region, settings)
+            detours.setdefault(robot, []).append(conflict)
+        for robot, shared in detours.items():
+            replans.append(f"{robot} re-planned around the space it shares: {shared[0].describe()}")
+        fresh = planner.run({robot: current[robot] for robot in detours})
+        for robot, res in fresh.items():
+            if not res.feasible:
+                reasons.append(
+                    f"{robot} cannot keep clear of the space it shares with another robot "
+                    f"({detours[robot][0].describe()}): {res.reason}"
+                )
+        if reasons:
+            return safety
+        results.update(fresh)
+    return safety
+
+
+def _walls_around(region, settings: ConflictSettings) -> tuple[Wall, ...]:
+    """Wall segments around `region` grown by half the clearance (for a robot to keep out)."""
+    grown = region.buffer(settings.clearance / 2.0, join_style="mitre")
+    ring = list(shapely.get_coordinates(grown.exterior))
+    return tuple(
+        Wall((float(p[0]), float(p[1])), (float(q[0]), float(q[1])))
+        for p, q in itertools.pairwise(ring)
+        if tuple(p) != tuple(q)
     )

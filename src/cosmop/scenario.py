@@ -364,12 +364,24 @@ class DfaSpec:
         The marked (accepting) states; by default all states, i.e. a prefix-closed mission.
     transitions : tuple of (str, Event, str)
         Deterministic transitions ``(source, event, target)``.
+    marked_given : bool
+        Whether the file listed ``marked``.  Then the mission is complete exactly in the marked
+        states; otherwise in the states without an outgoing transition.
     """
 
     states: tuple[str, ...]
     initial: str
     marked: tuple[str, ...]
     transitions: tuple[tuple[str, Event, str], ...]
+    marked_given: bool = False
+
+    @property
+    def complete_states(self) -> tuple[str, ...]:
+        """The states in which the mission is complete (file order)."""
+        if self.marked_given:
+            return self.marked
+        busy = {source for source, _, _ in self.transitions}
+        return tuple(q for q in self.states if q not in busy)
 
     @property
     def alphabet(self) -> tuple[Event, ...]:
@@ -1083,7 +1095,11 @@ class _Builder:
                         (*base, "marked", index), f"unknown marked state {state!r}; it is not in {where}"
                     )
         return DfaSpec(
-            states=states, initial=model.initial, marked=tuple(marked), transitions=tuple(transitions)
+            states=states,
+            initial=model.initial,
+            marked=tuple(marked),
+            transitions=tuple(transitions),
+            marked_given=model.marked is not None,
         )
 
     def unique_states(self, path: _Path, states: list[str]) -> tuple[str, ...]:

@@ -13,9 +13,9 @@ shared by three robots (DESIGN.md; the paper's figures draw R3's two answers as 
   this one in its sequence.  A responder that others wait on is thereby answered first (in the
   10×10 example R3 answers R2 before R1).  If that order still blocks, the other orders of B's
   answers are tried.
-* The result is proved deadlock-free: for every cluster of robots linked by coordination
-  events, the synchronous product of their sequences (each marked only when complete) is
-  nonblocking, i.e. every reachable state can still reach the state where all are complete.
+* The result is proved deadlock-free: with asynchronous messages (the responder sends and
+  goes on, the requester waits until it has been sent) the robots can block only if their
+  waits form a cycle, which :func:`blocking_word` rules out.
 """
 
 from __future__ import annotations
@@ -25,11 +25,8 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from types import MappingProxyType
 
-from cosmop.automata import DFA, parallel
-from cosmop.automata.composition import clusters, shortest_word
-from cosmop.automata.operations import coaccessible_mask
 from cosmop.missions.events import Event
-from cosmop.missions.mission import sequence_automaton
+from cosmop.missions.team import blocking_word as team_blocking_word
 
 
 @dataclass(frozen=True)
@@ -83,7 +80,7 @@ def requests_by_phase(
     realised = {"pick": "PickUp", "drop": "DropOff"}
     out, event_index = [], 0
     for primitive, obj in steps:
-        if primitive == "Req":
+        if primitive == "Req" and obj is not None:  # (a Req without object waits for a msg)
             out.append((obj, event_index))
         while event_index < len(mission):
             event = mission[event_index]
@@ -99,24 +96,11 @@ def requests_by_phase(
 def blocking_word(sequences: Mapping[str, Sequence[Event]]) -> tuple[str, ...] | None:
     """A shortest word into a deadlock, or ``None`` when the robots can always all complete.
 
-    A deadlock is a reachable state of the product with no event enabled in which not every
-    robot has completed its sequence.  (Sequences are acyclic, so a state that cannot complete
-    always leads to one.)  Checked per cluster of robots linked by shared events: robots in
-    different clusters cannot block each other.
+    Messages are asynchronous (a responder sends and goes on; a requester waits until the
+    answer has been sent), as the robots execute them: see
+    :func:`cosmop.missions.team.blocking_word`.
     """
-    robots = list(sequences)
-    dfas = [sequence_automaton([e.name for e in sequences[r]], closed=False) for r in robots]
-    for members in clusters(dfas):
-        if len(members) == 1:
-            continue
-        product = parallel(*(dfas[i] for i in members))
-        if coaccessible_mask(product).all():
-            continue
-        stuck = ~(product.delta >= 0).any(axis=1) & ~product.marked
-        word = shortest_word(DFA(product.alphabet, product.delta, product.initial, stuck))
-        if word is not None:
-            return word
-    return None
+    return team_blocking_word({r: [e.name for e in seq] for r, seq in sequences.items()})
 
 
 def coordinate(

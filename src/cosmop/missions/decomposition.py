@@ -4,9 +4,13 @@ Section III of the paper: the local missions are :math:`K^i_{MI} = P_i(K_{MI})`;
 satisfy the global mission iff :math:`\\|_i K^i_{MI} \\subseteq K_{MI}`.  The converse inclusion
 always holds (:math:`K \\subseteq P_i^{-1} P_i(K)` for every ``i``), so this is the
 *separability* of :math:`K_{MI}` with respect to the local alphabets,
-:math:`K_{MI} = \\|_i P_i(K_{MI})` (the paper's Remark).  When it fails, a counterexample
-:math:`t \\in \\|_i K^i \\setminus K` is used to shrink the local missions,
-:math:`K^i := K^i - P_i(t)`, until the product is included in :math:`K_{MI}`.
+:math:`K_{MI} = \\|_i P_i(K_{MI})` (the paper's Remark).  When it fails because the product
+allows an interleaving of different robots' events that :math:`K_{MI}` forbids, the robots are
+given an order by messages (:mod:`cosmop.missions.ordering`) instead of losing behaviour: this
+keeps every task and only adds waiting.  Only when no placement of messages can work (a local
+mission that branches, or words that no complete word of the mission interleaves) does the
+paper's pruning run: a counterexample :math:`t \\in \\|_i K^i \\setminus K` shrinks the local
+missions, :math:`K^i := K^i - P_i(t)`, until the product is included in :math:`K_{MI}`.
 
 Both checks work on the mission's factors (:class:`~cosmop.automata.Composition`):
 :math:`L \\subseteq \\|_j T_j` iff :math:`P_{\\Sigma(T_j)}(L) \\subseteq T_j` for every factor,
@@ -33,7 +37,8 @@ from cosmop.automata import (
     project_composition,
 )
 from cosmop.automata.composition import SizeLog, lift_word
-from cosmop.missions.mission import GlobalMission
+from cosmop.missions.mission import GlobalMission, sequence_automaton, sequence_of
+from cosmop.missions.ordering import Edge, order_words, with_messages
 
 Word = tuple[str, ...]
 
@@ -210,6 +215,59 @@ def resynthesize(
 
 
 @dataclass(frozen=True)
+class Messaging:
+    """Messages that order the robots' events so that the local missions add up to :math:`K`.
+
+    Attributes
+    ----------
+    messages : tuple of (str, Edge)
+        Each ``msg(S,R,tag)`` with its edge ``((S, a), (R, b))``: S sends it right after its
+        event *a*, R waits for it right before its event *b* (indices into the words without
+        the new messages).
+    words : Mapping[str, tuple of str]
+        Every robot's local mission with the messages in place.
+    local_missions : Mapping[str, DFA]
+        The same, as sequence automata.
+    rounds : int
+        Counterexamples used.
+    """
+
+    messages: tuple[tuple[str, Edge], ...]
+    words: Mapping[str, tuple[str, ...]]
+    local_missions: Mapping[str, DFA]
+    rounds: int
+
+    def to_dict(self, words: Mapping[str, tuple[str, ...]]) -> list[dict]:
+        """JSON-ready list: ``{"event", "sender", "receiver", "after", "before"}`` per message."""
+        out = []
+        for name, ((a, i), (b, j)) in self.messages:
+            out.append(
+                {"event": name, "sender": a, "receiver": b, "after": words[a][i], "before": words[b][j]}
+            )
+        return out
+
+
+def order_by_messages(mission: GlobalMission, local: Mapping[str, DFA]) -> Messaging | None:
+    """Order the robots by messages when every local mission is one sequence of events.
+
+    ``None`` when a local mission branches or no complete word of the mission interleaves the
+    sequences (then only pruning or other words can help).
+    """
+    words = {}
+    for robot, dfa in local.items():
+        seq = sequence_of(dfa)
+        if seq is None:
+            return None
+        words[robot] = seq
+    result = order_words(mission.complete, words)
+    if not result.feasible:
+        return None
+    placed, messages = with_messages(words, result.edges)
+    dfas = {r: sequence_automaton(list(w)) for r, w in placed.items()}
+    return Messaging(tuple(messages), MappingProxyType(placed), MappingProxyType(dfas), result.rounds)
+
+
+@dataclass(frozen=True)
 class DecompositionStats:
     """Where the time and memory of a decomposition went.
 
@@ -255,8 +313,11 @@ class Decomposition:
     counterexample : tuple of str or None
         When not separable, a word of :math:`\\|_i P_i(K_{MI})` outside :math:`K_{MI}`.
     resynthesis : Resynthesis or None
-        When not separable, the re-synthesised (sound) local missions.
+        When not separable and messages cannot order the robots, the pruned (sound) local
+        missions.
     stats : DecompositionStats
+    messaging : Messaging or None
+        When not separable: the messages that order the robots (then no pruning is done).
     """
 
     alphabets: Mapping[str, tuple[str, ...]]
@@ -265,15 +326,19 @@ class Decomposition:
     counterexample: Word | None
     resynthesis: Resynthesis | None
     stats: DecompositionStats = field(repr=False)
+    messaging: Messaging | None = None
 
     @property
     def sound_local_missions(self) -> Mapping[str, DFA]:
-        """Local missions whose product is included in :math:`K_{MI}`, when known.
+        """Local missions that together do what :math:`K_{MI}` asks, when known.
 
-        The projections if separable, else the re-synthesised ones if they converged.
+        The projections if separable, else the projections with their ordering messages, else
+        the re-synthesised (pruned) ones if they converged.
         """
         if self.separable:
             return self.local_missions
+        if self.messaging is not None:
+            return self.messaging.local_missions
         if self.resynthesis is not None and self.resynthesis.converged:
             return self.resynthesis.local_missions
         raise ValueError("no sound local missions: re-synthesis did not converge")
@@ -285,8 +350,15 @@ class Decomposition:
             "counterexample": list(self.counterexample) if self.counterexample is not None else None,
             "local_missions": {r: d.to_dict(with_alphabet=True) for r, d in self.local_missions.items()},
             "resynthesis": self.resynthesis.to_dict() if self.resynthesis is not None else None,
+            "messages": [] if self.messaging is None else self.messaging.to_dict(self._words()),
+            "coordinated_missions": None
+            if self.messaging is None
+            else {r: list(w) for r, w in self.messaging.words.items()},
             "stats": self.stats.to_dict(),
         }
+
+    def _words(self) -> dict[str, tuple[str, ...]]:
+        return {r: sequence_of(d) or () for r, d in self.local_missions.items()}
 
 
 def decompose(mission: GlobalMission, *, max_iterations: int = 100) -> Decomposition:
@@ -312,8 +384,11 @@ def decompose(mission: GlobalMission, *, max_iterations: int = 100) -> Decomposi
     t1 = time.perf_counter()
     cex = separability_counterexample(mission.automaton, local, log)
     t2 = time.perf_counter()
+    messaging = None if cex is None else order_by_messages(mission, local)
     resynthesis = (
-        None if cex is None else resynthesize(mission, local, max_iterations=max_iterations, log=log)
+        None
+        if cex is None or messaging is not None
+        else resynthesize(mission, local, max_iterations=max_iterations, log=log)
     )
     t3 = time.perf_counter()
     stats = DecompositionStats(
@@ -333,4 +408,5 @@ def decompose(mission: GlobalMission, *, max_iterations: int = 100) -> Decomposi
         counterexample=cex,
         resynthesis=resynthesis,
         stats=stats,
+        messaging=messaging,
     )

@@ -9,12 +9,18 @@ canonical                 compact (paper)  in a task list      meaning
 ``pick(R1,O1)``           ``R1pO1``        ``pick O1``         R1 picks up object O1
 ``drop(R1,O1,W1)``        ``R1dO1aW1``     ``drop O1 at W1``   R1 drops O1 off inside workspace W1
 ``return(R1)``            ``r1``           ``return``          R1 is back at its initial pose
+``msg(R1,R2,t)``          --               --                  R1 sends R2 the message tagged t
 ``away(O2,R1,R2)``        --               --                  R2 tells R1 that O2 has been moved
 ========================  ===============  ==================  ================================
 
-``away(O,A,B)`` is shared by the requester A (for whom it is the request ``?O Away``) and the
-responder B (the response ``!O Away``); one such event exists per (object, requester,
-responder), so that several robots can ask the same responder without deadlock.
+*Messages* link robots.  ``msg(S,R,tag)`` is sent by S right after a given step of its plan
+(the primitive ``Res``) and awaited by R before a given step of its plan (``Req``); nothing
+else changes.  ``away(O,A,B)`` is the paper's message, a message from the responder B to the
+requester A whose meaning is fixed: object O has been moved away, so A's model marks O away
+(``?O Away`` for A, ``!O Away`` for B).  Both are shared by their sender and receiver
+(:attr:`Event.sender`, :attr:`Event.receiver`); one exists per (tag or object, sender,
+receiver), so that several robots can wait on the same robot without deadlock.  Messages are
+asynchronous: sending never waits, receiving waits until the message has been sent.
 """
 
 from __future__ import annotations
@@ -24,19 +30,23 @@ from dataclasses import dataclass
 
 from cosmop.errors import EventSyntaxError
 
-__all__ = ["ACCEPTED_FORMS", "EVENT_KINDS", "ID_PATTERN", "Event", "parse_event"]
+__all__ = ["ACCEPTED_FORMS", "EVENT_KINDS", "ID_PATTERN", "MESSAGE_KINDS", "Event", "message", "parse_event"]
 
 ID_PATTERN = r"[A-Za-z_][A-Za-z0-9_-]*"
 """Regular expression that robot, object and workspace ids must match."""
 
-EVENT_KINDS = ("pick", "drop", "return", "away")
+EVENT_KINDS = ("pick", "drop", "return", "away", "msg")
 """The kinds of mission events."""
+
+MESSAGE_KINDS = frozenset({"away", "msg"})
+"""The kinds of events that are messages between two robots."""
 
 ACCEPTED_FORMS = (
     "pick(R,O)",
     "drop(R,O,W)",
     "return(R)",
     "away(O,A,B)",
+    "msg(SENDER,RECEIVER,TAG)",
     "in a robot's task list: 'pick O', 'drop O at W', 'return'",
     "compact: 'R1pO1', 'R1dO1aW1', 'r1'",
 )
@@ -58,6 +68,7 @@ _SIGNATURES: dict[str, tuple[tuple[str, str], ...]] = {
     "drop": (("robot", "robot"), ("obj", "object"), ("workspace", "workspace")),
     "return": (("robot", "robot"),),
     "away": (("obj", "object"), ("robot", "requester"), ("responder", "responder")),
+    "msg": (("responder", "sender"), ("robot", "receiver"), ("tag", "tag")),
 }
 
 
@@ -67,28 +78,32 @@ class Event:
 
     Parameters
     ----------
-    kind : {"pick", "drop", "return", "away"}
+    kind : {"pick", "drop", "return", "away", "msg"}
         What happens.
     robot : str
-        The robot that performs a pick, drop or return; for ``away``, the requester A that
-        asked for the object to be moved.
+        The robot that performs a pick, drop or return; for a message (``away``, ``msg``),
+        the robot that receives it (for ``away``, the requester A that asked for the object to
+        be moved).
     obj : str, optional
         The object picked, dropped or moved away (required for those kinds, else ``None``).
     workspace : str, optional
         The workspace the object is dropped in (``drop`` only).
     responder : str, optional
-        The robot B that moved the object away and answers A (``away`` only, B != A).
+        The robot that sends a message: for ``away`` the robot B that moved the object away
+        and answers A, for ``msg`` its sender (messages only; sender != receiver).
+    tag : str, optional
+        What a ``msg`` is about, an id (``msg`` only).
 
     Raises
     ------
     EventSyntaxError
         If the kind is unknown, an id is not of the form ``[A-Za-z_][A-Za-z0-9_-]*``, the
-        fields do not match the kind, or an ``away`` event has requester == responder.
+        fields do not match the kind, or a message has sender == receiver.
 
     Notes
     -----
     Events are immutable, hashable and totally ordered (by kind, robot, object, workspace,
-    responder), so sets of events can be sorted deterministically.
+    responder, tag), so sets of events can be sorted deterministically.
     """
 
     kind: str
@@ -96,6 +111,7 @@ class Event:
     obj: str | None = None
     workspace: str | None = None
     responder: str | None = None
+    tag: str | None = None
 
     def __post_init__(self) -> None:
         if self.kind not in _SIGNATURES:
@@ -109,22 +125,40 @@ class Event:
                 raise EventSyntaxError(
                     f"{self.kind} event: {description} must be an id matching {ID_PATTERN}, got {value!r}"
                 )
-        for attr in ("obj", "workspace", "responder"):
+        for attr in ("obj", "workspace", "responder", "tag"):
             if attr not in required and getattr(self, attr) is not None:
                 raise EventSyntaxError(f"a {self.kind} event has no {attr}, got {getattr(self, attr)!r}")
-        if self.kind == "away" and self.robot == self.responder:
-            raise EventSyntaxError(f"the requester and the responder of {self.name} must be different robots")
+        if self.kind in MESSAGE_KINDS and self.robot == self.responder:
+            roles = "requester and the responder" if self.kind == "away" else "sender and the receiver"
+            raise EventSyntaxError(f"the {roles} of {self.name} must be different robots")
 
     @property
     def name(self) -> str:
-        """Canonical text, e.g. ``pick(R1,O1)``, ``drop(R1,O1,W1)``, ``return(R1)``, ``away(O2,R1,R2)``."""
+        """Canonical text, e.g. ``pick(R1,O1)``, ``drop(R1,O1,W1)``, ``return(R1)``,
+        ``away(O2,R1,R2)``, ``msg(R1,R2,t)``."""
         args = ",".join(getattr(self, attr) for attr, _ in _SIGNATURES[self.kind])
         return f"{self.kind}({args})"
 
     @property
+    def is_message(self) -> bool:
+        """Whether the event is a message between two robots (``away`` or ``msg``)."""
+        return self.kind in MESSAGE_KINDS
+
+    @property
+    def sender(self) -> str | None:
+        """The robot that sends a message (``away``: the responder), else ``None``."""
+        return self.responder if self.kind in MESSAGE_KINDS else None
+
+    @property
+    def receiver(self) -> str | None:
+        """The robot that waits for a message (``away``: the requester), else ``None``."""
+        return self.robot if self.kind in MESSAGE_KINDS else None
+
+    @property
     def owners(self) -> frozenset[str]:
-        """The robots whose alphabets contain this event: ``{A, B}`` for ``away``, else ``{robot}``."""
-        if self.kind == "away":
+        """The robots whose alphabets contain this event: sender and receiver for a message,
+        else ``{robot}``."""
+        if self.kind in MESSAGE_KINDS:
             return frozenset((self.robot, self.responder))
         return frozenset((self.robot,))
 
@@ -133,13 +167,14 @@ class Event:
         """The paper's compact name (``R1pO1``, ``R1dO1aW1``, ``r1``), or ``None`` if it has none.
 
         Only events whose ids follow the paper's pattern (``R<n>``, ``O<n>``, ``W<n>``) have a
-        compact name; ``away`` events never do.
+        compact name; messages never do.
         """
         candidate = {
             "pick": f"{self.robot}p{self.obj}",
             "drop": f"{self.robot}d{self.obj}a{self.workspace}",
             "return": f"r{self.robot[1:]}" if self.robot.startswith("R") else "",
             "away": "",
+            "msg": "",
         }[self.kind]
         return candidate if candidate and _parse_compact(candidate) == self else None
 
@@ -154,7 +189,7 @@ def parse_event(text: str, robot: str | None = None) -> Event:
     ----------
     text : str
         One of the accepted forms: canonical (``pick(R1,O1)``, ``drop(R1,O1,W1)``,
-        ``return(R1)``, ``away(O2,R1,R2)``; whitespace around the parentheses and commas is
+        ``return(R1)``, ``away(O2,R1,R2)``, ``msg(R1,R2,t)``; whitespace around the parentheses and commas is
         ignored), the paper's compact names (``R1pO1``, ``R1dO1aW1``, ``r1``; ids must then be
         ``R<n>``, ``O<n>``, ``W<n>``), or, when `robot` is given, a task step with the robot
         implied (``pick O1``, ``drop O1 at W1``, ``return``).
@@ -221,6 +256,15 @@ def parse_event(text: str, robot: str | None = None) -> Event:
             text, f"a {words[0]} task step is written {_STEP_USAGE[words[0]]} with ids matching {ID_PATTERN}"
         )
     raise _error(text, "not a mission event")
+
+
+def message(sender: str, receiver: str, tag: str) -> Event:
+    """The message event ``msg(sender,receiver,tag)``.
+
+    >>> message("R1", "R2", "after_drop_O1").name
+    'msg(R1,R2,after_drop_O1)'
+    """
+    return Event("msg", receiver, responder=sender, tag=tag)
 
 
 def _parse_compact(text: str) -> Event | None:

@@ -1,9 +1,17 @@
 """The global mission :math:`K_{MI}` and its distribution over the robots.
 
-A global mission is a prefix-closed regular language over every robot's mission events
-(Section III-B).  It is held as a :class:`~cosmop.automata.Composition`: the tasks form of the
-scenario file is the synchronous product of one sequence automaton per robot (kept as its
-factors, never built), the explicit DFA form is a composition of one factor.
+A global mission is a regular language over every robot's mission events (Section III-B).  It
+is held as a :class:`~cosmop.automata.Composition`: the tasks form of the scenario file is the
+synchronous product of one sequence automaton per robot (kept as its factors, never built),
+the explicit DFA form is a composition of one factor.
+
+**When a mission is complete.**  Planning and execution aim at a *complete* team run, never a
+mere prefix.  A DFA that lists ``marked`` states is complete exactly in them (a mission that is
+not prefix-closed); a DFA without ``marked`` (prefix-closed: every state marked) is complete in
+the states with no outgoing transition; the tasks form is complete when every task list is
+done.  :attr:`GlobalMission.complete` is the mission with exactly those states marked, trimmed
+to the runs that can still complete; :attr:`GlobalMission.prefixes` is its prefix-closure, the
+behaviour the team may show on the way.
 
 Event ownership gives the local alphabets :math:`\\Sigma^i_{MI}`: ``pick``, ``drop`` and
 ``return`` belong to their robot; a coordination event ``away(O, A, B)`` belongs to both the
@@ -16,7 +24,9 @@ from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from types import MappingProxyType
 
-from cosmop.automata import DFA, Composition
+import numpy as np
+
+from cosmop.automata import DFA, Composition, prefix_closure, trim
 from cosmop.missions.events import Event, parse_event
 from cosmop.scenario import Mission, Scenario
 
@@ -50,6 +60,29 @@ def sequence_of(dfa: DFA) -> tuple[str, ...] | None:
         seen.add(q)
 
 
+def completion(dfa: DFA, *, explicit: bool) -> DFA:
+    """The mission automaton marked exactly in its complete states, trimmed.
+
+    Parameters
+    ----------
+    dfa : DFA
+        A mission factor as written.
+    explicit : bool
+        Whether its marked states were given (then they are the complete states); otherwise
+        the complete states are those without an outgoing transition.
+
+    Returns
+    -------
+    DFA
+        Accessible and co-accessible: every run of it can still complete.  Its marked language
+        is empty when no complete state can be reached.
+    """
+    if explicit:
+        return trim(dfa)
+    sinks = ~(dfa.delta >= 0).any(axis=1)
+    return trim(DFA(dfa.alphabet, dfa.delta, dfa.initial, sinks, dfa.state_names))
+
+
 def local_alphabets(events: Iterable[Event], robots: Iterable[str]) -> dict[str, tuple[str, ...]]:
     """:math:`\\Sigma^i_{MI}` for every robot: the names of the events it owns, sorted.
 
@@ -76,19 +109,50 @@ class GlobalMission:
     robots : tuple of str
         The team, in scenario order (robots without events included).
     form : str
-        ``"tasks"`` or ``"dfa"``: how the scenario wrote it.
+        ``"tasks"``, ``"dfa"`` or ``"deliveries"``: how the scenario wrote it.
+    complete : Composition, optional
+        The mission marked exactly where it is complete (see the module docstring); by
+        default computed from `automaton` (its marked states when not all are marked, else its
+        states without an outgoing transition).
     """
 
     automaton: Composition
     events: Mapping[str, Event]
     robots: tuple[str, ...]
     form: str
+    complete: Composition | None = None
 
     def __post_init__(self) -> None:
         missing = set(self.automaton.alphabet) - set(self.events)
         if missing:
             raise ValueError(f"events without a definition: {sorted(missing)}")
         object.__setattr__(self, "events", MappingProxyType(dict(self.events)))
+        if self.complete is None:
+            factors = tuple(
+                completion(f, explicit=not bool(np.all(f.marked))) for f in self.automaton.components
+            )
+            object.__setattr__(self, "complete", Composition(factors))
+
+    @property
+    def prefixes(self) -> Composition:
+        r""":math:`\overline{K}`: every factor's runs that can still complete, all marked."""
+        return Composition(tuple(prefix_closure(f) for f in self.complete.components))
+
+    def is_complete_word(self, word: Sequence[str]) -> bool:
+        """Whether `word` (event names; messages ignored) is a complete word of the mission."""
+        known = set(self.complete.alphabet)
+        if any(e not in known and not parse_event(e).is_message for e in word):
+            return False
+        for factor in self.complete.components:
+            alphabet = set(factor.alphabet)
+            if not factor.accepts([e for e in word if e in alphabet]):
+                return False
+        return True
+
+    @property
+    def completable(self) -> bool:
+        """Whether every factor can reach a complete state (else no team run can complete)."""
+        return all(bool(f.marked.any()) for f in self.complete.components)
 
     @property
     def alphabets(self) -> dict[str, tuple[str, ...]]:
@@ -101,8 +165,10 @@ class GlobalMission:
         robots = tuple(robots)
         if mission.tasks is not None:
             events = {e.name: e for seq in mission.tasks.values() for e in seq}
-            factors = tuple(sequence_automaton([e.name for e in mission.tasks[r]]) for r in mission.tasks)
-            return cls(Composition(factors), events, robots, "tasks")
+            words = [[e.name for e in mission.tasks[r]] for r in mission.tasks]
+            factors = tuple(sequence_automaton(w) for w in words)
+            ends = tuple(sequence_automaton(w, closed=False) for w in words)
+            return cls(Composition(factors), events, robots, "tasks", Composition(ends))
         spec = mission.dfa
         if spec is None:
             raise ValueError("the mission has neither tasks nor a DFA")
@@ -113,7 +179,16 @@ class GlobalMission:
             marked=spec.marked,
             states=spec.states or None,
         )
-        return cls(Composition((dfa,)), events, robots, "dfa")
+        done = completion(
+            DFA.from_transitions(
+                spec.initial,
+                [(q, e.name, t) for q, e, t in spec.transitions],
+                marked=spec.complete_states,
+                states=spec.states or None,
+            ),
+            explicit=True,
+        )
+        return cls(Composition((dfa,)), events, robots, "dfa", Composition((done,)))
 
     @classmethod
     def from_scenario(cls, scenario: Scenario) -> GlobalMission:
@@ -138,6 +213,6 @@ class GlobalMission:
         """The parallel composition of one event sequence per robot (canonical event names)."""
         events = {name: parse_event(name) for seq in tasks.values() for name in seq}
         factors = tuple(sequence_automaton(list(seq)) for seq in tasks.values())
-        return cls(
-            Composition(factors), events, tuple(robots) if robots is not None else tuple(tasks), "tasks"
-        )
+        ends = tuple(sequence_automaton(list(seq), closed=False) for seq in tasks.values())
+        team = tuple(robots) if robots is not None else tuple(tasks)
+        return cls(Composition(factors), events, team, "tasks", Composition(ends))

@@ -49,8 +49,7 @@ coordinator only adds ``away`` events), and request/response pairs agree with th
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
-from dataclasses import dataclass
+from collections.abc import Iterable
 from typing import Any
 
 from shapely import Polygon, box
@@ -59,7 +58,10 @@ from shapely.geometry.base import BaseGeometry
 
 from cosmop.errors import EventSyntaxError
 from cosmop.missions.events import Event, parse_event
+from cosmop.planning.joint import check_team
 from cosmop.planning.plan import PlanSet, RobotPlan, State, Step, _fmt, _point, initial_state
+from cosmop.planning.realisation import TOLERANCE, event_instants, holds_at, step_primitive
+from cosmop.planning.report import RULES, CheckReport, Violation
 from cosmop.scenario import Scenario, Scene, Wall
 
 __all__ = [
@@ -73,87 +75,6 @@ __all__ = [
     "square",
     "swept_square",
 ]
-
-TOLERANCE = 1e-6
-"""Tolerance of numeric equality, mm or degrees."""
-
-RULES: Mapping[str, str] = {
-    "scenario": "the plan names another scenario",
-    "robot": "the plan is for a robot the scene does not have",
-    "objects": "a step does not list exactly the scene's objects, or names an unknown object",
-    "robot-static": "the robot moved during a primitive other than GoTo",
-    "position": "an object moved other than by being dropped off",
-    "carried": "a carried flag is wrong (picking, dropping, carrying)",
-    "away": "an away flag is wrong (only Req sets one)",
-    "wall": "the robot's swept area or a dropped object overlaps a wall, or the gripper reaches through one",
-    "object-collision": "the robot's swept area or a dropped object overlaps a resting object",
-    "pick-pose": "PickUp from a pose other than facing the object at distance d",
-    "drop-pose": "DropOff at a heading other than 0 or the object not put at distance d in front",
-    "req-room": "the requester stands where a robot picking the object must stand",
-    "mission": "a mission event is not realised in order, or does not belong to the robot or scenario",
-    "coordination": "a request/response pair and the missions disagree",
-}
-"""The rule identifiers of :class:`Violation`, with what each one means."""
-
-
-# ----------------------------------------------------------------------------------------------
-# Results
-# ----------------------------------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class Violation:
-    """One way a plan breaks a rule.
-
-    Parameters
-    ----------
-    robot : str or None
-        The robot whose plan breaks the rule; ``None`` for the plan set as a whole.
-    instant : int or None
-        The instant *k* (step ``k``, ``steps[k-1]`` in the file) where it happens; ``None``
-        when the rule concerns the whole plan (e.g. the mission).
-    rule : str
-        The rule's identifier, a key of :data:`RULES`.
-    message : str
-        What is wrong, naming the robot, the instant and the primitive.
-    """
-
-    robot: str | None
-    instant: int | None
-    rule: str
-    message: str
-
-    def to_dict(self) -> dict[str, Any]:
-        """The JSON form: ``{"robot", "instant", "rule", "message"}``."""
-        return {"robot": self.robot, "instant": self.instant, "rule": self.rule, "message": self.message}
-
-
-@dataclass(frozen=True)
-class CheckReport:
-    """The result of :func:`check_plan`.
-
-    Parameters
-    ----------
-    ok : bool
-        Whether the plan breaks no rule.
-    violations : tuple of Violation
-        Every violation found, by robot and instant.
-    checked_steps : int
-        The number of steps checked (over all robots of the scene).
-    """
-
-    ok: bool
-    violations: tuple[Violation, ...]
-    checked_steps: int
-
-    def to_dict(self) -> dict[str, Any]:
-        """The JSON form: ``{"ok", "checked_steps", "violations": [...]}``."""
-        return {
-            "ok": self.ok,
-            "checked_steps": self.checked_steps,
-            "violations": [v.to_dict() for v in self.violations],
-        }
-
 
 # ----------------------------------------------------------------------------------------------
 # Geometry
@@ -322,7 +243,9 @@ class _RobotChecker:
         return sorted(self.violations, key=lambda v: (v.instant is None, v.instant or 0))
 
     def transition(self, k: int, step: Step, prev: State, cur: State) -> None:
-        if step.primitive == "GoTo":
+        if step.message is not None:
+            self.message(k, step, prev, cur)
+        elif step.primitive == "GoTo":
             self.goto(k, step, prev, cur)
         elif step.primitive == "PickUp":
             self.pickup(k, step, prev, cur)
@@ -565,6 +488,22 @@ class _RobotChecker:
                 f"{oid} at instants {k - 1} and {k}; pick it up first",
             )
 
+    def message(self, k: int, step: Step, prev: State, cur: State) -> None:
+        """A ``Req`` (wait) or ``Res`` (send) of a ``msg``: nothing moves, the robot is its party."""
+        self.robot_static(k, prev, cur)
+        self.positions_static(k, prev, cur)
+        self.flags_static(k, prev, cur, "carried")
+        self.flags_static(k, prev, cur, "away")
+        event = parse_event(step.message)
+        role, robot = ("receiver", event.receiver) if step.primitive == "Req" else ("sender", event.sender)
+        if robot != self.robot_id:
+            self.add(
+                k,
+                "message",
+                f"{step.message} is {'awaited' if role == 'receiver' else 'sent'} by its {role} {robot}, "
+                f"not by {self.robot_id}",
+            )
+
     # -- mission -----------------------------------------------------------------------------
 
     def mission(self) -> None:
@@ -592,39 +531,23 @@ class _RobotChecker:
                 )
                 return
             events.append(event)
-        last: int | None = None
-        for n, event in enumerate(events, 1):
-            start = 0 if last is None else last + 1
-            found = next((i for i in range(start, self.plan.horizon + 1) if self.holds(event, i)), None)
+        instants = event_instants(self.plan, self.robot_id, self.scene, events, self.initial)
+        for n, (event, found) in enumerate(zip(events, instants, strict=True), 1):
             if found is None:
+                last = instants[n - 2] if n > 1 else None
                 self.add(None, "mission", self.unmatched(event, n, len(events), last, events))
                 return
-            last = found
 
     def holds(self, event: Event, i: int) -> bool:
-        if event.kind == "return":
-            return _pose_eq(self.states[i].robot, self.home)
-        if i == 0:
-            return False
-        step = self.plan.steps[i - 1]
-        if event.kind == "pick":
-            return step.primitive == "PickUp" and step.object == event.obj
-        if event.kind == "drop":
-            if step.primitive != "DropOff" or step.object != event.obj:
-                return False
-            obj = step.objects.get(event.obj)
-            return obj is not None and self.scene.workspaces[event.workspace].contains(
-                *obj.position, TOLERANCE
-            )
-        primitive = "Req" if self.robot_id == event.robot else "Res"
-        return step.primitive == primitive and step.object == event.obj
+        return holds_at(event, self.robot_id, self.plan, self.states, self.scene, i)
 
     def expectation(self, event: Event) -> str:
         if event.kind == "pick":
             return f"PickUp({event.obj})"
         if event.kind == "drop":
             return f"DropOff({event.obj}) that leaves {event.obj} in {event.workspace}"
-        return f"{'Req' if self.robot_id == event.robot else 'Res'}({event.obj})"
+        primitive, obj, name = step_primitive(event, self.robot_id)
+        return f"{primitive}({obj or name})"
 
     def unmatched(self, event: Event, n: int, total: int, last: int | None, events: list[Event]) -> str:
         after = "anywhere in the plan" if last is None else f"after instant {last} ({events[n - 2].name})"
@@ -749,6 +672,12 @@ def check_plan(scenario: Scenario, plan: PlanSet) -> CheckReport:
         for robot_id, sequence in tasks.items():
             violations.extend(_check_tasks(robot_id, sequence, plan.robots.get(robot_id)))
     violations.extend(_check_coordination(plan))
+    if not plan.feasible:
+        violations.append(
+            Violation(None, None, "infeasible", f"the plan file marks the scenario infeasible: {plan.reason}")
+        )
+    elif not violations:  # the team-level rules presume sound single plans
+        violations.extend(check_team(scenario, plan))
     return CheckReport(not violations, tuple(violations), checked)
 
 
@@ -793,7 +722,7 @@ def _check_tasks(robot_id: str, sequence: tuple[Event, ...], plan: RobotPlan | N
             ]
         matched.add(position)
         position += 1
-    added = [e.name for i, e in enumerate(events) if i not in matched and e.kind != "away"]
+    added = [e.name for i, e in enumerate(events) if i not in matched and not e.is_message]
     if added:
         return [
             Violation(
@@ -801,7 +730,7 @@ def _check_tasks(robot_id: str, sequence: tuple[Event, ...], plan: RobotPlan | N
                 None,
                 "mission",
                 f"{robot_id}: the plan's mission adds {', '.join(added)}, which the scenario's tasks "
-                f"({tasks}) do not have; only away events may be added",
+                f"({tasks}) do not have; only messages (away, msg) may be added",
             )
         ]
     return []

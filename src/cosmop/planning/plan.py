@@ -19,15 +19,23 @@ A plan set holds, for every robot, a sequence of motion primitives and the state
           ]
         }
       },
-      "coordination": [{"object": "O2", "requester": "R1", "responder": "R2"}]
+      "coordination": [{"object": "O2", "requester": "R1", "responder": "R2"}],
+      "messages": [{"event": "msg(R2,R1,clear1)", "sender": "R2", "receiver": "R1", "kind": "conflict",
+                    "protects": "...", "place": [x_min, y_min, x_max, y_max]}]
     }
 
 ``steps[k-1]`` is instant *k*: the primitive taken between *k-1* and *k* and the whole state
 *after* it, as this robot's model sees it (robot pose ``[x, y, heading]`` in mm and degrees;
 every object's centre in mm, whether this robot carries it, and whether it has been moved away
 by another robot). ``primitive`` is one of ``GoTo``, ``PickUp``, ``DropOff``, ``Req`` (the
-paper's ``?ObjAway``) and ``Res`` (``!ObjAway``); all but ``GoTo`` name their ``object``.
-An infeasible scenario still has a plan file, with ``"feasible": false`` and a ``"reason"``.
+paper's ``?ObjAway``) and ``Res`` (``!ObjAway``); all but ``GoTo`` name their ``object``,
+except the ``Req`` and ``Res`` of a message ``msg(S,R,tag)``, which name their ``message``
+instead: ``{"primitive": "Res", "object": null, "message": "msg(R2,R1,clear1)", ...}`` is
+sent by S right after its previous step, ``Req`` with the same message waits in R's plan
+until it has been sent.  ``messages`` lists every such message with what it protects (an order
+the mission requires, or a place two robots' plans share: then ``place`` is its bounding box,
+mm).  An infeasible scenario still has a plan file, with ``"feasible": false`` and a
+``"reason"``.
 
 :func:`load_plan` and :meth:`PlanSet.from_dict` validate the shape of a plan and raise
 :class:`PlanError` naming the file, the field (e.g. ``robots.R1.steps[3].primitive``) and what
@@ -57,12 +65,15 @@ if TYPE_CHECKING:
     from cosmop.scenario import Scene
 
 __all__ = [
+    "MESSAGE_PRIMITIVES",
+    "MESSAGE_REASONS",
     "OBJECT_PRIMITIVES",
     "PLAN_FORMAT",
     "PRIMITIVES",
     "Coordination",
     "ObjectState",
     "PlanError",
+    "PlanMessage",
     "PlanSet",
     "RobotPlan",
     "State",
@@ -80,7 +91,15 @@ PRIMITIVES = ("GoTo", "PickUp", "DropOff", "Req", "Res")
 """The motion primitives, in the paper's order :math:`\\pi^1, \\dots, \\pi^5`."""
 
 OBJECT_PRIMITIVES = frozenset({"PickUp", "DropOff", "Req", "Res"})
-"""The primitives that act on an object (every primitive but ``GoTo``)."""
+"""The primitives that act on an object (every primitive but ``GoTo``; ``Req`` and ``Res`` of a
+``msg`` name a message instead)."""
+
+MESSAGE_PRIMITIVES = frozenset({"Req", "Res"})
+"""The primitives that can carry a ``msg`` message (wait for it, send it)."""
+
+MESSAGE_REASONS = ("order", "conflict", "mission")
+"""Why a planned message exists: an order between robots that the global mission requires, a
+place that two robots' plans share (a conflict), or a message the mission itself names."""
 
 _ID_RE = re.compile(rf"{ID_PATTERN}\Z")
 
@@ -300,16 +319,20 @@ class Step:
     primitive : {"GoTo", "PickUp", "DropOff", "Req", "Res"}
         The motion primitive.
     object : str or None
-        The object the primitive acts on; ``None`` exactly for ``GoTo``.
+        The object the primitive acts on; ``None`` for ``GoTo`` and for the ``Req``/``Res`` of
+        a message.
     robot : tuple of float
         The robot's pose after the step, ``(x, y, heading)`` in mm and degrees.
     objects : Mapping[str, ObjectState]
         Every object's state after the step, by id (read-only).
+    message : str, optional
+        For ``Req`` (wait) and ``Res`` (send) of a message: its event ``msg(S,R,tag)``.
 
     Raises
     ------
     ValueError
-        If the primitive is unknown, or `object` is missing (or given, for ``GoTo``).
+        If the primitive is unknown, or `object` is missing (or given, for ``GoTo``), or a
+        message is given to a primitive other than ``Req``/``Res`` or together with an object.
     """
 
     __reduce__ = reduce_frozen  # picklable for worker processes
@@ -318,11 +341,19 @@ class Step:
     object: str | None
     robot: Pose
     objects: Mapping[str, ObjectState]
+    message: str | None = None
 
     def __post_init__(self) -> None:
         if self.primitive not in PRIMITIVES:
             raise ValueError(f"unknown primitive {self.primitive!r}; expected one of {', '.join(PRIMITIVES)}")
-        if self.primitive in OBJECT_PRIMITIVES and not self.object:
+        if self.message is not None:
+            if self.primitive not in MESSAGE_PRIMITIVES or self.object is not None:
+                raise ValueError(f"only Req and Res without an object carry a message, not {self.primitive}")
+            event = parse_event(self.message)
+            if event.kind != "msg":
+                raise ValueError(f"a step's message is a msg(S,R,tag) event, got {self.message!r}")
+            object.__setattr__(self, "message", event.name)
+        elif self.primitive in OBJECT_PRIMITIVES and not self.object:
             raise ValueError(f"{self.primitive} needs the object it acts on")
         if self.primitive == "GoTo" and self.object is not None:
             raise ValueError(f"GoTo acts on no object, got {self.object!r}")
@@ -331,8 +362,9 @@ class Step:
 
     @property
     def label(self) -> str:
-        """The primitive with its object, e.g. ``PickUp(O1)``, or ``GoTo``."""
-        return self.primitive if self.object is None else f"{self.primitive}({self.object})"
+        """The primitive with its object or message: ``PickUp(O1)``, ``Req(msg(R2,R1,t))``, ``GoTo``."""
+        what = self.object if self.object is not None else self.message
+        return self.primitive if what is None else f"{self.primitive}({what})"
 
     @property
     def state(self) -> State:
@@ -340,13 +372,13 @@ class Step:
         return State(self.robot, self.objects)
 
     def to_dict(self) -> dict[str, Any]:
-        """The JSON form of the step (``object`` is ``null`` for ``GoTo``)."""
-        return {
-            "primitive": self.primitive,
-            "object": self.object,
-            "robot": [_num(v) for v in self.robot],
-            "objects": {oid: state.to_dict() for oid, state in self.objects.items()},
-        }
+        """The JSON form of the step (``object`` is ``null`` for ``GoTo``; ``message`` only when set)."""
+        data: dict[str, Any] = {"primitive": self.primitive, "object": self.object}
+        if self.message is not None:
+            data["message"] = self.message
+        data["robot"] = [_num(v) for v in self.robot]
+        data["objects"] = {oid: state.to_dict() for oid, state in self.objects.items()}
+        return data
 
     def to_text(self) -> str:
         """The step as one line: primitive, robot pose, and what is carried, dropped or away."""
@@ -484,6 +516,62 @@ class Coordination:
 
 
 @dataclass(frozen=True)
+class PlanMessage:
+    """A message the plans rely on: what it is, between whom, and what it protects.
+
+    Parameters
+    ----------
+    event : str
+        The message event ``msg(S,R,tag)`` (canonical text).
+    kind : {"order", "conflict", "mission"}
+        Why it exists (:data:`MESSAGE_REASONS`).
+    protects : str
+        In words: which step of the receiver waits for which step of the sender, and why.
+    place : tuple of float, optional
+        For a conflict: the bounding box ``(x_min, y_min, x_max, y_max)`` (mm) of the space
+        the two robots share.
+    """
+
+    event: str
+    kind: str
+    protects: str
+    place: tuple[float, float, float, float] | None = None
+
+    def __post_init__(self) -> None:
+        event = parse_event(self.event)
+        if event.kind != "msg":
+            raise ValueError(f"a planned message is a msg(S,R,tag) event, got {self.event!r}")
+        if self.kind not in MESSAGE_REASONS:
+            raise ValueError(f"a message's kind is one of {', '.join(MESSAGE_REASONS)}, got {self.kind!r}")
+        object.__setattr__(self, "event", event.name)
+        if self.place is not None:
+            object.__setattr__(self, "place", _floats(self.place, 4, "a place"))
+
+    @property
+    def sender(self) -> str:
+        """The robot that sends the message."""
+        return parse_event(self.event).sender
+
+    @property
+    def receiver(self) -> str:
+        """The robot that waits for it."""
+        return parse_event(self.event).receiver
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON form: ``{"event", "sender", "receiver", "kind", "protects"[, "place"]}``."""
+        data: dict[str, Any] = {
+            "event": self.event,
+            "sender": self.sender,
+            "receiver": self.receiver,
+            "kind": self.kind,
+            "protects": self.protects,
+        }
+        if self.place is not None:
+            data["place"] = [_num(v) for v in self.place]
+        return data
+
+
+@dataclass(frozen=True)
 class PlanSet:
     """The plans of all robots for one scenario (the content of a ``cosmop.plan/1`` file).
 
@@ -499,6 +587,10 @@ class PlanSet:
         The request/response pairs the plans rely on.
     reason : str, optional
         Why no plan exists, in words a person can act on (required when not `feasible`).
+    messages : tuple of PlanMessage
+        The messages (``msg`` events) the plans send and wait for, with what each protects.
+    allocation : Mapping[str, str], optional
+        When the mission let the planner choose: the chosen robot by object (or task).
 
     Raises
     ------
@@ -513,11 +605,15 @@ class PlanSet:
     robots: Mapping[str, RobotPlan] = field(default_factory=dict)
     coordination: tuple[Coordination, ...] = ()
     reason: str | None = None
+    messages: tuple[PlanMessage, ...] = ()
+    allocation: Mapping[str, str] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if not isinstance(self.robots, MappingProxyType):
             object.__setattr__(self, "robots", MappingProxyType(dict(self.robots)))
         object.__setattr__(self, "coordination", tuple(self.coordination))
+        object.__setattr__(self, "messages", tuple(self.messages))
+        object.__setattr__(self, "allocation", MappingProxyType(dict(self.allocation)))
         if not self.feasible and not self.reason:
             raise ValueError("an infeasible plan set needs a reason")
 
@@ -537,6 +633,9 @@ class PlanSet:
             data["reason"] = self.reason
         data["robots"] = {robot: plan.to_dict() for robot, plan in self.robots.items()}
         data["coordination"] = [pair.to_dict() for pair in self.coordination]
+        data["messages"] = [message.to_dict() for message in self.messages]
+        if self.allocation:
+            data["allocation"] = dict(self.allocation)
         return data
 
     @classmethod
@@ -585,6 +684,8 @@ class PlanSet:
             lines.extend("  " + line for line in plan.to_text().splitlines())
         for pair in self.coordination:
             lines.append(f"coordination: {pair.responder} moves {pair.object} away for {pair.requester}")
+        for message in self.messages:
+            lines.append(f"message {message.event} ({message.kind}): {message.protects}")
         return "\n".join(lines)
 
 
@@ -726,7 +827,10 @@ class _Reader:
             # another format (version) first: its other fields may legitimately differ
             raise self.fail(("format",), f"unknown format {data['format']!r}; expected {PLAN_FORMAT!r}")
         root = self.mapping(
-            data, (), ("format", "scenario", "feasible", "robots"), ("coordination", "reason")
+            data,
+            (),
+            ("format", "scenario", "feasible", "robots"),
+            ("coordination", "reason", "messages", "allocation"),
         )
         scenario = self.string(root["scenario"], ("scenario",), "the scenario's name as text")
         feasible = self.boolean(root["feasible"], ("feasible",))
@@ -748,7 +852,42 @@ class _Reader:
         if not isinstance(pairs_data, list):
             raise self.fail(("coordination",), f"expected a list, got {_describe(pairs_data)}")
         pairs = tuple(self.coordination(item, ("coordination", i)) for i, item in enumerate(pairs_data))
-        return PlanSet(scenario, feasible, robots, pairs, reason)
+        messages_data = root.get("messages", [])
+        if not isinstance(messages_data, list):
+            raise self.fail(("messages",), f"expected a list, got {_describe(messages_data)}")
+        messages = tuple(self.message(item, ("messages", i)) for i, item in enumerate(messages_data))
+        allocation_data = root.get("allocation", {})
+        if not isinstance(allocation_data, dict):
+            raise self.fail(
+                ("allocation",), f"expected an object of robots by task, got {_describe(allocation_data)}"
+            )
+        allocation = {
+            key: self.ident(value, ("allocation", key), "robot") for key, value in allocation_data.items()
+        }
+        return PlanSet(scenario, feasible, robots, pairs, reason, messages, allocation)
+
+    def message(self, value: Any, path: _Path) -> PlanMessage:
+        item = self.mapping(value, path, ("event", "kind", "protects"), ("sender", "receiver", "place"))
+        text = self.string(item["event"], (*path, "event"), "a message such as 'msg(R1,R2,t1)'")
+        try:
+            event = parse_event(text)
+        except EventSyntaxError as err:
+            raise self.fail((*path, "event"), str(err)) from None
+        if event.kind != "msg":
+            raise self.fail((*path, "event"), f"expected a msg(SENDER,RECEIVER,TAG) event, got {event.name}")
+        for key, robot in (("sender", event.sender), ("receiver", event.receiver)):
+            if key in item and item[key] != robot:
+                raise self.fail(
+                    (*path, key), f"expected {robot!r} (from {event.name}), got {_describe(item[key])}"
+                )
+        kind = self.string(item["kind"], (*path, "kind"))
+        if kind not in MESSAGE_REASONS:
+            raise self.fail((*path, "kind"), f"expected one of {', '.join(MESSAGE_REASONS)}, got {kind!r}")
+        protects = self.string(item["protects"], (*path, "protects"))
+        place = item.get("place")
+        if place is not None:
+            place = self.numbers(place, (*path, "place"), ("x_min", "y_min", "x_max", "y_max"), "mm")
+        return PlanMessage(event.name, kind, protects, place)
 
     def coordination(self, value: Any, path: _Path) -> Coordination:
         item = self.mapping(value, path, ("object", "requester", "responder"))
@@ -789,7 +928,7 @@ class _Reader:
         return RobotPlan(tuple(mission), horizon, steps)
 
     def step(self, value: Any, path: _Path) -> Step:
-        item = self.mapping(value, path, ("primitive", "robot", "objects"), ("object",))
+        item = self.mapping(value, path, ("primitive", "robot", "objects"), ("object", "message"))
         primitive = item["primitive"]
         if primitive not in PRIMITIVES:
             raise self.fail(
@@ -797,11 +936,15 @@ class _Reader:
                 f"unknown primitive {_describe(primitive)}; expected one of {', '.join(PRIMITIVES)}",
             )
         obj = item.get("object")
-        if primitive == "GoTo":
+        message = self.step_message(item, path, primitive)
+        if primitive == "GoTo" or message is not None:
             if obj is not None:
-                raise self.fail(
-                    (*path, "object"), f"GoTo acts on no object; expected null, got {_describe(obj)}"
+                what = (
+                    "GoTo acts on no object"
+                    if message is None
+                    else f"{primitive} of a message names no object"
                 )
+                raise self.fail((*path, "object"), f"{what}; expected null, got {_describe(obj)}")
         else:
             if obj is None:
                 raise self.fail((*path, "object"), f"{primitive} needs the id of the object it acts on")
@@ -826,7 +969,25 @@ class _Reader:
         if obj is not None and obj not in objects:
             listed = ", ".join(objects) or "none"
             raise self.fail((*path, "object"), f"{obj!r} is not among the step's objects ({listed})")
-        return Step(primitive, obj, robot, objects)
+        return Step(primitive, obj, robot, objects, message)
+
+    def step_message(self, item: dict, path: _Path, primitive: str) -> str | None:
+        """The step's ``message`` (a msg event of a Req or Res), or None."""
+        message = item.get("message")
+        if message is None:
+            return None
+        if primitive not in MESSAGE_PRIMITIVES:
+            raise self.fail((*path, "message"), f"only Req and Res carry a message, not {primitive}")
+        text = self.string(message, (*path, "message"), "a message such as 'msg(R1,R2,t1)'")
+        try:
+            event = parse_event(text)
+        except EventSyntaxError as err:
+            raise self.fail((*path, "message"), str(err)) from None
+        if event.kind != "msg":
+            raise self.fail(
+                (*path, "message"), f"expected a msg(SENDER,RECEIVER,TAG) event, got {event.name}"
+            )
+        return event.name
 
 
 # ----------------------------------------------------------------------------------------------

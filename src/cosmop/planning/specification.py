@@ -94,6 +94,8 @@ class RobotProblem:
         Instant 0 when it is not the scenario: a robot that replans mid-mission starts where it
         is (integer mm and degrees), with the objects as it knows them; ``return`` still means
         the scenario's initial pose.
+    unrequestable : frozenset of str
+        Objects the robot may not ask for (nobody can move them, or asking deadlocks the team).
 
     Notes
     -----
@@ -108,6 +110,7 @@ class RobotProblem:
     requests: bool = True
     primitives: Mapping[str, Primitive] | None = None
     start: State | None = None
+    unrequestable: frozenset[str] = frozenset()
     actions: tuple[Action, ...] = field(init=False)
 
     def __post_init__(self) -> None:
@@ -350,7 +353,9 @@ class Req(Primitive):
     name = "Req"
 
     def targets(self, p):
-        return tuple(o for o in p.scene.objects if o not in p.own_objects) if p.requests else ()
+        if not p.requests:
+            return ()
+        return tuple(o for o in p.scene.objects if o not in p.own_objects and o not in p.unrequestable)
 
     def parts(self, p, obj):
         v, d, side = p.obj(obj), p.clearance(obj), p.side

@@ -24,6 +24,7 @@ import z3
 
 from cosmop.logic import IncrementalUnrolling, Signature, Unrolling, conj
 from cosmop.missions.events import Event
+from cosmop.planning.messages import answer_early, place_mission_messages, strip_messages, wait_early
 from cosmop.planning.plan import ObjectState, RobotPlan, State, Step
 from cosmop.planning.specification import (
     NONE,
@@ -144,6 +145,7 @@ def synthesize(
     incremental: bool = True,
     start: State | None = None,
     explain: bool = True,
+    unrequestable: frozenset[str] = frozenset(),
 ) -> Synthesis:
     """The shortest safe plan of motion primitives for one robot's local mission.
 
@@ -167,14 +169,22 @@ def synthesize(
     explain : bool
         When infeasible, search for the first unreachable event and an unsat core (the
         ``reason``); a replan that only needs yes or no skips it.
+    unrequestable : frozenset of str
+        Objects the plan may not request.
 
     Returns
     -------
     Synthesis
+
+    Notes
+    -----
+    ``msg`` events of the mission move nothing: the solver plans the rest, and the messages are
+    put in afterwards (:func:`cosmop.planning.messages.place_mission_messages`).
     """
     t0 = time.perf_counter()
-    events = events_of(mission)
-    p = RobotProblem(scene, robot, events, requests, start=start)
+    full = events_of(mission)
+    events = strip_messages(full)
+    p = RobotProblem(scene, robot, events, requests, start=start, unrequestable=frozenset(unrequestable))
     formula = conj(f for _, f in specification(p))
     signature = Signature.of(formula)
     checks = 0
@@ -218,6 +228,10 @@ def synthesize(
                 best = model.eval(count, model_completion=True).as_long()
                 s.pop()
         plan, asked = _plan(p, u, model)
+        plan = answer_early(plan)
+        if start is None:  # where a robot waits for answers: before it drives (no start state mid-run)
+            plan = wait_early(scene, robot, plan)
+        plan = place_mission_messages(scene, robot, plan, full, start)
         return Synthesis(
             robot,
             True,

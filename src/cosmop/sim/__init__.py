@@ -15,7 +15,6 @@ from cosmop.sim.simulation import (
     SimResult,
     SimSettings,
     simulate,
-    wait_in_place,
 )
 
 __all__ = [
@@ -28,5 +27,4 @@ __all__ = [
     "replan",
     "sensed_scene",
     "simulate",
-    "wait_in_place",
 ]

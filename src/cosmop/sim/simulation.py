@@ -17,8 +17,10 @@ control cycle :math:`\\varepsilon` (the scenario's ``dynamics.cycle``):
     A carried object rides on its robot, inside the robot's square, as in the plan model where
     a carried object takes no room.
 ``Req``
-    stops and waits for the responder's message; ``Res`` stops and sends it (the message bus
-    logs every message).
+    stops and waits for its message (the answer ``away(O, A, B)`` to a request, or a
+    ``msg``); ``Res`` stops and sends it.  The message bus logs every message.  Plans are
+    executed exactly as written: the messages that keep robots apart sit where the plan put
+    them (:mod:`cosmop.planning.teamsafety`).
 
 Robots are unicycles: each cycle the robot holds an acceleration in :math:`[-b, A]` and a turn
 rate in :math:`[-\\Omega, \\Omega]`.  The footprint is the scenario's axis-aligned square, so a
@@ -49,9 +51,8 @@ from cosmop.control.geometry import box_gaps, point_segment_linf, segment_array
 from cosmop.control.paths import GlobalPath, plan_path
 from cosmop.control.safety import is_safe, obstacle_speed, stopping_horizon, stopping_margin
 from cosmop.io import write_atomic
-from cosmop.missions.events import Event
-from cosmop.planning.checker import check_robot_plan
-from cosmop.planning.plan import ObjectState, PlanSet, RobotPlan, State, Step, plan_from_actions
+from cosmop.missions.events import Event, parse_event
+from cosmop.planning.plan import ObjectState, PlanSet, State, Step
 from cosmop.scenario import Scenario
 from cosmop.sim.humans import Walker
 from cosmop.sim.replan import replan
@@ -64,7 +65,6 @@ __all__ = [
     "SimResult",
     "SimSettings",
     "simulate",
-    "wait_in_place",
 ]
 
 SIM_FORMAT = "cosmop.sim/1"
@@ -111,8 +111,6 @@ class SimSettings:
         Progress (mm of path) that resets the stall clock.
     replan : bool
         Whether stalled robots replan (else they keep trying).
-    wait_in_place : bool
-        Issue requests before driving to where the plan waits (:func:`wait_in_place`).
     sense_range : float
         Robots and people within this gap (mm) of a stalled robot are added to its scene.
     max_horizon, rlimit : int
@@ -134,7 +132,6 @@ class SimSettings:
     stall_time: float = 12.0
     stall_progress: float = 50.0
     replan: bool = True
-    wait_in_place: bool = True
     sense_range: float = 800.0
     max_horizon: int = 12
     rlimit: int = 10_000_000
@@ -143,12 +140,15 @@ class SimSettings:
 
 @dataclass(frozen=True)
 class Message:
-    """A message on the bus: ``sender`` answers ``receiver``'s request about ``object``."""
+    """A message on the bus: ``event`` from ``sender`` to ``receiver`` at time ``t`` (s).
+
+    ``object`` is the object of an ``away`` answer (``None`` for a ``msg``).
+    """
 
     t: float
     sender: str
     receiver: str
-    object: str
+    object: str | None
     event: str
 
     def to_dict(self) -> dict[str, Any]:
@@ -208,6 +208,11 @@ class SimResult:
         ``(None, GoTo, PickUp, DropOff, Req, Res)``), ``waiting`` (n, R), ``humans`` (n, H, 2),
         ``objects`` (n, O, 2).
     robot_ids, human_ids, object_ids : tuple of str
+    events : tuple of (float, str, str)
+        ``(t, robot, event)``: the mission events and messages as the robots realised them --
+        a pick when the gripper closes, a drop when the object lies in its workspace, a return
+        when the robot ends its plan at home, a message when it is sent (and again when it is
+        received).
     """
 
     scenario: str
@@ -227,6 +232,11 @@ class SimResult:
     robot_ids: tuple[str, ...] = ()
     human_ids: tuple[str, ...] = ()
     object_ids: tuple[str, ...] = ()
+    events: tuple[tuple[float, str, str], ...] = ()
+
+    def executed_word(self) -> tuple[str, ...]:
+        """The mission events the run realised, in time order (messages left out)."""
+        return tuple(name for _, _, name in sorted(self.events) if not name.startswith(("msg(", "away(")))
 
     @property
     def contacts_while_moving(self) -> int:
@@ -247,6 +257,7 @@ class SimResult:
             "replans": self.replans,
             "replan_attempts": self.replan_attempts,
             "messages": [m.to_dict() for m in self.messages],
+            "events": [{"t": t, "robot": r, "event": e} for t, r, e in self.events],
             "objects": {
                 oid: {"position": [round(p[0], 3), round(p[1], 3)], "carried_by": by}
                 for oid, (p, by) in self.objects.items()
@@ -393,12 +404,15 @@ class _World:
         self.agents = []
         for i, rid in enumerate(self.rids):
             plan = plans.robots.get(rid)
-            if plan is not None and settings.wait_in_place:
-                plan = wait_in_place(scene, rid, plan)
             steps = plan.steps if plan is not None else ()
             events = plan.events if plan is not None else ()
             self.agents.append(_Agent(rid, i, steps, events))
-        self.inbox: set[tuple[str, str]] = set()  # (object, receiver)
+        self.inbox: set[str] = set()  # the message events sent
+        self.events: list[tuple[float, str, str]] = [  # (t, robot, event) as the robots do them
+            (0.0, a.id, f"return({a.id})")
+            for a in self.agents
+            if a.done and any(e.kind == "return" for e in a.mission)
+        ]
         self.messages: list[Message] = []
         self.contacts: list[Contact] = []
         self.touching: dict[tuple[int, str], int] = {}  # pair -> index in contacts
@@ -503,50 +517,59 @@ class _World:
 
     # -- messages ----------------------------------------------------------------------------
 
-    def send(self, agent: _Agent, obj: str) -> None:
-        """Answer the next request about `obj`: the k-th Res(obj) answers the k-th such event."""
-        sender = agent.id
-        requesters = [
-            e.robot for e in agent.mission if e.kind == "away" and e.obj == obj and e.robot != sender
-        ]
-        sent = agent.answered.get(obj, 0)
-        agent.answered[obj] = sent + 1
-        receiver = requesters[min(sent, len(requesters) - 1)]
-        event = f"away({obj},{receiver},{sender})"
-        self.messages.append(Message(round(self.t, 6), sender, receiver, obj, event))
-        self.inbox.add((obj, receiver))
-
-
-def wait_in_place(scene, robot: str, plan: RobotPlan) -> RobotPlan:
-    """The plan with every run of requests issued before the drive that precedes it.
-
-    A plan may drive somewhere and then wait there for another robot's answer (``GoTo``,
-    ``Req``).  Where a robot waits does not matter to the mission, but a robot parked next to
-    the objects can stand in the way of the very robot it waits for.  Requests are therefore
-    moved before the drive when the reordered plan still passes the exact plan checker (the
-    drive then meets fewer objects: the requested ones are away); otherwise the plan is kept.
-    """
-    actions: list[tuple] = [
-        ("GoTo", st.robot) if st.primitive == "GoTo" else (st.primitive, st.object) for st in plan.steps
-    ]
-    k, changed = 0, False
-    while k < len(actions):
-        if actions[k][0] == "Req" and k > 0 and actions[k - 1][0] == "GoTo":
-            b = k - 1
-            while b > 0 and actions[b - 1][0] == "GoTo":
-                b -= 1
-            e = k
-            while e + 1 < len(actions) and actions[e + 1][0] == "Req":
-                e += 1
-            actions = actions[:b] + actions[k : e + 1] + actions[b:k] + actions[e + 1 :]
-            changed = True
-            k = e + 1
+    def send(self, agent: _Agent, step: Step) -> None:
+        """Send the message of a ``Res`` step: its ``msg``, or the next ``away`` answer about its
+        object (the k-th Res(O) answers the k-th away(O, *, sender) of the mission)."""
+        if step.message is not None:
+            event = parse_event(step.message)
         else:
-            k += 1
-    if not changed:
-        return plan
-    reordered = plan_from_actions(scene, robot, plan.mission, actions)
-    return reordered if not check_robot_plan(scene, robot, reordered) else plan
+            answers = [
+                e for e in agent.mission if e.kind == "away" and e.obj == step.object and e.sender == agent.id
+            ]
+            sent = agent.answered.get(step.object, 0)
+            agent.answered[step.object] = sent + 1
+            event = answers[min(sent, len(answers) - 1)]
+        self.messages.append(Message(round(self.t, 6), agent.id, event.receiver, event.obj, event.name))
+        self.inbox.add(event.name)
+        self.events.append((round(self.t, 6), agent.id, event.name))
+
+    def record(self, agent: _Agent, step: Step) -> None:
+        """Log the mission events a finished step realises (the executed word of the run)."""
+        done = {name for _, robot, name in self.events if robot == agent.id}
+        if step.primitive == "PickUp":
+            wanted = [e for e in agent.mission if e.kind == "pick" and e.obj == step.object]
+        elif step.primitive == "DropOff":
+            x, y = self.obj_pos[self.oids.index(step.object)]
+            workspaces = self.scenario.scene.workspaces
+            wanted = [
+                e
+                for e in agent.mission
+                if e.kind == "drop" and e.obj == step.object and workspaces[e.workspace].contains(x, y, 1e-6)
+            ]
+        elif step.primitive == "Req":
+            wanted = [e for e in agent.mission if e.name in self.inbox and e.receiver == agent.id]
+            wanted = [
+                e for e in wanted if step.message == e.name or (step.message is None and e.obj == step.object)
+            ]
+        else:
+            wanted = []
+        event = next((e for e in wanted if e.name not in done), None)
+        if event is not None:
+            self.events.append((round(self.t, 6), agent.id, event.name))
+        if agent.done and any(e.kind == "return" for e in agent.mission):
+            home = self.scenario.scene.robots[agent.id].pose
+            if math.dist(self.pose[agent.index, :2], home[:2]) <= self.settings.goal_tolerance + 1e-6:
+                self.events.append((round(self.t, 6), agent.id, f"return({agent.id})"))
+
+    def received(self, agent: _Agent, step: Step) -> bool:
+        """Whether the message a ``Req`` step waits for has been sent."""
+        if step.message is not None:
+            return step.message in self.inbox
+        return any(
+            e.name in self.inbox
+            for e in agent.mission
+            if e.kind == "away" and e.obj == step.object and e.receiver == agent.id
+        )
 
 
 def _wrap(angle: np.ndarray | float) -> np.ndarray | float:
@@ -574,7 +597,7 @@ def _decide(world: _World, agent: _Agent) -> tuple[str, Any]:
             agent.waiting = True
             if world.v[i] > 0:
                 return brake
-            if (step.object, agent.id) in world.inbox and not world.crowded(i):
+            if world.received(agent, step) and not world.crowded(i):
                 agent.waiting = False
                 action = None
             else:
@@ -582,11 +605,12 @@ def _decide(world: _World, agent: _Agent) -> tuple[str, Any]:
         else:  # Res
             if world.v[i] > 0:
                 return brake
-            world.send(agent, step.object)
+            world.send(agent, step)
             action = None
         if action is not None:
             return action
         agent.k += 1  # the step is done
+        world.record(agent, step)
         agent.left = 0.0
         agent.phase = "start"
         agent.stage = None
@@ -1121,6 +1145,7 @@ def simulate(
         robot_ids=world.rids,
         human_ids=world.hids,
         object_ids=world.oids,
+        events=tuple(world.events),
     )
 
 

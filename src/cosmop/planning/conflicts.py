@@ -1,0 +1,532 @@
+"""Conflicts between robots' plans: places two plans use, and the orders that keep them apart.
+
+Each robot's plan is checked alone against the scene as it knows it; two plans can still need
+the same place.  An *occupancy* is a region held over an interval of the team's execution,
+from the start of one step to the completion of another (:class:`Occupancy`):
+
+* a robot at pose :math:`p_k` holds its square from the start of step *k* (time 0 for
+  :math:`k = 0`) to the completion of step *k + 1*, and forever after its last step; so a robot
+  between two steps, or waiting for a message, holds the place where it stands;
+* a robot's ``GoTo`` step *k* holds the area it sweeps (the convex hull of its squares at the
+  two ends) during that step;
+* an object rests at its scenario position until its first ``PickUp`` completes, and where a
+  ``DropOff`` puts it from that step's start until it is picked again (or forever).
+
+Robot regions are grown by half the clearance the simulator keeps between moving robots
+(:attr:`ConflictSettings.clearance`), so that two of them closer than that overlap; objects are
+not grown.  Two occupancies of different robots (an object counts for the robots that move it)
+*conflict* when their regions' interiors overlap, and the conflict is *ordered* when one of
+them always ends before the other starts (:meth:`cosmop.missions.precedence.Precedence.before_start`).
+A plan set is team-safe when every conflict is ordered: then no execution the messages allow
+puts two robots, or a robot and another robot's goods, in one place at one time.
+
+:func:`order_conflicts` orders the open conflicts by adding start edges: the occupancy that
+is expected to begin first (:mod:`cosmop.planning.timing`) goes first, unless that closes a
+cycle (a deadlock) or it never ends (a robot parked for good); an edge is never added that
+would deadlock.  Conflicts that no order can resolve are returned for re-planning.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+import shapely
+from shapely import STRtree
+from shapely.geometry.base import BaseGeometry
+
+from cosmop.missions.precedence import Link, Node, Precedence
+from cosmop.planning.plan import RobotPlan, State, _fmt, _point, initial_state
+from cosmop.planning.realisation import at_pose
+from cosmop.scenario import Scene
+
+__all__ = [
+    "Conflict",
+    "ConflictSettings",
+    "Occupancy",
+    "conflicts",
+    "occupancies",
+    "order_conflicts",
+]
+
+
+@dataclass(frozen=True)
+class ConflictSettings:
+    """How conflicts are found.
+
+    Attributes
+    ----------
+    clearance : float
+        Distance (mm) two robots keep when both may move: their regions are grown by half of it
+        (the simulator's standoff, 100 mm by default).
+    segment : float
+        Drives longer than this (mm) are cut into pieces before ordering, so that a robot waits
+        only until another has passed the place they share (default 1500).
+    """
+
+    clearance: float = 100.0
+    segment: float = 1500.0
+
+
+@dataclass(frozen=True)
+class Occupancy:
+    """A region held from the start of step `first` to the completion of step `last`.
+
+    Attributes
+    ----------
+    what : str
+        The robot or object that holds it.
+    parties : frozenset of str
+        The robots whose plans decide it: the robot itself, or the robots that move the object.
+    region : shapely geometry
+        The region (mm).
+    first : Node or None
+        ``(robot, k)``: held from the start of step *k*; ``None``: from the beginning.
+    last : Node or None
+        ``(robot, k)``: held until step *k* completes; ``None``: forever.
+    label : str
+        In words, e.g. ``R1's GoTo at instant 3 from (0, 0) to (500, 0)``.
+    movable : bool
+        Whether re-planning can move it: a drive can take another route and goods can be put
+        down elsewhere, but a robot's start, the pose it picks from and its home cannot move,
+        nor where goods start.
+    """
+
+    what: str
+    parties: frozenset[str]
+    region: BaseGeometry = field(repr=False)
+    first: Node | None
+    last: Node | None
+    label: str
+    movable: bool = True
+
+
+@dataclass(frozen=True)
+class Conflict:
+    """Two occupancies of different robots whose regions overlap."""
+
+    a: Occupancy
+    b: Occupancy
+
+    @property
+    def place(self) -> tuple[float, float, float, float]:
+        """Bounding box ``(x_min, y_min, x_max, y_max)`` of the shared region (mm)."""
+        shared = self.a.region.intersection(self.b.region)
+        if shared.is_empty:
+            shared = self.a.region
+        return tuple(float(v) for v in shared.bounds)
+
+    @property
+    def robots(self) -> tuple[str, ...]:
+        return tuple(sorted(self.a.parties | self.b.parties))
+
+    def describe(self) -> str:
+        x0, y0, x1, y1 = (_fmt(round(v, 1)) for v in self.place)
+        return f"{self.a.label} and {self.b.label} share the space x in [{x0}, {x1}], y in [{y0}, {y1}]"
+
+
+def _square(x: float, y: float, side: float) -> BaseGeometry:
+    h = side / 2.0
+    return shapely.box(x - h, y - h, x + h, y + h)
+
+
+def _swept(p: Sequence[float], q: Sequence[float], side: float) -> BaseGeometry:
+    if p[0] == q[0] and p[1] == q[1]:
+        return _square(p[0], p[1], side)
+    return shapely.union(_square(p[0], p[1], side), _square(q[0], q[1], side)).convex_hull
+
+
+def _robot_occupancies(
+    robot: str, plan: RobotPlan, start: State, side: float, home: Sequence[float]
+) -> list[Occupancy]:
+    """Where `robot` stands (merged over steps that keep its pose) and what its GoTo steps sweep."""
+    K = plan.horizon
+    poses = [start.robot, *(s.robot for s in plan.steps)]
+    party = frozenset((robot,))
+    out: list[Occupancy] = []
+    k = 0
+    while k <= K:
+        end = k
+        while end < K and plan.steps[end].primitive != "GoTo":
+            end += 1  # steps end+1 keep the pose
+        x, y, _ = poses[k]
+        first = None if k == 0 else (robot, k)
+        last = None if end + 1 > K else (robot, end + 1)
+        where = "at its start" if k == 0 else f"from instant {k}"
+        fixed = (
+            k == 0
+            or any(plan.steps[i].primitive == "PickUp" for i in range(k, end))
+            or (end == K and at_pose(poses[k], home))
+        )
+        out.append(
+            Occupancy(
+                robot,
+                party,
+                _square(x, y, side),
+                first,
+                last,
+                f"{robot} standing at {_point((x, y))} {where}",
+                not fixed,
+            )
+        )
+        k = end + 1
+    for k, step in enumerate(plan.steps, 1):
+        if step.primitive == "GoTo":
+            p, q = poses[k - 1], poses[k]
+            out.append(
+                Occupancy(
+                    robot,
+                    party,
+                    _swept(p, q, side),
+                    (robot, k),
+                    (robot, k),
+                    f"{robot}'s GoTo at instant {k} from {_point(p[:2])} to {_point(q[:2])}",
+                )
+            )
+    return out
+
+
+def _object_occupancies(
+    scene: Scene, plans: Mapping[str, RobotPlan], precedence: Precedence
+) -> tuple[list[Occupancy], list[str]]:
+    """Where every moved object rests between the steps that handle it; problems found."""
+    out, problems = [], []
+    for oid, spec in scene.objects.items():
+        handling = [
+            (robot, k, step.primitive)
+            for robot, plan in plans.items()
+            for k, step in enumerate(plan.steps, 1)
+            if step.object == oid and step.primitive in ("PickUp", "DropOff")
+        ]
+        if not handling:
+            continue
+        handling.sort(key=lambda h: (precedence.start_time((h[0], h[1])), h[0], h[1]))
+        for (r1, k1, _), (r2, k2, _) in itertools.pairwise(handling):
+            if not precedence.precedes((r1, k1), (r2, k2)):
+                problems.append(
+                    f"{oid} is handled by {r1} at instant {k1} and by {r2} at instant {k2} with no "
+                    "order between them"
+                )
+        parties = frozenset(h[0] for h in handling)
+        position, first = spec.position, None
+        for robot, k, primitive in handling:
+            if primitive == "PickUp":
+                if position is not None:
+                    where = "at its start" if first is None else f"from {first[0]}'s instant {first[1]}"
+                    out.append(
+                        Occupancy(
+                            oid,
+                            parties,
+                            _square(*position, spec.size),
+                            first,
+                            (robot, k),
+                            f"{oid} resting at {_point(position)} {where}",
+                            first is not None,
+                        )
+                    )
+                position = None
+            else:
+                position, first = plans[robot].steps[k - 1].objects[oid].position, (robot, k)
+        if position is not None:
+            where = "at its start" if first is None else f"from {first[0]}'s instant {first[1]}"
+            out.append(
+                Occupancy(
+                    oid,
+                    parties,
+                    _square(*position, spec.size),
+                    first,
+                    None,
+                    f"{oid} resting at {_point(position)} {where}",
+                    first is not None,
+                )
+            )
+    return out, problems
+
+
+def occupancies(
+    scene: Scene,
+    plans: Mapping[str, RobotPlan],
+    precedence: Precedence,
+    settings: ConflictSettings | None = None,
+    starts: Mapping[str, State] | None = None,
+) -> tuple[list[Occupancy], list[str]]:
+    """Every occupancy of the robots and the objects they move; problems with object handling."""
+    grow = (settings or ConflictSettings()).clearance
+    out: list[Occupancy] = []
+    for robot, plan in plans.items():
+        start = (starts or {}).get(robot) or initial_state(scene, robot)
+        size, home = scene.robots[robot].size + grow, scene.robots[robot].pose
+        out += _robot_occupancies(robot, plan, start, size, home)
+    objects, problems = _object_occupancies(scene, plans, precedence)
+    return out + objects, problems
+
+
+def conflicts(items: Sequence[Occupancy]) -> list[Conflict]:
+    """Pairs of occupancies of disjoint parties whose regions' interiors overlap."""
+    if not items:
+        return []
+    regions = [item.region for item in items]
+    tree = STRtree(regions)
+    left, right = tree.query(regions, predicate="intersects")
+    keep = left < right
+    out = []
+    for i, j in zip(left[keep].tolist(), right[keep].tolist(), strict=True):
+        a, b = items[i], items[j]
+        if a.parties & b.parties:
+            continue
+        if shapely.intersection(a.region, b.region).area <= 1e-9:
+            continue  # they only touch
+        out.append(Conflict(a, b))
+    return out
+
+
+def is_ordered(conflict: Conflict, precedence: Precedence) -> bool:
+    """Whether one occupancy always ends before the other starts."""
+    a, b = conflict.a, conflict.b
+    return _before(a, b, precedence) or _before(b, a, precedence)
+
+
+def _before(x: Occupancy, y: Occupancy, precedence: Precedence) -> bool:
+    return x.last is not None and y.first is not None and precedence.before_start(x.last, y.first)
+
+
+def order_conflicts(
+    found: Sequence[Conflict],
+    horizons: Mapping[str, int],
+    links: Sequence[Link],
+    starts: Sequence[tuple[Node, Node]],
+    durations: Mapping[str, Sequence[float]],
+    *,
+    max_backtracks: int = 200,
+    fixed: Mapping[str, Sequence[BaseGeometry]] | None = None,
+) -> tuple[list[tuple[tuple[Node, Node], Conflict]], list[Conflict]]:
+    """Start edges that order every conflict in `found`, and the conflicts no order resolves.
+
+    A depth-first search over the two ways of ordering each conflict (:func:`_search`).  When
+    it finds no way to order them all, the conflict at its deepest dead end is set aside as
+    unresolved (to be removed by re-planning) and the search runs again on the others, so that
+    as few conflicts as possible are left for re-planning.
+
+    Returns the edges added (on top of `starts`), each with the conflict it orders, and the
+    unresolved conflicts.
+    """
+    unresolved: list[Conflict] = []
+    while True:
+        left = [c for c in found if not any(c is u for u in unresolved)]
+        chosen, culprit = _search(left, horizons, links, starts, durations, max_backtracks, fixed)
+        if culprit is None:
+            return chosen, unresolved
+        unresolved.append(culprit)
+
+
+class _Sides:
+    """Both ways of ordering every conflict, as arrays, to ask many questions at once.
+
+    Side 0 puts occupancy ``a`` first, side 1 ``b``: "x before y" is the start edge from
+    x's last step to y's first.  A side is *possible* when x ends and y does not start at the
+    beginning; it *holds* when the order already implies it; it *closes a cycle* when y's first
+    step must already complete before x's last one does.
+    """
+
+    def __init__(self, found: Sequence[Conflict], precedence: Precedence) -> None:
+        n = len(found)
+        self.possible = np.zeros((n, 2), dtype=bool)
+        self.x_col = np.zeros((n, 2), dtype=np.int64)
+        self.x_k = np.zeros((n, 2), dtype=np.int64)
+        self.x_row = np.zeros((n, 2), dtype=np.int64)
+        self.y_col = np.zeros((n, 2), dtype=np.int64)
+        self.y_k = np.zeros((n, 2), dtype=np.int64)
+        self.y_row = np.zeros((n, 2), dtype=np.int64)
+        self.same = np.zeros((n, 2), dtype=bool)
+        for i, c in enumerate(found):
+            for side, (x, y) in enumerate(((c.a, c.b), (c.b, c.a))):
+                if x.last is None or y.first is None or y.first[1] <= 0:
+                    continue
+                (xr, xk), (yr, yk) = x.last, y.first
+                self.possible[i, side] = True
+                self.x_col[i, side], self.x_k[i, side] = precedence.column[xr], xk
+                self.x_row[i, side] = precedence.offsets[xr] + xk
+                self.y_col[i, side], self.y_k[i, side] = precedence.column[yr], yk
+                self.y_row[i, side] = precedence.offsets[yr] + min(yk, precedence.horizons[yr] + 1)
+                self.same[i, side] = xr == yr
+
+    def holds(self, precedence: Precedence) -> np.ndarray:
+        """(n, 2): whether each side is already implied."""
+        implied = precedence.begin_flat[self.y_row, self.x_col] >= self.x_k
+        return self.possible & np.where(self.same, self.x_k < self.y_k, implied)
+
+    def ways(self, precedence: Precedence) -> np.ndarray:
+        """(n, 2): whether each side can still be added without closing a cycle."""
+        cycle = precedence.done_flat[self.x_row, self.y_col] >= self.y_k
+        return self.possible & ~np.where(self.same, self.y_k <= self.x_k, cycle)
+
+
+def _search(found, horizons, links, starts, durations, max_backtracks, fixed):
+    """Depth-first search for edges ordering every conflict; ``(edges, None)`` or ``([], culprit)``.
+
+    At every point the open conflicts are checked forward: one that has no way left to be
+    ordered (both ways close a cycle, or the way left never ends) sends the search back to the
+    last choice.  A conflict with a single way left is ordered first; otherwise the one expected
+    to start first, the way that keeps the team's expected makespan lower.  The culprit is the
+    conflict without a way at the deepest dead end.  The order is updated incrementally and
+    taken back on backtracking (:meth:`~cosmop.missions.precedence.Precedence.add_start`).
+    """
+    precedence = Precedence(horizons, links, starts, durations)
+    sides = _Sides(found, precedence)
+    chosen: list[tuple[tuple[Node, Node], Conflict, list]] = []
+    stack: list[tuple[int, list[tuple[Node, Node]], Conflict]] = []  # (depth, untried, conflict)
+    backtracks, deepest, culprit = 0, -1, None
+    while True:
+        open_ = ~sides.holds(precedence).any(axis=1)
+        if not open_.any():
+            return [(edge, conflict) for edge, conflict, _ in chosen], None
+        counts = np.where(open_, sides.ways(precedence).sum(axis=1), -1)
+        stuck = [found[i] for i in np.flatnonzero(counts == 0)]
+        if stuck:
+            if len(chosen) > deepest:
+                edges = [(e, c) for e, c, _ in chosen]
+                worst = min(stuck, key=lambda c: _replannable(c, fixed))
+                deepest, culprit = len(chosen), _culprit(worst, horizons, links, edges, fixed)
+            if not stack or backtracks >= max_backtracks:
+                return [], culprit
+            backtracks += 1
+            depth, untried, conflict = stack[-1]
+            while len(chosen) > depth:
+                precedence.undo(chosen.pop()[2])
+            edge = untried.pop(0)
+            chosen.append((edge, conflict, precedence.add_start(edge)))
+            if not untried:
+                stack.pop()
+            continue
+        pool = np.flatnonzero(counts == 1)
+        if not len(pool):
+            pool = np.flatnonzero(open_)
+        conflict = min((found[i] for i in pool), key=lambda c: _expected_start(c, precedence))
+        options = _ways(conflict, precedence)
+        if len(options) > 1:  # the way that keeps the team's expected makespan lower first
+            options = sorted(options, key=lambda e: _makespan_with(precedence, e))
+            stack.append((len(chosen), options[1:], conflict))
+        chosen.append((options[0], conflict, precedence.add_start(options[0])))
+
+
+def _expected_start(conflict: Conflict, precedence: Precedence) -> float:
+    return min(_start(conflict.a, precedence), _start(conflict.b, precedence))
+
+
+def _start(x: Occupancy, precedence: Precedence) -> float:
+    return 0.0 if x.first is None else precedence.start_time(x.first)
+
+
+def _makespan_with(precedence: Precedence, edge: tuple[Node, Node]) -> float:
+    log = precedence.add_start(edge)
+    makespan = precedence.makespan
+    precedence.undo(log)
+    return makespan
+
+
+def _culprit(stuck: Conflict, horizons, links, chosen, fixed) -> Conflict:
+    """The conflict to re-plan around when `stuck` has no way to be ordered.
+
+    If `stuck` itself cannot be re-planned (two robots standing where their goods require), the
+    orders that close its cycles came from other conflicts: the most re-plannable of those.
+    """
+    if _replannable(stuck, fixed) < 3:
+        return stuck
+    graph: dict[Node, list[tuple[Node, Conflict | None]]] = {}
+    for robot, k in horizons.items():
+        for i in range(1, k):
+            graph.setdefault((robot, i), []).append(((robot, i + 1), None))
+    for link in links:
+        if link.send is not None and link.wait is not None:
+            graph.setdefault((link.sender, link.send), []).append(((link.receiver, link.wait), None))
+    for (source, target), conflict in chosen:
+        graph.setdefault(source, []).append((target, conflict))
+    on_cycles: list[Conflict] = []
+    for x, y in ((stuck.a, stuck.b), (stuck.b, stuck.a)):
+        if x.last is not None and y.first is not None:
+            on_cycles += _path_conflicts(graph, y.first, x.last)
+    best = min(on_cycles, key=lambda c: _replannable(c, fixed), default=stuck)
+    return best if _replannable(best, fixed) < 3 else stuck
+
+
+def _path_conflicts(graph, start: Node, goal: Node) -> list[Conflict]:
+    """The conflicts whose edges lie on a shortest path from `start` to `goal` (breadth first)."""
+    parent: dict[Node, tuple[Node, Conflict | None] | None] = {start: None}
+    queue = [start]
+    for node in queue:
+        if node == goal:
+            break
+        for nxt, conflict in graph.get(node, ()):
+            if nxt not in parent:
+                parent[nxt] = (node, conflict)
+                queue.append(nxt)
+    out, node = [], goal
+    while parent.get(node) is not None:
+        node, conflict = parent[node]
+        if conflict is not None:
+            out.append(conflict)
+    return out
+
+
+def detours(conflict: Conflict, fixed: Mapping[str, Sequence[BaseGeometry]]) -> list[tuple[str, Occupancy]]:
+    """Who can be re-planned around an unresolved conflict, best first: ``(robot, what to avoid)``.
+
+    The side that moves must be movable (:attr:`Occupancy.movable`): a drive (best: one that
+    meets something staying for good) or dropped goods (moved by the robot that drops them).
+    Avoiding the other side must leave the mover's fixed places -- its start, the poses it picks
+    from, its home, given in `fixed` by robot (regions already grown) -- free.
+    """
+    out = []
+    for mover, keep in ((conflict.a, conflict.b), (conflict.b, conflict.a)):
+        if not mover.movable or mover.first is None:
+            continue
+        robot = mover.what if mover.what in mover.parties else mover.first[0]
+        if any(shapely.intersection(keep.region, place).area > 1e-9 for place in fixed.get(robot, ())):
+            continue
+        drive = mover.first == mover.last
+        out.append((0 if drive and keep.last is None else 1 if drive else 2, robot, keep))
+    return [(robot, keep) for _, robot, keep in sorted(out, key=lambda o: o[0])]
+
+
+def fixed_places(items: Sequence[Occupancy]) -> dict[str, list[BaseGeometry]]:
+    """Every robot's places that re-planning cannot move (start, pick poses, home), by robot."""
+    out: dict[str, list[BaseGeometry]] = {}
+    for item in items:
+        if not item.movable and item.what in item.parties:
+            out.setdefault(item.what, []).append(item.region)
+    return out
+
+
+def _replannable(conflict: Conflict, fixed: Mapping[str, Sequence[BaseGeometry]] | None = None) -> int:
+    """Rank of a conflict as a culprit to re-plan (lower first): a drive against something that
+    stays for good, then any detour, then none (two robots standing where their goods require)."""
+    options = detours(conflict, fixed or {})
+    if not options:
+        return 3
+    _, keep = options[0]
+    return 0 if keep.last is None else 1
+
+
+def _count_ways(conflict: Conflict, precedence: Precedence) -> int:
+    """How many of the two ways of ordering `conflict` are still possible."""
+    n = 0
+    for x, y in ((conflict.a, conflict.b), (conflict.b, conflict.a)):
+        if x.last is not None and y.first is not None and not precedence.would_cycle(x.last, y.first):
+            n += 1
+    return n
+
+
+def _ways(conflict: Conflict, precedence: Precedence) -> list[tuple[Node, Node]]:
+    """The start edges that can order `conflict`, the one expected to happen first first."""
+    a, b = conflict.a, conflict.b
+    options = sorted(((a, b), (b, a)), key=lambda xy: (_start(xy[0], precedence), _start(xy[1], precedence)))
+    out = []
+    for x, y in options:
+        if x.last is None or y.first is None:
+            continue  # x never ends, or y holds its place from the beginning
+        if precedence.would_cycle(x.last, y.first):
+            continue
+        out.append((x.last, y.first))
+    return out

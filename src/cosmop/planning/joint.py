@@ -1,0 +1,108 @@
+"""The checks that involve several robots' plans at once (part of the exact plan checker).
+
+A plan set is sound for the team, beyond each robot's plan being sound alone, when
+
+* every message is sent by exactly its sender's plan and awaited by exactly its receiver's
+  (``message``), and the plan file's ``messages`` list names exactly the ``msg`` events the
+  plans use;
+* the messages cannot deadlock the team (``deadlock``): the partial order they impose on the
+  steps has no cycle (:mod:`cosmop.missions.precedence`); the shortest blocking word is given;
+* every conflict between two robots' plans is ordered by the messages (``conflict``,
+  :mod:`cosmop.planning.conflicts`): no execution puts two robots, or a robot and goods that
+  another robot moves, in one place at one time;
+* every complete run of the team is a complete word of the global mission, whatever its form
+  (``mission``, :func:`cosmop.missions.team.verify_team`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+from cosmop.missions.mission import GlobalMission
+from cosmop.missions.precedence import Precedence
+from cosmop.missions.team import check_words
+from cosmop.planning.conflicts import ConflictSettings, conflicts, is_ordered, occupancies
+from cosmop.planning.plan import PlanSet, RobotPlan
+from cosmop.planning.realisation import message_links
+from cosmop.planning.report import Violation
+from cosmop.scenario import Scenario
+
+__all__ = ["check_team"]
+
+
+def _violation(robot: str | None, instant: int | None, rule: str, message: str) -> Violation:
+    return Violation(robot, instant, rule, message)
+
+
+def _messages(plan: PlanSet, plans: Mapping[str, RobotPlan]) -> list[Violation]:
+    out = []
+    links = message_links(plans)
+    for link in links:
+        if link.send is None:
+            out.append(
+                _violation(
+                    link.receiver,
+                    link.wait,
+                    "message",
+                    f"{link.receiver} waits at instant {link.wait} for {link.event}, which "
+                    f"{link.sender}'s plan never sends: the robot would wait forever",
+                )
+            )
+        if link.wait is None:
+            out.append(
+                _violation(
+                    link.sender,
+                    link.send,
+                    "message",
+                    f"{link.sender} sends {link.event} at instant {link.send}, but "
+                    f"{link.receiver}'s plan never waits for it",
+                )
+            )
+    used = {link.event for link in links if link.event.startswith("msg(")}
+    listed = {m.event for m in plan.messages}
+    for name in sorted(used - listed):
+        out.append(_violation(None, None, "message", f"the plans use {name}, but the messages list lacks it"))
+    for name in sorted(listed - used):
+        out.append(_violation(None, None, "message", f"the messages list has {name}, but no plan uses it"))
+    return out
+
+
+def check_team(
+    scenario: Scenario, plan: PlanSet, settings: ConflictSettings | None = None
+) -> list[Violation]:
+    """The violations of the team-level rules (module docstring) by a feasible plan set."""
+    scene = scenario.scene
+    plans = {r: p for r, p in plan.robots.items() if r in scene.robots}
+    violations = _messages(plan, plans)
+    links = message_links(plans)
+    precedence = Precedence({r: p.horizon for r, p in plans.items()}, links)
+    if not precedence.complete:
+        done = [f"{r}@{k}" for r, k in precedence.order]
+        stuck = ", ".join(f"{r} at instant {k}" for r, k in precedence.stuck.items())
+        violations.append(
+            _violation(
+                None,
+                None,
+                "deadlock",
+                f"the plans' messages can deadlock: after the steps {' '.join(done) or '(none)'} "
+                f"nobody can go on ({stuck} wait for messages that are never sent)",
+            )
+        )
+        return violations
+    items, problems = occupancies(scene, plans, precedence, settings)
+    violations += [_violation(None, None, "conflict", text) for text in problems]
+    for conflict in conflicts(items):
+        if not is_ordered(conflict, precedence):
+            violations.append(
+                _violation(
+                    None,
+                    None,
+                    "conflict",
+                    f"{conflict.describe()}, and no message orders them: the robots may meet there",
+                )
+            )
+    words = {r: plans[r].mission if r in plans else () for r in scene.robots}
+    verdict = check_words(GlobalMission.from_scenario(scenario), words)
+    if not verdict.holds:
+        violations.append(_violation(None, None, "mission", f"{verdict.reason()}"))
+    return violations

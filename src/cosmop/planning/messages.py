@@ -1,0 +1,283 @@
+"""Messages in plans: the ``Req`` and ``Res`` steps that wait for and send ``msg`` events.
+
+A message does not move anything, so it is placed after synthesis instead of by the solver:
+
+* :func:`place_mission_messages` puts the messages a robot's local mission names (orders
+  between robots, written by the user or added by :mod:`cosmop.missions.ordering`) into its
+  plan: a send right after the step that realises the event before it, a wait right before the
+  step that realises the event after it;
+* :func:`place_edges` turns start edges ("B may start step *j* once A has completed step *i*",
+  from :mod:`cosmop.planning.conflicts`) into messages: ``Res`` right after A's step *i*,
+  ``Req`` right before B's step *j*.
+
+Both go through :func:`insert_steps`, which keeps the plan's mission list in the order its
+steps realise it.  A sent message comes before a wait placed at the same point.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import replace
+
+from cosmop.missions.events import Event, message, parse_event
+from cosmop.missions.precedence import Node
+from cosmop.planning.checker import check_robot_plan
+from cosmop.planning.plan import RobotPlan, State, Step, initial_state, plan_from_actions
+from cosmop.planning.realisation import event_instants
+from cosmop.scenario import Scene
+
+__all__ = [
+    "answer_early",
+    "insert_steps",
+    "merge_drives",
+    "place_edges",
+    "place_mission_messages",
+    "split_drives",
+    "strip_messages",
+    "wait_early",
+]
+
+Insert = tuple[int, int, str]
+"""``(after instant p, 0 for a send / 1 for a wait, message event name)``."""
+
+
+def strip_messages(mission: Sequence[Event]) -> tuple[Event, ...]:
+    """The mission without its ``msg`` events (what the solver plans; ``away`` stays)."""
+    return tuple(e for e in mission if e.kind != "msg")
+
+
+def answer_early(plan: RobotPlan) -> RobotPlan:
+    """`plan` with every answer ``Res(O)`` moved right after the ``PickUp(O)`` it follows.
+
+    An answer changes nothing but tells another robot that O is out of the way; the solver may
+    put it after some drives, which keeps the requester waiting (and can close a wait cycle
+    with robots those drives must pass).  Moved forward it takes the pose and objects of the
+    step it now follows; the order of the plan's mission events is unchanged.
+    """
+    out: list[Step] = []
+    for step in plan.steps:
+        if step.primitive == "Res" and step.message is None:
+            pick = max(
+                (n for n, s in enumerate(out) if s.primitive == "PickUp" and s.object == step.object),
+                default=None,
+            )
+            if pick is not None:
+                at = pick + 1
+                while at < len(out) and out[at].primitive == "Res" and out[at].message is None:
+                    at += 1
+                before = out[at - 1]
+                out.insert(at, replace(step, robot=before.robot, objects=before.objects))
+                continue
+        out.append(step)
+    return RobotPlan.from_steps(plan.mission, out)
+
+
+def wait_early(scene: Scene, robot: str, plan: RobotPlan) -> RobotPlan:
+    """`plan` with every run of requests issued before the drives that lead to it.
+
+    A plan may drive somewhere and then wait there for another robot's answer (``GoTo``,
+    ``Req``).  Where a robot waits does not matter to its mission, but a robot parked next to
+    the goods stands in the way of the very robot it waits for.  Requests are moved before the
+    drive when the reordered plan still passes the exact checker (the drive then meets fewer
+    objects: the requested ones are away); otherwise the plan is kept.
+    """
+    actions: list[tuple] = [
+        ("GoTo", st.robot) if st.primitive == "GoTo" else (st.primitive, st.object) for st in plan.steps
+    ]
+    k, changed = 0, False
+    while k < len(actions):
+        if actions[k][0] == "Req" and k > 0 and actions[k - 1][0] == "GoTo":
+            b = k - 1
+            while b > 0 and actions[b - 1][0] == "GoTo":
+                b -= 1
+            e = k
+            while e + 1 < len(actions) and actions[e + 1][0] == "Req":
+                e += 1
+            actions = actions[:b] + actions[k : e + 1] + actions[b:k] + actions[e + 1 :]
+            changed = True
+            k = e + 1
+        else:
+            k += 1
+    if not changed:
+        return plan
+    reordered = plan_from_actions(scene, robot, plan.mission, actions)
+    return reordered if not check_robot_plan(scene, robot, reordered) else plan
+
+
+def split_drives(
+    plan: RobotPlan,
+    start: Sequence[float],
+    max_length: float,
+    roomy: Callable[[float, float], bool] | None = None,
+) -> RobotPlan:
+    """`plan` (from pose `start`) with every drive longer than `max_length` (mm) cut into pieces.
+
+    A piece sweeps part of what the whole drive sweeps, so the plan stays sound; the pieces let
+    another robot wait only until this one has passed the place they share, not until the whole
+    drive is over.  Drives are halved until short enough, so the new waypoints are exact
+    (dyadic fractions of integer coordinates).  A cut is made only where ``roomy(x, y)`` (a
+    robot may have to wait there for a message: not in a narrow passage).
+    """
+    out: list[Step] = []
+    pose = tuple(start)
+    for step in plan.steps:
+        start, pose = pose, step.robot
+        if step.primitive != "GoTo":
+            out.append(step)
+            continue
+        length = ((pose[0] - start[0]) ** 2 + (pose[1] - start[1]) ** 2) ** 0.5
+        pieces = 1
+        while length / pieces > max_length and pieces < 64:
+            pieces *= 2
+        for j in range(1, pieces):
+            t = j / pieces
+            point = (start[0] + (pose[0] - start[0]) * t, start[1] + (pose[1] - start[1]) * t, pose[2])
+            if roomy is None or roomy(point[0], point[1]):
+                out.append(replace(step, robot=point))
+        out.append(step)
+    return RobotPlan.from_steps(plan.mission, out)
+
+
+def merge_drives(plan: RobotPlan, waypoints: set[tuple[float, float]]) -> RobotPlan:
+    """Undo :func:`split_drives` where no message came between the pieces.
+
+    Two consecutive GoTo steps are joined when the point between them is not one of
+    `waypoints` (the plan's own, before splitting): the joined drive sweeps exactly what the two
+    pieces swept, and nothing waits or is sent between them, so every order between robots
+    stays as it was.
+    """
+    out: list[Step] = []
+    for step in plan.steps:
+        if (
+            step.primitive == "GoTo"
+            and out
+            and out[-1].primitive == "GoTo"
+            and (out[-1].robot[0], out[-1].robot[1]) not in waypoints
+        ):
+            out[-1] = step
+            continue
+        out.append(step)
+    return RobotPlan.from_steps(plan.mission, out)
+
+
+def insert_steps(
+    scene: Scene,
+    robot: str,
+    plan: RobotPlan,
+    inserts: Sequence[Insert],
+    start: State | None = None,
+    mission: Sequence[str] | None = None,
+) -> tuple[RobotPlan, dict[int, int]]:
+    """`plan` with a ``Res`` (send) or ``Req`` (wait) step of each message inserted.
+
+    Parameters
+    ----------
+    scene : Scene
+    robot : str
+    plan : RobotPlan
+    inserts : sequence of Insert
+        Where each message goes: after instant *p* (0 = before the first step).
+    start : State, optional
+        Instant 0 when it is not the scenario.
+    mission : sequence of str, optional
+        The new plan's mission list, when the caller knows it; by default the old mission with
+        each message placed where its step is.
+
+    Returns
+    -------
+    RobotPlan, dict
+        The new plan, and the new instant of every old instant.
+    """
+    if mission is None:
+        instants = event_instants(plan, robot, scene, start=start)
+        keyed = [
+            ((float(t) if t is not None else float(plan.horizon), 0, 0), name)
+            for t, name in zip(instants, plan.mission, strict=True)
+        ]
+        keyed += [((p + 0.5, rank, n), name) for n, (p, rank, name) in enumerate(sorted(inserts))]
+        mission = [name for _, name in sorted(keyed)]
+    at: dict[int, list[tuple[int, str]]] = {}
+    for p, rank, name in inserts:
+        at.setdefault(p, []).append((rank, name))
+    state = start or initial_state(scene, robot)
+    steps: list[Step] = []
+    moved: dict[int, int] = {0: 0}
+    for k in range(plan.horizon + 1):
+        if k > 0:
+            step = plan.steps[k - 1]
+            steps.append(step)
+            state = step.state
+            moved[k] = len(steps)
+        for rank, name in sorted(at.get(k, ())):
+            primitive = "Res" if rank == 0 else "Req"
+            steps.append(Step(primitive, None, state.robot, state.objects, name))
+    return RobotPlan.from_steps(mission, steps), moved
+
+
+def place_mission_messages(
+    scene: Scene, robot: str, plan: RobotPlan, mission: Sequence[Event], start: State | None = None
+) -> RobotPlan:
+    """Put the ``msg`` events of `mission` into `plan`, which realises the rest of it.
+
+    A message the robot sends goes right after the step that realises the mission event before
+    it (at the start if there is none); a message it waits for goes right before the step that
+    realises the event after it (at the end if there is none).
+    """
+    if not any(e.kind == "msg" for e in mission):
+        return plan
+    planned = [e for e in mission if e.kind != "msg"]
+    instants = event_instants(plan, robot, scene, planned, start)
+    inserts: list[Insert] = []
+    seen = 0  # events of `planned` before the current message
+    for event in mission:
+        if event.kind != "msg":
+            seen += 1
+            continue
+        if event.sender == robot:
+            p = 0 if seen == 0 else (instants[seen - 1] or 0)
+            inserts.append((p, 0, event.name))
+        else:
+            nxt = instants[seen] if seen < len(instants) else None
+            p = plan.horizon if nxt is None else max(nxt - 1, 0)
+            if seen > 0 and instants[seen - 1] is not None:
+                p = max(p, instants[seen - 1])
+            inserts.append((p, 1, event.name))
+    new, _ = insert_steps(scene, robot, plan, inserts, start, [e.name for e in mission])
+    return new
+
+
+def place_edges(
+    scene: Scene,
+    plans: Mapping[str, RobotPlan],
+    edges: Sequence[tuple[Node, Node]],
+    tag: str = "clear",
+    used: set[str] | None = None,
+) -> tuple[dict[str, RobotPlan], list[tuple[str, tuple[Node, Node], tuple[Node, Node]]]]:
+    """One message per start edge ``((A, i), (B, j))``: A sends after step *i*, B waits before *j*.
+
+    Returns the new plans and, per message, ``(event name, old edge, edge in new instants)``;
+    the new edge ``((A, i'), (B, j'))`` names A's ``Res`` and B's ``Req`` steps.
+    """
+    used = set() if used is None else used
+    inserts: dict[str, list[Insert]] = {r: [] for r in plans}
+    names = []
+    for n, ((a, i), (b, j)) in enumerate(edges, 1):
+        number = n
+        name = message(a, b, f"{tag}{number}").name
+        while name in used:
+            number += len(edges)
+            name = message(a, b, f"{tag}{number}").name
+        used.add(name)
+        inserts[a].append((i, 0, name))
+        inserts[b].append((j - 1, 1, name))
+        names.append(name)
+    out, moved = {}, {}
+    for robot, plan in plans.items():
+        out[robot], moved[robot] = insert_steps(scene, robot, plan, inserts[robot])
+    placed = []
+    for name, edge in zip(names, edges, strict=True):
+        event = parse_event(name)
+        send = next(k for k, s in enumerate(out[event.sender].steps, 1) if s.message == name)
+        wait = next(k for k, s in enumerate(out[event.receiver].steps, 1) if s.message == name)
+        placed.append((name, edge, ((event.sender, send), (event.receiver, wait))))
+    return out, placed

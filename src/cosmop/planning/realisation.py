@@ -1,0 +1,169 @@
+"""Where a plan realises its mission events: the one mapping from events to steps.
+
+A plan's ``mission`` is realised in order: there are instants :math:`0 \\le i_1 < i_2 < \\dots`
+with event *m* holding at :math:`i_m` (a ``return``, a pose rather than a step, may hold at the
+same instant as the event before it) --
+
+* ``pick(R,O)``: step *i* is ``PickUp(O)``;
+* ``drop(R,O,W)``: step *i* is ``DropOff(O)`` and O's position after it lies in W;
+* ``return(R)``: the pose at instant *i* is the robot's initial pose in the scenario;
+* ``away(O,A,B)``: step *i* is ``Req(O)`` for the requester A, ``Res(O)`` for the responder B;
+* ``msg(S,R,tag)``: step *i* is ``Res`` carrying the message for the sender S, ``Req`` carrying
+  it for the receiver R.
+
+:func:`event_instants` finds the earliest such instants (greedily, which finds a realisation
+whenever one exists, since each event is matched at its first chance after the previous one).
+The checker, the coordination layer and the simulator all use it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+from cosmop.errors import EventSyntaxError
+from cosmop.missions.events import Event, parse_event
+from cosmop.missions.precedence import Link
+from cosmop.planning.plan import RobotPlan, State, initial_state
+from cosmop.scenario import Scene
+
+__all__ = ["TOLERANCE", "at_pose", "event_instants", "holds_at", "message_links", "step_primitive"]
+
+TOLERANCE = 1e-6
+"""Tolerance of numeric equality, mm or degrees."""
+
+
+def _angle_eq(a: float, b: float) -> bool:
+    diff = (a - b) % 360.0
+    return min(diff, 360.0 - diff) <= TOLERANCE
+
+
+def at_pose(pose: Sequence[float], home: Sequence[float]) -> bool:
+    """Whether two poses ``(x, y, heading)`` agree within :data:`TOLERANCE`."""
+    return (
+        abs(pose[0] - home[0]) <= TOLERANCE
+        and abs(pose[1] - home[1]) <= TOLERANCE
+        and _angle_eq(pose[2], home[2])
+    )
+
+
+def step_primitive(event: Event, robot: str) -> tuple[str, str | None, str | None] | None:
+    """The step that realises `event` for `robot`: ``(primitive, object, message)``.
+
+    ``None`` for ``return`` (realised by a pose, not a step).
+    """
+    if event.kind == "pick":
+        return "PickUp", event.obj, None
+    if event.kind == "drop":
+        return "DropOff", event.obj, None
+    if event.kind == "away":
+        return ("Req" if robot == event.receiver else "Res"), event.obj, None
+    if event.kind == "msg":
+        return ("Req" if robot == event.receiver else "Res"), None, event.name
+    return None
+
+
+def holds_at(
+    event: Event, robot: str, plan: RobotPlan, states: Sequence[State], scene: Scene, i: int
+) -> bool:
+    """Whether `event` holds at instant `i` of `robot`'s `plan` (`states` are instants 0..K)."""
+    if event.kind == "return":
+        return at_pose(states[i].robot, scene.robots[robot].pose)
+    if i == 0:
+        return False
+    step = plan.steps[i - 1]
+    wanted = step_primitive(event, robot)
+    if wanted is None or (step.primitive, step.object, step.message) != wanted:
+        return False
+    if event.kind == "drop":
+        obj = step.objects.get(event.obj)
+        return obj is not None and scene.workspaces[event.workspace].contains(*obj.position, TOLERANCE)
+    return True
+
+
+def event_instants(
+    plan: RobotPlan,
+    robot: str,
+    scene: Scene,
+    events: Sequence[Event] | None = None,
+    start: State | None = None,
+) -> list[int | None]:
+    """The instant at which each mission event is realised, in order.
+
+    Parameters
+    ----------
+    plan : RobotPlan
+    robot : str
+    scene : Scene
+    events : sequence of Event, optional
+        The events to realise (default: the plan's mission).
+    start : State, optional
+        Instant 0 when it is not the scenario.
+
+    Returns
+    -------
+    list of (int or None)
+        One entry per event: its instant, or ``None`` for the first event that cannot be
+        realised after the previous one and every event after it.
+    """
+    events = plan.events if events is None else tuple(events)
+    states = [start or initial_state(scene, robot), *(s.state for s in plan.steps)]
+    out: list[int | None] = []
+    last = None
+    for event in events:
+        after = 0 if last is None else last + (0 if event.kind == "return" else 1)
+        found = next(
+            (i for i in range(after, plan.horizon + 1) if holds_at(event, robot, plan, states, scene, i)),
+            None,
+        )
+        if found is None:
+            return out + [None] * (len(events) - len(out))
+        out.append(found)
+        last = found
+    return out
+
+
+def _events(plan: RobotPlan) -> list[Event]:
+    try:
+        return list(plan.events)
+    except EventSyntaxError:
+        return []
+
+
+def message_links(plans: Mapping[str, RobotPlan]) -> list[Link]:
+    """Every message of the plans with the steps that send and await it.
+
+    A ``msg`` is matched through the ``message`` of its ``Req`` and ``Res`` steps.  An
+    ``away(O,A,B)`` is awaited by A's ``Req(O)`` and sent by B's ``Res(O)``: the *k*-th
+    ``Res(O)`` of B's plan sends the *k*-th ``away(O,*,B)`` of B's mission.
+    """
+    sends: dict[str, tuple[str, int]] = {}
+    waits: dict[str, tuple[str, int]] = {}
+    for robot, plan in plans.items():
+        pending = [e for e in _events(plan) if e.kind == "away"]
+        for k, step in enumerate(plan.steps, 1):
+            if step.primitive not in ("Req", "Res"):
+                continue
+            if step.message is not None:
+                event = parse_event(step.message)
+            else:  # the next away event of this object and role in the mission
+                role = "receiver" if step.primitive == "Req" else "sender"
+                event = next((e for e in pending if e.obj == step.object and getattr(e, role) == robot), None)
+                if event is None:
+                    continue
+                pending.remove(event)
+            table = waits if step.primitive == "Req" else sends
+            table.setdefault(event.name, (robot, k))
+    out = []
+    for name in sorted(set(sends) | set(waits)):
+        event = parse_event(name)
+        send, wait = sends.get(name), waits.get(name)
+        out.append(
+            Link(
+                name,
+                event.sender,
+                send[1] if send is not None and send[0] == event.sender else None,
+                event.receiver,
+                wait[1] if wait is not None and wait[0] == event.receiver else None,
+            )
+        )
+    return out

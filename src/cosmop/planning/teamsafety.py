@@ -1,0 +1,230 @@
+"""Team-safe plans: every place two robots' plans share is ordered by a message.
+
+:func:`make_team_safe` takes plans that are each sound alone (and the messages they already
+have), finds their conflicts (:mod:`cosmop.planning.conflicts`), orders each one by a start
+edge -- the occupancy expected first goes first, never closing a cycle -- drops the edges the
+others imply, and turns the rest into messages (:mod:`cosmop.planning.messages`): the robot
+that must wait gets a ``Req`` right before the step that enters the shared place, the other a
+``Res`` right after the step that leaves it.  Conflicts no order can resolve (a robot parked
+for good where another must pass, or two orders that would wait on each other) are returned,
+for the caller to re-plan one robot around the other's space.
+
+Expected times come from :mod:`cosmop.planning.timing`, so the orders follow what is likely to
+happen first and the team's makespan stays low.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+
+import shapely
+
+from cosmop.missions.events import parse_event
+from cosmop.missions.precedence import Link, Node, Precedence
+from cosmop.planning.conflicts import (
+    Conflict,
+    ConflictSettings,
+    conflicts,
+    detours,
+    fixed_places,
+    is_ordered,
+    occupancies,
+    order_conflicts,
+)
+from cosmop.planning.messages import merge_drives, place_edges, split_drives
+from cosmop.planning.plan import PlanMessage, RobotPlan
+from cosmop.planning.realisation import message_links
+from cosmop.planning.timing import ExecutionModel, step_durations
+from cosmop.scenario import Scene
+
+__all__ = ["TeamSafety", "durations", "make_team_safe"]
+
+
+@dataclass(frozen=True)
+class TeamSafety:
+    """Result of :func:`make_team_safe`.
+
+    Attributes
+    ----------
+    plans : Mapping[str, RobotPlan]
+        The plans with the conflict messages in place.
+    messages : tuple of PlanMessage
+        The messages added, each with what it protects and where.
+    conflicts : int
+        Conflicts found between the plans.
+    ordered_before : int
+        Of those, how many the plans' own messages already ordered.
+    unresolved : tuple of Conflict
+        Conflicts no order can resolve (then ``plans`` are not team-safe).
+    makespan_alone, makespan : float
+        Expected seconds until the whole team is done: each robot on its own (no waiting), and
+        with every message.
+    time_s : float
+        Seconds this took.
+    fixed : Mapping[str, list]
+        Every robot's places that re-planning cannot move (to choose detours).
+    """
+
+    plans: Mapping[str, RobotPlan]
+    messages: tuple[PlanMessage, ...]
+    conflicts: int
+    ordered_before: int
+    unresolved: tuple[Conflict, ...]
+    makespan_alone: float
+    makespan: float
+    time_s: float
+    fixed: Mapping[str, list] = field(default_factory=dict, repr=False)
+
+    @property
+    def safe(self) -> bool:
+        return not self.unresolved
+
+    def detours(self, conflict: Conflict) -> list:
+        """Who can be re-planned around `conflict` (:func:`~cosmop.planning.conflicts.detours`)."""
+        return detours(conflict, self.fixed)
+
+
+def durations(
+    scene: Scene, plans: Mapping[str, RobotPlan], model: ExecutionModel | None = None
+) -> dict[str, list[float]]:
+    """Expected seconds of every step of every plan (:func:`cosmop.planning.timing.step_durations`)."""
+    return {
+        r: step_durations(p, scene.robots[r].pose, scene.robots[r].dynamics, model) for r, p in plans.items()
+    }
+
+
+def _reduce(
+    horizons: Mapping[str, int], links: Sequence[Link], chosen: Sequence[tuple[tuple[Node, Node], Conflict]]
+) -> list[tuple[tuple[Node, Node], Conflict]]:
+    """Drop every edge that the program order, the messages and the other kept edges imply.
+
+    The edge ``(A, i) -> start of (B, j)`` is implied when, without it, a path leads from A's
+    step *i* to a step of B before *j* or to another edge into the start of B's step *j*.
+    """
+    links_out: dict[Node, list[Node]] = {}
+    for link in links:
+        if link.send is not None and link.wait is not None:
+            links_out.setdefault((link.sender, link.send), []).append((link.receiver, link.wait))
+    kept = list(chosen)
+    for item in reversed(list(chosen)):
+        rest = [e for e in kept if e is not item]
+        starts: dict[Node, list[Node]] = {}
+        for (source, target), _ in rest:
+            starts.setdefault(source, []).append(target)
+        if _reaches(horizons, links_out, starts, *item[0]):
+            kept = rest
+    return kept
+
+
+def _reaches(horizons, links_out, starts, source: Node, target: Node) -> bool:
+    """Whether `source` completes before `target` starts through program order, links, `starts`."""
+    robot, j = target
+    seen, todo = {source}, [source]
+    while todo:
+        r, k = todo.pop()
+        if r == robot and k < j:
+            return True
+        nxt = [(r, k + 1)] if k < horizons[r] else []
+        nxt += links_out.get((r, k), [])
+        for into in starts.get((r, k), ()):
+            if into == target:
+                return True
+            nxt.append(into)
+        for node in nxt:
+            if node not in seen:
+                seen.add(node)
+                todo.append(node)
+    return False
+
+
+def make_team_safe(
+    scene: Scene,
+    plans: Mapping[str, RobotPlan],
+    *,
+    settings: ConflictSettings | None = None,
+    used: set[str] | None = None,
+) -> TeamSafety:
+    """Order every conflict between `plans` by messages (see the module docstring).
+
+    Parameters
+    ----------
+    scene : Scene
+    plans : Mapping[str, RobotPlan]
+        Every robot's plan, sound alone, with the messages it already has (no deadlock).
+    settings : ConflictSettings, optional
+    used : set of str, optional
+        Message names already taken (new ones avoid them; the set is updated).
+
+    Returns
+    -------
+    TeamSafety
+    """
+    t0 = time.perf_counter()
+    settings = settings or ConflictSettings()
+    waypoints = {r: {(s.robot[0], s.robot[1]) for s in p.steps} for r, p in plans.items()}
+    plans = {
+        r: split_drives(p, scene.robots[r].pose, settings.segment, _roomy(scene, r, settings.clearance))
+        for r, p in plans.items()
+    }
+    horizons = {r: p.horizon for r, p in plans.items()}
+    links = message_links(plans)
+    times = durations(scene, plans)
+    precedence = Precedence(horizons, links, (), times)
+    if not precedence.complete:
+        raise ValueError("the plans' own messages deadlock; order them before the conflicts")
+    alone = max((sum(d) for d in times.values()), default=0.0)
+    items, _ = occupancies(scene, plans, precedence, settings)
+    found = conflicts(items)
+    ordered = sum(1 for c in found if is_ordered(c, precedence))
+    fixed = fixed_places(items)
+    chosen, unresolved = order_conflicts(found, horizons, links, [], times, fixed=fixed)
+    kept = _reduce(horizons, links, chosen)
+    new_plans, placed = place_edges(scene, plans, [edge for edge, _ in kept], "clear", used)
+    new_plans = {r: merge_drives(p, waypoints[r]) for r, p in new_plans.items()}
+    messages = tuple(
+        PlanMessage(name, "conflict", _protects(new_plans, name, conflict), conflict.place)
+        for (name, _, _), (_, conflict) in zip(placed, kept, strict=True)
+    )
+    final = Precedence(
+        {r: p.horizon for r, p in new_plans.items()},
+        message_links(new_plans),
+        (),
+        durations(scene, new_plans),
+    )
+    return TeamSafety(
+        new_plans,
+        messages,
+        len(found),
+        ordered,
+        tuple(unresolved),
+        alone,
+        final.makespan,
+        time.perf_counter() - t0,
+        fixed,
+    )
+
+
+def _roomy(scene: Scene, robot: str, room: float):
+    """Whether the robot's square at ``(x, y)`` keeps `room` (mm) from every wall."""
+    walls = shapely.MultiLineString([[w.start, w.end] for w in scene.obstacles]) if scene.obstacles else None
+    half = scene.robots[robot].size / 2.0 + room
+
+    def roomy(x: float, y: float) -> bool:
+        return walls is None or not walls.intersects(shapely.box(x - half, y - half, x + half, y + half))
+
+    return roomy
+
+
+def _protects(plans: Mapping[str, RobotPlan], name: str, conflict: Conflict) -> str:
+    event = parse_event(name)
+    a, b = event.sender, event.receiver
+    send = next(k for k, s in enumerate(plans[a].steps, 1) if s.message == name)
+    wait = next(k for k, s in enumerate(plans[b].steps, 1) if s.message == name)
+    cleared = plans[a].steps[send - 2].label if send >= 2 else "its start"
+    entered = plans[b].steps[wait].label if wait < plans[b].horizon else "the end of its plan"
+    return (
+        f"{b} waits before its {entered} at instant {wait + 1} until {a} has done its {cleared} "
+        f"at instant {send - 1}: {conflict.describe()}"
+    )

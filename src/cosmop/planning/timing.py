@@ -1,0 +1,143 @@
+"""How long each step of a plan takes: the execution model the coordination layer reasons with.
+
+The simulator drives unicycles with the limits of :class:`~cosmop.scenario.Dynamics`; this
+module estimates the same motions in closed form, so that plans can be ordered by when their
+steps are expected to happen (and shared as itineraries):
+
+``GoTo`` from pose :math:`p` to pose :math:`q`
+    turn on the spot to face :math:`q` (at the turn rate :math:`\\Omega`), drive the straight
+    distance :math:`d` with a trapezoidal speed profile (accelerate at :math:`A` up to the top
+    speed :math:`v_{max}`, brake at :math:`b` to a stop), then turn to :math:`q`'s heading.  The
+    drive takes :math:`v/A + v/b + (d - v^2/(2A) - v^2/(2b))/v_{max}` with :math:`v = v_{max}`
+    when :math:`d \\ge v_{max}^2/(2A) + v_{max}^2/(2b)`, else the triangle profile
+    :math:`v = \\sqrt{2dAb/(A+b)}`, :math:`t = v/A + v/b`.
+``PickUp``, ``DropOff``
+    docking and the gripper: :attr:`ExecutionModel.handling_time`.
+``Req``, ``Res``
+    no time of their own (a ``Req`` lasts until its message has been sent).
+
+Consecutive GoTo steps in one direction (a drive cut into pieces) are one drive, shared by the
+pieces in proportion to their lengths; a change of direction is estimated stop to stop (the
+controller passes intermediate waypoints without stopping, so real runs are usually faster).
+The estimates order events; they are not a promise.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from cosmop.planning.plan import RobotPlan
+from cosmop.scenario import Dynamics
+
+__all__ = ["ExecutionModel", "drive_time", "step_durations", "turn_time"]
+
+
+@dataclass(frozen=True)
+class ExecutionModel:
+    """Times of the primitives that do not drive.
+
+    Attributes
+    ----------
+    handling_time : float
+        Seconds a PickUp or DropOff takes: docking, the gripper, backing off (default 2).
+    """
+
+    handling_time: float = 2.0
+
+
+def turn_time(angle_deg: float, dynamics: Dynamics) -> float:
+    """Seconds to turn on the spot by `angle_deg` degrees (the shorter way round)."""
+    angle = abs((angle_deg + 180.0) % 360.0 - 180.0)
+    return angle / dynamics.turn_rate
+
+
+def drive_time(distance: float, dynamics: Dynamics) -> float:
+    """Seconds to drive `distance` mm in a straight line from standstill to standstill.
+
+    >>> round(drive_time(1500.0, Dynamics(max_speed=750, acceleration=300, braking=500)), 3)
+    4.0
+    """
+    if distance <= 0.0:
+        return 0.0
+    vmax, a, b = dynamics.max_speed, dynamics.acceleration, dynamics.braking
+    ramps = vmax * vmax / (2.0 * a) + vmax * vmax / (2.0 * b)
+    if distance >= ramps:
+        return vmax / a + vmax / b + (distance - ramps) / vmax
+    v = math.sqrt(2.0 * distance * a * b / (a + b))
+    return v / a + v / b
+
+
+def _goto_time(start: tuple[float, ...], end: tuple[float, ...], dynamics: Dynamics) -> float:
+    dx, dy = end[0] - start[0], end[1] - start[1]
+    distance = math.hypot(dx, dy)
+    if distance == 0.0:
+        return turn_time(end[2] - start[2], dynamics)
+    facing = math.degrees(math.atan2(dy, dx))
+    return (
+        turn_time(facing - start[2], dynamics)
+        + drive_time(distance, dynamics)
+        + turn_time(end[2] - facing, dynamics)
+    )
+
+
+def step_durations(
+    plan: RobotPlan,
+    start: tuple[float, float, float],
+    dynamics: Dynamics,
+    model: ExecutionModel | None = None,
+) -> list[float]:
+    """Expected seconds of every step of `plan` (``[d_1, ..., d_K]``), without waiting.
+
+    Parameters
+    ----------
+    plan : RobotPlan
+    start : tuple of float
+        The pose at instant 0 ``(x, y, heading)``, mm and degrees.
+    dynamics : Dynamics
+        The robot's limits.
+    model : ExecutionModel, optional
+
+    Returns
+    -------
+    list of float
+    """
+    model = model or ExecutionModel()
+    out, pose = [], tuple(start)
+    run: list[tuple[int, tuple, tuple]] = []  # pieces of one straight drive: (index, from, to)
+    for step in plan.steps:
+        if step.primitive == "GoTo" and run and not _collinear(run[-1][1], run[-1][2], step.robot):
+            _close(run, out, dynamics)
+            run = []
+        out.append(0.0)
+        if step.primitive == "GoTo":
+            run.append((len(out) - 1, pose, step.robot))
+        else:
+            _close(run, out, dynamics)
+            run = []
+            if step.primitive in ("PickUp", "DropOff"):
+                out[-1] = model.handling_time
+        pose = step.robot
+    _close(run, out, dynamics)
+    return out
+
+
+def _collinear(a: tuple, b: tuple, c: tuple) -> bool:
+    """Whether going on from `b` to `c` continues the drive from `a` to `b` (within 1 degree)."""
+    u = (b[0] - a[0], b[1] - a[1])
+    v = (c[0] - b[0], c[1] - b[1])
+    nu, nv = math.hypot(*u), math.hypot(*v)
+    if nu == 0.0 or nv == 0.0:
+        return False
+    return (u[0] * v[0] + u[1] * v[1]) / (nu * nv) >= math.cos(math.radians(1.0))
+
+
+def _close(run: list, out: list[float], dynamics: Dynamics) -> None:
+    """Share the time of one straight drive among its pieces, by length."""
+    if not run:
+        return
+    total = _goto_time(run[0][1], run[-1][2], dynamics)
+    lengths = [math.dist(p[:2], q[:2]) for _, p, q in run]
+    whole = sum(lengths)
+    for (index, _, _), length in zip(run, lengths, strict=True):
+        out[index] = total * (length / whole if whole > 0 else 1.0 / len(run))
