@@ -383,7 +383,8 @@ def _escape_ok(
     This is passive safety checked directly along one arc, used when ``safe`` (which covers
     every arc at once) fails, so that a robot standing close to something can still leave.
     ``keep`` (shape ``(U, M)``, mm): the gap to each box may not end below it (``-inf``: no
-    such rule), so that a robot inside another's standoff only leaves or slides along.
+    such rule), so that a robot inside another's standoff only leaves or slides along.  Turning
+    on the spot from a standstill is always admitted (the square footprint does not move).
     """
     U, K = V.shape
     _top, _acc, brk, _omega, eps = (limits[:, i] for i in range(5))
@@ -428,4 +429,6 @@ def _escape_ok(
         if skip is not None:
             fine |= skip[:, None, None, :]
         ok &= fine.all(axis=(2, 3))
-    return ok
+    # A robot that stands and stays standing (it may turn: its square does not move) cannot
+    # run into anything: that is always allowed, so a robot touching a wall can turn away.
+    return ok | ((v[:, None] == 0) & (V == 0))

@@ -123,8 +123,13 @@ class Conflict:
         return tuple(sorted(self.a.parties | self.b.parties))
 
     def describe(self) -> str:
+        """The two occupancies and the space they share, in words."""
+        return f"{self.a.label} and {self.b.label} share the space {self.space()}"
+
+    def space(self) -> str:
+        """The shared space's bounding box in words: ``x in [.., ..], y in [.., ..]`` (mm)."""
         x0, y0, x1, y1 = (_fmt(round(v, 1)) for v in self.place)
-        return f"{self.a.label} and {self.b.label} share the space x in [{x0}, {x1}], y in [{y0}, {y1}]"
+        return f"x in [{x0}, {x1}], y in [{y0}, {y1}]"
 
 
 def _square(x: float, y: float, side: float) -> BaseGeometry:
@@ -189,9 +194,15 @@ def _robot_occupancies(
 
 
 def _object_occupancies(
-    scene: Scene, plans: Mapping[str, RobotPlan], precedence: Precedence
+    scene: Scene,
+    plans: Mapping[str, RobotPlan],
+    precedence: Precedence,
+    positions: Mapping[str, tuple[float, float] | None] | None = None,
 ) -> tuple[list[Occupancy], list[str]]:
-    """Where every moved object rests between the steps that handle it; problems found."""
+    """Where every moved object rests between the steps that handle it; problems found.
+
+    `positions` gives where objects are at the start (``None``: carried); by default the scene's.
+    """
     out, problems = [], []
     for oid, spec in scene.objects.items():
         handling = [
@@ -210,7 +221,7 @@ def _object_occupancies(
                     "order between them"
                 )
         parties = frozenset(h[0] for h in handling)
-        position, first = spec.position, None
+        position, first = (positions or {}).get(oid, spec.position), None
         for robot, k, primitive in handling:
             if primitive == "PickUp":
                 if position is not None:
@@ -251,15 +262,20 @@ def occupancies(
     precedence: Precedence,
     settings: ConflictSettings | None = None,
     starts: Mapping[str, State] | None = None,
+    positions: Mapping[str, tuple[float, float] | None] | None = None,
 ) -> tuple[list[Occupancy], list[str]]:
-    """Every occupancy of the robots and the objects they move; problems with object handling."""
+    """Every occupancy of the robots and the objects they move; problems with object handling.
+
+    `starts` gives the robots' states at the start when it is not the scenario (mid-run), and
+    `positions` where the objects are then (``None``: carried).
+    """
     grow = (settings or ConflictSettings()).clearance
     out: list[Occupancy] = []
     for robot, plan in plans.items():
         start = (starts or {}).get(robot) or initial_state(scene, robot)
         size, home = scene.robots[robot].size + grow, scene.robots[robot].pose
         out += _robot_occupancies(robot, plan, start, size, home)
-    objects, problems = _object_occupancies(scene, plans, precedence)
+    objects, problems = _object_occupancies(scene, plans, precedence, positions)
     return out + objects, problems
 
 

@@ -252,6 +252,7 @@ def place_edges(
     edges: Sequence[tuple[Node, Node]],
     tag: str = "clear",
     used: set[str] | None = None,
+    starts: Mapping[str, State] | None = None,
 ) -> tuple[dict[str, RobotPlan], list[tuple[str, tuple[Node, Node], tuple[Node, Node]]]]:
     """One message per start edge ``((A, i), (B, j))``: A sends after step *i*, B waits before *j*.
 
@@ -273,7 +274,8 @@ def place_edges(
         names.append(name)
     out, moved = {}, {}
     for robot, plan in plans.items():
-        out[robot], moved[robot] = insert_steps(scene, robot, plan, inserts[robot])
+        start = (starts or {}).get(robot)
+        out[robot], moved[robot] = insert_steps(scene, robot, plan, inserts[robot], start)
     placed = []
     for name, edge in zip(names, edges, strict=True):
         event = parse_event(name)

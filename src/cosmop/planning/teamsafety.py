@@ -34,7 +34,7 @@ from cosmop.planning.conflicts import (
     order_conflicts,
 )
 from cosmop.planning.messages import merge_drives, place_edges, split_drives
-from cosmop.planning.plan import PlanMessage, RobotPlan
+from cosmop.planning.plan import PlanMessage, RobotPlan, State
 from cosmop.planning.realisation import message_links
 from cosmop.planning.timing import ExecutionModel, step_durations
 from cosmop.scenario import Scene
@@ -87,12 +87,22 @@ class TeamSafety:
 
 
 def durations(
-    scene: Scene, plans: Mapping[str, RobotPlan], model: ExecutionModel | None = None
+    scene: Scene,
+    plans: Mapping[str, RobotPlan],
+    model: ExecutionModel | None = None,
+    starts: Mapping[str, State] | None = None,
 ) -> dict[str, list[float]]:
     """Expected seconds of every step of every plan (:func:`cosmop.planning.timing.step_durations`)."""
     return {
-        r: step_durations(p, scene.robots[r].pose, scene.robots[r].dynamics, model) for r, p in plans.items()
+        r: step_durations(p, _pose(scene, r, starts), scene.robots[r].dynamics, model)
+        for r, p in plans.items()
     }
+
+
+def _pose(scene: Scene, robot: str, starts: Mapping[str, State] | None) -> tuple[float, float, float]:
+    """Where `robot` starts: its state in `starts`, else the scenario's pose."""
+    state = (starts or {}).get(robot)
+    return state.robot if state is not None else scene.robots[robot].pose
 
 
 def _reduce(
@@ -145,6 +155,8 @@ def make_team_safe(
     *,
     settings: ConflictSettings | None = None,
     used: set[str] | None = None,
+    starts: Mapping[str, State] | None = None,
+    positions: Mapping[str, tuple[float, float] | None] | None = None,
 ) -> TeamSafety:
     """Order every conflict between `plans` by messages (see the module docstring).
 
@@ -156,6 +168,10 @@ def make_team_safe(
     settings : ConflictSettings, optional
     used : set of str, optional
         Message names already taken (new ones avoid them; the set is updated).
+    starts : Mapping[str, State], optional
+        The robots' states at instant 0 when it is not the scenario (re-coordination mid-run).
+    positions : Mapping[str, tuple or None], optional
+        Where the objects are at instant 0 (``None``: carried), when it is not the scenario.
 
     Returns
     -------
@@ -165,23 +181,23 @@ def make_team_safe(
     settings = settings or ConflictSettings()
     waypoints = {r: {(s.robot[0], s.robot[1]) for s in p.steps} for r, p in plans.items()}
     plans = {
-        r: split_drives(p, scene.robots[r].pose, settings.segment, _roomy(scene, r, settings.clearance))
+        r: split_drives(p, _pose(scene, r, starts), settings.segment, _roomy(scene, r, settings.clearance))
         for r, p in plans.items()
     }
     horizons = {r: p.horizon for r, p in plans.items()}
     links = message_links(plans)
-    times = durations(scene, plans)
+    times = durations(scene, plans, starts=starts)
     precedence = Precedence(horizons, links, (), times)
     if not precedence.complete:
         raise ValueError("the plans' own messages deadlock; order them before the conflicts")
     alone = max((sum(d) for d in times.values()), default=0.0)
-    items, _ = occupancies(scene, plans, precedence, settings)
+    items, _ = occupancies(scene, plans, precedence, settings, starts, positions)
     found = conflicts(items)
     ordered = sum(1 for c in found if is_ordered(c, precedence))
     fixed = fixed_places(items)
     chosen, unresolved = order_conflicts(found, horizons, links, [], times, fixed=fixed)
     kept = _reduce(horizons, links, chosen)
-    new_plans, placed = place_edges(scene, plans, [edge for edge, _ in kept], "clear", used)
+    new_plans, placed = place_edges(scene, plans, [edge for edge, _ in kept], "clear", used, starts)
     new_plans = {r: merge_drives(p, waypoints[r]) for r, p in new_plans.items()}
     messages = tuple(
         PlanMessage(name, "conflict", _protects(new_plans, name, conflict), conflict.place)
@@ -191,7 +207,7 @@ def make_team_safe(
         {r: p.horizon for r, p in new_plans.items()},
         message_links(new_plans),
         (),
-        durations(scene, new_plans),
+        durations(scene, new_plans, starts=starts),
     )
     return TeamSafety(
         new_plans,
@@ -226,5 +242,5 @@ def _protects(plans: Mapping[str, RobotPlan], name: str, conflict: Conflict) -> 
     entered = plans[b].steps[wait].label if wait < plans[b].horizon else "the end of its plan"
     return (
         f"{b} waits before its {entered} at instant {wait + 1} until {a} has done its {cleared} "
-        f"at instant {send - 1}: {conflict.describe()}"
+        f"at instant {send - 1}: they share the space {conflict.space()}"
     )

@@ -14,6 +14,7 @@ from cosmop.sim.simulation import (
     Message,
     SimResult,
     SimSettings,
+    footprint_overlaps,
     simulate,
 )
 
@@ -24,6 +25,7 @@ __all__ = [
     "Message",
     "SimResult",
     "SimSettings",
+    "footprint_overlaps",
     "replan",
     "sensed_scene",
     "simulate",

@@ -52,9 +52,11 @@ from cosmop.control.paths import GlobalPath, plan_path
 from cosmop.control.safety import is_safe, obstacle_speed, stopping_horizon, stopping_margin
 from cosmop.io import write_atomic
 from cosmop.missions.events import Event, parse_event
-from cosmop.planning.plan import ObjectState, PlanSet, State, Step
+from cosmop.planning.plan import ObjectState, PlanSet, RobotPlan, State, Step, initial_state
+from cosmop.planning.realisation import event_instants
 from cosmop.scenario import Scenario
 from cosmop.sim.humans import Walker
+from cosmop.sim.recoordinate import Remaining, recoordinate
 from cosmop.sim.replan import replan
 
 __all__ = [
@@ -64,6 +66,7 @@ __all__ = [
     "Message",
     "SimResult",
     "SimSettings",
+    "footprint_overlaps",
     "simulate",
 ]
 
@@ -208,6 +211,9 @@ class SimResult:
         ``(None, GoTo, PickUp, DropOff, Req, Res)``), ``waiting`` (n, R), ``humans`` (n, H, 2),
         ``objects`` (n, O, 2).
     robot_ids, human_ids, object_ids : tuple of str
+    replan_log : tuple of dict
+        Every replan attempt: ``t``, ``robot``, ``accepted`` (its new plan was ordered with the
+        others' again, :mod:`cosmop.sim.recoordinate`), ``why`` not, and the ``messages`` added.
     events : tuple of (float, str, str)
         ``(t, robot, event)``: the mission events and messages as the robots realised them --
         a pick when the gripper closes, a drop when the object lies in its workspace, a return
@@ -233,6 +239,7 @@ class SimResult:
     human_ids: tuple[str, ...] = ()
     object_ids: tuple[str, ...] = ()
     events: tuple[tuple[float, str, str], ...] = ()
+    replan_log: tuple[dict[str, Any], ...] = ()
 
     def executed_word(self) -> tuple[str, ...]:
         """The mission events the run realised, in time order (messages left out)."""
@@ -258,6 +265,7 @@ class SimResult:
             "replan_attempts": self.replan_attempts,
             "messages": [m.to_dict() for m in self.messages],
             "events": [{"t": t, "robot": r, "event": e} for t, r, e in self.events],
+            "replan_log": list(self.replan_log),
             "objects": {
                 oid: {"position": [round(p[0], 3), round(p[1], 3)], "carried_by": by}
                 for oid, (p, by) in self.objects.items()
@@ -418,6 +426,11 @@ class _World:
         self.touching: dict[tuple[int, str], int] = {}  # pair -> index in contacts
         self.replans = 0
         self.replan_attempts = 0
+        self.replan_log: list[dict[str, Any]] = []  # every replan: time, robot, accepted, messages
+        self.conflict_names = {m.event for m in plans.messages if m.kind == "conflict"}
+        self.used_names = {
+            name for p in plans.robots.values() for name in p.mission if name.startswith("msg(")
+        }
         self.detours = 0
         self.t = 0.0
 
@@ -865,7 +878,9 @@ def _stalled(world: _World, agent: _Agent) -> None:
         if n != agent.id and n not in world.oids and g < s.sense_range
     ]
     done_steps = agent.steps[: agent.k]
-    remaining = _remaining_events(agent.mission, done_steps, agent.id)
+    _, todo = _split_mission(world, agent)
+    # the mission's own events and messages; messages that kept plans apart are ordered afresh
+    remaining = [e for e in todo if e.name not in world.conflict_names and e.name not in world.inbox]
     objects = {}
     for j, oid in enumerate(world.oids):
         carried = world.carried_by[j] == i
@@ -890,31 +905,81 @@ def _stalled(world: _World, agent: _Agent) -> None:
         rlimit=s.rlimit,
     )
     if plan is None:
+        world.replan_log.append(
+            {"t": round(world.t, 6), "robot": agent.id, "accepted": False, "why": "no plan"}
+        )
         return
-    world.replans += 1
-    agent.steps = done_steps + list(plan.steps)
-    agent.phase = "start"
-    agent.stage = None
-    agent.path = None
+    accepted, why, added = _recoordinate(world, agent, plan, start)
+    world.replan_log.append(
+        {
+            "t": round(world.t, 6),
+            "robot": agent.id,
+            "accepted": accepted,
+            "why": why or None,
+            "messages": added,
+        }
+    )
+    if accepted:
+        world.replans += 1
 
 
-def _remaining_events(mission: list[Event], done: list[Step], robot: str) -> list[Event]:
-    """The mission events that the executed steps have not realised yet, in order."""
-    k = 0
-    for n, event in enumerate(mission):
-        if event.kind == "return":
-            if n == len(mission) - 1:
-                return mission[n:]
-            continue
-        want = {"pick": "PickUp", "drop": "DropOff"}.get(event.kind)
-        if want is None:
-            want = "Req" if event.robot == robot else "Res"
-        while k < len(done) and not (done[k].primitive == want and done[k].object == event.obj):
-            k += 1
-        if k >= len(done):
-            return mission[n:]
-        k += 1
-    return []
+def _split_mission(world: _World, agent: _Agent) -> tuple[list[Event], list[Event]]:
+    """The agent's mission events done (by its completed steps) and those still to do."""
+    plan = RobotPlan.from_steps([e.name for e in agent.mission], agent.steps)
+    instants = event_instants(plan, agent.id, world.scenario.scene)
+    done = [e for e, t in zip(agent.mission, instants, strict=True) if t is not None and t <= agent.k]
+    return done, agent.mission[len(done) :]
+
+
+def _state_now(world: _World, agent: _Agent) -> State:
+    """Where the agent is (mm, degrees) and the objects as its plan sees them now."""
+    i = agent.index
+    if agent.k > 0:
+        objects = agent.steps[agent.k - 1].objects
+    else:
+        objects = initial_state(world.scenario.scene, agent.id).objects
+    x, y, h = world.pose[i]
+    return State((float(x), float(y), math.degrees(float(h))), objects)
+
+
+def _recoordinate(world: _World, agent: _Agent, new: RobotPlan, start: State) -> tuple[bool, str, list[str]]:
+    """Order the rest of every plan again around the agent's new one (:mod:`cosmop.sim.recoordinate`)."""
+    rests = {}
+    for other in world.agents:
+        if other is agent:
+            rests[other.id] = Remaining(new.steps, new.mission, start)
+        else:
+            _, todo = _split_mission(world, other)
+            rests[other.id] = Remaining(
+                tuple(other.steps[other.k :]), tuple(e.name for e in todo), _state_now(world, other)
+            )
+    positions = {
+        oid: None if world.carried_by[j] >= 0 else tuple(float(v) for v in world.obj_pos[j])
+        for j, oid in enumerate(world.oids)
+    }
+    result = recoordinate(
+        world.scenario.scene,
+        rests,
+        sent=world.inbox,
+        conflict_messages=world.conflict_names,
+        used=world.used_names,
+        positions=positions,
+    )
+    if not result.accepted:
+        return False, result.reason or "", []
+    for other in world.agents:
+        done, _ = (
+            _split_mission(world, other) if other is not agent else (_split_mission(world, other)[0], None)
+        )
+        plan = result.plans[other.id]
+        current = other.steps[other.k] if other.k < len(other.steps) else None
+        other.steps = other.steps[: other.k] + list(plan.steps)
+        other.mission = list(done) + [parse_event(e) for e in plan.mission]
+        if other is agent or (other.k < len(other.steps) and other.steps[other.k] != current):
+            other.phase, other.stage, other.path = "start", None, None
+    added = [m.event for m in result.messages]
+    world.conflict_names |= set(added)
+    return True, "", added
 
 
 # ----------------------------------------------------------------------------------------------
@@ -1146,7 +1211,31 @@ def simulate(
         human_ids=world.hids,
         object_ids=world.oids,
         events=tuple(world.events),
+        replan_log=tuple(world.replan_log),
     )
+
+
+def footprint_overlaps(
+    scene, result: SimResult, tolerance: float = 1e-6
+) -> list[tuple[float, str, str, float]]:
+    """Every recorded instant at which two robots' squares overlap (touching allowed).
+
+    Returns ``(t, robot, other, depth)`` for the first instant of each overlapping pair and
+    episode, depth in mm; an empty list for a run in which robots never overlap.
+    """
+    pose = result.frames["pose"]
+    half = np.array([scene.robots[r].size / 2.0 for r in result.robot_ids])
+    out = []
+    for i in range(len(half)):
+        for j in range(i + 1, len(half)):
+            gap = np.abs(pose[:, i, :2] - pose[:, j, :2]).max(axis=1) - (half[i] + half[j])
+            bad = gap < -tolerance
+            starts = np.flatnonzero(bad & ~np.concatenate([[False], bad[:-1]]))
+            for n in starts:
+                out.append(
+                    (float(result.frames["t"][n]), result.robot_ids[i], result.robot_ids[j], float(-gap[n]))
+                )
+    return sorted(out)
 
 
 def _dock_safe(world: _World, i: int, agent: _Agent, target: tuple | None = None) -> bool:

@@ -1,0 +1,119 @@
+"""Re-coordination mid-run: a robot's new plan goes through the same team-safety layer.
+
+When a stalled robot replans (:mod:`cosmop.sim.replan`), its new route may meet the other
+robots' routes where its old one did not.  Its new plan is therefore not executed on its own:
+the rest of every robot's plan, from where each robot is now, is ordered again by
+:func:`cosmop.planning.teamsafety.make_team_safe`, exactly as before the run --
+
+* messages already sent stay sent: the steps that wait for them are done;
+* the messages that kept the old plans apart and have not been sent yet are dropped (they
+  protected places the new plans may no longer share) and the conflicts are ordered afresh,
+  proved free of deadlock, with new message names;
+* the orders the mission itself requires (``away`` answers, order messages) are kept.
+
+If some conflict cannot be ordered, the new plan is refused and the robot keeps its old one.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+
+from cosmop.planning.conflicts import ConflictSettings
+from cosmop.planning.plan import PlanMessage, RobotPlan, State, Step
+from cosmop.planning.teamsafety import make_team_safe
+from cosmop.scenario import Scene
+
+__all__ = ["Recoordination", "Remaining", "recoordinate"]
+
+
+@dataclass(frozen=True)
+class Remaining:
+    """What is left of one robot's plan: its steps from the current one, from `start`.
+
+    Attributes
+    ----------
+    steps : tuple of Step
+    mission : tuple of str
+        The events those steps still realise, messages included, in order.
+    start : State
+        Where the robot is and how it sees the objects now.
+    """
+
+    steps: tuple[Step, ...]
+    mission: tuple[str, ...]
+    start: State
+
+
+@dataclass(frozen=True)
+class Recoordination:
+    """The result of :func:`recoordinate`: the new rest of every robot's plan, or why not."""
+
+    accepted: bool
+    plans: Mapping[str, RobotPlan]
+    messages: tuple[PlanMessage, ...]
+    dropped: tuple[str, ...]
+    reason: str | None = None
+
+
+def _without(rest: Remaining, names: set[str]) -> RobotPlan:
+    """The rest of a plan without the message steps and events in `names`."""
+    steps = [s for s in rest.steps if not (s.message in names and s.primitive in ("Req", "Res"))]
+    steps = [
+        s for s in steps if not (s.primitive == "Req" and s.message is None and _away_of(rest, s) in names)
+    ]
+    mission = [e for e in rest.mission if e not in names]
+    return RobotPlan.from_steps(mission, steps)
+
+
+def _away_of(rest: Remaining, step: Step) -> str | None:
+    """The away event a ``Req(O)`` step waits for, from the mission."""
+    return next((e for e in rest.mission if e.startswith(f"away({step.object},")), None)
+
+
+def recoordinate(
+    scene: Scene,
+    rests: Mapping[str, Remaining],
+    *,
+    sent: Iterable[str],
+    conflict_messages: Iterable[str],
+    used: set[str],
+    positions: Mapping[str, tuple[float, float] | None],
+    settings: ConflictSettings | None = None,
+) -> Recoordination:
+    """Order the rest of every robot's plan again (module docstring).
+
+    Parameters
+    ----------
+    scene : Scene
+    rests : Mapping[str, Remaining]
+        Every robot's remaining plan (the stalled robot's new plan among them).
+    sent : iterable of str
+        Messages already sent (their waits are done).
+    conflict_messages : iterable of str
+        The messages that keep plans apart (the others are the mission's own).
+    used : set of str
+        Message names already used (new ones avoid them; updated).
+    positions : Mapping[str, tuple or None]
+        Where every object is now (``None``: carried).
+    settings : ConflictSettings, optional
+
+    Returns
+    -------
+    Recoordination
+    """
+    sent = set(sent)
+    pending = set(conflict_messages) - sent
+    drop = sent | pending
+    plans = {r: _without(rest, drop) for r, rest in rests.items()}
+    starts = {r: rest.start for r, rest in rests.items()}
+    safety = make_team_safe(scene, plans, settings=settings, used=used, starts=starts, positions=positions)
+    if not safety.safe:
+        return Recoordination(
+            False,
+            {},
+            (),
+            tuple(sorted(pending)),
+            f"the new plans share a place no order resolves: {safety.unresolved[0].describe()}",
+        )
+    return Recoordination(True, safety.plans, safety.messages, tuple(sorted(pending)))

@@ -1,0 +1,196 @@
+"""Team-safe plans: messages order the places robots share and the orders the mission requires.
+
+The examples 07 (one-lane corridor) and 08 (an order between robots) are planned and simulated,
+and their traces checked: every robot finishes, no two robots' footprints ever overlap, and the
+executed word of mission events is a complete word of the global mission.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from cosmop.cli import app
+from cosmop.missions.events import message, parse_event
+from cosmop.missions.mission import GlobalMission
+from cosmop.missions.precedence import Precedence
+from cosmop.pipeline import plan_team
+from cosmop.planning.conflicts import conflicts, is_ordered, occupancies
+from cosmop.planning.plan import load_plan
+from cosmop.planning.realisation import message_links
+from cosmop.scenario import load_scenario, parse_scenario
+from cosmop.sim import simulate
+from cosmop.sim.recoordinate import Remaining, recoordinate
+from team_checks import assert_complete_word, assert_no_overlap
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+runner = CliRunner()
+
+
+@pytest.fixture(scope="module")
+def corridor():
+    scenario = load_scenario(EXAMPLES / "07_corridor" / "scenario.yaml")
+    return scenario, plan_team(scenario)
+
+
+@pytest.fixture(scope="module")
+def ordered():
+    scenario = load_scenario(EXAMPLES / "08_ordered" / "scenario.yaml")
+    return scenario, plan_team(scenario)
+
+
+def test_message_events_round_trip():
+    event = parse_event("msg(R1, R2, clear1)")
+    assert event == message("R1", "R2", "clear1") and event.name == "msg(R1,R2,clear1)"
+    assert (event.sender, event.receiver, event.owners) == ("R1", "R2", frozenset({"R1", "R2"}))
+    away = parse_event("away(O2,R1,R2)")  # the paper's message: R2 tells R1 that O2 is away
+    assert (away.sender, away.receiver, away.is_message) == ("R2", "R1", True)
+
+
+def test_corridor_conflicts_are_ordered_by_messages(corridor):
+    scenario, result = corridor
+    plans = result.plans
+    assert plans.feasible and result.report.ok
+    assert result.safety.conflicts > 0 and plans.messages
+    assert all(m.kind == "conflict" and m.place is not None for m in plans.messages)
+    # every conflict between the final plans is ordered, and the order cannot deadlock
+    links = message_links(plans.robots)
+    precedence = Precedence({r: p.horizon for r, p in plans.robots.items()}, links)
+    assert precedence.complete
+    items, problems = occupancies(scenario.scene, plans.robots, precedence)
+    found = conflicts(items)
+    assert found and not problems and all(is_ordered(c, precedence) for c in found)
+
+
+def test_corridor_simulation_has_no_stand_off(corridor):
+    scenario, result = corridor
+    run = simulate(scenario, result.plans)
+    assert run.completed and run.contacts_while_moving == 0 and run.replans == 0
+    assert_no_overlap(scenario, run)
+    assert_complete_word(scenario, run)
+    x, y = run.frames["pose"][:, :, 0], run.frames["pose"][:, :, 1]
+    inside = (np.abs(x) < 1500) & (np.abs(y) < 250)
+    assert inside.any(axis=0).all()  # both robots crossed it
+    assert not (inside.sum(axis=1) > 1).any()  # never both in the corridor
+    for i in range(inside.shape[1]):  # nobody backs out: every crossing leaves on the far side
+        edges = np.flatnonzero(np.diff(inside[:, i].astype(int)))
+        for enter, leave in zip(edges[::2], edges[1::2], strict=False):
+            assert np.sign(x[enter, i]) != np.sign(x[leave + 1, i])
+
+
+def test_an_order_between_robots_is_kept_by_a_message(ordered):
+    scenario, result = ordered
+    plans = result.plans
+    assert plans.feasible and result.report.ok
+    kinds = {m.event: m.kind for m in plans.messages}
+    (order,) = [name for name, kind in kinds.items() if kind == "order"]
+    assert parse_event(order).sender == "R1" and parse_event(order).receiver == "R2"
+    r1, r2 = plans.robots["R1"].mission, plans.robots["R2"].mission
+    assert r1.index(order) == r1.index("drop(R1,O1,W1)") + 1  # sent right after the drop
+    assert r2.index(order) == r2.index("pick(R2,O2)") - 1  # awaited right before the pick
+    run = simulate(scenario, plans)
+    assert run.completed and run.contacts_while_moving == 0
+    when = {event: t for t, _, event in run.events}
+    assert when["pick(R2,O2)"] > when["drop(R1,O1,W1)"]
+    assert_no_overlap(scenario, run)
+    assert_complete_word(scenario, run)
+
+
+def test_the_executed_word_check_can_fail(ordered):
+    scenario, _ = ordered
+    mission = GlobalMission.from_scenario(scenario)
+    word = ["pick(R2,O2)", "pick(R1,O1)", "drop(R1,O1,W1)", "drop(R2,O2,W2)", "return(R1)", "return(R2)"]
+    assert not mission.is_complete_word(word)  # R2 picked first
+    assert not mission.is_complete_word(word[2:])  # not complete
+    assert mission.is_complete_word([word[1], word[2], word[0], word[3], word[4], word[5]])
+
+
+def _parking_swap(tmp_path: Path) -> Path:
+    """Two robots in a one-lane corridor, each told to park where the other starts."""
+    data = {
+        "name": "swap",
+        "scene": {
+            "obstacles": [
+                [[-3000, -250], [3000, -250]],
+                [[3000, -250], [3000, 250]],
+                [[3000, 250], [-3000, 250]],
+                [[-3000, 250], [-3000, -250]],
+            ],
+            "robots": {"R1": {"size": 400, "pose": [-2500, 0, 0]}, "R2": {"size": 400, "pose": [2500, 0, 0]}},
+            "objects": {
+                "O1": {"size": 100, "position": [-2050, 0]},
+                "O2": {"size": 100, "position": [2950, 0]},
+            },
+            "workspaces": {"W1": {"point": [2550, 0]}, "W2": {"point": [-1950, 0]}},
+        },
+        "mission": {"tasks": {"R1": ["pick O1", "drop O1 at W1"], "R2": ["pick O2", "drop O2 at W2"]}},
+    }
+    path = tmp_path / "swap.yaml"
+    path.write_text(yaml.safe_dump(data))
+    return path
+
+
+def test_conflicts_no_order_resolves_exit_1_naming_robots_steps_and_place(tmp_path):
+    path = _parking_swap(tmp_path)
+    out = tmp_path / "plan.json"
+    result = runner.invoke(app, ["plan", str(path), "-o", str(out)], env={"COLUMNS": "250"})
+    assert result.exit_code == 1, result.output
+    plans = load_plan(out)
+    assert not plans.feasible
+    reason = plans.reason
+    assert "R1" in reason and "R2" in reason and "share the space" in reason
+    assert "instant" in reason and "x in [" in reason
+
+
+def test_a_replan_mid_run_is_ordered_again(corridor):
+    # R1, still at home, gets a new plan straight through the corridor to the east room and back;
+    # the rest of both plans is ordered again, with new messages, never deadlocking
+    scenario, result = corridor
+    plans = result.plans.robots
+    scene = scenario.scene
+    start = {r: Remaining(tuple(p.steps), tuple(p.mission), _initial(scenario, r)) for r, p in plans.items()}
+    conflict_names = {m.event for m in result.plans.messages if m.kind == "conflict"}
+    used = {n for p in plans.values() for n in p.mission if n.startswith("msg(")}
+    outcome = recoordinate(
+        scene,
+        start,
+        sent=(),
+        conflict_messages=conflict_names,
+        used=used,
+        positions={o: tuple(spec.position) for o, spec in scene.objects.items()},
+    )
+    assert outcome.accepted and outcome.messages
+    assert set(outcome.dropped) == conflict_names
+    assert {m.event for m in outcome.messages}.isdisjoint(conflict_names)  # fresh names
+    links = message_links(outcome.plans)
+    precedence = Precedence({r: p.horizon for r, p in outcome.plans.items()}, links)
+    assert precedence.complete
+    items, _ = occupancies(scene, outcome.plans, precedence)
+    assert all(is_ordered(c, precedence) for c in conflicts(items))
+
+
+def _initial(scenario, robot):
+    from cosmop.planning.plan import initial_state
+
+    return initial_state(scenario.scene, robot)
+
+
+def test_user_written_messages_order_a_tasks_mission():
+    data = yaml.safe_load((EXAMPLES / "08_ordered" / "scenario.yaml").read_text())
+    data["mission"] = {
+        "tasks": {
+            "R1": ["pick O1", "drop O1 at W1", "msg(R1,R2,stocked)", "return"],
+            "R2": ["msg(R1,R2,stocked)", "pick O2", "drop O2 at W2", "return"],
+        }
+    }
+    result = plan_team(parse_scenario(data))
+    assert result.plans.feasible and result.report.ok
+    kinds = {m.event: m.kind for m in result.plans.messages}
+    assert kinds["msg(R1,R2,stocked)"] == "mission"
+    run = simulate(parse_scenario(data), result.plans)
+    when = {event: t for t, _, event in run.events}
+    assert run.completed and when["pick(R2,O2)"] >= when["drop(R1,O1,W1)"]
