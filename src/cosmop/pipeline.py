@@ -379,43 +379,58 @@ def _coordinate_requests(
         results.update(planner.run(changed))
 
 
-def _bad_requests(coordinated: Coordinated) -> dict[str, dict[str, str]]:
-    """Requests to forbid, by robot and object, with why: nobody can answer, or they close a wait cycle."""
-    out: dict[str, dict[str, str]] = {}
+def _bad_requests(coordinated: Coordinated) -> list[dict[str, dict[str, str]]]:
+    """Ways out of bad requests, to try in order: ``{robot: {object: why}}`` to forbid.
+
+    Requests nobody can answer are all forbidden at once.  Of the requests that close a wait
+    cycle, forbidding one robot's may break the cycle for everyone: one option per waiting robot.
+    """
+    unanswered: dict[str, dict[str, str]] = {}
     for obj, requester in coordinated.unanswered:
-        out.setdefault(requester, {})[obj] = f"no robot's mission picks {obj}"
-    if not coordinated.deadlock_free:
-        words = {r: [e.name for e in seq] for r, seq in coordinated.sequences.items()}
-        for line in blocking_word(words) or ():
-            if line.startswith("[") and " waits for away(" in line:
-                robot, _, event = line[1:-1].partition(" waits for ")
-                obj = event[5:].split(",")[0]
-                out.setdefault(robot, {})[obj] = f"waiting for {obj} deadlocks the team ({event})"
-    return out
+        unanswered.setdefault(requester, {})[obj] = f"no robot's mission picks {obj}"
+    if unanswered or coordinated.deadlock_free:
+        return [unanswered] if unanswered else []
+    words = {r: [e.name for e in seq] for r, seq in coordinated.sequences.items()}
+    options = []
+    for line in blocking_word(words) or ():
+        if line.startswith("[") and " waits for away(" in line:
+            robot, _, event = line[1:-1].partition(" waits for ")
+            obj = event[5:].split(",")[0]
+            options.append({robot: {obj: f"waiting for {obj} deadlocks the team ({event})"}})
+    return options
 
 
 def _forbid(
-    forbid: Mapping[str, Mapping[str, str]],
+    options: list[dict[str, dict[str, str]]],
     base: dict[str, tuple[Event, ...]],
     results: dict[str, Synthesis],
     planner: _Planner,
     reasons: list[str],
     replans: list[str],
 ) -> bool:
-    """Re-plan each robot without the requests in `forbid`; False (with reasons) if one cannot."""
-    for robot, why in forbid.items():
-        planner.forbidden[robot] = planner.forbidden.get(robot, frozenset()) | frozenset(why)
-        replans.append(
-            f"{robot} re-planned without requesting {', '.join(sorted(why))}: {'; '.join(why.values())}"
-        )
-    fresh = planner.run({r: base[r] for r in forbid})
-    results.update(fresh)
-    for robot, res in fresh.items():
-        if not res.feasible:
+    """Re-plan robots without the requests of the first option that leaves them a plan; False
+    (with the reasons of every option) if none does."""
+    why_not: list[str] = []
+    for forbid in options:
+        saved = dict(planner.forbidden)
+        for robot, why in forbid.items():
+            planner.forbidden[robot] = planner.forbidden.get(robot, frozenset()) | frozenset(why)
+        fresh = planner.run({r: base[r] for r in forbid})
+        failed = [(r, res) for r, res in fresh.items() if not res.feasible]
+        if not failed:
+            results.update(fresh)
+            for robot, why in forbid.items():
+                asked = ", ".join(sorted(why))
+                replans.append(f"{robot} re-planned without requesting {asked}: {'; '.join(why.values())}")
+            return True
+        planner.forbidden = saved
+        for robot, res in failed:
             for obj, why in sorted(forbid[robot].items()):
-                reasons.append(f"{robot} needs {obj} moved away, but {why}")
-            reasons.append(f"without that request: {res.reason}")
-    return not reasons
+                why_not.append(
+                    f"{robot} needs {obj} moved away, but {why}; without that request: {res.reason}"
+                )
+    reasons.extend(why_not or ["the requests cannot be answered"])
+    return False
 
 
 def _make_safe(
@@ -436,6 +451,10 @@ def _make_safe(
     """
     settings = settings or ConflictSettings()
     for n in range(max_rounds + 1):
+        if reasons:
+            return make_team_safe(
+                scenario.scene, {r: res.plan for r, res in results.items()}, settings=settings
+            )
         plans = {r: res.plan for r, res in results.items()}
         used = {name for p in plans.values() for name in p.mission if name.startswith("msg(")}
         t0 = time.perf_counter()
@@ -470,7 +489,7 @@ def _make_safe(
 
 
 def _walls_around(region, settings: ConflictSettings) -> tuple[Wall, ...]:
-    """Wall segments around `region` grown by half the clearance (for a robot to keep out)."""
+    """Wall segments around `region`, grown by half the clearance (for a robot to keep out)."""
     grown = region.buffer(settings.clearance / 2.0, join_style="mitre")
     ring = list(shapely.get_coordinates(grown.exterior))
     return tuple(

@@ -220,7 +220,7 @@ def dwa_commands(
         along_x = np.abs(delta[:, 0]) >= np.abs(delta[:, 1])
         away = np.where(along_x[:, None], [[1.0, 0.0]], [[0.0, 1.0]]) * np.sign(delta).clip(-1, 1)
         away[np.all(away == 0, axis=1)] = [1.0, 0.0]
-        retreat = xy[rows] + away * (settings.standoff * 2)
+        retreat = _open_retreat(xy[rows], half[rows], away, delta, walls, settings.standoff * 2)
         target = target.copy()
         target[rows[close]] = retreat[close]
         low, high, V, W = _window(pose, v, limits, target, np.full(R, np.inf), settings)
@@ -327,6 +327,28 @@ def dwa_commands(
     w_out = np.where(np.isfinite(score[rows_all, best]), W[rows_all, best], w_out)
     v_out = np.where(np.isfinite(score[rows_all, best]), v_out, low)
     return DwaCommand(v=v_out, w=w_out, safe=safe, gap=min_gap)
+
+
+def _open_retreat(xy, half, away, delta, walls, reach: float) -> np.ndarray:
+    """Where to step back from the nearest box: `reach` along `away` unless a wall is in the way,
+    then along the other axis (the side farther from the box first), else staying put."""
+    other = np.where(away[:, :1] != 0, [[0.0, 1.0]], [[1.0, 0.0]])
+    side = np.sign((delta * other).sum(axis=1, keepdims=True))
+    side[side == 0] = 1.0
+    options = [away, other * side, -other * side]
+    out = xy.copy()
+    chosen = np.zeros(len(xy), dtype=bool)
+    for direction in options:
+        point = xy + direction * reach
+        free = (
+            np.ones(len(xy), dtype=bool)
+            if not len(walls)
+            else (point_segment_linf(point, walls).min(axis=1) - half) >= 0.0
+        )
+        take = free & ~chosen
+        out[take] = point[take]
+        chosen |= take
+    return out
 
 
 def _window(

@@ -22,7 +22,7 @@ import numpy as np
 import shapely
 from shapely.geometry import MultiPoint, Polygon
 
-__all__ = ["GlobalPath", "plan_path"]
+__all__ = ["GlobalPath", "plan_path", "straight_path"]
 
 Point = tuple[float, float]
 
@@ -175,6 +175,28 @@ def plan_path(
     index = {(int(a), int(b)): k for k, (a, b) in enumerate(zip(i, j, strict=True))}
     least = min((float(clearance[index[e]]) for e in used), default=float("inf"))
     return GlobalPath(tuple((float(x), float(y)) for x, y in nodes[route]), min(least, margin))
+
+
+def straight_path(
+    start: Point, goal: Point, half: float, walls: np.ndarray, boxes: np.ndarray
+) -> GlobalPath | None:
+    """The straight segment from `start` to `goal` when the robot's square can follow it.
+
+    A plan's drive is a straight segment proved free of walls and resting objects (touching
+    allowed); the executor follows it as it is -- a shortest path among the grown obstacles
+    would hug their corners, and in a passage one robot wide that puts the robot against a
+    corner it cannot leave.  ``None`` when something now stands on the segment (a parked robot,
+    a person), for :func:`plan_path` to find a way around.
+    """
+    grown = shapely.unary_union(_grown(walls, boxes, half))
+    if not grown.is_empty:
+        line = shapely.linestrings([start, goal])
+        if shapely.intersects(_interior(grown), line):
+            return None
+        clearance = float(shapely.distance(grown.boundary, line))
+    else:
+        clearance = float("inf")
+    return GlobalPath((tuple(map(float, start)), tuple(map(float, goal))), clearance)
 
 
 def _interior(geometry):

@@ -92,6 +92,9 @@ class Occupancy:
         Whether re-planning can move it: a drive can take another route and goods can be put
         down elsewhere, but a robot's start, the pose it picks from and its home cannot move,
         nor where goods start.
+    body : shapely geometry, optional
+        The region without the clearance robots keep from each other (a robot may pass goods
+        as close as its plan allows); by default `region`.
     """
 
     what: str
@@ -101,6 +104,7 @@ class Occupancy:
     last: Node | None
     label: str
     movable: bool = True
+    body: BaseGeometry | None = field(default=None, repr=False)
 
 
 @dataclass(frozen=True)
@@ -144,7 +148,7 @@ def _swept(p: Sequence[float], q: Sequence[float], side: float) -> BaseGeometry:
 
 
 def _robot_occupancies(
-    robot: str, plan: RobotPlan, start: State, side: float, home: Sequence[float]
+    robot: str, plan: RobotPlan, start: State, side: float, home: Sequence[float], grow: float = 0.0
 ) -> list[Occupancy]:
     """Where `robot` stands (merged over steps that keep its pose) and what its GoTo steps sweep."""
     K = plan.horizon
@@ -174,6 +178,7 @@ def _robot_occupancies(
                 last,
                 f"{robot} standing at {_point((x, y))} {where}",
                 not fixed,
+                _square(x, y, side - grow),
             )
         )
         k = end + 1
@@ -188,6 +193,8 @@ def _robot_occupancies(
                     (robot, k),
                     (robot, k),
                     f"{robot}'s GoTo at instant {k} from {_point(p[:2])} to {_point(q[:2])}",
+                    True,
+                    _swept(p, q, side - grow),
                 )
             )
     return out
@@ -274,7 +281,7 @@ def occupancies(
     for robot, plan in plans.items():
         start = (starts or {}).get(robot) or initial_state(scene, robot)
         size, home = scene.robots[robot].size + grow, scene.robots[robot].pose
-        out += _robot_occupancies(robot, plan, start, size, home)
+        out += _robot_occupancies(robot, plan, start, size, home, grow)
     objects, problems = _object_occupancies(scene, plans, precedence, positions)
     return out + objects, problems
 
@@ -292,8 +299,10 @@ def conflicts(items: Sequence[Occupancy]) -> list[Conflict]:
         a, b = items[i], items[j]
         if a.parties & b.parties:
             continue
-        if shapely.intersection(a.region, b.region).area <= 1e-9:
-            continue  # they only touch
+        robots = a.what in a.parties and b.what in b.parties
+        ra, rb = (a.region, b.region) if robots else (a.body or a.region, b.body or b.region)
+        if shapely.intersection(ra, rb).area <= 1e-9:
+            continue  # they only touch (a robot keeps its clearance from robots, not from goods)
         out.append(Conflict(a, b))
     return out
 
@@ -317,24 +326,102 @@ def order_conflicts(
     *,
     max_backtracks: int = 200,
     fixed: Mapping[str, Sequence[BaseGeometry]] | None = None,
+    rlimit: int = 200_000_000,
 ) -> tuple[list[tuple[tuple[Node, Node], Conflict]], list[Conflict]]:
     """Start edges that order every conflict in `found`, and the conflicts no order resolves.
 
-    A depth-first search over the two ways of ordering each conflict (:func:`_search`).  When
-    it finds no way to order them all, the conflict at its deepest dead end is set aside as
-    unresolved (to be removed by re-planning) and the search runs again on the others, so that
-    as few conflicts as possible are left for re-planning.
+    First a depth-first search over the two ways of ordering each conflict (:func:`_search`),
+    fast when the conflicts are few or loosely tied.  When it finds no way to order them all,
+    the question is settled exactly as a scheduling problem (:func:`_schedule`, Z3 over the
+    steps' start and end times): either a schedule orders every conflict, or an unsat core
+    names a small set of conflicts no order resolves together, of which the most re-plannable
+    is returned as unresolved -- and the others are ordered again without it.
 
     Returns the edges added (on top of `starts`), each with the conflict it orders, and the
     unresolved conflicts.
     """
+    chosen, culprit = _search(found, horizons, links, starts, durations, max_backtracks, fixed)
+    if culprit is None:
+        return chosen, []
     unresolved: list[Conflict] = []
     while True:
         left = [c for c in found if not any(c is u for u in unresolved)]
-        chosen, culprit = _search(left, horizons, links, starts, durations, max_backtracks, fixed)
-        if culprit is None:
-            return chosen, unresolved
-        unresolved.append(culprit)
+        chosen, core = _schedule(left, horizons, links, starts, durations, rlimit, optimize=False)
+        if core is None:
+            break
+        unresolved.append(min(core, key=lambda c: _replannable(c, fixed)))
+    # the search's choices keep the makespan low; the schedule stands in where the search fails
+    better, culprit = _search(left, horizons, links, starts, durations, max_backtracks, fixed)
+    return (chosen if culprit is not None else better), unresolved
+
+
+def _schedule(found, horizons, links, starts, durations, rlimit, optimize: bool = True):
+    """Order every conflict by a schedule, exactly; ``(edges, None)`` or ``([], core)``.
+
+    Each step *k* of robot *r* gets a start :math:`s_{rk}` and an end :math:`e_{rk}` (seconds):
+    :math:`s_{rk} \\ge e_{r,k-1}`, :math:`e_{rk} \\ge s_{rk} + \\max(d_{rk}, \\epsilon)`; a message
+    is received after it is sent, a start edge starts its step after its source ends; and every
+    conflict has one of its two ways, "x before y": :math:`s_{y} \\ge e_{x} + \\epsilon`.  The
+    :math:`\\epsilon` makes every cycle of the order infeasible, so a schedule orders the
+    conflicts without deadlock; its makespan is minimised within the solver's resource limit.
+    Without a schedule, the unsat core over the conflicts' disjunctions is returned.
+    """
+    import z3
+
+    eps = 1e-3
+    ctx = z3.Context()
+    opt = z3.Optimize(ctx=ctx) if optimize else z3.Solver(ctx=ctx)
+    opt.set("rlimit", rlimit)
+    start = {(r, k): z3.Real(f"s_{r}_{k}", ctx) for r, n in horizons.items() for k in range(1, n + 1)}
+    end = {(r, k): z3.Real(f"e_{r}_{k}", ctx) for r, n in horizons.items() for k in range(1, n + 1)}
+    span = z3.Real("makespan", ctx)
+    for (r, k), s_rk in start.items():
+        opt.add(s_rk >= (end[(r, k - 1)] if k > 1 else 0))
+        opt.add(end[(r, k)] >= s_rk + max(float(durations[r][k - 1]), eps))
+        if k == horizons[r]:
+            opt.add(span >= end[(r, k)])
+    for link in links:
+        if link.send is not None and link.wait is not None:
+            opt.add(end[(link.receiver, link.wait)] >= end[(link.sender, link.send)] + eps)
+    for source, target in starts:
+        if target in start and source in end:
+            opt.add(start[target] >= end[source] + eps)
+    labels = {}
+    for n, c in enumerate(found):
+        ways = [
+            start[y.first] >= end[x.last] + eps
+            for x, y in ((c.a, c.b), (c.b, c.a))
+            if x.last is not None and y.first is not None and y.first in start and x.last in end
+        ]
+        label = z3.Bool(f"c{n}", ctx)
+        labels[label] = c
+        opt.add(z3.Implies(label, z3.Or(ways, ctx) if ways else z3.BoolVal(False, ctx)))
+    if optimize:
+        opt.minimize(span)
+    verdict = opt.check(*labels)
+    if verdict == z3.unsat:
+        core = [labels[lit] for lit in opt.unsat_core()]
+        return [], core or list(found)
+    if verdict != z3.sat:
+        raise RuntimeError(f"the conflict schedule was not decided ({opt.reason_unknown()}); raise rlimit")
+    model = opt.model()
+    chosen = []
+    for c in found:
+        for x, y in ((c.a, c.b), (c.b, c.a)):
+            if x.last is None or y.first is None or y.first not in start or x.last not in end:
+                continue
+            if _holds(model, start[y.first], end[x.last], eps):
+                chosen.append(((x.last, y.first), c))
+                break
+    return chosen, None
+
+
+def _holds(model, later, earlier, eps) -> bool:
+    """Whether the model puts `later` at least `eps` after `earlier`."""
+    import z3
+
+    gap = model.eval(later - earlier, model_completion=True)
+    return z3.is_true(z3.simplify(gap >= eps - 1e-12))
 
 
 class _Sides:
@@ -391,6 +478,10 @@ def _search(found, horizons, links, starts, durations, max_backtracks, fixed):
     """
     precedence = Precedence(horizons, links, starts, durations)
     sides = _Sides(found, precedence)
+    # priorities: the robot expected to finish first goes first, so that it clears out early;
+    # one order for all robots keeps most choices consistent (no cycles among them)
+    alone = {r: sum(durations[r]) for r in horizons}
+    rank = {r: n for n, r in enumerate(sorted(horizons, key=lambda r: (alone[r], r)))}
     chosen: list[tuple[tuple[Node, Node], Conflict, list]] = []
     stack: list[tuple[int, list[tuple[Node, Node]], Conflict]] = []  # (depth, untried, conflict)
     backtracks, deepest, culprit = 0, -1, None
@@ -421,8 +512,8 @@ def _search(found, horizons, links, starts, durations, max_backtracks, fixed):
             pool = np.flatnonzero(open_)
         conflict = min((found[i] for i in pool), key=lambda c: _expected_start(c, precedence))
         options = _ways(conflict, precedence)
-        if len(options) > 1:  # the way that keeps the team's expected makespan lower first
-            options = sorted(options, key=lambda e: _makespan_with(precedence, e))
+        if len(options) > 1:  # the robot of higher priority first, then the lower makespan
+            options = sorted(options, key=lambda e: (rank[e[0][0]], _makespan_with(precedence, e)))
             stack.append((len(chosen), options[1:], conflict))
         chosen.append((options[0], conflict, precedence.add_start(options[0])))
 

@@ -48,7 +48,7 @@ import numpy as np
 
 from cosmop.control.dwa import DwaSettings, dwa_commands, robot_gaps
 from cosmop.control.geometry import box_gaps, point_segment_linf, segment_array
-from cosmop.control.paths import GlobalPath, plan_path
+from cosmop.control.paths import GlobalPath, plan_path, straight_path
 from cosmop.control.safety import is_safe, obstacle_speed, stopping_horizon, stopping_margin
 from cosmop.io import write_atomic
 from cosmop.missions.events import Event, parse_event
@@ -465,9 +465,12 @@ class _World:
         )
 
     def crowded(self, i: int) -> bool:
-        """Whether another robot is within the standoff of robot `i` (it stays parked then)."""
+        """Whether another robot that may still move is within the standoff of robot `i` (it
+        stays parked then).  A robot that has finished never moves again: it cannot hold the
+        promise against it, so it does not keep `i` parked."""
         gaps = box_gaps(self.pose[i, :2], self.half[i], np.column_stack([self.pose[:, :2], self.half]))
         gaps[i] = np.inf
+        gaps[[a.index for a in self.agents if a.done]] = np.inf
         return bool((gaps < self.settings.dwa.standoff).any())
 
     def box_velocity(self, names: list[str]) -> np.ndarray:
@@ -640,11 +643,36 @@ def _brake(world: _World, i: int) -> tuple[str, Any]:
 def _goto(world: _World, agent: _Agent, step: Step) -> tuple[str, Any] | None:
     final = agent.k + 1 >= len(agent.steps) or agent.steps[agent.k + 1].primitive != "GoTo"
     goal = step.robot
-    return _drive(world, agent, goal, final, heading=final)
+    origin = agent.steps[agent.k - 1].robot if agent.k > 0 else None
+    return _drive(world, agent, goal, final, heading=final, origin=origin)
+
+
+def _route(world: _World, i: int, goal: tuple, origin: tuple | None) -> GlobalPath:
+    """The global path to `goal`: the plan's own segment where the robot can follow it.
+
+    Straight from where the robot is; else back onto the plan's segment at its `origin` (an
+    intermediate waypoint passed within the tolerance leaves the robot beside it) and along it;
+    else around what now stands in the way (:func:`cosmop.control.paths.plan_path`).
+    """
+    xy = world.pose[i, :2]
+    here, boxes = (float(xy[0]), float(xy[1])), world.static_boxes(i, goal)
+    half, target = float(world.half[i]), (goal[0], goal[1])
+    path = straight_path(here, target, half, world.walls, boxes)
+    if path is None and origin is not None:
+        back = straight_path(here, (origin[0], origin[1]), half, world.walls, boxes)
+        on = straight_path((origin[0], origin[1]), target, half, world.walls, boxes)
+        if back is not None and on is not None:
+            path = GlobalPath((here, (origin[0], origin[1]), target), min(back.margin, on.margin))
+    return path or plan_path(here, target, half, world.walls, boxes) or GlobalPath((here, target), 0.0)
 
 
 def _drive(
-    world: _World, agent: _Agent, goal: tuple[float, float, float], final: bool, heading: bool
+    world: _World,
+    agent: _Agent,
+    goal: tuple[float, float, float],
+    final: bool,
+    heading: bool,
+    origin: tuple | None = None,
 ) -> tuple[str, Any] | None:
     """Drive towards `goal`; ``None`` once it is reached (and turned to, if `heading`)."""
     s = world.settings
@@ -652,13 +680,7 @@ def _drive(
     xy = world.pose[i, :2]
     fresh = agent.phase == "start" or agent.path is None
     if fresh:
-        agent.path = plan_path(
-            (float(xy[0]), float(xy[1])),
-            (goal[0], goal[1]),
-            float(world.half[i]),
-            world.walls,
-            world.static_boxes(i, goal),
-        ) or GlobalPath(((float(xy[0]), float(xy[1])), (goal[0], goal[1])), 0.0)
+        agent.path = _route(world, i, goal, origin)
         agent.phase = "drive"
         agent.room = float(world.static_gaps(goal[:2], world.half[i])[0])
         agent.best = math.inf
@@ -872,8 +894,9 @@ def _stalled(world: _World, agent: _Agent) -> None:
     world.replan_attempts += 1
     boxes, _, names = world.boxes()
     gaps = box_gaps(world.pose[i, :2], world.half[i], boxes)
+    # robots keep the clearance the team-safety layer checks; people a little room
     sensed = [
-        (float(b[0]), float(b[1]), float(b[2]) + 10.0)
+        (float(b[0]), float(b[1]), float(b[2]) + (s.dwa.standoff if n in world.rids else 10.0))
         for b, n, g in zip(boxes, names, gaps, strict=True)
         if n != agent.id and n not in world.oids and g < s.sense_range
     ]
