@@ -120,7 +120,7 @@ class Precedence:
         # one flat table per quantity (rows: robot by robot), with per-robot views into it, so
         # that many queries can be answered at once (:attr:`done_rows`, :attr:`begin_rows`)
         sizes = [self.horizons[r] + 2 for r in self.robots]
-        self.offsets = dict(zip(self.robots, np.cumsum([0, *sizes[:-1]]).tolist(), strict=True))
+        self.offsets = dict(zip(self.robots, np.cumsum([0, *sizes]).tolist()[:-1], strict=True))
         self.done_flat = np.zeros((sum(sizes), n), dtype=np.int64)
         self.begin_flat = np.zeros((sum(sizes), n), dtype=np.int64)
         self.finish_flat = np.zeros(sum(sizes))

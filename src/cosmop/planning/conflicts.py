@@ -29,6 +29,7 @@ would deadlock.  Conflicts that no order can resolve are returned for re-plannin
 from __future__ import annotations
 
 import itertools
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
@@ -67,7 +68,7 @@ class ConflictSettings:
     """
 
     clearance: float = 100.0
-    segment: float = 1500.0
+    segment: float = math.inf
 
 
 @dataclass(frozen=True)
@@ -343,77 +344,84 @@ def order_conflicts(
     chosen, culprit = _search(found, horizons, links, starts, durations, max_backtracks, fixed)
     if culprit is None:
         return chosen, []
+    schedule = _Schedule(found, horizons, links, starts, durations, rlimit)
     unresolved: list[Conflict] = []
     while True:
-        left = [c for c in found if not any(c is u for u in unresolved)]
-        chosen, core = _schedule(left, horizons, links, starts, durations, rlimit, optimize=False)
+        chosen, core = schedule.solve([c for c in found if not any(c is u for u in unresolved)])
         if core is None:
             break
         unresolved.append(min(core, key=lambda c: _replannable(c, fixed)))
     # the search's choices keep the makespan low; the schedule stands in where the search fails
+    left = [c for c in found if not any(c is u for u in unresolved)]
     better, culprit = _search(left, horizons, links, starts, durations, max_backtracks, fixed)
     return (chosen if culprit is not None else better), unresolved
 
 
-def _schedule(found, horizons, links, starts, durations, rlimit, optimize: bool = True):
-    """Order every conflict by a schedule, exactly; ``(edges, None)`` or ``([], core)``.
+class _Schedule:
+    """The conflicts as one scheduling problem in Z3, asked again with fewer conflicts each time.
 
     Each step *k* of robot *r* gets a start :math:`s_{rk}` and an end :math:`e_{rk}` (seconds):
     :math:`s_{rk} \\ge e_{r,k-1}`, :math:`e_{rk} \\ge s_{rk} + \\max(d_{rk}, \\epsilon)`; a message
     is received after it is sent, a start edge starts its step after its source ends; and every
-    conflict has one of its two ways, "x before y": :math:`s_{y} \\ge e_{x} + \\epsilon`.  The
-    :math:`\\epsilon` makes every cycle of the order infeasible, so a schedule orders the
-    conflicts without deadlock; its makespan is minimised within the solver's resource limit.
-    Without a schedule, the unsat core over the conflicts' disjunctions is returned.
+    conflict, under its own assumption literal, has one of its two ways, "x before y":
+    :math:`s_{y} \\ge e_{x} + \\epsilon`.  The :math:`\\epsilon` makes every cycle of the order
+    infeasible, so a schedule orders the conflicts without deadlock.  Without a schedule, the
+    unsat core over the assumed conflicts names a small set no order resolves together.
     """
-    import z3
 
-    eps = 1e-3
-    ctx = z3.Context()
-    opt = z3.Optimize(ctx=ctx) if optimize else z3.Solver(ctx=ctx)
-    opt.set("rlimit", rlimit)
-    start = {(r, k): z3.Real(f"s_{r}_{k}", ctx) for r, n in horizons.items() for k in range(1, n + 1)}
-    end = {(r, k): z3.Real(f"e_{r}_{k}", ctx) for r, n in horizons.items() for k in range(1, n + 1)}
-    span = z3.Real("makespan", ctx)
-    for (r, k), s_rk in start.items():
-        opt.add(s_rk >= (end[(r, k - 1)] if k > 1 else 0))
-        opt.add(end[(r, k)] >= s_rk + max(float(durations[r][k - 1]), eps))
-        if k == horizons[r]:
-            opt.add(span >= end[(r, k)])
-    for link in links:
-        if link.send is not None and link.wait is not None:
-            opt.add(end[(link.receiver, link.wait)] >= end[(link.sender, link.send)] + eps)
-    for source, target in starts:
-        if target in start and source in end:
-            opt.add(start[target] >= end[source] + eps)
-    labels = {}
-    for n, c in enumerate(found):
-        ways = [
-            start[y.first] >= end[x.last] + eps
-            for x, y in ((c.a, c.b), (c.b, c.a))
-            if x.last is not None and y.first is not None and y.first in start and x.last in end
-        ]
-        label = z3.Bool(f"c{n}", ctx)
-        labels[label] = c
-        opt.add(z3.Implies(label, z3.Or(ways, ctx) if ways else z3.BoolVal(False, ctx)))
-    if optimize:
-        opt.minimize(span)
-    verdict = opt.check(*labels)
-    if verdict == z3.unsat:
-        core = [labels[lit] for lit in opt.unsat_core()]
-        return [], core or list(found)
-    if verdict != z3.sat:
-        raise RuntimeError(f"the conflict schedule was not decided ({opt.reason_unknown()}); raise rlimit")
-    model = opt.model()
-    chosen = []
-    for c in found:
-        for x, y in ((c.a, c.b), (c.b, c.a)):
-            if x.last is None or y.first is None or y.first not in start or x.last not in end:
-                continue
-            if _holds(model, start[y.first], end[x.last], eps):
-                chosen.append(((x.last, y.first), c))
-                break
-    return chosen, None
+    def __init__(self, found, horizons, links, starts, durations, rlimit: int) -> None:
+        import z3
+
+        eps = 1e-3
+        self.ctx = ctx = z3.Context()
+        self.solver = z3.Solver(ctx=ctx)
+        self.solver.set("rlimit", rlimit)
+        self.start = {
+            (r, k): z3.Real(f"s_{r}_{k}", ctx) for r, n in horizons.items() for k in range(1, n + 1)
+        }
+        self.end = {(r, k): z3.Real(f"e_{r}_{k}", ctx) for r, n in horizons.items() for k in range(1, n + 1)}
+        add = self.solver.add
+        for (r, k), s_rk in self.start.items():
+            add(s_rk >= (self.end[(r, k - 1)] if k > 1 else 0))
+            add(self.end[(r, k)] >= s_rk + max(float(durations[r][k - 1]), eps))
+        for link in links:
+            if link.send is not None and link.wait is not None:
+                add(self.end[(link.receiver, link.wait)] >= self.end[(link.sender, link.send)] + eps)
+        for source, target in starts:
+            if target in self.start and source in self.end:
+                add(self.start[target] >= self.end[source] + eps)
+        self.label: dict[int, object] = {}
+        self.ways: dict[int, list] = {}
+        for n, c in enumerate(found):
+            ways = [
+                (x.last, y.first)
+                for x, y in ((c.a, c.b), (c.b, c.a))
+                if x.last is not None and y.first is not None and y.first in self.start and x.last in self.end
+            ]
+            label = z3.Bool(f"c{n}", ctx)
+            terms = [self.start[b] >= self.end[a] + eps for a, b in ways]
+            add(z3.Implies(label, z3.Or(terms) if terms else z3.BoolVal(False, ctx)))
+            self.label[id(c)], self.ways[id(c)] = label, ways
+
+    def solve(self, conflicts: Sequence[Conflict]):
+        """``(edges, None)`` ordering `conflicts`, or ``([], core)``."""
+        import z3
+
+        by_label = {self.label[id(c)]: c for c in conflicts}
+        verdict = self.solver.check(*by_label)
+        if verdict == z3.unsat:
+            core = [by_label[lit] for lit in self.solver.unsat_core()]
+            return [], core or list(conflicts)
+        if verdict != z3.sat:
+            raise RuntimeError(f"the conflict schedule was not decided ({self.solver.reason_unknown()})")
+        model = self.solver.model()
+        chosen = []
+        for c in conflicts:
+            for a, b in self.ways[id(c)]:
+                if _holds(model, self.start[b], self.end[a], 1e-3):
+                    chosen.append(((a, b), c))
+                    break
+        return chosen, None
 
 
 def _holds(model, later, earlier, eps) -> bool:
