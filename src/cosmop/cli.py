@@ -466,7 +466,7 @@ def _summary_table(scenario: Scenario) -> Table:
     def row(part: str, count: int, details: str) -> None:
         table.add_row(part, str(count), Text(details))  # Text: ids are data, never markup
 
-    row("robots", len(scene.robots), ", ".join(f"{r.id} (size {r.size:g})" for r in scene.robots.values()))
+    row("robots", len(scene.robots), ", ".join(f"{r.id} (size {r.size:g} mm)" for r in scene.robots.values()))
     row("objects", len(scene.objects), ", ".join(scene.objects) or "-")
     row(
         "workspaces",
