@@ -497,3 +497,7 @@ def _summary_table(scenario: Scenario) -> Table:
 def main() -> None:
     """Run the command line (``python -m cosmop``), with the program name ``cosmop``."""
     app(prog_name="cosmop")
+
+
+# The ecosystem commands (import-map, export, view) live in their own module and register on `app`.
+from cosmop import cli_ecosystem as _cli_ecosystem  # noqa: E402, F401

@@ -1,0 +1,112 @@
+"""``cosmop`` commands that connect cosmop to the robotics ecosystem: grid maps, ROS 2 bags, a web viewer.
+
+They register on :data:`cosmop.cli.app` (imported at the end of :mod:`cosmop.cli`) and follow its
+rules: thin functions, input errors reported by the command group as one line with exit status 2.
+"""
+
+from __future__ import annotations
+
+from enum import StrEnum
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.text import Text
+
+from cosmop.cli import _stdout, app
+from cosmop.io import write_atomic
+
+__all__: list[str] = []
+
+
+class _Unknown(StrEnum):
+    blocked = "blocked"
+    free = "free"
+
+
+class _Walls(StrEnum):
+    boundary = "boundary"
+    rectangles = "rectangles"
+
+
+class _Units(StrEnum):
+    mm = "mm"
+    m = "m"
+
+
+@app.command("import-map")
+def import_map(
+    map_file: Annotated[
+        Path,
+        typer.Argument(
+            metavar="MAP", help="A MovingAI .map file or a ROS map_server .yaml file.", show_default=False
+        ),
+    ],
+    output: Annotated[
+        Path, typer.Option("-o", "--output", help="Scenario YAML to write.", show_default=False)
+    ],
+    cell_size: Annotated[
+        float | None,
+        typer.Option(help="Side of a cell in mm [default: 1000 for .map, the YAML's resolution]", min=1e-9),
+    ] = None,
+    origin: Annotated[
+        tuple[float, float] | None,
+        typer.Option(help="The map's lower-left corner X Y in mm [default: 0 0, or the ROS origin]"),
+    ] = None,
+    unknown: Annotated[_Unknown, typer.Option(help="ROS maps: what unknown cells are.")] = _Unknown.blocked,
+    walls: Annotated[
+        _Walls,
+        typer.Option(help="boundary: only edges between free and blocked cells; rectangles: every outline."),
+    ] = _Walls.boundary,
+    units: Annotated[
+        _Units | None, typer.Option(help="Units to write: mm (and degrees) or m (and radians).")
+    ] = None,
+    template: Annotated[
+        Path | None,
+        typer.Option(
+            help="A scenario whose robots, objects, workspaces and mission to keep (its walls are replaced).",
+            show_default=False,
+        ),
+    ] = None,
+    name: Annotated[str | None, typer.Option(help="The scenario's name.", show_default=False)] = None,
+) -> None:
+    """Turn a grid map into scenario walls: blocked cells merged into rectangles and walled in.
+
+    Without --template it writes the scene's walls only (add robots, objects, workspaces and a
+    mission); with one, a whole scenario, which is validated before it is written. Exit status
+    0 written, 2 bad input (nothing written).
+    """
+    from cosmop.maps import import_map as read_map
+    from cosmop.maps import scenario_text
+    from cosmop.scenario import load_scenario
+
+    imported = read_map(
+        map_file,
+        cell_size=cell_size,
+        origin=origin,
+        unknown=unknown.value,
+        walls=walls.value,
+    )
+    text = scenario_text(imported, name=name, units=None if units is None else units.value, template=template)
+    if template is not None:  # a whole scenario: it must load before it is written
+        import tempfile
+
+        with tempfile.TemporaryDirectory() as tmp:
+            check = Path(tmp) / output.name
+            check.write_text(text, encoding="utf-8")
+            try:
+                load_scenario(check)
+            except Exception as err:  # report it against the file the user will get
+                typer.echo(f"error: {output} (from {template}): {getattr(err, 'expected', err)}", err=True)
+                raise typer.Exit(2) from None
+    write_atomic(output, text)
+    grid = imported.grid
+    rows, cols = grid.shape
+    _stdout().print(
+        Text(
+            f"wrote {output}: {cols} x {rows} cells of {grid.cell_size:g} mm, {int(grid.blocked.sum())} "
+            f"blocked cells in {len(imported.rectangles)} rectangles, {len(imported.walls)} walls "
+            f"({imported.outline_walls} as rectangle outlines)",
+            style="green",
+        )
+    )
