@@ -351,6 +351,10 @@ def simulate(
     ] = None,
     gif: Annotated[Path | None, typer.Option(help="Write an animation (GIF).", show_default=False)] = None,
     mp4: Annotated[Path | None, typer.Option(help="Write an animation (MP4).", show_default=False)] = None,
+    bag: Annotated[
+        Path | None,
+        typer.Option(help="Write a ROS 2 bag DIRECTORY (MCAP; the ros extra).", show_default=False),
+    ] = None,
     max_time: Annotated[float, typer.Option(help="Simulated seconds before giving up.", min=1.0)] = 900.0,
     replan: Annotated[bool, typer.Option(help="Stalled robots replan their remaining mission.")] = True,
 ) -> None:
@@ -377,6 +381,8 @@ def simulate(
             extra = "video" if check_video else "viz"
             typer.echo(f"error: --{path.suffix[1:]} needs pip install 'cosmop[{extra}]'", err=True)
             raise typer.Exit(EXIT_INPUT_ERROR)
+    if bag is not None:
+        _cli_ecosystem.check_bag_target(bag)  # before any work
     err = Console(file=sys.stderr, highlight=False)
     if plan_file is not None:
         plans: PlanSet = load_plan(plan_file)
@@ -417,6 +423,8 @@ def simulate(
         result.save_summary(summary)
     if trace is not None:
         result.save_trace(trace)
+    if bag is not None:
+        _cli_ecosystem.write_bag_and_report(loaded.scene, result.trace(), bag, plans, None, 5.0)
     for path in (gif, mp4):
         if path is not None:
             from cosmop.viz import save_animation
@@ -500,4 +508,4 @@ def main() -> None:
 
 
 # The ecosystem commands (import-map, export, view) live in their own module and register on `app`.
-from cosmop import cli_ecosystem as _cli_ecosystem  # noqa: E402, F401
+from cosmop import cli_ecosystem as _cli_ecosystem  # noqa: E402
