@@ -189,3 +189,38 @@ def export(
     plans = load_plan(plan_file) if plan_file is not None else None
     check_bag_target(bag)
     write_bag_and_report(loaded.scene, data, bag, plans, rate, scene_rate)
+
+
+@app.command()
+def view(
+    scenario: Annotated[
+        Path, typer.Argument(metavar="SCENARIO", help="Scenario file (YAML).", show_default=False)
+    ],
+    output: Annotated[Path, typer.Option("-o", "--output", help="HTML file to write.", show_default=False)],
+    plan_file: Annotated[
+        Path | None, typer.Option("--plan", help="Plan file (cosmop.plan/1) to draw.", show_default=False)
+    ] = None,
+    trace: Annotated[
+        Path | None,
+        typer.Option(help="A run (cosmop.trace/1) to play with a time slider.", show_default=False),
+    ] = None,
+) -> None:
+    """Write one self-contained web page of the scene, the plans and the run (no network needed).
+
+    Open it in any browser: a time slider and a play button move the robots (labelled, with
+    what they carry) and draw each message as an arrow with its time. Exit status 0 written,
+    2 bad input (nothing written).
+    """
+    from cosmop.cli import _load
+    from cosmop.planning.plan import load_plan
+    from cosmop.traces import load_trace
+    from cosmop.viz.web import save_html
+
+    loaded = _load(scenario)
+    plans = load_plan(plan_file) if plan_file is not None else None
+    data = load_trace(trace) if trace is not None else None
+    size = save_html(loaded.scene, output, plans=plans, trace=data, title=loaded.name)
+    frames = len(data["frames"]) if data is not None else 0
+    _stdout().print(
+        Text(f"wrote {output} ({size / 1e6:.2f} MB, {frames} frames); open it in a browser", style="green")
+    )
