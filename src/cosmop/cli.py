@@ -351,6 +351,15 @@ def simulate(
     ] = None,
     gif: Annotated[Path | None, typer.Option(help="Write an animation (GIF).", show_default=False)] = None,
     mp4: Annotated[Path | None, typer.Option(help="Write an animation (MP4).", show_default=False)] = None,
+    speed: Annotated[
+        float | None,
+        typer.Option(
+            help="Animation: simulated seconds per second [default: the run lasts at most 45 s]", min=1e-3
+        ),
+    ] = None,
+    size: Annotated[
+        int | None, typer.Option(help="Animation width in pixels [default: about 790]", min=100)
+    ] = None,
     bag: Annotated[
         Path | None,
         typer.Option(help="Write a ROS 2 bag DIRECTORY (MCAP; the ros extra).", show_default=False),
@@ -433,7 +442,7 @@ def simulate(
                 TextColumn(f"drawing {path.name}"), TimeElapsedColumn(), console=err, transient=True
             ) as p:
                 p.add_task("drawing", total=None)
-                save_animation(loaded.scene, result.trace(), path, plans=plans)
+                save_animation(loaded.scene, result.trace(), path, plans=plans, speed=speed, size=size)
     console = _stdout()
     table = Table(title=Text(f"simulation of {loaded.name} (seed {seed})"), header_style="bold")
     for column in ("robot", "pose [mm, deg]", "distance", "finished"):

@@ -19,7 +19,7 @@ from cosmop.errors import CosmopInputError
 from cosmop.io import read_text
 from cosmop.units import check_units_field
 
-__all__ = ["TRACE_FORMAT", "TraceError", "check_trace", "load_trace"]
+__all__ = ["TRACE_FORMAT", "TraceError", "check_trace", "load_trace", "message_label"]
 
 TRACE_FORMAT = "cosmop.trace/1"
 """The ``format`` of the traces this module reads."""
@@ -97,3 +97,11 @@ def load_trace(path: str | os.PathLike[str]) -> dict[str, Any]:
     except json.JSONDecodeError as err:
         raise TraceError(f"invalid JSON: {err.msg}", file=file, line=err.lineno, column=err.colno) from None
     return check_trace(data, file)
+
+
+def message_label(message: Mapping[str, Any]) -> str:
+    """A short text for a message of any kind: its object, else its event, kind or type, else "message"."""
+    for key in ("object", "event", "kind", "type"):
+        if isinstance(message.get(key), str):
+            return message[key]
+    return "message"

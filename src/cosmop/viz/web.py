@@ -19,6 +19,7 @@ from typing import Any
 from cosmop.io import write_atomic
 from cosmop.planning.plan import PlanSet
 from cosmop.scenario import Scene
+from cosmop.traces import message_label
 from cosmop.viz.palette import robot_colours, to_hex
 
 __all__ = ["MESSAGE_SHOWN_S", "render_html", "save_html"]
@@ -106,14 +107,6 @@ def _trace(trace: Mapping[str, Any], object_ids: list[str], max_frames: int) -> 
     return {"t": [round(float(f["t"]), 3) for f in picked], "robots": robots, **points}
 
 
-def _message_label(message: Mapping[str, Any]) -> str:
-    """A short text for a message of any kind: its object or event, else its kind, else 'message'."""
-    for key in ("object", "event", "kind", "type"):
-        if isinstance(message.get(key), str):
-            return message[key]
-    return "message"
-
-
 def render_html(
     scene: Scene,
     *,
@@ -174,7 +167,7 @@ def render_html(
         "trace": _trace(trace, object_ids, max_frames) if trace is not None else None,
         "messages": sorted(
             (
-                {"t": float(m["t"]), "from": m["from"], "to": m["to"], "label": _message_label(m)}
+                {"t": float(m["t"]), "from": m["from"], "to": m["to"], "label": message_label(m)}
                 for m in (trace or {}).get("messages") or []
             ),
             key=lambda m: m["t"],
