@@ -34,7 +34,7 @@ def ordered_scenario(tmp_path: Path) -> Path:
 
 
 def test_table_output_for_the_paper_example():
-    result = runner.invoke(app, ["decompose", str(DFA_FILE)])
+    result = runner.invoke(app, ["decompose", str(DFA_FILE), "--verbose"])
     assert result.exit_code == 0, result.output
     out = result.stdout
     assert "pick(R1,O1) -> drop(R1,O1,W1) -> return(R1)" in out

@@ -26,6 +26,7 @@ from typer.core import TyperGroup
 
 from cosmop import __version__
 from cosmop.automata import DFA
+from cosmop.cli_words import decompose_verdict, plan_verdict
 from cosmop.errors import CosmopInputError, EventSyntaxError
 from cosmop.io import write_atomic
 from cosmop.missions.decomposition import decompose as run_decompose
@@ -138,6 +139,9 @@ def decompose(
             help="Also write each local mission as Graphviz DOT into this DIRECTORY.", show_default=False
         ),
     ] = None,
+    verbose: Annotated[
+        bool, typer.Option("--verbose", "-v", help="Also print the verification's statistics.")
+    ] = False,
 ) -> None:
     """Decompose the global mission into local missions and verify them (paper, Section III).
 
@@ -156,12 +160,17 @@ def decompose(
         dot.mkdir(parents=True, exist_ok=True)
         for robot, dfa in result.local_missions.items():
             write_atomic(dot / f"{robot}.dot", dfa.to_dot(f"K_{robot}"))
+        names = ", ".join(f"{robot}.dot" for robot in result.local_missions)
+        if as_json:  # stdout is the JSON alone
+            typer.echo(f"wrote the local missions as Graphviz DOT to {dot}/: {names}", err=True)
     ok = result.separable and verification.holds
     if as_json:
         data = result.to_dict() | {"verification": verification.to_dict()}
         typer.echo(json.dumps(data, indent=2))
         raise typer.Exit(0 if ok else 1)
     console = _stdout()
+    verdict, good = decompose_verdict(result, verification)
+    console.print(Text(verdict, style="green" if good else "red"))
     table = Table(title=Text(f"local missions of {loaded.name}"), header_style="bold")
     for column in ("robot", "events", "states", "local mission K_i = P_i(K)"):
         table.add_column(column)
@@ -169,12 +178,10 @@ def decompose(
         table.add_row(robot, str(len(result.alphabets[robot])), str(dfa.n_states), Text(_sequence_text(dfa)))
     console.print(table)
     stats = result.stats
-    console.print(
-        Text(
-            f"separable: {'yes' if result.separable else 'no'}"
-            f"   (largest automaton {stats.largest_automaton} states, {stats.total_s:.3f} s)"
-        )
+    details = (
+        f"   (largest automaton {stats.largest_automaton} states, {stats.total_s:.3f} s)" if verbose else ""
     )
+    console.print(Text(f"formally: separable: {'yes' if result.separable else 'no'} (||_i K_i = K){details}"))
     if result.counterexample is not None:
         console.print(Text(f"counterexample: {' '.join(result.counterexample)}", style="red"))
     if result.resynthesis is not None:
@@ -190,17 +197,22 @@ def decompose(
                 console.print(Text(f"  {robot} can no longer perform: {', '.join(events)}", style="yellow"))
     v = verification
     sizes = ", ".join(str(a.assumption.n_states if a.assumption else 0) for a in v.assumptions) or "-"
+    details = (
+        f"; {v.membership_queries} membership / {v.equivalence_queries} equivalence queries; "
+        f"assumption sizes {sizes}; largest automaton {v.largest_automaton}; {v.time_s:.3f} s"
+        if verbose
+        else ""
+    )
     console.print(
         Text(
-            f"verification: {'holds' if v.holds else 'fails'} ({v.method}; "
-            f"{v.membership_queries} membership / {v.equivalence_queries} equivalence queries; "
-            f"assumption sizes {sizes}; "
-            f"largest automaton {v.largest_automaton}; {v.time_s:.3f} s)",
+            f"verification: {'holds' if v.holds else 'fails'} ({v.method}{details})",
             style="green" if v.holds else "red",
         )
     )
     if v.counterexample is not None:
         console.print(Text(f"violation: {' '.join(v.counterexample)}", style="red"))
+    if dot is not None:
+        console.print(Text(f"wrote the local missions as Graphviz DOT to {dot}/: {names}"))
     raise typer.Exit(0 if ok else 1)
 
 
@@ -310,11 +322,13 @@ def plan(
             f"{res.solve_s:.2f} s",
         )
     console.print(table)
+    if result.plans.feasible:
+        console.print(Text(plan_verdict(result.plans, result.verification), style="green"))
     if result.verification is not None:
         v = result.verification
         console.print(
             Text(
-                f"coordination: {len(result.plans.coordination)} pair(s), deadlock-free; "
+                f"formally: coordination: {len(result.plans.coordination)} pair(s), deadlock-free; "
                 f"verification: {'holds' if v.holds else 'fails'} ({v.method})",
                 style="green" if v.holds else "red",
             )
