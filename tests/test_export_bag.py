@@ -121,3 +121,16 @@ def test_cli_export_and_its_bad_input(tmp_path):
     assert result.exit_code == 2 and not out.exists()
     assert f"{bad}: frames[0].robots.R1.pose: expected [x, y, heading] (mm, mm, degrees)" in result.stderr
     assert [p.name for p in tmp_path.iterdir() if p.name.startswith(".")] == []  # no staging left
+
+
+def test_simulate_writes_a_bag_and_refuses_an_existing_directory_before_any_work(tmp_path):
+    _, plans, _ = run_2x2()
+    plans.save(tmp_path / "plan.json")
+    args = ["simulate", str(EXAMPLE), "--plan", str(tmp_path / "plan.json"), "--bag", str(tmp_path / "bag")]
+    result = runner.invoke(app, args)
+    assert result.exit_code == 0, result.output
+    topics = read_bag(tmp_path / "bag")
+    assert {"/tf", "/R1/pose", "/R1/plan", "/scene", "/coordination"} <= set(topics)
+    again = runner.invoke(app, [*args, "--summary", str(tmp_path / "s.json")])
+    assert again.exit_code == 2 and "exists" in again.stderr
+    assert not (tmp_path / "s.json").exists()  # refused before simulating
