@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import base64
 import contextlib
+import fcntl
 import itertools
 import json
 import os
@@ -53,8 +54,11 @@ class Browser:
         self._from_browser, from_browser = os.pipe()
 
         def wire() -> None:  # in the child: the protocol's fds 3 (commands) and 4 (answers)
-            os.dup2(to_browser, 3)
-            os.dup2(from_browser, 4)
+            # copy both above 10 first: either pipe end may itself be fd 3 or 4
+            high_in = fcntl.fcntl(to_browser, fcntl.F_DUPFD, 10)
+            high_out = fcntl.fcntl(from_browser, fcntl.F_DUPFD, 10)
+            os.dup2(high_in, 3)  # dup2 makes them inheritable: they survive the exec
+            os.dup2(high_out, 4)
 
         self.proc = subprocess.Popen(
             [executable, *FLAGS, f"--user-data-dir={self.profile}", "about:blank"],
