@@ -112,6 +112,13 @@ def import_map(
     )
 
 
+def _warn_if_other_scenario(loaded, trace: dict | None, plans) -> None:
+    """A trace or plan made for another scenario (by name) is drawn anyway, with a warning."""
+    for what, name in (("trace", (trace or {}).get("scenario")), ("plan", getattr(plans, "scenario", None))):
+        if name is not None and name != loaded.name:
+            typer.echo(f"warning: the {what} is of scenario {name!r}, not {loaded.name!r}", err=True)
+
+
 def check_bag_target(bag: Path) -> None:
     """Before any work: the ``ros`` extra is installed and the bag directory is new (else exit 2)."""
     from cosmop.export import ros_available
@@ -188,6 +195,7 @@ def export(
     data = load_trace(trace)
     plans = load_plan(plan_file) if plan_file is not None else None
     check_bag_target(bag)
+    _warn_if_other_scenario(loaded, data, plans)
     write_bag_and_report(loaded.scene, data, bag, plans, rate, scene_rate)
 
 
@@ -219,6 +227,7 @@ def view(
     loaded = _load(scenario)
     plans = load_plan(plan_file) if plan_file is not None else None
     data = load_trace(trace) if trace is not None else None
+    _warn_if_other_scenario(loaded, data, plans)
     size = save_html(loaded.scene, output, plans=plans, trace=data, title=loaded.name)
     frames = len(data["frames"]) if data is not None else 0
     _stdout().print(
