@@ -87,6 +87,11 @@ def place_labels(
         cx, cy, box = choice
         placed.append(box)
         arrow = {"arrowprops": {"arrowstyle": "-", "lw": 0.5, "color": "grey"}} if leader else {}
+        style = {
+            "zorder": 5,
+            "bbox": {"boxstyle": "round,pad=0.1", "fc": "white", "ec": "none", "alpha": 0.75},
+        }
+        style.update(label.style)  # a white backing keeps a label readable over lines
         out.append(
             ax.annotate(
                 label.text,
@@ -96,7 +101,7 @@ def place_labels(
                 ha="center",
                 va="center",
                 **arrow,
-                **label.style,
+                **style,
             )
         )
     return out
