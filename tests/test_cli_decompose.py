@@ -34,7 +34,7 @@ def ordered_scenario(tmp_path: Path) -> Path:
 
 
 def test_table_output_for_the_paper_example():
-    result = runner.invoke(app, ["decompose", str(DFA_FILE)])
+    result = runner.invoke(app, ["decompose", str(DFA_FILE), "--verbose"])
     assert result.exit_code == 0, result.output
     out = result.stdout
     assert "pick(R1,O1) -> drop(R1,O1,W1) -> return(R1)" in out
@@ -85,9 +85,8 @@ def test_not_separable_is_ordered_by_messages(tmp_path):
     assert data["verification"]["holds"] is True and data["verification"]["deadlock_free"] is True
 
 
-def test_not_separable_and_not_orderable_exits_1_with_resynthesis(tmp_path):
-    # a choice between robots: either R1 or R2 picks O1, never both; no order can make the
-    # robots agree, so the paper's pruning runs and the verdict stays "not proven"
+def choice_scenario(tmp_path: Path) -> Path:
+    """The 2x2 example whose global DFA lets either R1 or R2 move O1 to W1 (never both)."""
     data = yaml.safe_load(DFA_FILE.read_text())
     data["mission"] = {
         "dfa": {
@@ -103,7 +102,13 @@ def test_not_separable_and_not_orderable_exits_1_with_resynthesis(tmp_path):
     }
     path = tmp_path / "choice.yaml"
     path.write_text(yaml.safe_dump(data))
-    result = runner.invoke(app, ["decompose", str(path), "--json"])
+    return path
+
+
+def test_not_separable_and_not_orderable_exits_1_with_resynthesis(tmp_path):
+    # a choice between robots: no order can make the robots agree on who moves O1, so the
+    # paper's pruning runs and the verdict stays "not proven"
+    result = runner.invoke(app, ["decompose", str(choice_scenario(tmp_path)), "--json"])
     assert result.exit_code == 1
     data = json.loads(result.stdout)
     assert data["separable"] is False and data["messages"] == []

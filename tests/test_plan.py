@@ -54,7 +54,7 @@ def plan_set() -> PlanSet:
 
 def test_to_dict_has_the_documented_shape() -> None:
     data = plan_set().to_dict()
-    assert list(data) == ["format", "scenario", "feasible", "robots", "coordination", "messages"]
+    assert list(data) == ["format", "scenario", "feasible", "units", "robots", "coordination", "messages"]
     assert data["format"] == PLAN_FORMAT == "cosmop.plan/1"
     r1 = data["robots"]["R1"]
     assert r1["mission"] == R1_MISSION
@@ -104,6 +104,7 @@ def test_infeasible_plan_set_round_trip(tmp_path: Path) -> None:
         "format": "cosmop.plan/1",
         "scenario": "warehouse-2x2",
         "feasible": False,
+        "units": {"length": "mm", "angle": "deg", "time": "s"},
         "reason": "R1 cannot reach O1: the walls enclose it",
         "robots": {},
         "coordination": [],

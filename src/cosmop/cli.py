@@ -26,6 +26,7 @@ from typer.core import TyperGroup
 
 from cosmop import __version__
 from cosmop.automata import DFA
+from cosmop.cli_words import decompose_verdict, plan_verdict
 from cosmop.errors import CosmopInputError, EventSyntaxError
 from cosmop.io import write_atomic
 from cosmop.missions.decomposition import decompose as run_decompose
@@ -139,6 +140,9 @@ def decompose(
             help="Also write each local mission as Graphviz DOT into this DIRECTORY.", show_default=False
         ),
     ] = None,
+    verbose: Annotated[
+        bool, typer.Option("--verbose", "-v", help="Also print the verification's statistics.")
+    ] = False,
 ) -> None:
     """Decompose the global mission into local missions and verify them (paper, Section III).
 
@@ -164,6 +168,9 @@ def decompose(
         dot.mkdir(parents=True, exist_ok=True)
         for robot, dfa in result.local_missions.items():
             write_atomic(dot / f"{robot}.dot", dfa.to_dot(f"K_{robot}"))
+        names = ", ".join(f"{robot}.dot" for robot in result.local_missions)
+        if as_json:  # stdout is the JSON alone
+            typer.echo(f"wrote the local missions as Graphviz DOT to {dot}/: {names}", err=True)
     holds = team.holds if team is not None else verification.holds
     ok = (result.separable or result.messaging is not None) and holds
     if as_json:
@@ -178,6 +185,8 @@ def decompose(
         typer.echo(json.dumps(data, indent=2))
         raise typer.Exit(0 if ok else 1)
     console = _stdout()
+    verdict, good = decompose_verdict(result, verification, holds)
+    console.print(Text(verdict, style="green" if good else "red"))
     table = Table(title=Text(f"local missions of {loaded.name}"), header_style="bold")
     for column in ("robot", "events", "states", "local mission K_i = P_i(K)"):
         table.add_column(column)
@@ -185,12 +194,10 @@ def decompose(
         table.add_row(robot, str(len(result.alphabets[robot])), str(dfa.n_states), Text(_sequence_text(dfa)))
     console.print(table)
     stats = result.stats
-    console.print(
-        Text(
-            f"separable: {'yes' if result.separable else 'no'}"
-            f"   (largest automaton {stats.largest_automaton} states, {stats.total_s:.3f} s)"
-        )
+    details = (
+        f"   (largest automaton {stats.largest_automaton} states, {stats.total_s:.3f} s)" if verbose else ""
     )
+    console.print(Text(f"formally: separable: {'yes' if result.separable else 'no'} (||_i K_i = K){details}"))
     if result.counterexample is not None:
         console.print(Text(f"counterexample: {' '.join(result.counterexample)}", style="red"))
     if result.messaging is not None:
@@ -217,12 +224,15 @@ def decompose(
                 console.print(Text(f"  {robot} can no longer perform: {', '.join(events)}", style="yellow"))
     v = verification
     sizes = ", ".join(str(a.assumption.n_states if a.assumption else 0) for a in v.assumptions) or "-"
+    details = (
+        f"; {v.membership_queries} membership / {v.equivalence_queries} equivalence queries; "
+        f"assumption sizes {sizes}; largest automaton {v.largest_automaton}; {v.time_s:.3f} s"
+        if verbose
+        else ""
+    )
     console.print(
         Text(
-            f"verification: {'holds' if holds else 'fails'} ({v.method}; "
-            f"{v.membership_queries} membership / {v.equivalence_queries} equivalence queries; "
-            f"assumption sizes {sizes}; "
-            f"largest automaton {v.largest_automaton}; {v.time_s:.3f} s)",
+            f"verification: {'holds' if holds else 'fails'} ({v.method}{details})",
             style="green" if holds else "red",
         )
     )
@@ -231,6 +241,8 @@ def decompose(
         violation = " ".join(v.counterexample)
     if violation is not None:
         console.print(Text(f"violation: {violation}", style="red"))
+    if dot is not None:
+        console.print(Text(f"wrote the local missions as Graphviz DOT to {dot}/: {names}"))
     raise typer.Exit(0 if ok else 1)
 
 
@@ -327,14 +339,16 @@ def plan(
         save_plan_png(loaded.scene, result.plans, png)
     console = _stdout()
     console.print(_plan_table(loaded, result))
+    if result.plans.feasible:
+        console.print(Text(plan_verdict(result.plans, result.verification), style="green"))
     if result.verification is not None:
         v = result.verification
         safety = result.safety
         ordered = f"{safety.conflicts} conflict(s) between plans, " if safety is not None else ""
         console.print(
             Text(
-                f"coordination: {len(result.plans.coordination)} pair(s), {len(result.plans.messages)} "
-                f"message(s) ({ordered}deadlock-free); verification: "
+                f"formally: coordination: {len(result.plans.coordination)} pair(s), "
+                f"{len(result.plans.messages)} message(s) ({ordered}deadlock-free); verification: "
                 f"{'holds' if v.holds else 'fails'} ({v.method})",
                 style="green" if v.holds else "red",
             )
@@ -378,6 +392,19 @@ def simulate(
     ] = None,
     gif: Annotated[Path | None, typer.Option(help="Write an animation (GIF).", show_default=False)] = None,
     mp4: Annotated[Path | None, typer.Option(help="Write an animation (MP4).", show_default=False)] = None,
+    speed: Annotated[
+        float | None,
+        typer.Option(
+            help="Animation: simulated seconds per second [default: the run lasts at most 45 s]", min=1e-3
+        ),
+    ] = None,
+    size: Annotated[
+        int | None, typer.Option(help="Animation width in pixels [default: about 790]", min=100)
+    ] = None,
+    bag: Annotated[
+        Path | None,
+        typer.Option(help="Write a ROS 2 bag DIRECTORY (MCAP; the ros extra).", show_default=False),
+    ] = None,
     max_time: Annotated[float, typer.Option(help="Simulated seconds before giving up.", min=1.0)] = 900.0,
     replan: Annotated[bool, typer.Option(help="Stalled robots replan their remaining mission.")] = True,
 ) -> None:
@@ -404,6 +431,8 @@ def simulate(
             extra = "video" if check_video else "viz"
             typer.echo(f"error: --{path.suffix[1:]} needs pip install 'cosmop[{extra}]'", err=True)
             raise typer.Exit(EXIT_INPUT_ERROR)
+    if bag is not None:
+        _cli_ecosystem.check_bag_target(bag)  # before any work
     err = Console(file=sys.stderr, highlight=False)
     if plan_file is not None:
         plans: PlanSet = load_plan(plan_file)
@@ -444,6 +473,8 @@ def simulate(
         result.save_summary(summary)
     if trace is not None:
         result.save_trace(trace)
+    if bag is not None:
+        _cli_ecosystem.write_bag_and_report(loaded.scene, result.trace(), bag, plans, None, 5.0)
     for path in (gif, mp4):
         if path is not None:
             from cosmop.viz import save_animation
@@ -452,7 +483,7 @@ def simulate(
                 TextColumn(f"drawing {path.name}"), TimeElapsedColumn(), console=err, transient=True
             ) as p:
                 p.add_task("drawing", total=None)
-                save_animation(loaded.scene, result.trace(), path, plans=plans)
+                save_animation(loaded.scene, result.trace(), path, plans=plans, speed=speed, size=size)
     console = _stdout()
     table = Table(title=Text(f"simulation of {loaded.name} (seed {seed})"), header_style="bold")
     for column in ("robot", "pose [mm, deg]", "distance", "finished"):
@@ -516,7 +547,7 @@ def _summary_table(scenario: Scenario) -> Table:
     def row(part: str, count: int, details: str) -> None:
         table.add_row(part, str(count), Text(details))  # Text: ids are data, never markup
 
-    row("robots", len(scene.robots), ", ".join(f"{r.id} (size {r.size:g})" for r in scene.robots.values()))
+    row("robots", len(scene.robots), ", ".join(f"{r.id} (size {r.size:g} mm)" for r in scene.robots.values()))
     row("objects", len(scene.objects), ", ".join(scene.objects) or "-")
     row(
         "workspaces",
@@ -547,3 +578,7 @@ def _summary_table(scenario: Scenario) -> Table:
 def main() -> None:
     """Run the command line (``python -m cosmop``), with the program name ``cosmop``."""
     app(prog_name="cosmop")
+
+
+# The ecosystem commands (import-map, export, view) live in their own module and register on `app`.
+from cosmop import cli_ecosystem as _cli_ecosystem  # noqa: E402

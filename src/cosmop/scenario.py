@@ -13,7 +13,8 @@ A scenario file (format version 1) is YAML::
     mission:
       tasks: {R1: [pick O1, drop O1 at W1, return], ...}   # or: dfa: {initial, transitions, ...}
 
-Lengths are millimetres, angles degrees and times seconds; robots, objects and people are
+Lengths are millimetres, angles degrees and times seconds (a file with ``units: m`` gives
+metres and radians instead, converted at load time: :mod:`cosmop.units`); robots, objects and people are
 axis-aligned squares of side ``size``. The optional ``dynamics`` (any subset of its keys) are
 the unicycle limits of every robot; a robot may override them field by field with its own
 ``dynamics`` key, e.g. ``R1: {size: 400, pose: [0, 0, 0], dynamics: {max_speed: 500}}``, but
@@ -51,6 +52,7 @@ from cosmop._frozen import reduce_frozen
 from cosmop.errors import EventSyntaxError, ScenarioError
 from cosmop.io import read_text
 from cosmop.missions.events import ID_PATTERN, Event, parse_event
+from cosmop.units import SCENARIO_UNITS, default_dynamics, localize, scene_to_internal
 
 __all__ = [
     "SCENARIO_VERSION",
@@ -678,6 +680,7 @@ class _ScenarioModel(_Model):
     name: Annotated[str, Field(strict=True, min_length=1)]
     scene: _SceneModel
     mission: _MissionModel
+    units: Literal[SCENARIO_UNITS] | None = None  # type: ignore[valid-type]
 
 
 _WALL = "a wall [[x1, y1], [x2, y2]]: two points of two numbers each (mm)"
@@ -696,6 +699,7 @@ _WAYPOINT = "a point [x, y] or [x, y, dwell]: two or three numbers (mm, mm, seco
 _EXPECTED: dict[tuple[str, ...], str] = {
     ("version",): f"{SCENARIO_VERSION}, the scenario format version",
     ("name",): "a non-empty name (text)",
+    ("units",): "mm (millimetres and degrees, the default) or m (metres and radians, SI)",
     ("scene", "obstacles"): "a list of walls [[x1, y1], [x2, y2]]",
     ("scene", "obstacles", "#"): _WALL,
     ("scene", "robots"): "a non-empty mapping from robot ids to {size, pose}",
@@ -836,6 +840,8 @@ class _Builder:
         self.data = data
         self.file = file
         self.marks = marks or {}
+        units = data.get("units") if isinstance(data, Mapping) else None
+        self.units = units if units in SCENARIO_UNITS else "mm"  # the words of its messages
 
     def fail(self, path: _Path, expected: str) -> NoReturn:
         line = column = None
@@ -844,7 +850,11 @@ class _Builder:
                 line, column = self.marks[path[:length]]
                 break
         raise ScenarioError(
-            expected, file=self.file, field=_format_path(path) if path else None, line=line, column=column
+            localize(expected, self.units),
+            file=self.file,
+            field=_format_path(path) if path else None,
+            line=line,
+            column=column,
         )
 
     # -- structure ----------------------------------------------------------------------------
@@ -901,7 +911,7 @@ class _Builder:
         model = self.validate_structure()
         if model.version is not None and model.version != SCENARIO_VERSION:
             self.fail(("version",), f"expected {_EXPECTED[('version',)]}, got {model.version}")
-        scene = self.build_scene(model.scene)
+        scene = scene_to_internal(self.build_scene(model.scene), model.units or "mm")
         mission = self.build_mission(model.mission, scene)
         return Scenario(name=model.name, scene=scene, mission=mission, source=source)
 
@@ -936,7 +946,8 @@ class _Builder:
                 )
             walls.append(Wall(start, end))
 
-        dynamics = Dynamics() if model.dynamics is None else replace(Dynamics(), **model.dynamics.overrides())
+        base = default_dynamics(self.units)  # the defaults in the file's units
+        dynamics = base if model.dynamics is None else replace(base, **model.dynamics.overrides())
         robots = {
             ident: Robot(
                 ident,

@@ -60,6 +60,7 @@ from cosmop._frozen import reduce_frozen
 from cosmop.errors import CosmopInputError, EventSyntaxError
 from cosmop.io import read_text, write_atomic
 from cosmop.missions.events import ID_PATTERN, Event, parse_event
+from cosmop.units import INTERNAL_UNITS, check_units_field
 
 if TYPE_CHECKING:
     from cosmop.scenario import Scene
@@ -628,6 +629,7 @@ class PlanSet:
             "format": PLAN_FORMAT,
             "scenario": self.scenario,
             "feasible": self.feasible,
+            "units": dict(INTERNAL_UNITS),
         }
         if self.reason is not None:
             data["reason"] = self.reason
@@ -830,8 +832,10 @@ class _Reader:
             data,
             (),
             ("format", "scenario", "feasible", "robots"),
-            ("coordination", "reason", "messages", "allocation"),
+            ("coordination", "reason", "messages", "allocation", "units"),
         )
+        if (problem := check_units_field(root.get("units"))) is not None:
+            raise self.fail(("units",), problem)
         scenario = self.string(root["scenario"], ("scenario",), "the scenario's name as text")
         feasible = self.boolean(root["feasible"], ("feasible",))
         reason = root.get("reason")

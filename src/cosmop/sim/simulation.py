@@ -58,6 +58,7 @@ from cosmop.scenario import Scenario
 from cosmop.sim.humans import Walker
 from cosmop.sim.recoordinate import Remaining, recoordinate
 from cosmop.sim.replan import replan
+from cosmop.units import INTERNAL_UNITS
 
 __all__ = [
     "SIM_FORMAT",
@@ -255,6 +256,7 @@ class SimResult:
         return {
             "format": SIM_FORMAT,
             "scenario": self.scenario,
+            "units": dict(INTERNAL_UNITS),
             "completed": self.completed,
             "sim_time_s": round(self.sim_time_s, 6),
             "wall_time_s": round(self.wall_time_s, 6),
@@ -310,6 +312,7 @@ class SimResult:
         return {
             "format": TRACE_FORMAT,
             "scenario": self.scenario,
+            "units": dict(INTERNAL_UNITS),
             "dt": self.dt,
             "frames": frames,
             "messages": [m.to_dict() for m in self.messages],

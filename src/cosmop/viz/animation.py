@@ -34,6 +34,8 @@ import numpy as np
 
 from cosmop.planning.plan import PlanSet
 from cosmop.scenario import Scene
+from cosmop.traces import message_label
+from cosmop.viz.palette import robot_colours
 
 __all__ = ["TRACE_FORMAT", "save_animation", "video_available"]
 
@@ -42,7 +44,8 @@ TRACE_FORMAT = "cosmop.trace/1"
 
 _SUFFIXES = (".gif", ".mp4")
 _MAX_FPS = 20.0
-_MESSAGE_SHOWN = 1.0  # seconds (simulated) a '!' stays above a robot after it sent a message
+_MESSAGE_SHOWN = 2.0  # seconds (simulated) a '!' and the message's arrow stay after it was sent
+_TARGET_LENGTH = 45.0  # seconds of animation by default: speed max(1, duration / 45)
 _DEFAULT_ROBOT_SIZE = 400.0  # mm, for robots in the trace but not in the scene
 _DEFAULT_OBJECT_SIZE = 100.0  # mm
 _DEFAULT_HUMAN_SIZE = 500.0  # mm
@@ -91,6 +94,36 @@ def _frame_indices(n: int, max_frames: int) -> tuple[list[int], int]:
     if indices[-1] != n - 1:
         indices.append(n - 1)
     return indices, stride
+
+
+def _timing(
+    trace: Mapping[str, Any],
+    frames: Sequence[Mapping[str, Any]],
+    max_frames: int,
+    fps: float | None,
+    speed: float | None,
+) -> tuple[list[int], int, float]:
+    """The frames to draw, their stride and the frame rate for a playback at `speed`.
+
+    Without `fps`, the stride is grown until ``speed / (dt * stride) <= 20`` and the rate is
+    exactly ``speed / (dt * stride)``; `speed` defaults to ``max(1, duration / 45)``.
+    """
+    times = [float(frame["t"]) for frame in frames]
+    dt = _cycle(trace, times)
+    if speed is None:
+        speed = max(1.0, (times[-1] - times[0]) / _TARGET_LENGTH)
+    indices, stride = _frame_indices(len(frames), max_frames)
+    if fps is not None:
+        return indices, stride, fps
+    if dt is None:
+        return indices, stride, _MAX_FPS
+    least = math.ceil(speed / (dt * _MAX_FPS) - 1e-9)
+    if least > stride:  # fewer frames, so that the rate stays at most 20 per second
+        stride = least
+        indices = list(range(0, len(frames), stride))
+        if indices[-1] != len(frames) - 1:
+            indices.append(len(frames) - 1)
+    return indices, stride, speed / (dt * stride)
 
 
 def _cycle(trace: Mapping[str, Any], times: Sequence[float]) -> float | None:
@@ -260,21 +293,22 @@ class _Animator:
         plans: PlanSet | None,
         title: str | None,
         dpi: float,
+        shown: float = _MESSAGE_SHOWN,
     ) -> None:
-        import matplotlib
         from matplotlib.backends.backend_agg import FigureCanvasAgg
         from matplotlib.collections import LineCollection
         from matplotlib.figure import Figure
         from matplotlib.patches import Circle, Rectangle
 
         self.frames = frames
+        self.shown = shown  # seconds a message stays drawn (at least about one frame's time step)
         x0, x1, y0, y1 = _limits(scene, frames)
         width, height = x1 - x0, y1 - y0
         base = 6.0
         if width >= height:
-            figsize = (base, max(2.5, base * height / width) + 0.5)
+            figsize = (base + _LEGEND_WIDTH, max(2.5, base * height / width) + 0.5)
         else:
-            figsize = (max(2.5, base * width / height) + 0.5, base)
+            figsize = (max(2.5, base * width / height) + 0.5 + _LEGEND_WIDTH, base)
         # A figure outside pyplot (drawn with Agg): nothing to close, the user's backend untouched.
         fig = Figure(figsize=figsize, dpi=dpi)
         FigureCanvasAgg(fig)
@@ -313,8 +347,8 @@ class _Animator:
                 )
                 ax.text(*ws.center, wid, ha="center", va="center", color="dimgrey", fontsize=7, zorder=1)
 
-        colours = matplotlib.colormaps["tab10"]
         self.robot_ids = _ids(scene.robots, frames, "robots")
+        colours = robot_colours(len(self.robot_ids))
         self.object_ids = _ids(scene.objects, frames, "objects")
         self.human_ids = _ids(getattr(scene, "humans", None) or {}, frames, "humans")
         humans = getattr(scene, "humans", None) or {}
@@ -335,7 +369,7 @@ class _Animator:
             self.object_patch[oid] = ax.add_patch(
                 Rectangle((0, 0), s, s, color="saddlebrown", zorder=3, visible=False)
             )
-            self.object_label[oid] = _text_marker(ax, oid, "black", 6, va="top", zorder=3, visible=False)
+            self.object_label[oid] = _text_marker(ax, oid, "black", 6, zorder=3, visible=False)
 
         # Robots: trail, planned path, body, heading tick, id, cargo, '?' and '!'.
         self.robot_size = {}
@@ -351,7 +385,7 @@ class _Animator:
         for times in self.sent.values():
             times.sort()
         for i, rid in enumerate(self.robot_ids):
-            colour = colours(i % 10)
+            colour = colours[i]
             size = float(scene.robots[rid].size) if rid in scene.robots else _DEFAULT_ROBOT_SIZE
             self.robot_size[rid] = size
             planned = _plan_polyline(scene, plans, rid)
@@ -391,7 +425,13 @@ class _Animator:
             )
             label = _text_marker(ax, hid, "black", 7, va="center", zorder=6, visible=False)
             self.human_artists[hid] = (disc, label)
+        self.arrows = self._message_arrows(messages, colours)
+        # GIF colours: few keep files small; each robot's colour needs its own shades
+        self.palette_size = min(256, 48 + 4 * len(self.robot_ids))
+        _legend(ax)
         fig.tight_layout()
+        self.mm_per_pt = _mm_per_point(ax)
+        self.spots: dict[tuple, dict[str, tuple[float, float]]] = {}
 
         # Everything that moves is drawn over a background rendered once (blitting).
         moving: list[Any] = [self.title]
@@ -400,8 +440,89 @@ class _Animator:
             moving += a.values()
         for disc, label in self.human_artists.values():
             moving += [disc, label]
+        for arrow, text, _ in self.arrows:
+            moving += [arrow, text]
         self.moving = sorted(moving, key=lambda artist: artist.get_zorder())
         self.background: Any = None
+
+    def _message_arrows(self, messages: Sequence[Any], colours: list) -> list[tuple[Any, Any, Mapping]]:
+        """One hidden arrow and time label per message between two robots of the trace."""
+        from matplotlib.patches import FancyArrowPatch
+
+        out = []
+        for message in messages:
+            if not (isinstance(message, Mapping) and isinstance(message.get("t"), int | float)):
+                continue
+            if message.get("from") not in self.artists or message.get("to") not in self.artists:
+                continue
+            colour = colours[self.robot_ids.index(message["from"])]
+            arrow = self.ax.add_patch(
+                FancyArrowPatch(
+                    (0, 0),
+                    (1, 1),
+                    arrowstyle="-|>",
+                    mutation_scale=12,
+                    lw=1.5,
+                    color=colour,
+                    zorder=8,
+                    visible=False,
+                )
+            )
+            text = self.ax.text(
+                0, 0, f"{message_label(message)} @ {float(message['t']):.1f} s", fontsize=7, color=colour,
+                ha="center", va="bottom", zorder=8, visible=False,
+                bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.8},
+            )  # fmt: skip
+            out.append((arrow, text, message))
+        return out
+
+    def _show_messages(self, t: float, robots: Mapping[str, Any]) -> None:
+        """Arrows from sender to receiver for the messages sent in the last ``shown`` seconds."""
+        for arrow, text, message in self.arrows:
+            age = t - float(message["t"])
+            sender, receiver = robots.get(message["from"]), robots.get(message["to"])
+            on = 0 <= age < self.shown and sender is not None and receiver is not None
+            arrow.set_visible(on)
+            text.set_visible(on)
+            if on:
+                a, b = (float(v) for v in sender["pose"][:2]), (float(v) for v in receiver["pose"][:2])
+                (x1, y1), (x2, y2) = tuple(a), tuple(b)
+                arrow.set_positions((x1, y1), (x2, y2))
+                text.set_position(((x1 + x2) / 2, (y1 + y2) / 2))
+
+    def _object_spots(self, carried: set[str]) -> dict[str, tuple[float, float]]:
+        """Where the ids of the objects on the ground go: near each, not over another id or object."""
+        visible = tuple(
+            (oid, self.object_at[oid])
+            for oid in self.object_ids
+            if self.object_at[oid] and oid not in carried
+        )
+        if visible not in self.spots:
+            boxes = [
+                (x - self.object_size[o] / 2, y - self.object_size[o] / 2, x + self.object_size[o] / 2,
+                 y + self.object_size[o] / 2)
+                for o, (x, y) in visible
+            ]  # fmt: skip
+            spots = {}
+            for oid, (x, y) in visible:
+                w = (0.7 * 6 * len(oid) + 2) * self.mm_per_pt
+                h = 1.3 * 6 * self.mm_per_pt
+                s = self.object_size[oid] / 2
+                candidates = [(0, -(s + h / 2)), (0, s + h / 2), (s + w / 2, 0), (-(s + w / 2), 0)]
+                candidates += [(dx * (s + w / 2), dy * (s + h / 2)) for dx in (1, -1) for dy in (-1, 1)]
+                for dx, dy in candidates:
+                    box = (x + dx - w / 2, y + dy - h / 2, x + dx + w / 2, y + dy + h / 2)
+                    if not any(
+                        b[0] < box[2] and box[0] < b[2] and b[1] < box[3] and box[1] < b[3] for b in boxes
+                    ):
+                        break
+                else:
+                    dx, dy = candidates[0]
+                    box = (x + dx - w / 2, y + dy - h / 2, x + dx + w / 2, y + dy + h / 2)
+                boxes.append(box)
+                spots[oid] = (x + dx, y + dy)
+            self.spots = {visible: spots}  # objects move rarely: keep the last placement only
+        return self.spots[visible]
 
     def draw(self, index: int) -> None:
         """Show frame `index` of the trace (an index into the full list of frames) on the canvas."""
@@ -427,7 +548,7 @@ class _Animator:
     def _message_recent(self, rid: str, t: float) -> bool:
         times = self.sent[rid]
         k = bisect.bisect_right(times, t)
-        return k > 0 and t - times[k - 1] <= _MESSAGE_SHOWN + 1e-9
+        return k > 0 and t - times[k - 1] < self.shown
 
     def update(self, index: int) -> None:
         """Move the artists to frame `index` of the trace (an index into the full list of frames)."""
@@ -481,8 +602,11 @@ class _Animator:
             if shown:
                 s = self.object_size[oid]
                 self.object_patch[oid].set_xy((where[0] - s / 2, where[1] - s / 2))
-                self.object_label[oid].set_data([where[0]], [where[1] - 0.6 * s])
+        spots = self._object_spots(carried)
+        for oid, (x, y) in spots.items():
+            self.object_label[oid].set_data([x], [y])
 
+        self._show_messages(t, robots)
         humans = frame.get("humans") or {}
         for hid, (disc, label) in self.human_artists.items():
             where = humans.get(hid)
@@ -491,6 +615,42 @@ class _Animator:
             if where is not None:
                 disc.set_center((float(where[0]), float(where[1])))
                 label.set_data([float(where[0])], [float(where[1])])
+
+
+_LEGEND_WIDTH = 1.9  # inches added on the right of the animation for the legend
+
+
+def _legend(ax: Any) -> None:
+    """What the markers of an animation mean, on the right of the axes."""
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    def symbol(text: str, label: str) -> Line2D:
+        return Line2D([], [], ls="none", marker=f"${text}$", color="black", ms=7, label=label)
+
+    handles = [
+        Line2D([], [], color="black", lw=2, label="wall"),
+        Patch(color="lightgrey", label="workspace"),
+        Line2D(
+            [], [], ls="none", marker="s", color="saddlebrown", ms=4, label="object (on a robot: carried)"
+        ),
+        Line2D([], [], ls="none", marker="s", mfc="none", mec="black", ms=8, label="robot, heading tick, id"),
+        Line2D([], [], color="grey", lw=1, label="path driven"),
+        Line2D([], [], color="grey", lw=0.8, ls="--", label="path planned"),
+        Line2D([], [], ls="none", marker="o", color="orange", ms=6, label="person"),
+        symbol("?", "waits for an answer (Req)"),
+        symbol("!", "sent an answer (Res)"),
+        Line2D([], [], color="grey", lw=1.5, marker=">", ms=4, label="message → receiver, time"),
+    ]
+    ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=6, frameon=False)
+
+
+def _mm_per_point(ax: Any) -> float:
+    """Data units (mm) per typographic point, with the axes' final layout (equal aspect)."""
+    ax.apply_aspect()
+    (x0, _), (x1, _) = ax.transData.transform([(0.0, 0.0), (1000.0, 0.0)])
+    px_per_mm = abs(x1 - x0) / 1000.0 or 1.0
+    return ax.figure.dpi / 72.0 / px_per_mm
 
 
 def _writer(animation: Any, suffix: str, fps: float, animator: _Animator) -> Any:
@@ -511,7 +671,9 @@ def _writer(animation: Any, suffix: str, fps: float, animator: _Animator) -> Any
                     super().grab_frame(**savefig_kwargs)
                     return
                 image = Image.frombuffer("RGBA", self.frame_size, pixels, "raw", "RGBA", 0, 1)
-                frames.append(image.convert("RGB").quantize(256, method=Image.Quantize.FASTOCTREE))
+                frames.append(
+                    image.convert("RGB").quantize(animator.palette_size, method=Image.Quantize.FASTOCTREE)
+                )
 
         return GifWriter(fps=fps)
 
@@ -537,6 +699,8 @@ def save_animation(
     max_frames: int = 400,
     title: str | None = None,
     dpi: float = 100,
+    speed: float | None = None,
+    size: int | None = None,
 ) -> int:
     """Render `trace` to `path` (.gif with Pillow, .mp4 with ffmpeg); return the number of frames written.
 
@@ -564,15 +728,20 @@ def save_animation(
     plans : PlanSet, optional
         If given, each robot's planned path (initial pose, then every GoTo pose) is drawn.
     fps : float, optional
-        Frames per second of the output. By default the real-time rate of the drawn frames
-        (``1 / (dt * stride)``), capped to 20.
+        Frames per second of the output; overrides `speed`. By default ``speed / (dt * stride)``,
+        with the stride grown so that it is at most 20.
     max_frames : int, optional
         At most this many frames are drawn (default 400): the trace is subsampled with a
         uniform stride; the last frame is always included.
     title : str, optional
         Text before the time in the title; by default the trace's scenario name.
     dpi : float, optional
-        Resolution of the frames, dots per inch (default 100; the figure is about 6 in wide).
+        Resolution of the frames, dots per inch (default 100; the figure is about 7.7 in wide).
+    speed : float, optional
+        Simulated seconds per second of animation (> 0). By default ``max(1, duration / 45)``:
+        real time for runs up to 45 s, and any longer run lasts 45 s.
+    size : int, optional
+        Width of the frames in pixels (overrides `dpi`); the height follows the scene's shape.
 
     Returns
     -------
@@ -601,16 +770,20 @@ def save_animation(
         raise ValueError(f"fps must be a positive number of frames per second, got {fps!r}")
     if not (isinstance(dpi, int | float) and math.isfinite(dpi) and dpi > 0):
         raise ValueError(f"dpi must be a positive number, got {dpi!r}")
+    if speed is not None and not (isinstance(speed, int | float) and math.isfinite(speed) and speed > 0):
+        raise ValueError(f"speed must be a positive number (simulated seconds per second), got {speed!r}")
+    if size is not None and (isinstance(size, bool) or not isinstance(size, int) or size < 100):
+        raise ValueError(f"size must be a width of at least 100 pixels, got {size!r}")
     frames = _check_trace(trace)
     matplotlib = _matplotlib()
     ffmpeg = _ffmpeg_exe() if suffix == ".mp4" else None
 
-    indices, stride = _frame_indices(len(frames), max_frames)
-    if fps is None:
-        dt = _cycle(trace, [float(frame["t"]) for frame in frames])
-        fps = _MAX_FPS if dt is None else min(_MAX_FPS, 1.0 / (dt * stride))
-
-    animator = _Animator(scene, trace, frames, plans, title, dpi)
+    indices, stride, fps = _timing(trace, frames, max_frames, fps, speed)
+    dt = _cycle(trace, [float(frame["t"]) for frame in frames]) or 0.0
+    animator = _Animator(scene, trace, frames, plans, title, dpi, max(_MESSAGE_SHOWN, 1.5 * stride * dt))
+    if size is not None:
+        dpi = size / animator.fig.get_figwidth()
+        animator.fig.set_dpi(dpi)
     rc: dict[str, Any] = {"savefig.bbox": None}  # the writers need frames of a fixed size
     if ffmpeg is not None:
         rc["animation.ffmpeg_path"] = ffmpeg

@@ -1,0 +1,120 @@
+"""Units: ``units: m`` scenarios (metres, radians) load to the same scene as mm/degree ones, and
+every JSON output says its units while older files without a ``units`` key stay readable."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from cosmop.cli import app
+from cosmop.errors import ScenarioError
+from cosmop.planning.plan import Coordination, PlanError, PlanSet, load_plan, plan_from_actions
+from cosmop.scenario import load_scenario
+from cosmop.units import INTERNAL_UNITS, localize, mm_from_m
+from handmade_plans import R1_ACTIONS, R1_MISSION, R2_RES_ACTIONS, R2_RES_MISSION
+
+ROOT = Path(__file__).resolve().parents[1]
+MM_FILE = ROOT / "examples" / "01_warehouse_2x2" / "scenario.yaml"
+runner = CliRunner()
+
+SI_TEXT = """
+name: warehouse-2x2
+units: m
+scene:
+  obstacles:
+    - [[-2.5, -2.5], [2.5, -2.5]]
+    - [[2.5, -2.5], [2.5, 2.5]]
+    - [[2.5, 2.5], [-2.5, 2.5]]
+    - [[-2.5, 2.5], [-2.5, -2.5]]
+    - [[0, 0], [0, 2.5]]
+    - [[-1, 0], [1, 0]]
+  robots:
+    R1: {size: 0.4, pose: [-2, -1, 0]}
+    R2: {size: 0.4, pose: [-2, -2, 0]}
+  objects:
+    O1: {size: 0.1, position: [2, -1]}
+    O2: {size: 0.1, position: [1.9, -1]}
+  workspaces:
+    W1: {x: [-1.5, -1], y: [2, 2.5]}
+    W2: {x: [1, 1.5], y: [2, 2.5]}
+mission:
+  tasks:
+    R1: [pick O1, drop O1 at W1, return]
+    R2: [pick O2, drop O2 at W2, return]
+"""
+
+
+def test_a_scenario_in_metres_is_the_same_scene_as_in_millimetres(tmp_path):
+    si = tmp_path / "si.yaml"
+    si.write_text(SI_TEXT)
+    assert load_scenario(si).scene == load_scenario(MM_FILE).scene  # exact, to the last bit
+
+
+def test_metres_convert_headings_speeds_and_people_and_keep_the_defaults(tmp_path):
+    text = SI_TEXT.replace("pose: [-2, -1, 0]", "pose: [-2, -1, 1.5707963267948966]")
+    text = text.replace(
+        "  workspaces:",
+        "  dynamics: {max_speed: 0.5, turn_rate: 1.0}\n"
+        "  humans: {H1: {size: 0.5, speed: 0.6, path: [[0, -1.5], [0, -2.2, 5]]}}\n  workspaces:",
+    )
+    path = tmp_path / "si.yaml"
+    path.write_text(text)
+    scene = load_scenario(path).scene
+    r1 = scene.robots["R1"]
+    assert r1.pose == (-2000.0, -1000.0, 90.0)
+    assert r1.dynamics.max_speed == 500.0 and r1.dynamics.turn_rate == pytest.approx(math.degrees(1.0))
+    assert r1.dynamics.acceleration == 300.0 and r1.dynamics.braking == 500.0  # defaults untouched
+    assert r1.dynamics.cycle == 0.1
+    h1 = scene.humans["H1"]
+    assert (h1.size, h1.speed, h1.path) == (500.0, 600.0, ((0.0, -1500.0, 0.0), (0.0, -2200.0, 5.0)))
+    assert mm_from_m(2.3) == 2300.0  # 2.3 * 1000 is 2299.9999999999995 in floating point
+
+
+def test_errors_in_a_metre_file_speak_in_metres(tmp_path):
+    path = tmp_path / "si.yaml"
+    path.write_text(SI_TEXT.replace("size: 0.4, pose: [-2, -1, 0]", "size: -0.4, pose: [-2, -1, 0]"))
+    with pytest.raises(ScenarioError) as info:
+        load_scenario(path)
+    assert info.value.field == "scene.robots.R1.size"
+    assert "(side of the square robot, m)" in info.value.expected
+    assert localize("a pose [x, y, heading]: three numbers (mm, mm, degrees)", "m") == (
+        "a pose [x, y, heading]: three numbers (m, m, radians)"
+    )
+
+
+def test_unknown_units_exit_2_naming_the_field(tmp_path):
+    path = tmp_path / "cm.yaml"
+    path.write_text(SI_TEXT.replace("units: m", "units: cm"))
+    result = runner.invoke(app, ["validate", str(path)])
+    assert result.exit_code == 2
+    assert f"{path}: units: expected mm (millimetres and degrees, the default) or m" in result.stderr
+
+
+def test_plan_files_say_their_units_and_old_ones_still_load(tmp_path):
+    scene = load_scenario(MM_FILE).scene
+    plans = PlanSet(
+        "warehouse-2x2",
+        True,
+        {
+            "R1": plan_from_actions(scene, "R1", R1_MISSION, R1_ACTIONS),
+            "R2": plan_from_actions(scene, "R2", R2_RES_MISSION, R2_RES_ACTIONS),
+        },
+        (Coordination("O2", "R1", "R2"),),
+    )
+    out = tmp_path / "plan.json"
+    plans.save(out)
+    data = json.loads(out.read_text())
+    assert data["units"] == dict(INTERNAL_UNITS) == {"length": "mm", "angle": "deg", "time": "s"}
+    old = dict(data)
+    del old["units"]  # a file written before units existed means mm and degrees
+    (tmp_path / "old.json").write_text(json.dumps(old))
+    assert load_plan(tmp_path / "old.json") == load_plan(out)
+    wrong = dict(data, units={"length": "m", "angle": "rad", "time": "s"})
+    (tmp_path / "si.json").write_text(json.dumps(wrong))
+    with pytest.raises(PlanError) as info:
+        load_plan(tmp_path / "si.json")
+    assert info.value.field == "units" and "mm" in info.value.expected
