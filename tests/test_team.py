@@ -158,13 +158,14 @@ def test_a_replan_mid_run_is_ordered_again(corridor):
     outcome = recoordinate(
         scene,
         start,
+        "R1",
         sent=(),
         conflict_messages=conflict_names,
         used=used,
         positions={o: tuple(spec.position) for o, spec in scene.objects.items()},
     )
     assert outcome.accepted and outcome.messages
-    assert set(outcome.dropped) == conflict_names
+    assert set(outcome.dropped) == {n for n in conflict_names if "R1" in parse_event(n).owners}
     assert {m.event for m in outcome.messages}.isdisjoint(conflict_names)  # fresh names
     links = message_links(outcome.plans)
     precedence = Precedence({r: p.horizon for r, p in outcome.plans.items()}, links)

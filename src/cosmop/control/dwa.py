@@ -429,7 +429,9 @@ def _escape_ok(
     if len(walls):
         gap = (point_segment_linf(pts, walls) - half[:, None, None]).reshape(U, K, steps, -1)
         now_gap = point_segment_linf(pose[:, :2], walls) - half[:, None]  # (U, W)
-        fine = (gap > slack[..., None]) | ((gap >= now_gap[:, None, None, :] - 1e-9) & (gap > 0))
+        # moving away never closes a gap, even one already (numerically) shut: it must open
+        opens = gap > np.minimum(now_gap, 0.0)[:, None, None, :]
+        fine = (gap > slack[..., None]) | ((gap >= now_gap[:, None, None, :] - 1e-9) & opens)
         ok &= fine.all(axis=(2, 3))
     if len(boxes):
         gap = box_gaps(pts, half[:, None, None], boxes).reshape(U, K, steps, -1)
@@ -445,7 +447,7 @@ def _escape_ok(
         # From a box that stands still (V = 0), moving away never closes the gap: an arc whose
         # sampled gaps never fall below the gap now (and open up at once) needs no slack.
         now_gap = box_gaps(pose[:, :2], half[:, None], boxes)  # (U, M)
-        away = (gap >= now_gap[:, None, None, :] - 1e-9) & (gap > 0)
+        away = (gap >= now_gap[:, None, None, :] - 1e-9) & (gap > np.minimum(now_gap, 0.0)[:, None, None, :])
         fine |= away & (bound[:, None, None, :] == 0)
         fine[:, :, -1, :] &= gap[:, :, -1, :] >= keep[:, None, :] - 1e-9
         if skip is not None:

@@ -350,11 +350,24 @@ def order_conflicts(
         chosen, core = schedule.solve([c for c in found if not any(c is u for u in unresolved)])
         if core is None:
             break
+        if not core:  # undecided within the solver's budget: the search's culprit stays unresolved
+            return _give_up(found, culprit, horizons, links, starts, durations, max_backtracks, fixed)
         unresolved.append(min(core, key=lambda c: _replannable(c, fixed)))
     # the search's choices keep the makespan low; the schedule stands in where the search fails
     left = [c for c in found if not any(c is u for u in unresolved)]
     better, culprit = _search(left, horizons, links, starts, durations, max_backtracks, fixed)
     return (chosen if culprit is not None else better), unresolved
+
+
+def _give_up(found, culprit, horizons, links, starts, durations, max_backtracks, fixed):
+    """Order what the search can, leaving each conflict it fails on unresolved (sound, not minimal)."""
+    unresolved = [culprit]
+    while True:
+        left = [c for c in found if not any(c is u for u in unresolved)]
+        chosen, culprit = _search(left, horizons, links, starts, durations, max_backtracks, fixed)
+        if culprit is None:
+            return chosen, unresolved
+        unresolved.append(culprit)
 
 
 class _Schedule:
@@ -404,7 +417,7 @@ class _Schedule:
             self.label[id(c)], self.ways[id(c)] = label, ways
 
     def solve(self, conflicts: Sequence[Conflict]):
-        """``(edges, None)`` ordering `conflicts`, or ``([], core)``."""
+        """``(edges, None)`` ordering `conflicts`; ``([], core)`` without; ``([], [])`` undecided."""
         import z3
 
         by_label = {self.label[id(c)]: c for c in conflicts}
@@ -413,7 +426,7 @@ class _Schedule:
             core = [by_label[lit] for lit in self.solver.unsat_core()]
             return [], core or list(conflicts)
         if verdict != z3.sat:
-            raise RuntimeError(f"the conflict schedule was not decided ({self.solver.reason_unknown()})")
+            return [], []  # undecided (resource limit): the caller falls back on the search
         model = self.solver.model()
         chosen = []
         for c in conflicts:

@@ -157,6 +157,7 @@ def make_team_safe(
     used: set[str] | None = None,
     starts: Mapping[str, State] | None = None,
     positions: Mapping[str, tuple[float, float] | None] | None = None,
+    about: str | None = None,
 ) -> TeamSafety:
     """Order every conflict between `plans` by messages (see the module docstring).
 
@@ -172,6 +173,9 @@ def make_team_safe(
         The robots' states at instant 0 when it is not the scenario (re-coordination mid-run).
     positions : Mapping[str, tuple or None], optional
         Where the objects are at instant 0 (``None``: carried), when it is not the scenario.
+    about : str, optional
+        Order only the conflicts of this robot's plan (the others' plans are already ordered
+        among themselves: a robot that replanned mid-run).
 
     Returns
     -------
@@ -192,7 +196,7 @@ def make_team_safe(
         raise ValueError("the plans' own messages deadlock; order them before the conflicts")
     alone = max((sum(d) for d in times.values()), default=0.0)
     items, _ = occupancies(scene, plans, precedence, settings, starts, positions)
-    found = conflicts(items)
+    found = [c for c in conflicts(items) if about is None or about in c.robots]
     ordered = sum(1 for c in found if is_ordered(c, precedence))
     fixed = fixed_places(items)
     chosen, unresolved = order_conflicts(found, horizons, links, [], times, fixed=fixed)

@@ -6,9 +6,10 @@ the rest of every robot's plan, from where each robot is now, is ordered again b
 :func:`cosmop.planning.teamsafety.make_team_safe`, exactly as before the run --
 
 * messages already sent stay sent: the steps that wait for them are done;
-* the messages that kept the old plans apart and have not been sent yet are dropped (they
-  protected places the new plans may no longer share) and the conflicts are ordered afresh,
-  proved free of deadlock, with new message names;
+* the messages that kept the robot's old plan apart from the others and have not been sent yet
+  are dropped (they protected places its new plan may no longer share) and its conflicts with
+  the others are ordered afresh, proved free of deadlock, with new message names; the others'
+  orders among themselves stay as they were;
 * the orders the mission itself requires (``away`` answers, order messages) are kept.
 
 If some conflict cannot be ordered, the new plan is refused and the robot keeps its old one.
@@ -19,6 +20,7 @@ from __future__ import annotations
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
+from cosmop.missions.events import parse_event
 from cosmop.planning.conflicts import ConflictSettings
 from cosmop.planning.plan import PlanMessage, RobotPlan, State, Step
 from cosmop.planning.teamsafety import make_team_safe
@@ -74,6 +76,7 @@ def _away_of(rest: Remaining, step: Step) -> str | None:
 def recoordinate(
     scene: Scene,
     rests: Mapping[str, Remaining],
+    robot: str,
     *,
     sent: Iterable[str],
     conflict_messages: Iterable[str],
@@ -88,6 +91,8 @@ def recoordinate(
     scene : Scene
     rests : Mapping[str, Remaining]
         Every robot's remaining plan (the stalled robot's new plan among them).
+    robot : str
+        The robot with the new plan.
     sent : iterable of str
         Messages already sent (their waits are done).
     conflict_messages : iterable of str
@@ -103,11 +108,13 @@ def recoordinate(
     Recoordination
     """
     sent = set(sent)
-    pending = set(conflict_messages) - sent
+    pending = {name for name in set(conflict_messages) - sent if robot in parse_event(name).owners}
     drop = sent | pending
     plans = {r: _without(rest, drop) for r, rest in rests.items()}
     starts = {r: rest.start for r, rest in rests.items()}
-    safety = make_team_safe(scene, plans, settings=settings, used=used, starts=starts, positions=positions)
+    safety = make_team_safe(
+        scene, plans, settings=settings, used=used, starts=starts, positions=positions, about=robot
+    )
     if not safety.safe:
         return Recoordination(
             False,

@@ -468,12 +468,16 @@ class _World:
         )
 
     def crowded(self, i: int) -> bool:
-        """Whether another robot that may still move is within the standoff of robot `i` (it
-        stays parked then).  A robot that has finished never moves again: it cannot hold the
-        promise against it, so it does not keep `i` parked."""
+        """Whether robot `i` must stay parked: another robot that may still move is within its
+        standoff.  A robot that has finished never moves again and does not count; of two parked
+        robots close together the one listed first may leave (the other keeps its promise), so
+        that two waiting robots never hold each other for ever."""
         gaps = box_gaps(self.pose[i, :2], self.half[i], np.column_stack([self.pose[:, :2], self.half]))
         gaps[i] = np.inf
-        gaps[[a.index for a in self.agents if a.done]] = np.inf
+        parked = self.parked()
+        for agent in self.agents:
+            if agent.done or (parked[agent.index] and agent.index > i):
+                gaps[agent.index] = np.inf
         return bool((gaps < self.settings.dwa.standoff).any())
 
     def box_velocity(self, names: list[str]) -> np.ndarray:
@@ -869,15 +873,20 @@ def _drop_clear(world: _World, i: int, j: int, spot: np.ndarray) -> bool:
 
     A new object must not appear inside another robot's stopping distance (that robot could
     no longer brake in time: passive safety assumes resting obstacles stay where they are) nor
-    on a person.
+    within the standoff of one that may move, nor on a parked robot or a person.  A parked robot
+    does not move while this one is close, and sees the object once it does.
     """
     others = [k for k in range(len(world.rids)) if k != i]
     if others:
         gaps = box_gaps(
             world.pose[others, :2], world.half[others][:, None], np.array([[*spot, world.obj_half[j]]])
         )
+        parked = world.parked()
         need = [
-            stopping_margin(world.v[k], 0.0, world.dynamics[k]) + world.settings.dwa.standoff for k in others
+            _TOUCH
+            if parked[k]
+            else stopping_margin(world.v[k], 0.0, world.dynamics[k]) + world.settings.dwa.standoff
+            for k in others
         ]
         if (gaps[:, 0] <= np.array(need)).any():
             return False
@@ -897,11 +906,13 @@ def _stalled(world: _World, agent: _Agent) -> None:
     world.replan_attempts += 1
     boxes, _, names = world.boxes()
     gaps = box_gaps(world.pose[i, :2], world.half[i], boxes)
-    # robots keep the clearance the team-safety layer checks; people a little room
+    # robots keep the clearance the team-safety layer checks, people a little room; a robot that
+    # has finished stays where it is for good, however far
+    finished = {a.id for a in world.agents if a.done}
     sensed = [
         (float(b[0]), float(b[1]), float(b[2]) + (s.dwa.standoff if n in world.rids else 10.0))
         for b, n, g in zip(boxes, names, gaps, strict=True)
-        if n != agent.id and n not in world.oids and g < s.sense_range
+        if n != agent.id and n not in world.oids and (g < s.sense_range or n in finished)
     ]
     done_steps = agent.steps[: agent.k]
     _, todo = _split_mission(world, agent)
@@ -986,6 +997,7 @@ def _recoordinate(world: _World, agent: _Agent, new: RobotPlan, start: State) ->
     result = recoordinate(
         world.scenario.scene,
         rests,
+        agent.id,
         sent=world.inbox,
         conflict_messages=world.conflict_names,
         used=world.used_names,
