@@ -204,7 +204,7 @@ def decompose(
         console.print(
             Text(f"ordered by {len(result.messaging.messages)} message(s) instead of removing tasks:")
         )
-        for entry in result.messaging.to_dict(result._words()):
+        for entry in result.messaging.to_dict():
             console.print(
                 Text(
                     f"  {entry['event']}: {entry['receiver']} waits before {entry['before']} "

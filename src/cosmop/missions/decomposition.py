@@ -230,16 +230,19 @@ class Messaging:
         The same, as sequence automata.
     rounds : int
         Counterexamples used.
+    unordered : Mapping[str, tuple of str]
+        The local missions before the messages (what the edges index).
     """
 
     messages: tuple[tuple[str, Edge], ...]
     words: Mapping[str, tuple[str, ...]]
     local_missions: Mapping[str, DFA]
     rounds: int
+    unordered: Mapping[str, tuple[str, ...]]
 
-    def to_dict(self, words: Mapping[str, tuple[str, ...]]) -> list[dict]:
+    def to_dict(self) -> list[dict]:
         """JSON-ready list: ``{"event", "sender", "receiver", "after", "before"}`` per message."""
-        out = []
+        out, words = [], self.unordered
         for name, ((a, i), (b, j)) in self.messages:
             out.append(
                 {"event": name, "sender": a, "receiver": b, "after": words[a][i], "before": words[b][j]}
@@ -264,7 +267,8 @@ def order_by_messages(mission: GlobalMission, local: Mapping[str, DFA]) -> Messa
         return None
     placed, messages = with_messages(words, result.edges)
     dfas = {r: sequence_automaton(list(w)) for r, w in placed.items()}
-    return Messaging(tuple(messages), MappingProxyType(placed), MappingProxyType(dfas), result.rounds)
+    frozen = MappingProxyType
+    return Messaging(tuple(messages), frozen(placed), frozen(dfas), result.rounds, frozen(words))
 
 
 @dataclass(frozen=True)
@@ -350,15 +354,12 @@ class Decomposition:
             "counterexample": list(self.counterexample) if self.counterexample is not None else None,
             "local_missions": {r: d.to_dict(with_alphabet=True) for r, d in self.local_missions.items()},
             "resynthesis": self.resynthesis.to_dict() if self.resynthesis is not None else None,
-            "messages": [] if self.messaging is None else self.messaging.to_dict(self._words()),
+            "messages": [] if self.messaging is None else self.messaging.to_dict(),
             "coordinated_missions": None
             if self.messaging is None
             else {r: list(w) for r, w in self.messaging.words.items()},
             "stats": self.stats.to_dict(),
         }
-
-    def _words(self) -> dict[str, tuple[str, ...]]:
-        return {r: sequence_of(d) or () for r, d in self.local_missions.items()}
 
 
 def decompose(mission: GlobalMission, *, max_iterations: int = 100) -> Decomposition:
