@@ -206,3 +206,41 @@ def test_cli_simulate_bad_plan_file(tmp_path):
     )
     assert result.exit_code == 2
     assert result.output.startswith("error: ") and "Traceback" not in result.output
+
+
+def test_robot_stopped_beside_its_waypoint_creeps_back_onto_the_segment():
+    # The plan's second drive runs along the top of a wall block, touching it (allowed).  The
+    # robot starts 14 mm below the drive's start, within the tolerance of its first waypoint:
+    # the straight way from where it stands runs into the block's corner, so it must first
+    # creep back onto the segment -- aiming along the path, it would stand there for ever.
+    from cosmop.planning.plan import PlanSet, plan_from_actions
+    from cosmop.scenario import parse_scenario
+
+    box = [[-2000, -1500], [0, -1500], [0, 0], [-2000, 0]]
+    room = [[-3000, -2000], [3000, -2000], [3000, 2000], [-3000, 2000]]
+    walls = [[a, b] for ring in (box, room) for a, b in zip(ring, ring[1:] + ring[:1], strict=True)]
+    scenario = parse_scenario(
+        {
+            "name": "corner",
+            "scene": {
+                "obstacles": walls,
+                "robots": {"R1": {"size": 400, "pose": [201, 186, 0]}},
+                "objects": {"O1": {"size": 100, "position": [2500, 1500]}},
+                "workspaces": {"W1": {"x": [1500, 2900], "y": [-1900, -1000]}},
+            },
+            "mission": {"tasks": {"R1": ["return"]}},
+        }
+    )
+    actions = [
+        ("GoTo", (200, 200, 180)),
+        ("GoTo", (-1500, 200, 180)),
+        ("GoTo", (200, 200, 0)),
+        ("GoTo", (201, 186, 0)),
+    ]
+    plan = plan_from_actions(scenario.scene, "R1", ["return(R1)"], actions)
+    plans = PlanSet("corner", True, {"R1": plan})
+    result = simulate(scenario, plans, settings=SimSettings(max_time=120, replan=False))
+    assert result.completed
+    assert result.contacts_while_moving == 0
+    west = result.frames["pose"][:, 0, 0].min()
+    assert west <= -1500 + SimSettings().pass_tolerance  # it drove the segment, not around

@@ -32,6 +32,7 @@ import itertools
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from fractions import Fraction
 
 import numpy as np
 import shapely
@@ -346,28 +347,31 @@ def order_conflicts(
         return chosen, []
     schedule = _Schedule(found, horizons, links, starts, durations, rlimit)
     unresolved: list[Conflict] = []
+    gone: set[int] = set()
     while True:
-        chosen, core = schedule.solve([c for c in found if not any(c is u for u in unresolved)])
+        chosen, core = schedule.solve([c for c in found if id(c) not in gone])
         if core is None:
             break
         if not core:  # undecided within the solver's budget: the search's culprit stays unresolved
             return _give_up(found, culprit, horizons, links, starts, durations, max_backtracks, fixed)
         unresolved.append(min(core, key=lambda c: _replannable(c, fixed)))
+        gone.add(id(unresolved[-1]))
     # the search's choices keep the makespan low; the schedule stands in where the search fails
-    left = [c for c in found if not any(c is u for u in unresolved)]
+    left = [c for c in found if id(c) not in gone]
     better, culprit = _search(left, horizons, links, starts, durations, max_backtracks, fixed)
     return (chosen if culprit is not None else better), unresolved
 
 
 def _give_up(found, culprit, horizons, links, starts, durations, max_backtracks, fixed):
     """Order what the search can, leaving each conflict it fails on unresolved (sound, not minimal)."""
-    unresolved = [culprit]
+    unresolved, gone = [culprit], {id(culprit)}
     while True:
-        left = [c for c in found if not any(c is u for u in unresolved)]
+        left = [c for c in found if id(c) not in gone]
         chosen, culprit = _search(left, horizons, links, starts, durations, max_backtracks, fixed)
         if culprit is None:
             return chosen, unresolved
         unresolved.append(culprit)
+        gone.add(id(culprit))
 
 
 class _Schedule:
@@ -405,6 +409,7 @@ class _Schedule:
                 add(self.start[target] >= self.end[source] + eps)
         self.label: dict[int, object] = {}
         self.ways: dict[int, list] = {}
+        self.by_id: dict[int, Conflict] = {}  # a label's Z3 id -> its conflict
         for n, c in enumerate(found):
             ways = [
                 (x.last, y.first)
@@ -415,34 +420,44 @@ class _Schedule:
             terms = [self.start[b] >= self.end[a] + eps for a, b in ways]
             add(z3.Implies(label, z3.Or(terms) if terms else z3.BoolVal(False, ctx)))
             self.label[id(c)], self.ways[id(c)] = label, ways
+            self.by_id[label.get_id()] = c
 
     def solve(self, conflicts: Sequence[Conflict]):
         """``(edges, None)`` ordering `conflicts`; ``([], core)`` without; ``([], [])`` undecided."""
         import z3
 
-        by_label = {self.label[id(c)]: c for c in conflicts}
-        verdict = self.solver.check(*by_label)
+        verdict = _check(self.solver, [self.label[id(c)] for c in conflicts])
         if verdict == z3.unsat:
-            core = [by_label[lit] for lit in self.solver.unsat_core()]
+            core = [self.by_id[lit.get_id()] for lit in self.solver.unsat_core()]
             return [], core or list(conflicts)
         if verdict != z3.sat:
             return [], []  # undecided (resource limit): the caller falls back on the search
-        model = self.solver.model()
+        start, end = _times(self.solver.model(), self.start), _times(self.solver.model(), self.end)
         chosen = []
         for c in conflicts:
             for a, b in self.ways[id(c)]:
-                if _holds(model, self.start[b], self.end[a], 1e-3):
+                if start[b] >= end[a] + Fraction(1, 1000):
                     chosen.append(((a, b), c))
                     break
         return chosen, None
 
 
-def _holds(model, later, earlier, eps) -> bool:
-    """Whether the model puts `later` at least `eps` after `earlier`."""
+def _check(solver, labels):
+    """``solver.check(*labels)`` without re-checking the sort of each label (thousands per call)."""
     import z3
 
-    gap = model.eval(later - earlier, model_completion=True)
-    return z3.is_true(z3.simplify(gap >= eps - 1e-12))
+    array = (z3.Ast * len(labels))(*(label.as_ast() for label in labels))
+    ctx = solver.ctx
+    return z3.CheckSatResult(z3.Z3_solver_check_assumptions(ctx.ref(), solver.solver, len(labels), array))
+
+
+def _times(model, variables: Mapping[Node, object]) -> dict[Node, Fraction]:
+    """The model's value of each variable, exactly (the eps of the order needs no rounding)."""
+    out = {}
+    for node, var in variables.items():
+        value = model.eval(var, model_completion=True)
+        out[node] = Fraction(value.numerator_as_long(), value.denominator_as_long())
+    return out
 
 
 class _Sides:

@@ -355,6 +355,7 @@ class _Agent:
         self.phase = "start"  # of driving: start, drive, turn
         self.stage: str | None = None  # of docking: approach, dock, handle
         self.path: GlobalPath | None = None
+        self.seat: tuple[float, float] | None = None  # the plan's segment start to creep back to
         self.goal: tuple[float, float, float] | None = None
         self.timer = 0.0
         self.grip: int | None = None  # object index touched by the gripper
@@ -673,6 +674,31 @@ def _route(world: _World, i: int, goal: tuple, origin: tuple | None) -> GlobalPa
     return path or plan_path(here, target, half, world.walls, boxes) or GlobalPath((here, target), 0.0)
 
 
+def _reseat(world: _World, agent: _Agent) -> tuple[str, Any] | None:
+    """Creep straight back onto the start of the plan's segment, turned along it; ``None`` once there.
+
+    A robot stops within a tolerance of its waypoint, and the plan's next segment may touch a
+    wall (the plan allows touching): a few millimetres off it, or turned a few degrees towards
+    the wall, the robot's first move along that segment runs into the corner, and the
+    controller, aiming along the path, never finds the sideways move out.  The docking creep
+    is that move: straight, slow, exact at the end.
+    """
+    i = agent.index
+    (sx, sy), (tx, ty) = agent.seat, agent.path.points[-1]
+    heading = math.atan2(ty - sy, tx - sx)
+    if math.dist(world.pose[i, :2], (sx, sy)) <= 1e-9 and abs(_wrap(heading - world.pose[i, 2])) <= 1e-9:
+        agent.seat = None
+        agent.path = GlobalPath(agent.path.points[1:], agent.path.margin)
+        agent.since = world.t
+        return None
+    if world.v[i] > 0:
+        return _brake(world, i)
+    pose = (sx, sy, math.degrees(heading))
+    if _dock_safe(world, i, agent, pose):
+        return ("dock", pose)
+    return ("move", (0.0, 0.0))  # something passes: wait for it
+
+
 def _drive(
     world: _World,
     agent: _Agent,
@@ -688,6 +714,9 @@ def _drive(
     fresh = agent.phase == "start" or agent.path is None
     if fresh:
         agent.path = _route(world, i, goal, origin)
+        back = agent.path.points[1] if len(agent.path.points) == 3 and origin is not None else None
+        near = back is not None and math.dist(xy, back) <= s.pass_tolerance + s.goal_tolerance
+        agent.seat = back if near and back == (origin[0], origin[1]) else None
         agent.phase = "drive"
         agent.room = float(world.static_gaps(goal[:2], world.half[i])[0])
         agent.best = math.inf
@@ -708,6 +737,10 @@ def _drive(
             return None
         w = max(-world.limits[i, 3], min(world.limits[i, 3], error / world.dt))
         return ("move", (0.0, w))
+    if agent.seat is not None:
+        action = _reseat(world, agent)
+        if action is not None:
+            return action
     target, left = agent.path.lookahead((float(xy[0]), float(xy[1])), s.dwa.lookahead)
     agent.left = left
     if left < agent.best - s.stall_progress:
@@ -754,7 +787,7 @@ def _detour(world: _World, agent: _Agent, goal: tuple[float, float, float]) -> N
     if path is None:
         return
     world.detours += int(bool(blockers))
-    agent.path = path
+    agent.path, agent.seat = path, None
     agent.best = path.length
 
 
