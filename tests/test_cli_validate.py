@@ -44,6 +44,36 @@ def test_validate_dfa_example() -> None:
     result = runner.invoke(app, ["validate", str(DFA_FILE)])
     assert result.exit_code == 0, result.output
     assert "dfa: 16 states, 24 transitions, 16 marked, 6 events" in result.stdout
+    # prefix-closed: complete where no event is left
+    assert "in q15 (the states with no outgoing event)" in result.stdout
+
+
+def test_validate_prints_where_the_mission_is_complete(tmp_path: Path) -> None:
+    result = runner.invoke(app, ["validate", str(TASKS_FILE)])
+    assert "when every robot's task list is done" in result.stdout
+    path = tmp_path / "marked.yaml"
+    write_atomic(
+        path, DFA_FILE.read_text().replace("    transitions:", "    marked: [q15, q3]\n    transitions:", 1)
+    )
+    result = runner.invoke(app, ["validate", str(path)])
+    assert result.exit_code == 0, result.output
+    assert "in q15, q3 (the marked states)" in result.stdout
+
+
+def test_unreachable_completion_is_bad_input(tmp_path: Path) -> None:
+    # complete only in q15, and every way into q15 removed: the mission can never be complete
+    text = DFA_FILE.read_text().replace("    transitions:", "    marked: [q15]\n    transitions:", 1)
+    kept = [line for line in text.splitlines() if not line.strip().startswith("- [") or "q15]" not in line]
+    path = tmp_path / "never.yaml"
+    write_atomic(path, "\n".join(kept) + "\n")
+    result = runner.invoke(app, ["validate", str(path)])
+    assert result.exit_code == EXIT_INPUT_ERROR
+    assert "mission.dfa" in result.stderr and "can never be complete" in result.stderr
+    assert "marked: q15" in result.stderr
+    assert "Traceback" not in result.stderr
+    # the same file with its transitions into q15 is valid
+    write_atomic(path, text)
+    assert runner.invoke(app, ["validate", str(path)]).exit_code == 0
 
 
 def test_validate_point_workspace(tmp_path: Path) -> None:

@@ -30,7 +30,15 @@ def test_example_1_coordinated():
     assert plans.messages and all(m.kind == "conflict" for m in plans.messages)
     assert result.safety.safe and result.safety.conflicts > 0
     assert result.verification.holds and result.report.ok
-    assert set(result.phases) == {"decompose", "synthesize", "coordinate", "conflicts", "verify", "check"}
+    assert set(result.phases) == {
+        "decompose",
+        "allocate",
+        "synthesize",
+        "coordinate",
+        "conflicts",
+        "verify",
+        "check",
+    }
 
 
 def test_a_blocking_object_nobody_picks_is_refused():
@@ -49,3 +57,15 @@ def test_worker_processes_do_not_change_the_result():
     one = plan_team(scenario, workers=1)
     two = plan_team(scenario, workers=2)
     assert one.plans.to_dict() == two.plans.to_dict()
+
+
+def test_a_mission_with_marked_states_plans_to_a_complete_state():
+    # the 2x2 DFA, not prefix-closed: complete only in q15 (both robots home); planning must
+    # reach it (and no prefix is taken for the mission)
+    path = ROOT / "examples" / "01_warehouse_2x2" / "scenario_dfa.yaml"
+    data = yaml.safe_load(path.read_text())
+    data["mission"]["dfa"]["marked"] = ["q15"]
+    team = plan_team(parse_scenario(data))
+    assert team.plans.feasible, team.plans.reason
+    done = {e for plan in team.plans.robots.values() for e in plan.mission}
+    assert {"return(R1)", "return(R2)"} <= done

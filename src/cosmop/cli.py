@@ -360,6 +360,15 @@ def plan(
                     f"{safety.makespan_alone:.0f} s)"
                 )
             )
+    if result.allocation is not None and result.allocation.alternative is not None:
+        choice = result.allocation
+        moved = ", ".join(f"{o} by {r}" for o, r in result.plans.allocation.items()) or "nothing moved"
+        console.print(
+            Text(
+                f"allocation: {moved} (the cheapest of {choice.considered} way(s) to complete the "
+                f"mission: longest plan {choice.makespan} steps, {choice.total} in all)"
+            )
+        )
     if result.plans.feasible:
         console.print(
             Text(
@@ -572,7 +581,17 @@ def _summary_table(scenario: Scenario) -> Table:
             f"dfa: {len(dfa.states)} states, {len(dfa.transitions)} transitions, "
             f"{len(dfa.marked)} marked, {len(events)} events",
         )
+    row("complete", *_completion(mission))
     return table
+
+
+def _completion(mission) -> tuple[int, str]:
+    """Where the mission is complete: the count and the words for the summary's row."""
+    if mission.tasks is not None:
+        return len(mission.tasks), "when every robot's task list is done"
+    done = mission.dfa.complete_states
+    why = "the marked states" if mission.dfa.marked_given else "the states with no outgoing event"
+    return len(done), f"in {', '.join(done)} ({why})"
 
 
 def main() -> None:

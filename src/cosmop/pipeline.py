@@ -32,10 +32,12 @@ from types import MappingProxyType
 
 import shapely
 
+from cosmop.missions.allocation import Choice, alternatives, choose
 from cosmop.missions.coordination import Coordinated, coordinate
 from cosmop.missions.decomposition import decompose
 from cosmop.missions.events import Event, parse_event
 from cosmop.missions.mission import GlobalMission, sequence_of
+from cosmop.missions.ordering import order_words, with_messages
 from cosmop.missions.team import TeamVerdict, blocking_word, check_words
 from cosmop.planning.checker import CheckReport, check_plan
 from cosmop.planning.conflicts import Conflict, ConflictSettings
@@ -47,7 +49,7 @@ from cosmop.scenario import Scenario, Scene, Wall
 
 __all__ = ["TeamResult", "plan_team"]
 
-PHASES = ("decompose", "synthesize", "coordinate", "conflicts", "verify", "check")
+PHASES = ("decompose", "allocate", "synthesize", "coordinate", "conflicts", "verify", "check")
 """The phases whose seconds :attr:`TeamResult.phases` records."""
 
 
@@ -77,6 +79,9 @@ class TeamResult:
         The conflicts between the plans and the messages that order them.
     replans : tuple of str
         Why robots were re-planned after their first plan (requests forbidden, conflicts).
+    allocation : Choice or None
+        When the mission left choices open: the alternative chosen, its cost, how many were
+        compared (:mod:`cosmop.missions.allocation`).
     """
 
     plans: PlanSet
@@ -89,6 +94,7 @@ class TeamResult:
     phases: Mapping[str, float]
     safety: TeamSafety | None = None
     replans: tuple[str, ...] = ()
+    allocation: Choice | None = None
 
 
 @dataclass(frozen=True)
@@ -134,6 +140,10 @@ class _Planner:
         self.phases = phases
         self.forbidden: dict[str, frozenset[str]] = {}
         self.obstacles: dict[str, tuple[Wall, ...]] = {}
+        self.cache: dict[tuple, Synthesis] = {}  # the same question is never solved twice
+
+    def key(self, robot: str, events: tuple[Event, ...]) -> tuple:
+        return (robot, tuple(events), self.forbidden.get(robot, frozenset()), self.obstacles.get(robot, ()))
 
     def job(self, robot: str, events: tuple[Event, ...]) -> _Job:
         scene = self.scenario.scene
@@ -146,8 +156,12 @@ class _Planner:
 
     def run(self, jobs: Mapping[str, tuple[Event, ...]]) -> dict[str, Synthesis]:
         t0 = time.perf_counter()
-        work = {robot: self.job(robot, events) for robot, events in jobs.items()}
-        out: dict[str, Synthesis] = {}
+        out: dict[str, Synthesis] = {
+            robot: self.cache[self.key(robot, events)]
+            for robot, events in jobs.items()
+            if self.key(robot, events) in self.cache
+        }
+        work = {robot: self.job(robot, events) for robot, events in jobs.items() if robot not in out}
         if self.executor is None or len(work) < 2:
             for robot, job in work.items():
                 out[robot] = _synthesize(job)
@@ -159,6 +173,8 @@ class _Planner:
                 out[robot] = future.result()
                 if self.on_robot is not None:
                     self.on_robot(robot, out[robot])
+        for robot, events in jobs.items():
+            self.cache[self.key(robot, events)] = out[robot]
         self.phases["synthesize"] += time.perf_counter() - t0
         return {robot: out[robot] for robot in jobs}
 
@@ -206,11 +222,19 @@ def plan_team(
     phases["decompose"] = time.perf_counter() - t
     pool = None
     if executor is None:
-        n_workers = min(os.cpu_count() or 1, len(words)) if workers is None else max(1, workers)
+        team = len(scenario.scene.robots)
+        n_workers = min(os.cpu_count() or 1, team) if workers is None else max(1, workers)
         pool = _pool(n_workers) if n_workers > 1 else None
     planner = _Planner(scenario, executor or pool, on_robot, max_horizon, rlimit, phases)
     try:
-        return _loop(scenario, mission, words, notes, reasons, planner, max_iterations, conflicts)
+        choice = None
+        if words is None:  # the mission leaves choices open: commit to the cheapest way
+            t = time.perf_counter()
+            before = phases["synthesize"]
+            words, notes, reasons, choice = _allocate(scenario, mission, planner)
+            phases["allocate"] = time.perf_counter() - t - (phases["synthesize"] - before)
+        result = _loop(scenario, mission, words, notes, reasons, planner, max_iterations, conflicts, choice)
+        return replace(result, allocation=choice)
     finally:
         if pool is not None:
             pool.shutdown()
@@ -218,8 +242,11 @@ def plan_team(
 
 def _local_words(
     scenario: Scenario, mission: GlobalMission
-) -> tuple[dict[str, tuple[Event, ...]], dict[str, tuple[str, str]], list[str]]:
-    """Each robot's word, what each message in them is for, and why planning cannot start."""
+) -> tuple[dict[str, tuple[Event, ...]] | None, dict[str, tuple[str, str]], list[str]]:
+    """Each robot's word, what each message in them is for, and why planning cannot start.
+
+    The words are ``None`` when the mission leaves choices open (see :func:`_allocate`).
+    """
     robots = tuple(scenario.scene.robots)
     notes: dict[str, tuple[str, str]] = {}
     if scenario.mission.tasks is not None:
@@ -235,19 +262,75 @@ def _local_words(
         for name, ((a, i), (b, j)) in result.messaging.messages:
             notes[name] = ("order", f"the mission orders {b}'s {plain[b][j]} after {a}'s {plain[a][i]}")
         local = {r: tuple(w) for r, w in result.messaging.words.items()}
-    elif not result.separable and result.resynthesis is not None:
-        lost = {r: e for r, e in result.resynthesis.lost_events.items() if e}
-        named = "; ".join(f"{r} loses {', '.join(e)}" for r, e in lost.items())
-        why = "the mission is not separable and no messages can order it; pruning it loses tasks: "
-        return {r: () for r in robots}, notes, [why + (named or "none")]
     else:
         local = {r: sequence_of(d) for r, d in result.local_missions.items()}
-        branching = [r for r, seq in local.items() if seq is None]
-        if branching:
-            why = f"planning needs each local mission to be one sequence of events; {branching[0]}'s branches"
-            return {r: () for r in robots}, notes, [why]
+        if not result.separable or any(seq is None for seq in local.values()):
+            # choices between robots or tasks: allocate (messages then order the chosen words;
+            # the paper's pruning, which would drop tasks, is never needed)
+            return None, notes, []
     words = {r: tuple(parse_event(e) for e in local.get(r) or ()) for r in robots}
     return words, notes, []
+
+
+def _allocate(
+    scenario: Scenario, mission: GlobalMission, planner: _Planner
+) -> tuple[dict[str, tuple[Event, ...]], dict[str, tuple[str, str]], list[str], Choice]:
+    """Commit the team to the alternative of least makespan (:mod:`cosmop.missions.allocation`).
+
+    Every robot's word in every alternative is planned (each once; in parallel across robots),
+    the cheapest alternative is ordered by messages, and its words go on to the usual loop.
+    """
+    robots = tuple(scenario.scene.robots)
+    found = alternatives(mission)
+    objects = frozenset(scenario.scene.objects)
+
+    def unanswerable(alt, robot: str) -> frozenset[str]:  # requests nobody in `alt` can answer
+        return objects - {o for o, r in alt.movers(mission).items() if r != robot}
+
+    pending: dict[str, list[tuple[tuple[str, ...], frozenset[str]]]] = {}
+    for alt in found.items:
+        for robot, word in alt.words.items():
+            job = (word, unanswerable(alt, robot))
+            if word and job not in pending.setdefault(robot, []):
+                pending[robot].append(job)
+    costs: dict[tuple, Synthesis] = {}
+    for rank in range(max((len(w) for w in pending.values()), default=0)):
+        batch = {r: jobs[rank] for r, jobs in pending.items() if rank < len(jobs)}
+        planner.forbidden = {r: forbid for r, (_, forbid) in batch.items()}
+        results = planner.run({r: tuple(mission.events[e] for e in w) for r, (w, _) in batch.items()})
+        costs.update({(r, *batch[r]): res for r, res in results.items()})
+    planner.forbidden = {}
+
+    def synthesis(alt, robot: str) -> Synthesis:
+        return costs[(robot, alt.words[robot], unanswerable(alt, robot))]
+
+    choice = choose(
+        found,
+        lambda alt, r: synthesis(alt, r).horizon if synthesis(alt, r).feasible else None,
+        lambda alt, r: synthesis(alt, r).reason or "no plan within the horizon",
+    )
+    if choice.alternative is None:
+        return {r: () for r in robots}, {}, [_no_alternative(choice, found.exhaustive)], choice
+    words = dict(choice.alternative.words)
+    # the loop starts from the plans costed here: same words, same requests ruled out
+    planner.forbidden = {r: unanswerable(choice.alternative, r) for r in robots if words.get(r)}
+    order = order_words(mission.complete, words)
+    placed, messages = with_messages(words, order.edges)
+    notes = {
+        name: ("order", f"the mission orders {b}'s {words[b][j]} after {a}'s {words[a][i]}")
+        for name, ((a, i), (b, j)) in messages
+    }
+    events = {r: tuple(parse_event(e) for e in placed.get(r, ())) for r in robots}
+    return events, notes, [], choice
+
+
+def _no_alternative(choice: Choice, exhaustive: bool) -> str:
+    """Why no way of completing the mission can be planned: each robot's word that fails."""
+    if not choice.considered:
+        bound = "" if exhaustive else " within the search bound"
+        return f"no way to complete the mission was found{bound}"
+    tried = [f"{r} cannot do {' '.join(w)} ({why})" for (r, w), why in choice.unplannable.items()]
+    return f"none of the {choice.considered} ways to complete the mission can be planned: " + "; ".join(tried)
 
 
 def _loop(
@@ -259,6 +342,7 @@ def _loop(
     planner: _Planner,
     max_iterations: int,
     settings: ConflictSettings | None,
+    choice: Choice | None = None,
 ) -> TeamResult:
     """Coordinate requests, make the plans team-safe, verify and check (steps 2-5)."""
     phases = planner.phases
@@ -290,6 +374,7 @@ def _loop(
         coordination=tuple(Coordination(p.obj, p.requester, p.responder) for p in pairs),
         reason="; ".join(reasons) if reasons else None,
         messages=tuple(messages) if not reasons else (),
+        allocation=choice.alternative.movers(mission) if choice and choice.alternative else {},
     )
     t0 = time.perf_counter()
     report = check_plan(scenario, plan_set)

@@ -1105,13 +1105,23 @@ class _Builder:
                     self.fail(
                         (*base, "marked", index), f"unknown marked state {state!r}; it is not in {where}"
                     )
-        return DfaSpec(
+        spec = DfaSpec(
             states=states,
             initial=model.initial,
             marked=tuple(marked),
             transitions=tuple(transitions),
             marked_given=model.marked is not None,
         )
+        reachable = _reachable(model.initial, transitions)
+        if not any(q in reachable for q in spec.complete_states):
+            where = "marked" if spec.marked_given else "without an outgoing transition"
+            listed_states = ", ".join(spec.complete_states) or "none"
+            self.fail(
+                base,
+                f"the mission can never be complete: no complete state ({where}: {listed_states}) "
+                f"can be reached from the initial state {model.initial!r}; expected at least one",
+            )
+        return spec
 
     def unique_states(self, path: _Path, states: list[str]) -> tuple[str, ...]:
         seen: dict[str, int] = {}
@@ -1152,6 +1162,20 @@ def _known(group: str, ids: Mapping[str, Any]) -> str:
 # ----------------------------------------------------------------------------------------------
 # Public entry points
 # ----------------------------------------------------------------------------------------------
+
+
+def _reachable(initial: str, transitions) -> set[str]:
+    """The states reachable from `initial` along `transitions` ``(source, event, target)``."""
+    successors: dict[str, list[str]] = {}
+    for source, _, target in transitions:
+        successors.setdefault(source, []).append(target)
+    seen, todo = {initial}, [initial]
+    while todo:
+        for nxt in successors.get(todo.pop(), ()):
+            if nxt not in seen:
+                seen.add(nxt)
+                todo.append(nxt)
+    return seen
 
 
 def parse_scenario(data: Mapping[str, Any], source: str | os.PathLike[str] | None = None) -> Scenario:
