@@ -676,13 +676,13 @@ RULES: list[tuple[str, Callable[[dict[str, Any]], object], str, tuple[str, ...]]
         "both tasks and dfa",
         lambda d: d["mission"].__setitem__("dfa", copy.deepcopy(SMALL_DFA)),
         "mission",
-        ("exactly one of 'tasks' or 'dfa'", "got both"),
+        ("exactly one of 'tasks', 'dfa' or 'deliveries'", "got tasks and dfa"),
     ),
     (
         "neither tasks nor dfa",
         lambda d: d.__setitem__("mission", {}),
         "mission",
-        ("exactly one of 'tasks' or 'dfa'", "got neither"),
+        ("exactly one of 'tasks', 'dfa' or 'deliveries'", "got none"),
     ),
     (
         "unknown mission key",

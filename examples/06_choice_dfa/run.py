@@ -25,7 +25,8 @@ for way in ways.items:
 result = plan_team(scenario)
 choice = result.allocation
 print(f"planned: {result.plans.feasible}; chosen: {choice.alternative.label()}")
-print(f"  longest plan {choice.makespan} steps, {choice.total} in all; who moves what: {dict(result.plans.allocation)}")
+print(f"  longest plan {choice.makespan} steps, {choice.total} in all")
+print(f"  who moves what: {dict(result.plans.allocation)}")
 print(f"messages: {[m.event for m in result.plans.messages]}")
 run = simulate(scenario, result.plans)
 print(f"completed in {run.sim_time_s:.1f} s: {run.completed}")

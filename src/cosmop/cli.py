@@ -363,10 +363,11 @@ def plan(
     if result.allocation is not None and result.allocation.alternative is not None:
         choice = result.allocation
         moved = ", ".join(f"{o} by {r}" for o, r in result.plans.allocation.items()) or "nothing moved"
+        proof = "the best" if choice.exhaustive else "the best found within the search bound"
         console.print(
             Text(
-                f"allocation: {moved} (the cheapest of {choice.considered} way(s) to complete the "
-                f"mission: longest plan {choice.makespan} steps, {choice.total} in all)"
+                f"allocation: {moved}; cost: longest {choice.makespan} steps, {choice.total} in all "
+                f"({proof}; {choice.method}, {choice.considered} compared)"
             )
         )
     if result.plans.feasible:
@@ -573,13 +574,23 @@ def _summary_table(scenario: Scenario) -> Table:
             len(events),
             f"tasks: {steps} steps for {len(mission.tasks)} robots, {len(events)} events",
         )
-    else:
+    elif mission.dfa is not None:
         dfa = mission.dfa
         row(
             "mission",
             len(events),
             f"dfa: {len(dfa.states)} states, {len(dfa.transitions)} transitions, "
             f"{len(dfa.marked)} marked, {len(events)} events",
+        )
+    else:
+        deliveries = mission.deliveries
+        choices = sum(len(d.to) * len(d.by) for d in deliveries)
+        movers = sorted({r for d in deliveries for r in d.by})
+        row(
+            "mission",
+            len(events),
+            f"deliveries: {len(deliveries)} objects, {choices} (robot, workspace) choices, "
+            f"robots {', '.join(movers)}{', return' if mission.returns else ''}; {len(events)} events",
         )
     row("complete", *_completion(mission))
     return table
@@ -589,6 +600,9 @@ def _completion(mission) -> tuple[int, str]:
     """Where the mission is complete: the count and the words for the summary's row."""
     if mission.tasks is not None:
         return len(mission.tasks), "when every robot's task list is done"
+    if mission.deliveries is not None:
+        home = " and every robot that moved something is home" if mission.returns else ""
+        return len(mission.deliveries), f"when every object is in one of its workspaces{home}"
     done = mission.dfa.complete_states
     why = "the marked states" if mission.dfa.marked_given else "the states with no outgoing event"
     return len(done), f"in {', '.join(done)} ({why})"

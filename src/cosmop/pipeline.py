@@ -32,7 +32,7 @@ from types import MappingProxyType
 
 import shapely
 
-from cosmop.missions.allocation import Choice, alternatives, choose
+from cosmop.missions.allocation import Alternative, Choice, alternatives, assign, choose
 from cosmop.missions.coordination import Coordinated, coordinate
 from cosmop.missions.decomposition import decompose
 from cosmop.missions.events import Event, parse_event
@@ -45,6 +45,7 @@ from cosmop.planning.plan import Coordination, PlanMessage, PlanSet, RobotPlan
 from cosmop.planning.realisation import event_instants
 from cosmop.planning.synthesis import DEFAULT_RLIMIT, Synthesis, synthesize
 from cosmop.planning.teamsafety import TeamSafety, make_team_safe
+from cosmop.planning.timing import step_durations
 from cosmop.scenario import Scenario, Scene, Wall
 
 __all__ = ["TeamResult", "plan_team"]
@@ -256,6 +257,8 @@ def _local_words(
                 if e.kind == "msg" and e.sender == r:
                     notes[e.name] = ("mission", f"the mission orders {e.receiver} to wait for {r} here")
         return words, notes, []
+    if scenario.mission.deliveries is not None:
+        return None, notes, []  # who moves what is the planner's to choose
     result = decompose(mission)
     if result.messaging is not None:
         plain = {r: sequence_of(d) or () for r, d in result.local_missions.items()}
@@ -281,6 +284,8 @@ def _allocate(
     the cheapest alternative is ordered by messages, and its words go on to the usual loop.
     """
     robots = tuple(scenario.scene.robots)
+    if scenario.mission.deliveries is not None:
+        return _allocate_deliveries(scenario, mission, planner)
     found = alternatives(mission)
     objects = frozenset(scenario.scene.objects)
 
@@ -322,6 +327,70 @@ def _allocate(
     }
     events = {r: tuple(parse_event(e) for e in placed.get(r, ())) for r in robots}
     return events, notes, [], choice
+
+
+def _allocate_deliveries(
+    scenario: Scenario, mission: GlobalMission, planner: _Planner
+) -> tuple[dict[str, tuple[Event, ...]], dict[str, tuple[str, str]], list[str], Choice]:
+    """Deliveries: cost each (robot, object, workspace) alone, then :func:`assign`.
+
+    A delivery alone is the robot's shortest plan from home that picks the object, drops it
+    in the workspace (and comes home, with ``return``).  A robot's words: its deliveries in the
+    file's order.  No robot's events order another's (each object is moved by one robot), so
+    the words need no messages.
+    """
+    spec = scenario.mission
+    robots = tuple(scenario.scene.robots)
+    nobody = frozenset(scenario.scene.objects) - {d.object for d in spec.deliveries}
+    pending: dict[str, list[tuple[str, str]]] = {}
+    for d in spec.deliveries:
+        for r in d.by:
+            pending.setdefault(r, []).extend((d.object, w) for w in d.to)
+    planner.forbidden = {r: nobody for r in pending}
+    costs: dict[tuple[str, str, str], Synthesis] = {}
+    for rank in range(max((len(v) for v in pending.values()), default=0)):
+        batch = {r: jobs[rank] for r, jobs in pending.items() if rank < len(jobs)}
+        results = planner.run({r: _delivery_word(r, o, w, spec.returns) for r, (o, w) in batch.items()})
+        costs.update({(r, *batch[r]): res for r, res in results.items()})
+    options = {d.object: [(r, w) for r in d.by for w in d.to] for d in spec.deliveries}
+    steps = {key: (res.horizon if res.feasible else None) for key, res in costs.items()}
+    home = scenario.scene.robots
+    seconds = {
+        key: sum(step_durations(res.plan, home[key[0]].pose, home[key[0]].dynamics))
+        for key, res in costs.items()
+        if res.feasible
+    }
+    chosen = assign(options, steps, seconds=seconds)
+    method = "branch and bound over (robot, workspace) per object, each delivery costed alone"
+    if chosen.stuck:
+        why = "; ".join(_undeliverable(o, options[o], costs) for o in chosen.stuck)
+        failed = Choice(None, None, None, chosen.nodes, method=method, costs=MappingProxyType(steps))
+        return {r: () for r in robots}, {}, [why], failed
+    words: dict[str, list[str]] = {r: [] for r in robots}
+    for d in spec.deliveries:
+        r, w = chosen.tasks[d.object]
+        words[r] += [f"pick({r},{d.object})", f"drop({r},{d.object},{w})"]
+    for r, word in words.items():
+        if word and spec.returns:
+            word.append(f"return({r})")
+    alternative = Alternative({r: tuple(w) for r, w in words.items()})
+    choice = Choice(
+        alternative, chosen.makespan, chosen.total, chosen.nodes, {}, chosen.exhaustive, method, steps
+    )
+    planner.forbidden = {r: nobody for r in robots if words[r]}
+    events = {r: tuple(mission.events[e] for e in w) for r, w in words.items()}
+    return events, {}, [], choice
+
+
+def _delivery_word(robot: str, obj: str, workspace: str, returns: bool) -> tuple[Event, ...]:
+    word = [Event("pick", robot, obj=obj), Event("drop", robot, obj=obj, workspace=workspace)]
+    return tuple(word + ([Event("return", robot)] if returns else []))
+
+
+def _undeliverable(obj: str, options, costs) -> str:
+    """Why no robot can deliver `obj`: each robot and workspace tried, with what blocks it."""
+    tried = [f"{r} to {w}: {costs[(r, obj, w)].reason or 'no plan within the horizon'}" for r, w in options]
+    return f"no robot can deliver {obj} (tried {'; '.join(tried)})"
 
 
 def _no_alternative(choice: Choice, exhaustive: bool) -> str:

@@ -56,6 +56,7 @@ from cosmop.units import SCENARIO_UNITS, default_dynamics, localize, scene_to_in
 
 __all__ = [
     "SCENARIO_VERSION",
+    "Delivery",
     "DfaSpec",
     "Dynamics",
     "Human",
@@ -351,6 +352,25 @@ class Scene:
         for name in ("robots", "objects", "workspaces", "humans"):
             object.__setattr__(self, name, _frozen_mapping(getattr(self, name)))
 
+    def blocked(self, half: float, slack: float = 0.5):
+        """Where the centre of an axis-aligned square of half-side `half` (mm) overlaps a wall.
+
+        Each wall grown by the square exactly (the convex hull of the square at both ends),
+        less `slack` mm: touching stays free, and so does a gap exactly as wide as the square
+        (the walls are shrunk one by one, so that gap is not closed by their union).  A shapely
+        geometry (empty without walls).
+        """
+        import shapely
+
+        h = half - slack
+        grown = [
+            shapely.MultiPoint(
+                [(x + sx * h, y + sy * h) for x, y in (w.start, w.end) for sx in (-1, 1) for sy in (-1, 1)]
+            ).convex_hull
+            for w in self.obstacles
+        ]
+        return shapely.unary_union(grown)
+
 
 @dataclass(frozen=True)
 class DfaSpec:
@@ -393,7 +413,7 @@ class DfaSpec:
 
 @dataclass(frozen=True)
 class Mission:
-    """The global mission: per-robot task sequences, or an explicit DFA (exactly one of them).
+    """The global mission: per-robot task sequences, an explicit DFA, or deliveries (one of them).
 
     Parameters
     ----------
@@ -401,32 +421,76 @@ class Mission:
         One event sequence per robot; the global mission is their parallel composition.
     dfa : DfaSpec, optional
         The global mission automaton.
+    deliveries : tuple of Delivery, optional
+        Goods to move, without saying which robot moves them (the planner chooses).
+    returns : bool
+        Deliveries only: every robot that moved something ends at its start pose.
     """
 
     __reduce__ = reduce_frozen  # picklable for worker processes
 
     tasks: Mapping[str, tuple[Event, ...]] | None = None
     dfa: DfaSpec | None = None
+    deliveries: tuple[Delivery, ...] | None = None
+    returns: bool = False
 
     def __post_init__(self) -> None:
-        if (self.tasks is None) == (self.dfa is None):
-            raise ValueError("a mission has exactly one of tasks or dfa")
+        if sum(x is not None for x in (self.tasks, self.dfa, self.deliveries)) != 1:
+            raise ValueError("a mission has exactly one of tasks, dfa or deliveries")
         if self.tasks is not None:
             object.__setattr__(
                 self, "tasks", MappingProxyType({robot: tuple(seq) for robot, seq in self.tasks.items()})
             )
+        if self.deliveries is not None:
+            object.__setattr__(self, "deliveries", tuple(self.deliveries))
 
     @property
-    def form(self) -> Literal["tasks", "dfa"]:
-        """``"tasks"`` or ``"dfa"``: how the mission was given."""
-        return "tasks" if self.tasks is not None else "dfa"
+    def form(self) -> Literal["tasks", "dfa", "deliveries"]:
+        """``"tasks"``, ``"dfa"`` or ``"deliveries"``: how the mission was given."""
+        if self.tasks is not None:
+            return "tasks"
+        return "dfa" if self.dfa is not None else "deliveries"
 
     @property
     def events(self) -> frozenset[Event]:
         """Every event the mission mentions (its alphabet)."""
         if self.tasks is not None:
             return frozenset(event for sequence in self.tasks.values() for event in sequence)
-        return frozenset(self.dfa.alphabet)
+        if self.dfa is not None:
+            return frozenset(self.dfa.alphabet)
+        out = set()
+        for d in self.deliveries:
+            out.update(d.events())
+            if self.returns:
+                out.update(Event("return", r) for r in d.by)
+        return frozenset(out)
+
+
+@dataclass(frozen=True)
+class Delivery:
+    """One delivery of a deliveries mission: an object to one of some workspaces.
+
+    Parameters
+    ----------
+    object : str
+        The object to move.
+    to : tuple of str
+        The workspaces it may go to (any one of them).
+    by : tuple of str
+        The robots that may move it (all the scene's robots when the file does not say).
+    """
+
+    object: str
+    to: tuple[str, ...]
+    by: tuple[str, ...]
+
+    def events(self) -> list[Event]:
+        """Every pick and drop event that can realise the delivery."""
+        out = []
+        for robot in self.by:
+            out.append(Event("pick", robot, obj=self.object))
+            out.extend(Event("drop", robot, obj=self.object, workspace=w) for w in self.to)
+        return out
 
 
 @dataclass(frozen=True)
@@ -670,9 +734,24 @@ class _DfaModel(_Model):
     marked: list[_StateName] | None = None
 
 
+def _one_to_list(value: Any) -> Any:
+    """``to: W1`` is ``to: [W1]``."""
+    return [value] if isinstance(value, str) else value
+
+
+class _DeliveryModel(_Model):
+    object: _Text
+    to: Annotated[list[_Text], BeforeValidator(_one_to_list), Field(min_length=1)]
+    by: Annotated[list[_Text], BeforeValidator(_one_to_list), Field(min_length=1)] | None = None
+
+
 class _MissionModel(_Model):
+    model_config = ConfigDict(extra="forbid", frozen=True, populate_by_name=True)
+
     tasks: dict[_Text, Annotated[list[_Text], _none_to([])]] | None = None
     dfa: _DfaModel | None = None
+    deliveries: Annotated[list[_DeliveryModel], Field(min_length=1)] | None = None
+    returns: Annotated[bool | None, Field(strict=True, alias="return")] = None
 
 
 class _ScenarioModel(_Model):
@@ -726,7 +805,17 @@ _EXPECTED: dict[tuple[str, ...], str] = {
     ("scene", "robots", "*", "dynamics"): _DYNAMICS,
     **{("scene", "dynamics", key): text for key, text in _DYNAMICS_FIELDS.items()},
     **{("scene", "robots", "*", "dynamics", key): text for key, text in _DYNAMICS_FIELDS.items()},
-    ("mission",): "exactly one of tasks: {robot: [steps]} or dfa: {initial, transitions}",
+    ("mission",): (
+        "exactly one of tasks: {robot: [steps]}, dfa: {initial, transitions} or deliveries: [{object, to}]"
+    ),
+    ("mission", "deliveries"): "a non-empty list of deliveries {object, to, by}",
+    ("mission", "deliveries", "#"): "a delivery {object: O1, to: W1 or [W1, W2], by: [R1, R2] (optional)}",
+    ("mission", "deliveries", "#", "object"): "an object id",
+    ("mission", "deliveries", "#", "to"): "a workspace id or a non-empty list of them",
+    ("mission", "deliveries", "#", "to", "#"): "a workspace id",
+    ("mission", "deliveries", "#", "by"): "a robot id or a non-empty list of them",
+    ("mission", "deliveries", "#", "by", "#"): "a robot id",
+    ("mission", "return"): "true or false (deliveries: robots that moved something end at home)",
     ("mission", "tasks"): "a mapping from robot ids to lists of task steps",
     ("mission", "tasks", "*"): "a list of task steps such as [pick O1, drop O1 at W1, return]",
     ("mission", "tasks", "*", "#"): "a task step (text) such as 'pick O1', 'drop O1 at W1' or 'return'",
@@ -892,7 +981,8 @@ class _Builder:
             self.fail(loc[: cut - 1], f"keys here must be ids (text), got {_show(key)}")
         if kind == "extra_forbidden":
             model = _model_at(loc[:-1])
-            allowed = ", ".join(model.model_fields) if model is not None else "none"
+            keys = model.model_fields.items() if model is not None else ()
+            allowed = ", ".join(f.alias or name for name, f in keys) or "none"
             self.fail(loc, f"unknown key {loc[-1]!r}; expected one of: {allowed}")
         if kind == "missing" and isinstance(loc[-1], str):
             path, text = _expected_at(loc)
@@ -1032,12 +1122,48 @@ class _Builder:
         return Workspace(ident, x=model.x, y=model.y)
 
     def build_mission(self, model: _MissionModel, scene: Scene) -> Mission:
-        if (model.tasks is None) == (model.dfa is None):
-            got = "both" if model.tasks is not None else "neither"
-            self.fail(("mission",), f"expected exactly one of 'tasks' or 'dfa', got {got}")
+        given = [k for k in ("tasks", "dfa", "deliveries") if getattr(model, k) is not None]
+        if len(given) != 1:
+            got = " and ".join(given) if given else "none"
+            expected = "expected exactly one of 'tasks', 'dfa' or 'deliveries'"
+            self.fail(("mission",), f"{expected}, got {got}")
+        if model.returns is not None and model.deliveries is None:
+            self.fail(
+                ("mission", "return"), "'return' goes with 'deliveries' (tasks and DFAs say it by events)"
+            )
         if model.tasks is not None:
             return Mission(tasks=self.build_tasks(model.tasks, scene))
-        return Mission(dfa=self.build_dfa(model.dfa, scene))
+        if model.dfa is not None:
+            return Mission(dfa=self.build_dfa(model.dfa, scene))
+        return Mission(deliveries=self.build_deliveries(model.deliveries, scene), returns=bool(model.returns))
+
+    def build_deliveries(self, models: list[_DeliveryModel], scene: Scene) -> tuple[Delivery, ...]:
+        out, first = [], {}
+        for index, model in enumerate(models):
+            path = ("mission", "deliveries", index)
+            obj = model.object
+            if obj not in scene.objects:
+                self.fail((*path, "object"), f"unknown object {obj!r}; {_known('objects', scene.objects)}")
+            if obj in first:
+                self.fail((*path, "object"), f"{obj} is already delivered by deliveries[{first[obj]}]")
+            first[obj] = index
+            for k, ws in enumerate(model.to):
+                if ws not in scene.workspaces:
+                    known = _known("workspaces", scene.workspaces)
+                    self.fail((*path, "to", k), f"unknown workspace {ws!r}; {known}")
+                if not _fits(scene, scene.objects[obj], scene.workspaces[ws]):
+                    size = scene.objects[obj].size
+                    self.fail(
+                        (*path, "to", k),
+                        f"workspace {ws} is too small for {obj} ({size:g} mm): no drop position "
+                        "in it keeps the object clear of the walls",
+                    )
+            by = tuple(model.by) if model.by is not None else tuple(scene.robots)
+            for k, robot in enumerate(by):
+                if robot not in scene.robots:
+                    self.fail((*path, "by", k), f"unknown robot {robot!r}; {_known('robots', scene.robots)}")
+            out.append(Delivery(model.object, tuple(dict.fromkeys(model.to)), tuple(dict.fromkeys(by))))
+        return tuple(out)
 
     def build_tasks(self, tasks: Mapping[str, list[str]], scene: Scene) -> dict[str, tuple[Event, ...]]:
         result = {}
@@ -1162,6 +1288,17 @@ def _known(group: str, ids: Mapping[str, Any]) -> str:
 # ----------------------------------------------------------------------------------------------
 # Public entry points
 # ----------------------------------------------------------------------------------------------
+
+
+def _fits(scene: Scene, obj: MovableObject, workspace: Workspace) -> bool:
+    """Whether some position in `workspace` holds `obj`'s square clear of every wall (touching allowed)."""
+    import shapely
+
+    if workspace.is_point:
+        places = shapely.Point(*workspace.point)
+    else:
+        places = shapely.box(workspace.x[0], workspace.y[0], workspace.x[1], workspace.y[1])
+    return not places.difference(scene.blocked(obj.size / 2.0)).is_empty
 
 
 def _reachable(initial: str, transitions) -> set[str]:

@@ -26,13 +26,13 @@ alternatives found first (depth-first, events in name order).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from types import MappingProxyType
 
 from cosmop.missions.mission import GlobalMission
 
-__all__ = ["Alternative", "Alternatives", "Choice", "alternatives", "choose"]
+__all__ = ["Alternative", "Alternatives", "Assignment", "Choice", "alternatives", "assign", "choose"]
 
 
 @dataclass(frozen=True)
@@ -180,9 +180,16 @@ class Choice:
     makespan, total : int or None
         Its longest plan and the sum of its plans, in primitive steps.
     considered : int
-        Alternatives compared.
+        Alternatives compared (search nodes, for deliveries).
     unplannable : Mapping[tuple, str]
         ``(robot, word)`` pairs without a plan, each with why.
+    exhaustive : bool
+        Whether the choice is proved the best (else: the best found within a bound).
+    method : str
+        How the choice was made, in words.
+    costs : Mapping[tuple, int or None]
+        The costs the choice was made from: by ``(robot, object, workspace)`` for deliveries,
+        by ``(robot, word)`` otherwise (``None``: no plan).
     """
 
     alternative: Alternative | None
@@ -190,6 +197,9 @@ class Choice:
     total: int | None
     considered: int
     unplannable: Mapping[tuple[str, tuple[str, ...]], str] = field(default_factory=dict)
+    exhaustive: bool = True
+    method: str = "every alternative costed by the robots' shortest plans"
+    costs: Mapping[tuple, int | None] = field(default_factory=dict)
 
 
 def choose(
@@ -215,11 +225,12 @@ def choose(
     Choice
         Ties go to the alternative found first.
     """
-    best, key, unplannable = None, None, {}
+    best, key, unplannable, table = None, None, {}, {}
     for alt in found.items:
         costs = []
         for robot, word in alt.words.items():
             c = cost(alt, robot) if word else 0
+            table.setdefault((robot, word), c)
             if c is None:
                 unplannable[(robot, word)] = why(alt, robot) if why is not None else "no plan"
                 break
@@ -234,4 +245,154 @@ def choose(
         key[1] if key else None,
         len(found.items),
         MappingProxyType(unplannable),
+        found.exhaustive,
+        costs=MappingProxyType(table),
     )
+
+
+# ----------------------------------------------------------------------------------------------
+# Deliveries: which robot moves each object, and to which of its workspaces
+# ----------------------------------------------------------------------------------------------
+
+Option = tuple[str, str]
+"""``(robot, workspace)``: one way to deliver an object."""
+
+
+@dataclass(frozen=True)
+class Assignment:
+    """Result of :func:`assign`.
+
+    Attributes
+    ----------
+    tasks : Mapping[str, Option]
+        The chosen ``(robot, workspace)`` by object (empty when some object has no option).
+    makespan, total : int or None
+        The largest robot load and the sum of the loads (load: the sum of the robot's costs).
+    exhaustive : bool
+        Whether the search proved the choice optimal (else: best found within the bound).
+    nodes : int
+        Search nodes visited.
+    stuck : tuple of str
+        Objects without any option that has a cost (then nothing is chosen).
+    """
+
+    tasks: Mapping[str, Option]
+    makespan: int | None
+    total: int | None
+    exhaustive: bool
+    nodes: int
+    stuck: tuple[str, ...] = ()
+
+    def loads(self, costs: Mapping[tuple[str, str, str], int | None]) -> dict[str, int]:
+        """Each robot's load under `costs` (robots with nothing to do left out)."""
+        out: dict[str, int] = {}
+        for obj, (robot, ws) in self.tasks.items():
+            out[robot] = out.get(robot, 0) + costs[(robot, obj, ws)]
+        return out
+
+
+def assign(
+    options: Mapping[str, Sequence[Option]],
+    costs: Mapping[tuple[str, str, str], int | None],
+    *,
+    seconds: Mapping[tuple[str, str, str], float] | None = None,
+    max_nodes: int = 200_000,
+) -> Assignment:
+    """Give each object one robot and workspace, least makespan first, then least total.
+
+    A robot's load is the sum of :math:`c(r, o, w)` over the objects it delivers, where
+    :math:`c` is the cost of delivering that object alone (the robot's shortest plan from home
+    for it, in primitive steps; ``None``: it cannot).  The makespan is the largest load.
+
+    Depth-first branch and bound over the objects, the most expensive first, each object's
+    options cheapest first, starting from the greedy assignment (each object, in that order,
+    where it raises (makespan, total) least) and pruning every branch that cannot beat the best
+    found.  Exact when it ends within `max_nodes` (``exhaustive``); otherwise the best found.
+
+    Parameters
+    ----------
+    options : Mapping[str, sequence of Option]
+        The allowed ``(robot, workspace)`` by object.
+    costs : Mapping[tuple, int or None]
+        :math:`c(r, o, w)` by ``(robot, object, workspace)``.
+    seconds : Mapping[tuple, float], optional
+        The expected duration of each delivery alone: among options of equal cost the faster
+        is tried first, so that of assignments equally good the first found moves less.
+    max_nodes : int
+
+    Examples
+    --------
+    >>> c = {("R1", "O1", "W"): 4, ("R2", "O1", "W"): 5, ("R1", "O2", "W"): 4, ("R2", "O2", "W"): 6}
+    >>> a = assign({"O1": [("R1", "W"), ("R2", "W")], "O2": [("R1", "W"), ("R2", "W")]}, c)
+    >>> dict(a.tasks), a.makespan, a.total
+    ({'O1': ('R2', 'W'), 'O2': ('R1', 'W')}, 5, 9)
+    """
+    seconds = seconds or {}
+
+    def ranked(o: str, opts: Sequence[Option]) -> list[tuple[int, str, str]]:
+        keyed = [
+            (c, seconds.get((r, o, w), 0.0), r, w) for r, w in opts if (c := costs.get((r, o, w))) is not None
+        ]
+        return [(c, r, w) for c, _, r, w in sorted(keyed)]
+
+    usable = {o: ranked(o, opts) for o, opts in options.items()}
+    stuck = tuple(o for o, opts in usable.items() if not opts)
+    if stuck:
+        return Assignment(MappingProxyType({}), None, None, True, 0, stuck)
+    order = sorted(usable, key=lambda o: (-usable[o][0][0], o))
+    floor = [0] * (len(order) + 1)  # the least total the objects from i on still add
+    for i in range(len(order) - 1, -1, -1):
+        floor[i] = floor[i + 1] + usable[order[i]][0][0]
+    best = _greedy(order, usable)
+    loads: dict[str, int] = {}
+    chosen: list[Option] = []
+    nodes, exhaustive = 0, True
+
+    def visit(i: int, total: int) -> None:
+        nonlocal best, nodes, exhaustive
+        if i == len(order):
+            key = (max(loads.values(), default=0), total)
+            if key < best[0]:  # strictly better: of equals, the first found stays
+                best = (key, list(chosen))
+            return
+        span_so_far = max(loads.values(), default=0)
+        for c, r, w in usable[order[i]]:
+            if nodes >= max_nodes:
+                exhaustive = False
+                return
+            nodes += 1
+            load = loads.get(r, 0) + c
+            # (span, total) only grow from here: a branch that cannot beat the best is cut
+            if (max(span_so_far, load), total + c + floor[i + 1]) >= best[0]:
+                continue
+            loads[r] = load
+            chosen.append((r, w))
+            visit(i + 1, total + c)
+            chosen.pop()
+            loads[r] = load - c
+
+    visit(0, 0)
+    (span, total), picks = best
+    tasks = MappingProxyType(dict(sorted(zip(order, picks, strict=True))))
+    return Assignment(tasks, span, total, exhaustive, nodes)
+
+
+def _greedy(order: Sequence[str], usable: Mapping[str, list]) -> tuple[tuple[int, int], list[Option]]:
+    """Each object in turn where it raises the makespan least: the first bound.
+
+    The options are ranked (cost, seconds), so of options that raise it equally the cheapest
+    and then the fastest is taken.
+    """
+    loads: dict[str, int] = {}
+    picks, total = [], 0
+    for o in order:
+        span = max(loads.values(), default=0)
+        rank = min(
+            range(len(usable[o])),
+            key=lambda n: (max(span, loads.get(usable[o][n][1], 0) + usable[o][n][0]), n),
+        )
+        c, r, w = usable[o][rank]
+        loads[r] = loads.get(r, 0) + c
+        total += c
+        picks.append((r, w))
+    return (max(loads.values(), default=0), total), picks

@@ -169,6 +169,8 @@ class GlobalMission:
             factors = tuple(sequence_automaton(w) for w in words)
             ends = tuple(sequence_automaton(w, closed=False) for w in words)
             return cls(Composition(factors), events, robots, "tasks", Composition(ends))
+        if mission.deliveries is not None:
+            return cls._from_deliveries(mission, robots)
         spec = mission.dfa
         if spec is None:
             raise ValueError("the mission has neither tasks nor a DFA")
@@ -189,6 +191,38 @@ class GlobalMission:
             explicit=True,
         )
         return cls(Composition((dfa,)), events, robots, "dfa", Composition((done,)))
+
+    @classmethod
+    def _from_deliveries(cls, mission: Mission, robots: tuple[str, ...]) -> GlobalMission:
+        """Deliveries as a product of small factors, never of the robots' alternatives.
+
+        One factor per object: picked by one of its robots, then dropped by the same robot in
+        one of its workspaces (complete once dropped).  One factor per robot that may move
+        something: it carries one object at a time and, with ``return``, goes home last once it
+        has moved something (complete when it moved nothing, or is home; without ``return``,
+        whenever it carries nothing).
+        """
+        events = {e.name: e for e in mission.events}
+        prefix, complete = [], []
+        for d in mission.deliveries:
+            moves = [(f"{d.object}", f"pick({r},{d.object})", f"by_{r}") for r in d.by]
+            moves += [(f"by_{r}", f"drop({r},{d.object},{w})", "done") for r in d.by for w in d.to]
+            prefix.append(DFA.from_transitions(d.object, moves))
+            complete.append(DFA.from_transitions(d.object, moves, marked=["done"]))
+        for r in robots:
+            mine = [d for d in mission.deliveries if r in d.by]
+            if not mine:
+                continue
+            moves = []
+            for d in mine:
+                moves += [(q, f"pick({r},{d.object})", f"with_{d.object}") for q in ("fresh", "free")]
+                moves += [(f"with_{d.object}", f"drop({r},{d.object},{w})", "free") for w in d.to]
+            if mission.returns:
+                moves.append(("free", f"return({r})", "home"))
+            done = ["fresh", "home"] if mission.returns else ["fresh", "free"]
+            prefix.append(DFA.from_transitions("fresh", moves))
+            complete.append(DFA.from_transitions("fresh", moves, marked=done))
+        return cls(Composition(tuple(prefix)), events, robots, "deliveries", Composition(tuple(complete)))
 
     @classmethod
     def from_scenario(cls, scenario: Scenario) -> GlobalMission:

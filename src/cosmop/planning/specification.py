@@ -235,6 +235,27 @@ def _gripper_clear(p: RobotProblem, obj: str, ox, oy) -> list[tuple[str, Formula
     return out
 
 
+HANDLING_CLEARANCE = Fraction(1)
+"""mm a robot keeps from every *other* resting object while it picks up or drops off.
+
+Touching is allowed everywhere else, but a robot that stands touching one resting object
+and puts another down on its other side (or picks one up there) is wedged: every way out
+slides along a face it touches.  A millimetre of room lets it leave without touching."""
+
+
+def _handling_room(p: RobotProblem, obj: str) -> list[tuple[str, Formula]]:
+    """The robot keeps :data:`HANDLING_CLEARANCE` from every resting object but `obj`."""
+    out = []
+    for o in p.scene.objects:
+        if o == obj:
+            continue
+        w = p.obj(o)
+        gap = (p.side + _num(p.scene.objects[o].size)) / 2 + HANDLING_CLEARANCE
+        apart = disj([p.x <= w.x - gap, p.x >= w.x + gap, p.y <= w.y - gap, p.y >= w.y + gap])
+        out.append((f"room from {o} while handling {obj}", Implies(~w.carried & ~w.away, apart)))
+    return out
+
+
 def _robot_static(p: RobotProblem) -> Formula:
     return _static(p.x, p.y, p.h)
 
@@ -302,7 +323,7 @@ class PickUp(Primitive):
         )
         pose = p.h.eq(0) & p.y.eq(v.y) & p.x.eq(v.x - d) & ~v.away
         out = [(f"PickUp {obj}", _robot_static(p) & carry & pose & _objects_static(p, carried=False))]
-        return out + _gripper_clear(p, obj, v.x, v.y)
+        return out + _gripper_clear(p, obj, v.x, v.y) + _handling_room(p, obj)
 
 
 class DropOff(Primitive):
@@ -320,7 +341,7 @@ class DropOff(Primitive):
         place = p.h.eq(0) & v.x.next().eq(p.x + d) & v.y.next().eq(p.y)
         rest = _objects_static(p, carried=False, skip=obj) & _static(v.away)
         out = [(f"DropOff {obj}", _robot_static(p) & held & released & place & rest)]
-        out += _gripper_clear(p, obj, v.x.next(), v.y.next())
+        out += _gripper_clear(p, obj, v.x.next(), v.y.next()) + _handling_room(p, obj)
         side = _num(p.scene.objects[obj].size)
         for i, wall in enumerate(p.scene.obstacles):
             regions = wall_regions(wall.start, wall.end, side, f"wall {i}")

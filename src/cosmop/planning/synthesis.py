@@ -26,6 +26,7 @@ from cosmop.logic import IncrementalUnrolling, Signature, Unrolling, conj
 from cosmop.missions.events import Event
 from cosmop.planning.messages import answer_early, place_mission_messages, strip_messages, wait_early
 from cosmop.planning.plan import ObjectState, RobotPlan, State, Step
+from cosmop.planning.reach import unreachable
 from cosmop.planning.specification import (
     NONE,
     RobotProblem,
@@ -184,6 +185,9 @@ def synthesize(
     t0 = time.perf_counter()
     full = events_of(mission)
     events = strip_messages(full)
+    walled_off = unreachable(scene, robot, events, start.robot[:2] if start is not None else None)
+    if walled_off is not None:  # no horizon can do it: say so without the solver
+        return Synthesis(robot, False, None, None, reason=walled_off, solve_s=time.perf_counter() - t0)
     p = RobotProblem(scene, robot, events, requests, start=start, unrequestable=frozenset(unrequestable))
     formula = conj(f for _, f in specification(p))
     signature = Signature.of(formula)
@@ -281,7 +285,9 @@ def _explain(p: RobotProblem, events: tuple[Event, ...], K: int, rlimit: int) ->
         core = [names[str(c)] for c in s.unsat_core()]
         # obstacles only: the primitives' own effects and the mission are in every core
         blocking = tuple(
-            n for n in core if n.startswith(("wall", "object", "gripper")) or " dropped clear of " in n
+            n
+            for n in core
+            if n.startswith(("wall", "object", "gripper", "room from")) or " dropped clear of " in n
         )
     what = ", ".join(blocking) if blocking else "the primitives' constraints"
     return (

@@ -1,0 +1,98 @@
+"""A fast, sound test that a robot can never perform an event: its free space does not reach.
+
+Proving with the solver that no plan of at most K steps exists takes every horizon up to K
+(seconds each on a warehouse); a robot walled off from an object needs no solver at all.  The
+robot's *free space* here is the set of centres where its square overlaps no wall (touching
+allowed), objects ignored; its *component* is the part connected to where the robot starts.  A
+plan moves the robot only inside that component (a straight GoTo never crosses a wall), so:
+
+* ``pick(R,O)`` needs the pick pose :math:`(o_x - d, o_y)` in it (:math:`d` the centre distance
+  at which robot and object touch, PickUp's pose);
+* ``drop(R,O,W)`` needs a pose :math:`(w_x - d, w_y)`, :math:`(w_x, w_y) \\in W`, in it.
+
+If not, the event is unreachable at any horizon.  Ignoring objects only enlarges the free
+space, and the walls are grown by the exact Minkowski sum with the square, less half a
+millimetre (a passage exactly one robot wide stays open), so the test never refuses a
+feasible mission; it proves only what no plan can do.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import shapely
+
+from cosmop.missions.events import Event
+from cosmop.scenario import Scene
+
+__all__ = ["unreachable"]
+
+_SLACK = 0.5  # mm the grown walls are shrunk by: touching and one-robot-wide passages stay free
+
+
+def unreachable(
+    scene: Scene, robot: str, events: Sequence[Event], start: tuple[float, float] | None = None
+) -> str | None:
+    """Why `robot` can never perform one of `events`, or ``None`` when the test cannot tell.
+
+    Parameters
+    ----------
+    scene : Scene
+    robot : str
+    events : sequence of Event
+        Its mission (messages and requests are ignored).
+    start : tuple of float, optional
+        Where the robot starts (mm), if not its pose in the scene.
+
+    Returns
+    -------
+    str or None
+        The first event it cannot reach, in words.
+    """
+    if not scene.obstacles:
+        return None
+    body = scene.robots[robot]
+    half = body.size / 2.0
+    x0, y0 = start if start is not None else body.pose[:2]
+    component = _component(scene, half, (x0, y0))
+    if component is None:
+        return None
+    for i, event in enumerate(events, 1):
+        if event.kind not in ("pick", "drop"):
+            continue
+        d = (body.size + scene.objects[event.obj].size) / 2.0
+        if event.kind == "pick":
+            ox, oy = scene.objects[event.obj].position
+            where = shapely.Point(ox - d, oy)
+            what = f"its pick pose ({ox - d:g}, {oy:g})"
+        else:
+            ws = scene.workspaces[event.workspace]
+            if ws.is_point:
+                where = shapely.Point(ws.point[0] - d, ws.point[1])
+            else:
+                where = shapely.box(ws.x[0] - d, ws.y[0], ws.x[1] - d, ws.y[1])
+            what = f"any pose that drops {event.obj} in {event.workspace}"
+        if not component.intersects(where):
+            return (
+                f"{robot} cannot reach {event.name} (event {i} of its mission) at any horizon: "
+                f"walls separate its start ({x0:g}, {y0:g}) from {what}"
+            )
+    return None
+
+
+def _component(scene: Scene, half: float, start: tuple[float, float]):
+    """The free space of a square of half-side `half` connected to `start` (``None``: unknown)."""
+    blocked = scene.blocked(half, _SLACK)
+    # a frame around everything: walls, objects, workspaces and the start
+    points = [start, *(o.position for o in scene.objects.values())]
+    for ws in scene.workspaces.values():
+        points += [ws.point] if ws.is_point else [(ws.x[0], ws.y[0]), (ws.x[1], ws.y[1])]
+    lo_x, lo_y, hi_x, hi_y = shapely.MultiPoint(points).union(blocked).bounds
+    margin = 4 * half + 1000.0
+    frame = shapely.box(lo_x - margin, lo_y - margin, hi_x + margin, hi_y + margin)
+    free = frame.difference(blocked)
+    point = shapely.Point(start)
+    for part in getattr(free, "geoms", [free]):
+        if part.intersects(point.buffer(_SLACK)):
+            return part
+    return None  # the start itself is inside a wall: leave the verdict to the solver
