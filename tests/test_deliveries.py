@@ -179,12 +179,14 @@ def test_assignment_is_the_brute_force_optimum():
 
 
 def test_assignment_within_a_bound_says_so():
-    options = {f"O{i}": [(f"R{r}", "W") for r in range(4)] for i in range(8)}
-    costs = {(f"R{r}", f"O{i}", "W"): 3 + (i * 7 + r * 5) % 4 for i in range(8) for r in range(4)}
-    cut = assign(options, costs, max_nodes=20)
+    rng = random.Random(7)
+    options = {f"O{i}": [(f"R{r}", "W") for r in range(4)] for i in range(12)}
+    costs = {(r, o, "W"): rng.randint(3, 12) for o, opts in options.items() for r, _ in opts}
+    cut = assign(options, costs, max_nodes=3)
     full = assign(options, costs)
-    assert not cut.exhaustive and full.exhaustive
+    assert not cut.exhaustive and cut.nodes == 3 and full.exhaustive
     assert (full.makespan, full.total) <= (cut.makespan, cut.total)  # the greedy start is never lost
+    assert set(cut.tasks) == set(options)  # cut short, still a whole assignment
 
 
 def test_an_object_no_allowed_robot_can_reach_exits_1_naming_it(tmp_path: Path):
@@ -230,3 +232,9 @@ def test_deliveries_plan_and_record_the_allocation(tmp_path: Path):
     assert plan["allocation"] == {"O1": "R2", "O2": "R1"}
     assert plan["robots"]["R1"]["mission"] == ["pick(R1,O2)", "drop(R1,O2,W2)", "return(R1)"]
     assert plan["robots"]["R2"]["mission"] == ["pick(R2,O1)", "drop(R2,O1,W1)", "return(R2)"]
+
+
+def test_decompose_says_deliveries_need_a_choice_first():
+    path = Path(__file__).resolve().parents[1] / "examples" / "05_deliveries" / "scenario.yaml"
+    result = runner.invoke(app, ["decompose", str(path)])
+    assert result.exit_code == 1 and "cosmop plan" in result.stdout and "Traceback" not in result.output

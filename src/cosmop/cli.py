@@ -152,6 +152,16 @@ def decompose(
     """
     loaded = _load(scenario)
     err = Console(file=sys.stderr, highlight=False)
+    if loaded.mission.deliveries is not None:
+        # any allowed robot may move each good: no split into robots exists before a choice
+        _stdout().print(
+            Text(
+                "not separable as written: a deliveries mission leaves open which robot moves each good; "
+                f"`cosmop plan {scenario}` chooses, then decomposes and verifies the chosen missions",
+                style="yellow",
+            )
+        )
+        raise typer.Exit(1)
     mission = GlobalMission.from_scenario(loaded)
     team = None
     with err.status("decomposing by natural projection ...", spinner="dots") as status:
@@ -294,7 +304,14 @@ def plan(
     png: Annotated[
         Path | None, typer.Option(help="Also draw the scene and the plans into this PNG.", show_default=False)
     ] = None,
-    max_horizon: Annotated[int, typer.Option(help="Longest plan tried per robot (steps).", min=0)] = 16,
+    max_horizon: Annotated[
+        int | None,
+        typer.Option(
+            help="Longest plan tried per robot (steps) [default: 16, or 3 per mission event + 6 if more]",
+            min=0,
+            show_default=False,
+        ),
+    ] = None,
 ) -> None:
     """Plan, coordinate and verify the team (paper, Fig. "Overall framework").
 

@@ -129,6 +129,13 @@ def _pool(workers: int) -> ProcessPoolExecutor:
     return ProcessPoolExecutor(max_workers=workers, mp_context=context)
 
 
+def default_horizon(events: tuple[Event, ...]) -> int:
+    """The longest plan tried for a mission when the caller sets none: 16, or 3 steps per
+    mission event plus 6 when that is more (a robot with several deliveries needs the room;
+    detours around the others' places add steps)."""
+    return max(16, 3 * sum(1 for e in events if not e.is_message) + 6)
+
+
 class _Planner:
     """Runs syntheses (in an executor when there is one) and keeps the phase times."""
 
@@ -151,9 +158,8 @@ class _Planner:
         extra = self.obstacles.get(robot, ())
         if extra:
             scene = replace(scene, obstacles=scene.obstacles + extra)
-        return _Job(
-            scene, robot, tuple(events), self.max_horizon, self.rlimit, self.forbidden.get(robot, frozenset())
-        )
+        horizon = self.max_horizon if self.max_horizon is not None else default_horizon(events)
+        return _Job(scene, robot, tuple(events), horizon, self.rlimit, self.forbidden.get(robot, frozenset()))
 
     def run(self, jobs: Mapping[str, tuple[Event, ...]]) -> dict[str, Synthesis]:
         t0 = time.perf_counter()
@@ -183,7 +189,7 @@ class _Planner:
 def plan_team(
     scenario: Scenario,
     *,
-    max_horizon: int = 16,
+    max_horizon: int | None = None,
     rlimit: int = DEFAULT_RLIMIT,
     max_iterations: int = 5,
     workers: int | None = None,
@@ -197,7 +203,8 @@ def plan_team(
     ----------
     scenario : Scenario
     max_horizon, rlimit
-        Passed to :func:`cosmop.planning.synthesis.synthesize`.
+        Passed to :func:`cosmop.planning.synthesis.synthesize`; without `max_horizon`, each
+        robot's is :func:`default_horizon` of its mission.
     max_iterations : int
         Cap on coordinate/re-synthesize rounds.
     workers : int, optional

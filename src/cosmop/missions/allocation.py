@@ -307,7 +307,8 @@ def assign(
     Depth-first branch and bound over the objects, the most expensive first, each object's
     options cheapest first, starting from the greedy assignment (each object, in that order,
     where it raises (makespan, total) least) and pruning every branch that cannot beat the best
-    found.  Exact when it ends within `max_nodes` (``exhaustive``); otherwise the best found.
+    found (bounds: the loads so far, each object left at its cheapest, shared at best evenly).
+    Exact when it ends within `max_nodes` (``exhaustive``); otherwise the best found.
 
     Parameters
     ----------
@@ -344,6 +345,7 @@ def assign(
     for i in range(len(order) - 1, -1, -1):
         floor[i] = floor[i + 1] + usable[order[i]][0][0]
     best = _greedy(order, usable)
+    team = len({r for opts in usable.values() for _, r, _ in opts})
     loads: dict[str, int] = {}
     chosen: list[Option] = []
     nodes, exhaustive = 0, True
@@ -362,8 +364,10 @@ def assign(
                 return
             nodes += 1
             load = loads.get(r, 0) + c
-            # (span, total) only grow from here: a branch that cannot beat the best is cut
-            if (max(span_so_far, load), total + c + floor[i + 1]) >= best[0]:
+            # (span, total) only grow from here, and the busiest robot carries at least an even
+            # share of the least total: a branch that cannot beat the best is cut
+            least = total + c + floor[i + 1]
+            if (max(span_so_far, load, -(-least // team)), least) >= best[0]:
                 continue
             loads[r] = load
             chosen.append((r, w))
