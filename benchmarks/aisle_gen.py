@@ -13,10 +13,9 @@ from __future__ import annotations
 
 import argparse
 import random
-import sys
 from pathlib import Path
 
-import yaml
+from _harness import emit_scenario
 
 AISLE, SHELF, LENGTH, PITCH = 700, 1000, 6000, 1200
 ROBOT, GOOD = 400, 100
@@ -71,11 +70,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("-o", "--output", type=Path)
     args = parser.parse_args(argv)
-    text = yaml.safe_dump(aisle_warehouse(args.n, args.seed), sort_keys=False, default_flow_style=None)
-    if args.output:
-        args.output.write_text(text)
-    else:
-        sys.stdout.write(text)
+    emit_scenario(aisle_warehouse(args.n, args.seed), args.output)
     return 0
 
 

@@ -22,12 +22,11 @@ import argparse
 import itertools
 import json
 import math
-import os
-import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
+
+from _harness import child_row, save_results
 
 HERE = Path(__file__).resolve().parent
 BRUTE_FORCE_LIMIT = 2_000_000  # allocations enumerated at most
@@ -113,19 +112,10 @@ def main() -> int:
         return 0
     rows = []
     for size in args.sizes.split(","):
-        cmd = [sys.executable, __file__, "--child", size, "--seed", str(args.seed)]
-        proc = subprocess.run(cmd, capture_output=True, text=True, check=True)
-        row = json.loads(proc.stdout.strip().splitlines()[-1])
+        row = child_row(__file__, "--child", size, "--seed", str(args.seed))
         rows.append(row)
         print(json.dumps(row), flush=True)
-    out = HERE / "results"
-    out.mkdir(exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=out, suffix=".tmp")
-    with os.fdopen(fd, "w") as fh:
-        json.dump(
-            {"date": time.strftime("%Y-%m-%d"), "cpu_count": os.cpu_count(), "runs": rows}, fh, indent=2
-        )
-    os.replace(tmp, out / "allocation.json")
+    save_results("allocation", rows)
     return 0
 
 

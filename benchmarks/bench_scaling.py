@@ -10,13 +10,12 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import resource
-import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
+
+from _harness import child_row, save_results
 
 HERE = Path(__file__).resolve().parent
 
@@ -58,14 +57,7 @@ def main() -> int:
         return 0
     rows = []
     for n in (int(s) for s in args.sizes.split(",")):
-        proc = subprocess.run(
-            [sys.executable, __file__, "--child", str(n), "--seed", str(args.seed)],
-            capture_output=True,
-            text=True,
-            timeout=3600,
-            check=True,
-        )
-        row = json.loads(proc.stdout.strip().splitlines()[-1])
+        row = child_row(__file__, "--child", str(n), "--seed", str(args.seed), timeout=3600)
         rows.append(row)
         print(
             f"N={n:3d} total {row['total_s']:7.1f} s (synthesize {row['synthesize_s']:6.1f}, verify "
@@ -74,14 +66,7 @@ def main() -> int:
             f"peak main {row['peak_main_mib']:.0f} MiB, worker {row['peak_worker_mib']:.0f} MiB",
             flush=True,
         )
-    out = HERE / "results"
-    out.mkdir(exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=out, suffix=".tmp")
-    with os.fdopen(fd, "w") as fh:
-        json.dump(
-            {"date": time.strftime("%Y-%m-%d"), "cpu_count": os.cpu_count(), "runs": rows}, fh, indent=2
-        )
-    os.replace(tmp, out / "scaling.json")
+    save_results("scaling", rows)
     return 0
 
 

@@ -19,12 +19,11 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
-import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
+
+from _harness import child_row, save_results
 
 HERE = Path(__file__).resolve().parent
 EXAMPLES = HERE.parent / "examples"
@@ -147,28 +146,10 @@ def main() -> int:
         return 0
     rows = []
     for job in ["corridor", "order", *args.sizes.split(",")]:
-        cmd = [
-            sys.executable,
-            __file__,
-            "--child",
-            job,
-            "--seed",
-            str(args.seed),
-            "--max-time",
-            str(args.max_time),
-        ]
-        proc = subprocess.run(cmd, capture_output=True, text=True, check=True)
-        row = json.loads(proc.stdout.strip().splitlines()[-1])
+        row = child_row(__file__, "--child", job, "--seed", str(args.seed), "--max-time", str(args.max_time))
         rows.append(row)
         print(json.dumps(row), flush=True)
-    out = HERE / "results"
-    out.mkdir(exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=out, suffix=".tmp")
-    with os.fdopen(fd, "w") as fh:
-        json.dump(
-            {"date": time.strftime("%Y-%m-%d"), "cpu_count": os.cpu_count(), "runs": rows}, fh, indent=2
-        )
-    os.replace(tmp, out / "team.json")
+    save_results("team", rows)
     return 0
 
 

@@ -12,10 +12,9 @@ from __future__ import annotations
 
 import argparse
 import random
-import sys
 from pathlib import Path
 
-import yaml
+from _harness import emit_scenario
 
 AISLE, SHELF, LENGTH, PITCH = 1500, 1000, 5000, 1200
 ROBOT, GOOD = 400, 100
@@ -78,13 +77,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("-o", "--output", type=Path)
     args = parser.parse_args(argv)
-    text = yaml.safe_dump(
-        delivery_warehouse(args.n, args.m, args.seed), sort_keys=False, default_flow_style=None
-    )
-    if args.output:
-        args.output.write_text(text)
-    else:
-        sys.stdout.write(text)
+    emit_scenario(delivery_warehouse(args.n, args.m, args.seed), args.output)
     return 0
 
 

@@ -14,10 +14,9 @@ from __future__ import annotations
 
 import argparse
 import random
-import sys
 from pathlib import Path
 
-import yaml
+from _harness import emit_scenario
 
 BAY = 10_000
 
@@ -68,11 +67,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("-o", "--output", type=Path)
     args = parser.parse_args(argv)
-    text = yaml.safe_dump(warehouse(args.n, args.seed), sort_keys=False, default_flow_style=None)
-    if args.output:
-        args.output.write_text(text)
-    else:
-        sys.stdout.write(text)
+    emit_scenario(warehouse(args.n, args.seed), args.output)
     return 0
 
 

@@ -36,6 +36,8 @@ from dataclasses import dataclass, field
 from fractions import Fraction
 from types import MappingProxyType
 
+import shapely
+
 from cosmop.logic import FALSE, TRUE, Always, Formula, Implies, Next, Not, Until, Var, conj, disj, eq
 from cosmop.missions.events import Event
 from cosmop.planning.plan import State
@@ -243,17 +245,62 @@ and puts another down on its other side (or picks one up there) is wedged: every
 slides along a face it touches.  A millimetre of room lets it leave without touching."""
 
 
-def _handling_room(p: RobotProblem, obj: str) -> list[tuple[str, Formula]]:
-    """The robot keeps :data:`HANDLING_CLEARANCE` from every resting object but `obj`."""
+def _handling_room(p: RobotProblem, obj: str, places: list | None) -> list[tuple[str, Formula]]:
+    """The robot keeps :data:`HANDLING_CLEARANCE` from every resting object but `obj`.
+
+    `places` are where the robot's centre can be while handling `obj` (shapely geometries;
+    ``None``: anywhere).  An object this robot never moves rests where it started: when it is
+    far from every such place its constraint always holds, and is left out (a smaller formula).
+    """
     out = []
     for o in p.scene.objects:
         if o == obj:
             continue
+        size = _num(p.scene.objects[o].size)
+        gap = (p.side + size) / 2 + HANDLING_CLEARANCE
+        if o not in p.own_objects and places is not None:
+            at = _resting(p, o)
+            if at is not None:
+                near = shapely.box(
+                    at[0] - float(gap), at[1] - float(gap), at[0] + float(gap), at[1] + float(gap)
+                )
+                if not any(place.intersects(near) for place in places):
+                    continue
         w = p.obj(o)
-        gap = (p.side + _num(p.scene.objects[o].size)) / 2 + HANDLING_CLEARANCE
         apart = disj([p.x <= w.x - gap, p.x >= w.x + gap, p.y <= w.y - gap, p.y >= w.y + gap])
         out.append((f"room from {o} while handling {obj}", Implies(~w.carried & ~w.away, apart)))
     return out
+
+
+def _resting(p: RobotProblem, o: str) -> tuple[float, float] | None:
+    """Where an object this robot never moves rests (``None``: carried at the start)."""
+    if p.start is not None:
+        state = p.start.objects.get(o)
+        return None if state is None or state.carried else state.position
+    return p.scene.objects[o].position
+
+
+def _drop_places(p: RobotProblem, obj: str) -> list | None:
+    """Robot centres that drop `obj` in one of the mission's workspaces for it (``None``: any)."""
+    d = float(p.clearance(obj))
+    places = []
+    for e in p.mission:
+        if e.kind == "drop" and e.obj == obj:
+            ws = p.scene.workspaces[e.workspace]
+            if ws.is_point:
+                places.append(shapely.Point(ws.point[0] - d, ws.point[1]))
+            else:
+                places.append(shapely.box(ws.x[0] - d, ws.y[0], ws.x[1] - d, ws.y[1]))
+    return places or None
+
+
+def _pick_places(p: RobotProblem, obj: str) -> list | None:
+    """Robot centres that pick `obj` up: in front of where it starts or is dropped."""
+    at = _resting(p, obj)
+    if at is None:
+        return None
+    d = float(p.clearance(obj))
+    return [shapely.Point(at[0] - d, at[1]), *(_drop_places(p, obj) or [])]
 
 
 def _robot_static(p: RobotProblem) -> Formula:
@@ -323,7 +370,7 @@ class PickUp(Primitive):
         )
         pose = p.h.eq(0) & p.y.eq(v.y) & p.x.eq(v.x - d) & ~v.away
         out = [(f"PickUp {obj}", _robot_static(p) & carry & pose & _objects_static(p, carried=False))]
-        return out + _gripper_clear(p, obj, v.x, v.y) + _handling_room(p, obj)
+        return out + _gripper_clear(p, obj, v.x, v.y) + _handling_room(p, obj, _pick_places(p, obj))
 
 
 class DropOff(Primitive):
@@ -341,7 +388,7 @@ class DropOff(Primitive):
         place = p.h.eq(0) & v.x.next().eq(p.x + d) & v.y.next().eq(p.y)
         rest = _objects_static(p, carried=False, skip=obj) & _static(v.away)
         out = [(f"DropOff {obj}", _robot_static(p) & held & released & place & rest)]
-        out += _gripper_clear(p, obj, v.x.next(), v.y.next()) + _handling_room(p, obj)
+        out += _gripper_clear(p, obj, v.x.next(), v.y.next()) + _handling_room(p, obj, _drop_places(p, obj))
         side = _num(p.scene.objects[obj].size)
         for i, wall in enumerate(p.scene.obstacles):
             regions = wall_regions(wall.start, wall.end, side, f"wall {i}")

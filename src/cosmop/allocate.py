@@ -1,0 +1,151 @@
+"""Commit a mission that leaves choices open to its cheapest way, costed by the robots' plans.
+
+The bottom-up half of allocation (the top-down half is :mod:`cosmop.missions.allocation`):
+every word a robot may be given is planned (once, through the pipeline's planner, in parallel
+across robots), the costs go to :func:`~cosmop.missions.allocation.choose` (a DFA with choices)
+or :func:`~cosmop.missions.allocation.assign` (deliveries), and the chosen words, with the
+messages that keep the order K needs, go on to the usual loop.  `planner` is the pipeline's:
+``run(jobs)`` synthesises a word per robot and ``forbidden`` holds each robot's objects it may
+not request.
+"""
+
+from __future__ import annotations
+
+from types import MappingProxyType
+
+from cosmop.missions.allocation import Alternative, Choice, alternatives, assign, choose
+from cosmop.missions.events import Event, parse_event
+from cosmop.missions.mission import GlobalMission
+from cosmop.missions.ordering import order_words, with_messages
+from cosmop.planning.synthesis import Synthesis
+from cosmop.planning.timing import step_durations
+from cosmop.scenario import Scenario
+
+__all__ = ["allocate"]
+
+
+def allocate(
+    scenario: Scenario, mission: GlobalMission, planner
+) -> tuple[dict[str, tuple[Event, ...]], dict[str, tuple[str, str]], list[str], Choice]:
+    """Commit the team to the alternative of least makespan (:mod:`cosmop.missions.allocation`).
+
+    Every robot's word in every alternative is planned (each once; in parallel across robots),
+    the cheapest alternative is ordered by messages, and its words go on to the usual loop.
+    """
+    robots = tuple(scenario.scene.robots)
+    if scenario.mission.deliveries is not None:
+        return _allocate_deliveries(scenario, mission, planner)
+    found = alternatives(mission)
+    objects = frozenset(scenario.scene.objects)
+
+    def unanswerable(alt, robot: str) -> frozenset[str]:  # requests nobody in `alt` can answer
+        return objects - {o for o, r in alt.movers(mission).items() if r != robot}
+
+    pending: dict[str, list[tuple[tuple[str, ...], frozenset[str]]]] = {}
+    for alt in found.items:
+        for robot, word in alt.words.items():
+            job = (word, unanswerable(alt, robot))
+            if word and job not in pending.setdefault(robot, []):
+                pending[robot].append(job)
+    costs: dict[tuple, Synthesis] = {}
+    for rank in range(max((len(w) for w in pending.values()), default=0)):
+        batch = {r: jobs[rank] for r, jobs in pending.items() if rank < len(jobs)}
+        planner.forbidden = {r: forbid for r, (_, forbid) in batch.items()}
+        results = planner.run({r: tuple(mission.events[e] for e in w) for r, (w, _) in batch.items()})
+        costs.update({(r, *batch[r]): res for r, res in results.items()})
+    planner.forbidden = {}
+
+    def synthesis(alt, robot: str) -> Synthesis:
+        return costs[(robot, alt.words[robot], unanswerable(alt, robot))]
+
+    choice = choose(
+        found,
+        lambda alt, r: synthesis(alt, r).horizon if synthesis(alt, r).feasible else None,
+        lambda alt, r: synthesis(alt, r).reason or "no plan within the horizon",
+    )
+    if choice.alternative is None:
+        return {r: () for r in robots}, {}, [_no_alternative(choice, found.exhaustive)], choice
+    words = dict(choice.alternative.words)
+    # the loop starts from the plans costed here: same words, same requests ruled out
+    planner.forbidden = {r: unanswerable(choice.alternative, r) for r in robots if words.get(r)}
+    order = order_words(mission.complete, words)
+    placed, messages = with_messages(words, order.edges)
+    notes = {
+        name: ("order", f"the mission orders {b}'s {words[b][j]} after {a}'s {words[a][i]}")
+        for name, ((a, i), (b, j)) in messages
+    }
+    events = {r: tuple(parse_event(e) for e in placed.get(r, ())) for r in robots}
+    return events, notes, [], choice
+
+
+def _allocate_deliveries(
+    scenario: Scenario, mission: GlobalMission, planner
+) -> tuple[dict[str, tuple[Event, ...]], dict[str, tuple[str, str]], list[str], Choice]:
+    """Deliveries: cost each (robot, object, workspace) alone, then :func:`assign`.
+
+    A delivery alone is the robot's shortest plan from home that picks the object, drops it
+    in the workspace (and comes home, with ``return``).  A robot's words: its deliveries in the
+    file's order.  No robot's events order another's (each object is moved by one robot), so
+    the words need no messages.
+    """
+    spec = scenario.mission
+    robots = tuple(scenario.scene.robots)
+    nobody = frozenset(scenario.scene.objects) - {d.object for d in spec.deliveries}
+    pending: dict[str, list[tuple[str, str]]] = {}
+    for d in spec.deliveries:
+        for r in d.by:
+            pending.setdefault(r, []).extend((d.object, w) for w in d.to)
+    planner.forbidden = {r: nobody for r in pending}
+    costs: dict[tuple[str, str, str], Synthesis] = {}
+    for rank in range(max((len(v) for v in pending.values()), default=0)):
+        batch = {r: jobs[rank] for r, jobs in pending.items() if rank < len(jobs)}
+        results = planner.run({r: _delivery_word(r, o, w, spec.returns) for r, (o, w) in batch.items()})
+        costs.update({(r, *batch[r]): res for r, res in results.items()})
+    options = {d.object: [(r, w) for r in d.by for w in d.to] for d in spec.deliveries}
+    steps = {key: (res.horizon if res.feasible else None) for key, res in costs.items()}
+    home = scenario.scene.robots
+    seconds = {
+        key: sum(step_durations(res.plan, home[key[0]].pose, home[key[0]].dynamics))
+        for key, res in costs.items()
+        if res.feasible
+    }
+    chosen = assign(options, steps, seconds=seconds)
+    method = "branch and bound over (robot, workspace) per object, each delivery costed alone"
+    if chosen.stuck:
+        why = "; ".join(_undeliverable(o, options[o], costs) for o in chosen.stuck)
+        failed = Choice(None, None, None, chosen.nodes, method=method, costs=MappingProxyType(steps))
+        return {r: () for r in robots}, {}, [why], failed
+    words: dict[str, list[str]] = {r: [] for r in robots}
+    for d in spec.deliveries:
+        r, w = chosen.tasks[d.object]
+        words[r] += [f"pick({r},{d.object})", f"drop({r},{d.object},{w})"]
+    for r, word in words.items():
+        if word and spec.returns:
+            word.append(f"return({r})")
+    alternative = Alternative({r: tuple(w) for r, w in words.items()})
+    choice = Choice(
+        alternative, chosen.makespan, chosen.total, chosen.nodes, {}, chosen.exhaustive, method, steps
+    )
+    planner.forbidden = {r: nobody for r in robots if words[r]}
+    events = {r: tuple(mission.events[e] for e in w) for r, w in words.items()}
+    return events, {}, [], choice
+
+
+def _delivery_word(robot: str, obj: str, workspace: str, returns: bool) -> tuple[Event, ...]:
+    word = [Event("pick", robot, obj=obj), Event("drop", robot, obj=obj, workspace=workspace)]
+    return tuple(word + ([Event("return", robot)] if returns else []))
+
+
+def _undeliverable(obj: str, options, costs) -> str:
+    """Why no robot can deliver `obj`: each robot and workspace tried, with what blocks it."""
+    tried = [f"{r} to {w}: {costs[(r, obj, w)].reason or 'no plan within the horizon'}" for r, w in options]
+    return f"no robot can deliver {obj} (tried {'; '.join(tried)})"
+
+
+def _no_alternative(choice: Choice, exhaustive: bool) -> str:
+    """Why no way of completing the mission can be planned: each robot's word that fails."""
+    if not choice.considered:
+        bound = "" if exhaustive else " within the search bound"
+        return f"no way to complete the mission was found{bound}"
+    tried = [f"{r} cannot do {' '.join(w)} ({why})" for (r, w), why in choice.unplannable.items()]
+    return f"none of the {choice.considered} ways to complete the mission can be planned: " + "; ".join(tried)
