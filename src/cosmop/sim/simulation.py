@@ -79,6 +79,7 @@ TRACE_FORMAT = "cosmop.trace/1"
 
 _PRIMITIVES = (None, "GoTo", "PickUp", "DropOff", "Req", "Res")
 _TOUCH = 1e-6  # mm: squares closer than this touch
+_GRAZE = 1.0  # mm: a straight way closer than this to an obstacle is not trusted off the plan
 
 
 @dataclass(frozen=True)
@@ -356,6 +357,7 @@ class _Agent:
         self.stage: str | None = None  # of docking: approach, dock, handle
         self.path: GlobalPath | None = None
         self.seat: tuple[float, float] | None = None  # the plan's segment start to creep back to
+        self.anchor: tuple[int, tuple] | None = None  # (step, pose): where a replan starts that step
         self.goal: tuple[float, float, float] | None = None
         self.timer = 0.0
         self.grip: int | None = None  # object index touched by the gripper
@@ -651,22 +653,29 @@ def _brake(world: _World, i: int) -> tuple[str, Any]:
 def _goto(world: _World, agent: _Agent, step: Step) -> tuple[str, Any] | None:
     final = agent.k + 1 >= len(agent.steps) or agent.steps[agent.k + 1].primitive != "GoTo"
     goal = step.robot
-    origin = agent.steps[agent.k - 1].robot if agent.k > 0 else None
+    if agent.anchor is not None and agent.anchor[0] == agent.k:  # a replan's first step
+        origin = agent.anchor[1]
+    else:
+        origin = agent.steps[agent.k - 1].robot if agent.k > 0 else None
     return _drive(world, agent, goal, final, heading=final, origin=origin)
 
 
 def _route(world: _World, i: int, goal: tuple, origin: tuple | None) -> GlobalPath:
     """The global path to `goal`: the plan's own segment where the robot can follow it.
 
-    Straight from where the robot is; else back onto the plan's segment at its `origin` (an
-    intermediate waypoint passed within the tolerance leaves the robot beside it) and along it;
-    else around what now stands in the way (:func:`cosmop.control.paths.plan_path`).
+    Straight from where the robot is, unless that is blocked or only grazes an obstacle; else
+    back onto the plan's segment at its `origin` (an intermediate waypoint passed within the
+    tolerance, or a replan's rounded start, leaves the robot beside it) and along it; else
+    around what now stands in the way (:func:`cosmop.control.paths.plan_path`).
     """
     xy = world.pose[i, :2]
     here, boxes = (float(xy[0]), float(xy[1])), world.static_boxes(i, goal)
     half, target = float(world.half[i]), (goal[0], goal[1])
     path = straight_path(here, target, half, world.walls, boxes)
-    if path is None and origin is not None:
+    # a way from here that only grazes an obstacle (margin under a millimetre) may in truth cut
+    # into it by a fraction of one: the plan's own segment is proved free, so go by it
+    tight = path is None or path.margin < _GRAZE
+    if tight and origin is not None and math.dist(here, origin[:2]) > 1e-9:
         back = straight_path(here, (origin[0], origin[1]), half, world.walls, boxes)
         on = straight_path((origin[0], origin[1]), target, half, world.walls, boxes)
         if back is not None and on is not None:
@@ -1048,6 +1057,8 @@ def _recoordinate(world: _World, agent: _Agent, new: RobotPlan, start: State) ->
         other.mission = list(done) + [parse_event(e) for e in plan.mission]
         if other is agent or (other.k < len(other.steps) and other.steps[other.k] != current):
             other.phase, other.stage, other.path = "start", None, None
+        if other is agent:  # its new plan starts where it stood, rounded to the millimetre
+            other.anchor = (other.k, start.robot)
     added = [m.event for m in result.messages]
     world.conflict_names |= set(added)
     return True, "", added
