@@ -47,12 +47,9 @@ def allocate(
             job = (word, unanswerable(alt, robot))
             if word and job not in pending.setdefault(robot, []):
                 pending[robot].append(job)
-    costs: dict[tuple, Synthesis] = {}
-    for rank in range(max((len(w) for w in pending.values()), default=0)):
-        batch = {r: jobs[rank] for r, jobs in pending.items() if rank < len(jobs)}
-        planner.forbidden = {r: forbid for r, (_, forbid) in batch.items()}
-        results = planner.run({r: tuple(mission.events[e] for e in w) for r, (w, _) in batch.items()})
-        costs.update({(r, *batch[r]): res for r, res in results.items()})
+    costs = _plan_all(
+        planner, pending, lambda r, job: tuple(mission.events[e] for e in job[0]), lambda r, job: job[1]
+    )
     planner.forbidden = {}
 
     def synthesis(alt, robot: str) -> Synthesis:
@@ -96,11 +93,7 @@ def _allocate_deliveries(
         for r in d.by:
             pending.setdefault(r, []).extend((d.object, w) for w in d.to)
     planner.forbidden = {r: nobody for r in pending}
-    costs: dict[tuple[str, str, str], Synthesis] = {}
-    for rank in range(max((len(v) for v in pending.values()), default=0)):
-        batch = {r: jobs[rank] for r, jobs in pending.items() if rank < len(jobs)}
-        results = planner.run({r: _delivery_word(r, o, w, spec.returns) for r, (o, w) in batch.items()})
-        costs.update({(r, *batch[r]): res for r, res in results.items()})
+    costs = _plan_all(planner, pending, lambda r, job: _delivery_word(r, *job, spec.returns))
     options = {d.object: [(r, w) for r in d.by for w in d.to] for d in spec.deliveries}
     steps = {key: (res.horizon if res.feasible else None) for key, res in costs.items()}
     home = scenario.scene.robots
@@ -129,6 +122,22 @@ def _allocate_deliveries(
     planner.forbidden = {r: nobody for r in robots if words[r]}
     events = {r: tuple(mission.events[e] for e in w) for r, w in words.items()}
     return events, {}, [], choice
+
+
+def _plan_all(planner, pending: dict[str, list[tuple]], word, forbid=None) -> dict[tuple, Synthesis]:
+    """Plan every robot's jobs, one job per robot at a time (the robots in parallel).
+
+    ``word(robot, job)`` is the mission to plan; ``forbid(robot, job)``, if given, the objects
+    the robot may not request for it.  The results are keyed ``(robot, *job)``.
+    """
+    costs: dict[tuple, Synthesis] = {}
+    for rank in range(max((len(jobs) for jobs in pending.values()), default=0)):
+        batch = {r: jobs[rank] for r, jobs in pending.items() if rank < len(jobs)}
+        if forbid is not None:
+            planner.forbidden = {r: forbid(r, job) for r, job in batch.items()}
+        results = planner.run({r: word(r, job) for r, job in batch.items()})
+        costs.update({(r, *batch[r]): res for r, res in results.items()})
+    return costs
 
 
 def _delivery_word(robot: str, obj: str, workspace: str, returns: bool) -> tuple[Event, ...]:
