@@ -93,6 +93,7 @@ def test_the_form_reads_one_or_many_docks_and_robots():
             "exactly one of",
         ),
         ({"deliveries": [{"object": "O1", "to": "W1"}], "return": "yes"}, "mission.return", "true or false"),
+        ({"deliveries": [{"object": "O1", "to": "W1"}], "returns": True}, "mission.returns", "unknown key"),
     ],
 )
 def test_bad_deliveries_name_the_field(tmp_path: Path, mission, field, fragment):

@@ -746,8 +746,6 @@ class _DeliveryModel(_Model):
 
 
 class _MissionModel(_Model):
-    model_config = ConfigDict(extra="forbid", frozen=True, populate_by_name=True)
-
     tasks: dict[_Text, Annotated[list[_Text], _none_to([])]] | None = None
     dfa: _DfaModel | None = None
     deliveries: Annotated[list[_DeliveryModel], Field(min_length=1)] | None = None
