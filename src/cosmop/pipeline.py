@@ -475,15 +475,18 @@ def _make_safe(
     reasons: list[str],
     replans: list[str],
     max_rounds: int = 6,
+    max_total: int = 16,
 ) -> TeamSafety:
     """Order every conflict by messages; re-plan around the ones no order resolves (step 4).
 
     Each round, every robot that must give way in an unresolved conflict is re-planned with the
     space of the other side as an obstacle (all of them at once), until the conflicts are
-    ordered or `max_rounds` rounds are spent.
+    ordered, or `max_rounds` rounds pass without fewer unresolved conflicts than before (a
+    large team may need more rounds, each resolving some), or `max_total` rounds are spent.
     """
     settings = settings or ConflictSettings()
-    for n in range(max_rounds + 1):
+    best, since = None, 0
+    for n in range(max_total + 1):
         if reasons:
             return make_team_safe(
                 scenario.scene, {r: res.plan for r, res in results.items()}, settings=settings
@@ -495,10 +498,13 @@ def _make_safe(
         planner.phases["conflicts"] += time.perf_counter() - t0
         if safety.safe:
             return safety
+        left = len(safety.unresolved)
+        best, since = (left, 0) if best is None or left < best else (best, since + 1)
+        last = since >= max_rounds or n == max_total
         detours: dict[str, list[Conflict]] = {}
         for conflict in safety.unresolved:
             options = safety.detours(conflict)
-            if not options or n == max_rounds:
+            if not options or last:
                 reasons.append(
                     f"no order or re-plan keeps {' and '.join(conflict.robots)} apart: {conflict.describe()}"
                 )
