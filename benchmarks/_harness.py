@@ -3,6 +3,7 @@ and the generators' scenario output."""
 
 from __future__ import annotations
 
+import argparse
 import json
 import os
 import subprocess
@@ -44,3 +45,15 @@ def emit_scenario(data: dict, output: Path | None) -> None:
         output.write_text(text)
     else:
         sys.stdout.write(text)
+
+
+def generator_main(doc: str, build, sizes: tuple[str, ...], argv: list[str] | None) -> int:
+    """The command line of a scenario generator: ``SIZES... [--seed S] [-o FILE]``."""
+    parser = argparse.ArgumentParser(description=doc.splitlines()[0])
+    for name in sizes:
+        parser.add_argument(name, type=int)
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("-o", "--output", type=Path)
+    args = parser.parse_args(argv)
+    emit_scenario(build(*(getattr(args, name) for name in sizes), args.seed), args.output)
+    return 0

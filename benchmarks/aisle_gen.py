@@ -11,11 +11,9 @@ dock, then comes home: robots meet in the aisles, in both directions.
 
 from __future__ import annotations
 
-import argparse
 import random
-from pathlib import Path
 
-from _harness import emit_scenario
+from _harness import generator_main
 
 AISLE, SHELF, LENGTH, PITCH = 700, 1000, 6000, 1200
 ROBOT, GOOD = 400, 100
@@ -65,13 +63,7 @@ def aisle_warehouse(n: int, seed: int = 0, per_aisle: int = 3) -> dict:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("n", type=int)
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("-o", "--output", type=Path)
-    args = parser.parse_args(argv)
-    emit_scenario(aisle_warehouse(args.n, args.seed), args.output)
-    return 0
+    return generator_main(__doc__, aisle_warehouse, ("n",), argv)
 
 
 if __name__ == "__main__":

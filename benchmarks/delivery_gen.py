@@ -10,11 +10,9 @@ either of two docks; every fourth may be moved by only two (random) robots.  ``r
 
 from __future__ import annotations
 
-import argparse
 import random
-from pathlib import Path
 
-from _harness import emit_scenario
+from _harness import generator_main
 
 AISLE, SHELF, LENGTH, PITCH = 1500, 1000, 5000, 1200
 ROBOT, GOOD = 400, 100
@@ -71,14 +69,7 @@ def delivery_warehouse(n: int, m: int, seed: int = 0) -> dict:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("n", type=int)
-    parser.add_argument("m", type=int)
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("-o", "--output", type=Path)
-    args = parser.parse_args(argv)
-    emit_scenario(delivery_warehouse(args.n, args.m, args.seed), args.output)
-    return 0
+    return generator_main(__doc__, delivery_warehouse, ("n", "m"), argv)
 
 
 if __name__ == "__main__":

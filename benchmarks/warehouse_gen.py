@@ -12,11 +12,9 @@ returns.
 
 from __future__ import annotations
 
-import argparse
 import random
-from pathlib import Path
 
-from _harness import emit_scenario
+from _harness import generator_main
 
 BAY = 10_000
 
@@ -62,13 +60,7 @@ def warehouse(n: int, seed: int = 0) -> dict:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("n", type=int)
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("-o", "--output", type=Path)
-    args = parser.parse_args(argv)
-    emit_scenario(warehouse(args.n, args.seed), args.output)
-    return 0
+    return generator_main(__doc__, warehouse, ("n",), argv)
 
 
 if __name__ == "__main__":

@@ -362,14 +362,10 @@ class Scene:
         """
         import shapely
 
-        h = half - slack
-        grown = [
-            shapely.MultiPoint(
-                [(x + sx * h, y + sy * h) for x, y in (w.start, w.end) for sx in (-1, 1) for sy in (-1, 1)]
-            ).convex_hull
-            for w in self.obstacles
-        ]
-        return shapely.unary_union(grown)
+        from cosmop.squares import swept_square
+
+        side = 2.0 * (half - slack)
+        return shapely.unary_union([swept_square(w.start, w.end, side) for w in self.obstacles])
 
 
 @dataclass(frozen=True)

@@ -20,7 +20,9 @@ from dataclasses import dataclass
 
 import numpy as np
 import shapely
-from shapely.geometry import MultiPoint, Polygon
+from shapely.geometry import Polygon
+
+from cosmop.squares import square, swept_square
 
 __all__ = ["GlobalPath", "plan_path", "straight_path"]
 
@@ -86,14 +88,8 @@ class GlobalPath:
 
 def _grown(walls: np.ndarray, boxes: np.ndarray, half: float) -> list[Polygon]:
     """Obstacles grown by the robot's square of half side `half` (configuration-space obstacles)."""
-    out: list[Polygon] = []
-    corners = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]], dtype=float) * half
-    for x1, y1, x2, y2 in walls:
-        pts = np.vstack([corners + np.array([x1, y1]), corners + np.array([x2, y2])])
-        out.append(MultiPoint([tuple(p) for p in pts]).convex_hull)
-    for x, y, k in boxes:
-        r = k + half
-        out.append(Polygon([(x - r, y - r), (x + r, y - r), (x + r, y + r), (x - r, y + r)]))
+    out: list[Polygon] = [swept_square((x1, y1), (x2, y2), 2.0 * half) for x1, y1, x2, y2 in walls]
+    out += [square(x, y, 2.0 * (k + half)) for x, y, k in boxes]
     return out
 
 

@@ -52,7 +52,6 @@ from __future__ import annotations
 from collections.abc import Iterable
 from typing import Any
 
-from shapely import Polygon, box
 from shapely.geometry import LineString
 from shapely.geometry.base import BaseGeometry
 
@@ -63,6 +62,7 @@ from cosmop.planning.plan import PlanSet, RobotPlan, State, Step, _fmt, _point, 
 from cosmop.planning.realisation import TOLERANCE, event_instants, holds_at, step_primitive
 from cosmop.planning.report import RULES, CheckReport, Violation
 from cosmop.scenario import Scenario, Scene, Wall
+from cosmop.squares import square, swept_square
 
 __all__ = [
     "RULES",
@@ -79,34 +79,6 @@ __all__ = [
 # ----------------------------------------------------------------------------------------------
 # Geometry
 # ----------------------------------------------------------------------------------------------
-
-
-def square(x: float, y: float, side: float) -> Polygon:
-    """The axis-aligned square of side `side` centred at ``(x, y)`` (mm)."""
-    half = side / 2.0
-    return box(x - half, y - half, x + half, y + half)
-
-
-def swept_square(start: Iterable[float], end: Iterable[float], side: float) -> Polygon:
-    """The area swept by a square moving in a straight line: the convex hull of its two squares.
-
-    Parameters
-    ----------
-    start, end : iterable of float
-        Centres ``(x, y, ...)`` at the two ends (mm); further items (a heading) are ignored.
-    side : float
-        The square's side, mm.
-
-    Returns
-    -------
-    shapely.Polygon
-    """
-    x0, y0, *_ = start
-    x1, y1, *_ = end
-    first = square(x0, y0, side)
-    if abs(x1 - x0) == 0 and abs(y1 - y0) == 0:
-        return first
-    return first.union(square(x1, y1, side)).convex_hull
 
 
 def overlaps(a: BaseGeometry, b: BaseGeometry) -> bool:

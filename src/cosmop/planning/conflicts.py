@@ -43,6 +43,7 @@ from cosmop.missions.precedence import Link, Node, Precedence
 from cosmop.planning.plan import RobotPlan, State, _fmt, _point, initial_state
 from cosmop.planning.realisation import at_pose
 from cosmop.scenario import Scene
+from cosmop.squares import square, swept_square
 
 __all__ = [
     "Conflict",
@@ -138,17 +139,6 @@ class Conflict:
         return f"x in [{x0}, {x1}], y in [{y0}, {y1}]"
 
 
-def _square(x: float, y: float, side: float) -> BaseGeometry:
-    h = side / 2.0
-    return shapely.box(x - h, y - h, x + h, y + h)
-
-
-def _swept(p: Sequence[float], q: Sequence[float], side: float) -> BaseGeometry:
-    if p[0] == q[0] and p[1] == q[1]:
-        return _square(p[0], p[1], side)
-    return shapely.union(_square(p[0], p[1], side), _square(q[0], q[1], side)).convex_hull
-
-
 def _robot_occupancies(
     robot: str, plan: RobotPlan, start: State, side: float, home: Sequence[float], grow: float = 0.0
 ) -> list[Occupancy]:
@@ -175,12 +165,12 @@ def _robot_occupancies(
             Occupancy(
                 robot,
                 party,
-                _square(x, y, side),
+                square(x, y, side),
                 first,
                 last,
                 f"{robot} standing at {_point((x, y))} {where}",
                 not fixed,
-                _square(x, y, side - grow),
+                square(x, y, side - grow),
             )
         )
         k = end + 1
@@ -191,12 +181,12 @@ def _robot_occupancies(
                 Occupancy(
                     robot,
                     party,
-                    _swept(p, q, side),
+                    swept_square(p, q, side),
                     (robot, k),
                     (robot, k),
                     f"{robot}'s GoTo at instant {k} from {_point(p[:2])} to {_point(q[:2])}",
                     True,
-                    _swept(p, q, side - grow),
+                    swept_square(p, q, side - grow),
                 )
             )
     return out
@@ -239,7 +229,7 @@ def _object_occupancies(
                         Occupancy(
                             oid,
                             parties,
-                            _square(*position, spec.size),
+                            square(*position, spec.size),
                             first,
                             (robot, k),
                             f"{oid} resting at {_point(position)} {where}",
@@ -255,7 +245,7 @@ def _object_occupancies(
                 Occupancy(
                     oid,
                     parties,
-                    _square(*position, spec.size),
+                    square(*position, spec.size),
                     first,
                     None,
                     f"{oid} resting at {_point(position)} {where}",
