@@ -240,8 +240,7 @@ def plan_team(
             before = phases["synthesize"]
             words, notes, reasons, choice = allocate(scenario, mission, planner)
             phases["allocate"] = time.perf_counter() - t - (phases["synthesize"] - before)
-        result = _loop(scenario, mission, words, notes, reasons, planner, max_iterations, conflicts, choice)
-        return replace(result, allocation=choice)
+        return _loop(scenario, mission, words, notes, reasons, planner, max_iterations, conflicts, choice)
     finally:
         if pool is not None:
             pool.shutdown()
@@ -340,6 +339,7 @@ def _loop(
         phases=MappingProxyType(phases),
         safety=safety,
         replans=tuple(replans),
+        allocation=choice,
     )
 
 

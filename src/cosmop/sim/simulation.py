@@ -660,8 +660,9 @@ def _goto(world: _World, agent: _Agent, step: Step) -> tuple[str, Any] | None:
     return _drive(world, agent, goal, final, heading=final, origin=origin)
 
 
-def _route(world: _World, i: int, goal: tuple, origin: tuple | None) -> GlobalPath:
-    """The global path to `goal`: the plan's own segment where the robot can follow it.
+def _route(world: _World, i: int, goal: tuple, origin: tuple | None) -> tuple[GlobalPath, tuple | None]:
+    """The global path to `goal` (the plan's own segment where the robot can follow it), and
+    the segment's start when the path goes back to it first (``None`` otherwise).
 
     Straight from where the robot is, unless that is blocked or only grazes an obstacle; else
     back onto the plan's segment at its `origin` (an intermediate waypoint passed within the
@@ -679,8 +680,10 @@ def _route(world: _World, i: int, goal: tuple, origin: tuple | None) -> GlobalPa
         back = straight_path(here, (origin[0], origin[1]), half, world.walls, boxes)
         on = straight_path((origin[0], origin[1]), target, half, world.walls, boxes)
         if back is not None and on is not None:
-            path = GlobalPath((here, (origin[0], origin[1]), target), min(back.margin, on.margin))
-    return path or plan_path(here, target, half, world.walls, boxes) or GlobalPath((here, target), 0.0)
+            start = (origin[0], origin[1])
+            return GlobalPath((here, start, target), min(back.margin, on.margin)), start
+    path = path or plan_path(here, target, half, world.walls, boxes) or GlobalPath((here, target), 0.0)
+    return path, None
 
 
 def _reseat(world: _World, agent: _Agent) -> tuple[str, Any] | None:
@@ -722,10 +725,9 @@ def _drive(
     xy = world.pose[i, :2]
     fresh = agent.phase == "start" or agent.path is None
     if fresh:
-        agent.path = _route(world, i, goal, origin)
-        back = agent.path.points[1] if len(agent.path.points) == 3 and origin is not None else None
+        agent.path, back = _route(world, i, goal, origin)
         near = back is not None and math.dist(xy, back) <= s.pass_tolerance + s.goal_tolerance
-        agent.seat = back if near and back == (origin[0], origin[1]) else None
+        agent.seat = back if near else None
         agent.phase = "drive"
         agent.room = float(world.static_gaps(goal[:2], world.half[i])[0])
         agent.best = math.inf
