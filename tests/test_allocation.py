@@ -16,6 +16,7 @@ from cosmop.cli import app
 from cosmop.missions.allocation import Alternative, Alternatives, alternatives, choose
 from cosmop.missions.mission import GlobalMission
 from cosmop.pipeline import plan_team
+from cosmop.planning.synthesis import synthesize
 from cosmop.scenario import load_scenario, parse_scenario
 from cosmop.sim import simulate
 from team_checks import assert_complete_word, assert_no_overlap
@@ -144,11 +145,22 @@ def test_a_choice_of_dock_is_planned():
         ["a", "drop(R1,O1,W2)", "b"],
         ["b", "return(R1)", "done"],
     ]
-    team = plan_team(parse_scenario(data))
+    scenario = parse_scenario(data)
+    team = plan_team(scenario)
     assert team.plans.feasible, team.plans.reason
-    assert team.allocation.considered == 2
-    # W1 is on O1's side of the room: the cheaper dock
-    assert "drop(R1,O1,W1)" in team.plans.robots["R1"].mission
+    # a choice no other robot takes part in: planned once, as R1's branching mission
+    assert team.allocation.considered == 1
+    assert "R1's own choices planned as one branching mission" in team.allocation.method
+    # the dock chosen is a cheapest one, as costing each word alone shows (no one else moves
+    # anything, so R1 may request nothing)
+    word = ("pick(R1,O1)", "drop(R1,O1,{})", "return(R1)")
+    nobody = frozenset(scenario.scene.objects)
+    alone = {
+        w: synthesize(scenario.scene, "R1", [e.format(w) for e in word], unrequestable=nobody).horizon
+        for w in ("W1", "W2")
+    }
+    (chosen,) = [w for w in alone if f"drop(R1,O1,{w})" in team.plans.robots["R1"].mission]
+    assert team.allocation.makespan == alone[chosen] == min(alone.values())
 
 
 def test_no_plannable_way_exits_1_naming_the_robots_words(tmp_path):

@@ -111,14 +111,19 @@ def test_bad_deliveries_name_the_field(tmp_path: Path, mission, field, fragment)
 
 def test_a_workspace_too_small_for_the_object_is_bad_input():
     scene = json.loads(json.dumps(SCENE))
-    # a slot 80 mm wide between two walls: the 100 mm object's centre has nowhere to go
-    scene["obstacles"] += [[[0, 1000], [0, 2500]], [[80, 1000], [80, 2500]]]
+    # a dock 80 mm wide for a 100 mm object
     scene["workspaces"]["W3"] = {"x": [0, 80], "y": [1500, 2000]}
     with pytest.raises(ScenarioError) as err:
         parse_scenario(scenario({"deliveries": [{"object": "O1", "to": ["W1", "W3"]}]}, scene))
     assert err.value.field == "mission.deliveries[0].to[1]"
+    assert "W3 (80 mm x 500 mm) cannot hold O1 (a 100 mm square)" in str(err.value)
+    # wide enough, but walls every 80 mm across it leave the object's centre nowhere to go
+    scene["workspaces"]["W3"] = {"x": [0, 160], "y": [1500, 2000]}
+    scene["obstacles"] += [[[x, 1000], [x, 2500]] for x in (0, 80, 160)]
+    with pytest.raises(ScenarioError) as err:
+        parse_scenario(scenario({"deliveries": [{"object": "O1", "to": ["W1", "W3"]}]}, scene))
     assert "too small for O1" in str(err.value)
-    scene["obstacles"][-1] = [[100, 1000], [100, 2500]]  # exactly the object's width: it fits
+    scene["obstacles"][-2] = [[100, 1000], [100, 2500]]  # a slot exactly the object's width: it fits
     parse_scenario(scenario({"deliveries": [{"object": "O1", "to": ["W1", "W3"]}]}, scene))
 
 

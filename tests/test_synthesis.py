@@ -145,3 +145,9 @@ def test_no_pick_through_a_wall():
 def test_a_robot_without_a_mission_gets_an_empty_plan(small):
     res = synthesize(small.scene, "R2", [])
     assert res.feasible and res.horizon == 0 and res.plan.steps == ()
+
+
+def test_a_solver_that_gives_up_is_reported_not_raised(small):
+    res = synthesize(small.scene, "R1", small.mission.tasks["R1"], rlimit=2_000)
+    assert not res.feasible and res.plan is None
+    assert "the solver gave up" in res.reason and "resource limit 2000" in res.reason

@@ -195,3 +195,45 @@ def test_user_written_messages_order_a_tasks_mission():
     run = simulate(parse_scenario(data), result.plans)
     when = {event: t for t, _, event in run.events}
     assert run.completed and when["pick(R2,O2)"] >= when["drop(R1,O1,W1)"]
+
+
+class _Conflict:
+    """A stand-in conflict: two robots and a name (what `_give_way` reads)."""
+
+    def __init__(self, name: str, robots: tuple[str, str]) -> None:
+        self.name, self.robots = name, robots
+
+    def describe(self) -> str:
+        return self.name
+
+
+class _Safety:
+    """A stand-in TeamSafety whose `detours` (rank, robot, space to avoid) are given, best first."""
+
+    def __init__(self, ways: dict) -> None:
+        self.ways = ways
+
+    def detours(self, conflict):
+        return self.ways[conflict]
+
+
+def test_two_robots_never_give_way_around_each_other_in_one_round():
+    from cosmop.pipeline import _give_way
+
+    # R1's and R2's goods on one dock spot (either may drop elsewhere), and R2's drive through
+    # R1's good (only R2 may move, the best kind of detour): R2 drives around, R1 keeps its
+    # plan, and the dock spot waits for the next round (R2's new plan may settle it)
+    spot = _Conflict("goods on one spot", ("R1", "R2"))
+    drive = _Conflict("R2 drives through O1", ("R2", "R1"))
+    safety = _Safety(
+        {spot: [(2, "R1", "O2's spot"), (2, "R2", "O1's spot")], drive: [(0, "R2", "O1's spot")]}
+    )
+    assert _give_way(safety, [spot, drive]) == {"R2": [(drive, "O1's spot")]}
+    # when R2 cannot keep clear, R1 gives way where it can, R2 keeps its plan
+    assert _give_way(safety, [spot, drive], {"R2"}) == {"R1": [(spot, "O2's spot")]}
+    # a third robot's conflict with R1 (which R2 avoids) also waits
+    other = _Conflict("R3 and R1", ("R3", "R1"))
+    safety.ways[other] = [(1, "R1", "R3's drive"), (1, "R3", "R1's drive")]
+    assert _give_way(safety, [spot, drive, other]) == {"R2": [(drive, "O1's spot")]}
+    # alone, a conflict goes ahead with its best way
+    assert _give_way(safety, [spot]) == {"R1": [(spot, "O2's spot")]}

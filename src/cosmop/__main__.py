@@ -1,6 +1,6 @@
 """``python -m cosmop``: the command line."""
 
-from cosmop.cli import main
+from cosmop._entry import run
 
 if __name__ == "__main__":
-    main()
+    run()

@@ -11,9 +11,20 @@ not request.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from types import MappingProxyType
 
-from cosmop.missions.allocation import Alternative, Choice, alternatives, assign, choose
+from cosmop.automata import DFA
+from cosmop.missions.allocation import (
+    Alternative,
+    Alternatives,
+    Choice,
+    alternatives,
+    assign,
+    choose,
+    others,
+    own_choices,
+)
 from cosmop.missions.events import Event, parse_event
 from cosmop.missions.mission import GlobalMission
 from cosmop.missions.ordering import order_words, with_messages
@@ -41,14 +52,17 @@ def allocate(
     def unanswerable(alt, robot: str) -> frozenset[str]:  # requests nobody in `alt` can answer
         return objects - {o for o, r in alt.movers(mission).items() if r != robot}
 
+    found, costs, settled = _settle_own_choices(planner, found, mission, unanswerable)
     pending: dict[str, list[tuple[tuple[str, ...], frozenset[str]]]] = {}
     for alt in found.items:
         for robot, word in alt.words.items():
             job = (word, unanswerable(alt, robot))
-            if word and job not in pending.setdefault(robot, []):
+            if word and (robot, word, job[1]) not in costs and job not in pending.setdefault(robot, []):
                 pending[robot].append(job)
-    costs = _plan_all(
-        planner, pending, lambda r, job: tuple(mission.events[e] for e in job[0]), lambda r, job: job[1]
+    costs.update(
+        _plan_all(
+            planner, pending, lambda r, job: tuple(mission.events[e] for e in job[0]), lambda r, job: job[1]
+        )
     )
     planner.forbidden = {}
 
@@ -60,6 +74,9 @@ def allocate(
         lambda alt, r: synthesis(alt, r).horizon if synthesis(alt, r).feasible else None,
         lambda alt, r: synthesis(alt, r).reason or "no plan within the horizon",
     )
+    if settled:
+        how = f"{', '.join(settled)}'s own choices planned as one branching mission each"
+        choice = replace(choice, method=f"{choice.method}; {how}")
     if choice.alternative is None:
         return {r: () for r in robots}, {}, [_no_alternative(choice, found.exhaustive)], choice
     words = dict(choice.alternative.words)
@@ -73,6 +90,55 @@ def allocate(
     }
     events = {r: tuple(parse_event(e) for e in placed.get(r, ())) for r in robots}
     return events, notes, [], choice
+
+
+def _settle_own_choices(
+    planner, found: Alternatives, mission: GlobalMission, unanswerable
+) -> tuple[Alternatives, dict[tuple, Synthesis], list[str]]:
+    """Plan the choices each robot makes alone as branching missions; keep the cheapest word.
+
+    Robot after robot (:func:`~cosmop.missions.allocation.own_choices`): each group of its
+    words that go with the same words of the others is planned once over the automaton of the
+    group (:func:`~cosmop.planning.synthesis.synthesize` with a DFA), the shortest plan over
+    all of them, and the alternatives keep only the word that plan performs (exact, see
+    :mod:`cosmop.missions.allocation`).  That synthesis also answers the plain question for its
+    word (no shorter plan of it exists), so the planning loop reuses it.  Costs are keyed like
+    :func:`allocate`'s; the robots that had such choices are returned last.
+    """
+    costs: dict[tuple, Synthesis] = {}
+    settled = []
+    for robot in mission.robots:
+        groups = own_choices(found, robot, mission)
+        if not groups:
+            continue
+        settled.append(robot)
+        jobs: list[tuple[tuple, frozenset[str]]] = []
+        where = {}
+        for alt in found.items:
+            rest = others(alt, robot)
+            if rest in groups:
+                where[rest] = (groups[rest], unanswerable(alt, robot))
+                if where[rest] not in jobs:
+                    jobs.append(where[rest])
+        results = _plan_all(
+            planner, {robot: jobs}, lambda r, job: DFA.from_words(job[0]), lambda r, job: job[1]
+        )
+        for (r, words, forbidden), res in results.items():
+            if res.feasible:
+                costs[(r, res.plan.mission, forbidden)] = res
+                planner.remember(r, res.plan.events, forbidden, res)
+            else:  # no word of the group can be planned: each keeps the reason
+                costs.update({(r, w, forbidden): res for w in words})
+
+        def cheapest(alt, robot=robot, where=where, results=results) -> bool:
+            job = where.get(others(alt, robot))
+            if job is None:
+                return True
+            res = results[(robot, *job)]
+            return not res.feasible or res.plan.mission == alt.words[robot]
+
+        found = Alternatives(tuple(a for a in found.items if cheapest(a)), found.exhaustive, found.explored)
+    return found, costs, settled
 
 
 def _allocate_deliveries(

@@ -28,7 +28,7 @@ from cosmop import __version__
 from cosmop.automata import DFA
 from cosmop.cli_words import decompose_verdict, plan_verdict
 from cosmop.errors import CosmopInputError, EventSyntaxError
-from cosmop.io import write_atomic
+from cosmop.io import check_writable, uninterrupted, write_atomic
 from cosmop.missions.decomposition import decompose as run_decompose
 from cosmop.missions.mission import GlobalMission, sequence_of
 from cosmop.missions.team import verify_team
@@ -47,7 +47,9 @@ class _Group(TyperGroup):
     """Command group that turns input errors into one line on stderr and exit status 2.
 
     Input errors are :class:`~cosmop.errors.CosmopInputError` (bad files) and
-    :class:`~cosmop.errors.EventSyntaxError` (an event typed on the command line).
+    :class:`~cosmop.errors.EventSyntaxError` (an event typed on the command line); a file the
+    system refuses to write (:class:`OSError`, e.g. a full disk) is reported the same way.
+    Ctrl-C ends with one line and status 130 (128 + SIGINT), as shells expect.
     """
 
     def invoke(self, ctx: typer.Context) -> Any:
@@ -57,6 +59,13 @@ class _Group(TyperGroup):
             # plain echo, not rich: field paths such as tasks.R1[0] must not be read as markup
             typer.echo(f"error: {err}", err=True)
             raise typer.Exit(EXIT_INPUT_ERROR) from None
+        except OSError as err:
+            where = f"{err.filename}: " if err.filename else ""
+            typer.echo(f"error: {where}{err.strerror or err}", err=True)
+            raise typer.Exit(EXIT_INPUT_ERROR) from None
+        except KeyboardInterrupt:
+            typer.echo("interrupted", err=True)
+            raise typer.Exit(130) from None
 
 
 app = typer.Typer(
@@ -151,6 +160,7 @@ def decompose(
     bad input.
     """
     loaded = _load(scenario)
+    check_writable(dot, "--dot", folder=True)
     err = Console(file=sys.stderr, highlight=False)
     if loaded.mission.deliveries is not None:
         # any allowed robot may move each good: no split into robots exists before a choice
@@ -327,6 +337,8 @@ def plan(
     from cosmop.pipeline import plan_team
 
     loaded = _load(scenario)
+    check_writable(output, "-o")
+    check_writable(png, "--png")
     if png is not None:
         from cosmop.viz import available
 
@@ -449,6 +461,8 @@ def simulate(
     from cosmop.sim import simulate as run_simulate
 
     loaded = _load(scenario)
+    for option, path in (("--summary", summary), ("--trace", trace), ("--gif", gif), ("--mp4", mp4)):
+        check_writable(path, option)
     for path, check_video in ((gif, False), (mp4, True)):
         if path is None:
             continue
@@ -496,10 +510,11 @@ def simulate(
             settings=settings,
             on_cycle=lambda t, done, robots: progress.update(task, completed=t, done=done),
         )
-    if summary is not None:
-        result.save_summary(summary)
-    if trace is not None:
-        result.save_trace(trace)
+    with uninterrupted():  # the trace and its summary: both or neither
+        if trace is not None:
+            result.save_trace(trace)
+        if summary is not None:
+            result.save_summary(summary)
     if bag is not None:
         _cli_ecosystem.write_bag_and_report(loaded.scene, result.trace(), bag, plans, None, 5.0)
     for path in (gif, mp4):

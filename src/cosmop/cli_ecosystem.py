@@ -14,7 +14,7 @@ import typer
 from rich.text import Text
 
 from cosmop.cli import _stdout, app
-from cosmop.io import write_atomic
+from cosmop.io import check_writable, write_atomic
 
 __all__: list[str] = []
 
@@ -80,6 +80,7 @@ def import_map(
     from cosmop.maps import scenario_text
     from cosmop.scenario import load_scenario
 
+    check_writable(output, "-o")
     imported = read_map(
         map_file,
         cell_size=cell_size,
@@ -225,6 +226,7 @@ def view(
     from cosmop.viz.web import save_html
 
     loaded = _load(scenario)
+    check_writable(output, "-o")
     plans = load_plan(plan_file) if plan_file is not None else None
     data = load_trace(trace) if trace is not None else None
     _warn_if_other_scenario(loaded, data, plans)

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import os
 
-__all__ = ["CosmopInputError", "EventSyntaxError", "ScenarioError"]
+__all__ = ["CosmopInputError", "EventSyntaxError", "OutputPathError", "ScenarioError"]
 
 
 class CosmopInputError(Exception):
@@ -74,6 +74,10 @@ def _rebuild(cls, expected, file, field, line, column):
 
 class ScenarioError(CosmopInputError):
     """A scenario file (or scenario mapping) that cannot be loaded or is invalid."""
+
+
+class OutputPathError(CosmopInputError):
+    """An output path that cannot be written: its folder is missing or read-only, or it is a folder."""
 
 
 class EventSyntaxError(ValueError):

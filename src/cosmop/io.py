@@ -7,9 +7,57 @@ import os
 import secrets
 from pathlib import Path
 
-from cosmop.errors import CosmopInputError
+from cosmop.errors import CosmopInputError, OutputPathError
 
-__all__ = ["write_atomic"]
+__all__ = ["check_writable", "uninterrupted", "write_atomic"]
+
+
+@contextlib.contextmanager
+def uninterrupted():
+    """Hold Ctrl-C (SIGINT) back while the block runs; it arrives, if pressed, right after.
+
+    For outputs that belong together (a run's summary and its trace): each is written
+    atomically, and together they are written all or nothing.  Outside the main thread, or
+    where signals cannot be masked, the block runs as it is.
+    """
+    import signal
+    import threading
+
+    if not hasattr(signal, "pthread_sigmask") or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
+def check_writable(path: str | os.PathLike[str] | None, option: str, *, folder: bool = False) -> None:
+    """Raise :class:`OutputPathError` unless `path` can be written (check before any work).
+
+    Parameters
+    ----------
+    path : str or os.PathLike or None
+        An output the user named (``None``: not asked for, nothing to check).
+    option : str
+        The command-line option that named it (``-o``, ``--png``), for the message.
+    folder : bool
+        Whether the output is a folder to create (then it must not exist yet as a file).
+    """
+    if path is None:
+        return
+    target = Path(path)
+    parent = target.parent
+    if not folder and target.is_dir():
+        raise OutputPathError("is a folder; expected the path of a file to write", file=target, field=option)
+    if folder and target.exists() and not target.is_dir():
+        raise OutputPathError("is a file; expected a folder to write into", file=target, field=option)
+    if not parent.is_dir():
+        missing = f"the folder {parent} does not exist; create it first"
+        raise OutputPathError(missing, file=target, field=option)
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise OutputPathError(f"the folder {parent} is not writable", file=target, field=option)
 
 
 def write_atomic(path: str | os.PathLike[str], data: str | bytes) -> None:

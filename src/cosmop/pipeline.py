@@ -24,6 +24,7 @@ from __future__ import annotations
 import itertools
 import multiprocessing
 import os
+import signal
 import time
 from collections.abc import Callable, Mapping
 from concurrent.futures import Executor, ProcessPoolExecutor
@@ -33,6 +34,7 @@ from types import MappingProxyType
 import shapely
 
 from cosmop.allocate import allocate
+from cosmop.automata import DFA
 from cosmop.missions.allocation import Choice
 from cosmop.missions.coordination import Coordinated, coordinate
 from cosmop.missions.decomposition import decompose
@@ -40,7 +42,7 @@ from cosmop.missions.events import Event, parse_event
 from cosmop.missions.mission import GlobalMission, sequence_of
 from cosmop.missions.team import TeamVerdict, blocking_word, check_words
 from cosmop.planning.checker import CheckReport, check_plan
-from cosmop.planning.conflicts import Conflict, ConflictSettings
+from cosmop.planning.conflicts import ConflictSettings
 from cosmop.planning.plan import Coordination, PlanMessage, PlanSet, RobotPlan
 from cosmop.planning.realisation import event_instants
 from cosmop.planning.synthesis import DEFAULT_RLIMIT, Synthesis, synthesize
@@ -103,10 +105,15 @@ class _Job:
 
     scene: Scene
     robot: str
-    events: tuple[Event, ...]
+    events: tuple[Event, ...] | DFA
     max_horizon: int
     rlimit: int
     unrequestable: frozenset[str] = frozenset()
+
+
+def _automaton_key(dfa: DFA) -> tuple:
+    """A branching mission by value (DFAs compare by identity)."""
+    return ("automaton", dfa.alphabet, dfa.delta.tobytes(), dfa.initial, dfa.marked.tobytes())
 
 
 def _synthesize(job: _Job) -> Synthesis:
@@ -125,7 +132,12 @@ def _pool(workers: int) -> ProcessPoolExecutor:
     """Worker processes (forked where the platform allows: no re-import of the package)."""
     methods = multiprocessing.get_all_start_methods()
     context = multiprocessing.get_context("fork" if "fork" in methods else "spawn")
-    return ProcessPoolExecutor(max_workers=workers, mp_context=context)
+    return ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=_leave_interrupts)
+
+
+def _leave_interrupts() -> None:
+    """In a worker: Ctrl-C reaches the whole process group; the parent alone answers it."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def default_horizon(events: tuple[Event, ...]) -> int:
@@ -149,16 +161,25 @@ class _Planner:
         self.obstacles: dict[str, tuple[Wall, ...]] = {}
         self.cache: dict[tuple, Synthesis] = {}  # the same question is never solved twice
 
-    def key(self, robot: str, events: tuple[Event, ...]) -> tuple:
-        return (robot, tuple(events), self.forbidden.get(robot, frozenset()), self.obstacles.get(robot, ()))
+    def key(self, robot: str, events: tuple[Event, ...] | DFA) -> tuple:
+        mission = _automaton_key(events) if isinstance(events, DFA) else tuple(events)
+        return (robot, mission, self.forbidden.get(robot, frozenset()), self.obstacles.get(robot, ()))
 
-    def job(self, robot: str, events: tuple[Event, ...]) -> _Job:
+    def remember(self, robot: str, events: tuple[Event, ...], forbidden: frozenset[str], result: Synthesis):
+        """Keep `result` as the answer for `events` with `forbidden` (one it answers exactly)."""
+        self.cache[(robot, tuple(events), forbidden, self.obstacles.get(robot, ()))] = result
+
+    def job(self, robot: str, events: tuple[Event, ...] | DFA) -> _Job:
         scene = self.scenario.scene
         extra = self.obstacles.get(robot, ())
         if extra:
             scene = replace(scene, obstacles=scene.obstacles + extra)
-        horizon = self.max_horizon if self.max_horizon is not None else default_horizon(events)
-        return _Job(scene, robot, tuple(events), horizon, self.rlimit, self.forbidden.get(robot, frozenset()))
+        branching = isinstance(events, DFA)
+        # a branching mission gets the horizon of its alphabet: no word of it has more events
+        mission = tuple(parse_event(e) for e in events.alphabet) if branching else tuple(events)
+        horizon = self.max_horizon if self.max_horizon is not None else default_horizon(mission)
+        forbidden = self.forbidden.get(robot, frozenset())
+        return _Job(scene, robot, events if branching else mission, horizon, self.rlimit, forbidden)
 
     def run(self, jobs: Mapping[str, tuple[Event, ...]]) -> dict[str, Synthesis]:
         t0 = time.perf_counter()
@@ -241,6 +262,14 @@ def plan_team(
             words, notes, reasons, choice = allocate(scenario, mission, planner)
             phases["allocate"] = time.perf_counter() - t - (phases["synthesize"] - before)
         return _loop(scenario, mission, words, notes, reasons, planner, max_iterations, conflicts, choice)
+    except BaseException:  # an interrupt or an error: do not wait for the workers' syntheses
+        if pool is not None:
+            pool.shutdown(wait=False, cancel_futures=True)
+            # a synthesis can run for minutes: end the workers now (no public call before 3.14)
+            for process in list((getattr(pool, "_processes", None) or {}).values()):
+                process.terminate()
+            pool = None
+        raise
     finally:
         if pool is not None:
             pool.shutdown()
@@ -479,10 +508,12 @@ def _make_safe(
 ) -> TeamSafety:
     """Order every conflict by messages; re-plan around the ones no order resolves (step 4).
 
-    Each round, every robot that must give way in an unresolved conflict is re-planned with the
-    space of the other side as an obstacle (all of them at once), until the conflicts are
+    Each round, the robots that give way in unresolved conflicts (:func:`_give_way`) are
+    re-planned with the space of the other side as an obstacle, until the conflicts are
     ordered, or `max_rounds` rounds pass without fewer unresolved conflicts than before (a
     large team may need more rounds, each resolving some), or `max_total` rounds are spent.
+    A robot that cannot keep clear is given back its plan and the other side gives way instead,
+    where it can.
     """
     settings = settings or ConflictSettings()
     best, since = None, 0
@@ -501,30 +532,75 @@ def _make_safe(
         left = len(safety.unresolved)
         best, since = (left, 0) if best is None or left < best else (best, since + 1)
         last = since >= max_rounds or n == max_total
-        detours: dict[str, list[Conflict]] = {}
-        for conflict in safety.unresolved:
-            options = safety.detours(conflict)
-            if not options or last:
-                reasons.append(
-                    f"no order or re-plan keeps {' and '.join(conflict.robots)} apart: {conflict.describe()}"
-                )
-                return safety
-            robot, keep = options[0]
-            planner.obstacles[robot] = planner.obstacles.get(robot, ()) + _walls_around(keep.region, settings)
-            detours.setdefault(robot, []).append(conflict)
-        for robot, shared in detours.items():
-            replans.append(f"{robot} re-planned around the space it shares: {shared[0].describe()}")
-        fresh = planner.run({robot: current[robot] for robot in detours})
-        for robot, res in fresh.items():
-            if not res.feasible:
-                reasons.append(
-                    f"{robot} cannot keep clear of the space it shares with another robot "
-                    f"({detours[robot][0].describe()}): {res.reason}"
-                )
+        stuck = [c for c in safety.unresolved if not safety.detours(c)]
+        if stuck or last:
+            conflict = (stuck or list(safety.unresolved))[0]
+            reasons.append(
+                f"no order or re-plan keeps {' and '.join(conflict.robots)} apart: {conflict.describe()}"
+            )
+            return safety
+        moves = _give_way(safety, safety.unresolved)
+        fresh, failed = _detour(planner, current, moves, settings, replans)
+        instead = _give_way(safety, [c for r in failed for c, _ in moves[r]], set(failed))
+        if instead:  # the other side of their conflicts gives way instead, where it can
+            again, failed = _detour(planner, current, instead, settings, replans)
+            fresh.update(again)
+        for robot, (conflict, why) in failed.items():
+            reasons.append(
+                f"{robot} cannot keep clear of the space it shares with another robot "
+                f"({conflict.describe()}): {why}"
+            )
         if reasons:
             return safety
         results.update(fresh)
     return safety
+
+
+def _give_way(
+    safety: TeamSafety, conflicts, exclude: frozenset[str] | set[str] = frozenset()
+) -> dict[str, list]:
+    """Who gives way in which of `conflicts`: ``robot -> [(conflict, space to avoid)]``.
+
+    Each conflict's best way (:meth:`TeamSafety.detours`), the conflicts with the best ways
+    first, except that a robot avoids only the space of one that keeps its plan this round
+    (else the space it avoids may move): when the best way would re-plan a robot another one
+    avoids, or have it avoid a robot being re-planned, the conflict waits for the next round
+    (when nothing else moves, it goes ahead).  Robots in `exclude` keep their plans.
+    """
+    moves: dict[str, list] = {}
+    keepers: set[str] = set()
+    best = {
+        c: next(((n, r, k) for n, r, k in safety.detours(c) if r not in exclude), None) for c in conflicts
+    }
+    for conflict in sorted((c for c in best if best[c] is not None), key=lambda c: best[c][0]):
+        _, robot, keep = best[conflict]
+        keeper = next((r for r in conflict.robots if r != robot), None)
+        if moves and (robot in keepers or keeper in moves):
+            continue  # it would re-plan a robot around one that is re-planned too: next round
+        moves.setdefault(robot, []).append((conflict, keep))
+        keepers.add(keeper)
+    return moves
+
+
+def _detour(planner, current, moves, settings, replans) -> tuple[dict[str, Synthesis], dict[str, tuple]]:
+    """Re-plan every robot in `moves` around its spaces; a robot that fails gets its walls back.
+
+    Returns the new syntheses and, for each robot that failed, its first conflict and why."""
+    saved = dict(planner.obstacles)
+    for robot, items in moves.items():
+        walls = tuple(w for _, keep in items for w in _walls_around(keep.region, settings))
+        planner.obstacles[robot] = planner.obstacles.get(robot, ()) + walls
+        replans.append(f"{robot} re-planned around the space it shares: {items[0][0].describe()}")
+    fresh = planner.run({robot: current[robot] for robot in moves})
+    failed = {}
+    for robot, res in list(fresh.items()):
+        if not res.feasible:
+            failed[robot] = (moves[robot][0][0], res.reason)
+            planner.obstacles[robot] = saved.get(robot, ())
+            if not planner.obstacles[robot]:
+                del planner.obstacles[robot]
+            del fresh[robot]
+    return fresh, failed
 
 
 def _walls_around(region, settings: ConflictSettings) -> tuple[Wall, ...]:

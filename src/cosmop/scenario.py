@@ -996,6 +996,7 @@ class _Builder:
         if model.version is not None and model.version != SCENARIO_VERSION:
             self.fail(("version",), f"expected {_EXPECTED[('version',)]}, got {model.version}")
         scene = scene_to_internal(self.build_scene(model.scene), model.units or "mm")
+        self.check_bodies(scene)
         mission = self.build_mission(model.mission, scene)
         return Scenario(name=model.name, scene=scene, mission=mission, source=source)
 
@@ -1053,6 +1054,15 @@ class _Builder:
             humans=humans,
             dynamics=dynamics,
         )
+
+    def check_bodies(self, scene: Scene) -> None:
+        """A physically possible scene: no body overlaps a wall or another body at the start."""
+        from cosmop.physics import overlaps
+
+        metres = self.units == "m"
+        found = overlaps(scene, scale=1000.0 if metres else 1.0, unit="m" if metres else "mm")
+        if found:
+            self.fail(found[0].field, found[0].describe())
 
     def check_cycles(self, robots: Mapping[str, Robot], default: Dynamics) -> None:
         """All robots share one control cycle: report the first robot off the most common one."""
@@ -1145,13 +1155,7 @@ class _Builder:
                 if ws not in scene.workspaces:
                     known = _known("workspaces", scene.workspaces)
                     self.fail((*path, "to", k), f"unknown workspace {ws!r}; {known}")
-                if not _fits(scene, scene.objects[obj], scene.workspaces[ws]):
-                    size = scene.objects[obj].size
-                    self.fail(
-                        (*path, "to", k),
-                        f"workspace {ws} is too small for {obj} ({size:g} mm): no drop position "
-                        "in it keeps the object clear of the walls",
-                    )
+                self.check_holds((*path, "to", k), scene.objects[obj], ws, scene)
             by = tuple(model.by) if model.by is not None else tuple(scene.robots)
             for k, robot in enumerate(by):
                 if robot not in scene.robots:
@@ -1160,7 +1164,10 @@ class _Builder:
         return tuple(out)
 
     def build_tasks(self, tasks: Mapping[str, list[str]], scene: Scene) -> dict[str, tuple[Event, ...]]:
+        if not tasks:
+            self.fail(("mission", "tasks"), "expected a task list for at least one robot, got none")
         result = {}
+        mover: dict[str, _Path] = {}  # the first task that moves each object
         for robot, steps in tasks.items():
             if robot not in scene.robots:
                 self.fail(
@@ -1177,6 +1184,15 @@ class _Builder:
                         f"expected an event of robot {robot}, got {event.name}, which belongs to {owners}",
                     )
                 self.check_references(path, event, scene)
+                if event.kind in ("pick", "drop"):
+                    first = mover.setdefault(event.obj, path)
+                    if first[2] != robot:
+                        self.fail(
+                            path,
+                            f"{event.obj} is already moved by {first[2]} ({_format_path(first)}); one robot "
+                            "moves each object in a task list (a relay between robots needs an order: "
+                            "write the mission as a dfa)",
+                        )
                 events.append(event)
             result[robot] = tuple(events)
         return result
@@ -1271,6 +1287,29 @@ class _Builder:
                 f"unknown workspace {event.workspace!r} in {event.name}; "
                 f"{_known('workspaces', scene.workspaces)}",
             )
+        if event.kind == "drop":
+            self.check_holds(path, scene.objects[event.obj], event.workspace, scene)
+
+    def check_holds(self, path: _Path, obj: MovableObject, workspace: str, scene: Scene) -> None:
+        """A drop's workspace can hold the object: as wide and as deep, with a place clear of walls."""
+        ws, size = scene.workspaces[workspace], self.length(obj.size)
+        if not ws.is_point and min(ws.x[1] - ws.x[0], ws.y[1] - ws.y[0]) < obj.size:
+            self.fail(
+                path,
+                f"workspace {workspace} ({self.length(ws.x[1] - ws.x[0])} x {self.length(ws.y[1] - ws.y[0])})"
+                f" cannot hold {obj.id} (a {size} square); expected a workspace at least as wide and deep "
+                "as its goods",
+            )
+        if not _fits(scene, obj, ws):
+            self.fail(
+                path,
+                f"workspace {workspace} is too small for {obj.id} ({size}): no drop position "
+                "in it keeps the object clear of the walls",
+            )
+
+    def length(self, mm: float) -> str:
+        """A length of the built scene (mm) in the file's units, with its unit."""
+        return f"{mm / 1000.0:g} m" if self.units == "m" else f"{mm:g} mm"
 
 
 def _known(group: str, ids: Mapping[str, Any]) -> str:

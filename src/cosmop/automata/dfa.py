@@ -194,6 +194,28 @@ class DFA:
         return cls(tuple(events), delta, order[initial], mask, tuple(order))
 
     @classmethod
+    def from_words(cls, words: Iterable[Sequence[str]]) -> DFA:
+        """The prefix tree of finitely many words: its marked language is exactly `words`.
+
+        Examples
+        --------
+        >>> d = DFA.from_words([("a", "b"), ("a", "c")])
+        >>> d.n_states, d.accepts(("a", "c")), d.accepts(("a",))
+        (4, True, False)
+        """
+        names: dict[tuple[str, ...], str] = {(): "q0"}
+        transitions, marked = [], []
+        for word in words:
+            word = tuple(word)
+            for i in range(len(word)):
+                prefix = word[: i + 1]
+                if prefix not in names:
+                    names[prefix] = f"q{len(names)}"
+                    transitions.append((names[word[:i]], word[i], names[prefix]))
+            marked.append(names[word])
+        return cls.from_transitions("q0", transitions, marked=marked, states=list(names.values()))
+
+    @classmethod
     def from_word(
         cls, word: Sequence[str], alphabet: Iterable[str] | None = None, *, closed: bool = True
     ) -> DFA:

@@ -21,6 +21,16 @@ word, in primitive steps), the alternative of least *makespan* (the longest plan
 total; this is exact over every alternative enumerated.  When the enumeration is cut short by
 its bound, the result says so (``exhaustive`` false) and the choice is the best among the
 alternatives found first (depth-first, events in name order).
+
+A robot's choice that concerns no one else (O2 to W2 *or* W3, the other robots' words the
+same either way) needs no word-by-word costing: :func:`own_choices` groups a robot's words by
+the others' words, and the bottom-up layer plans each group once over the automaton of its
+words (a branching local mission), which yields the group's cheapest word; the others are
+dropped.  That keeps the choice exact: for an alternative :math:`(w, s)`, with :math:`s` the
+others' words, :math:`(w^*, s)` is an alternative too, the robot's cost for :math:`w^*` is no
+larger and the others' are the same (:math:`w^*` picks the same objects, so the others may ask
+for the same ones): neither the makespan nor the total grows.  Done robot after robot, each
+step keeps an optimal alternative.
 """
 
 from __future__ import annotations
@@ -32,7 +42,17 @@ from types import MappingProxyType
 
 from cosmop.missions.mission import GlobalMission
 
-__all__ = ["Alternative", "Alternatives", "Assignment", "Choice", "alternatives", "assign", "choose"]
+__all__ = [
+    "Alternative",
+    "Alternatives",
+    "Assignment",
+    "Choice",
+    "alternatives",
+    "assign",
+    "choose",
+    "others",
+    "own_choices",
+]
 
 
 @dataclass(frozen=True)
@@ -149,6 +169,51 @@ def alternatives(mission: GlobalMission, *, max_nodes: int = 200_000) -> Alterna
             found.setdefault(grown)
         stack.append((target, grown, length + 1, iter(range(len(names)))))
     return Alternatives(_items(found, robots), True, nodes)
+
+
+Words = tuple[tuple[str, ...], ...]
+"""Several words of one robot, or every other robot's word in team order."""
+
+
+def own_choices(found: Alternatives, robot: str, mission: GlobalMission) -> dict[Words, Words]:
+    """The choices `robot` makes alone: its words that go with the same words of the others.
+
+    The alternatives are grouped by the others' words (:func:`others`); a group in which
+    `robot` has several words, each picking the same objects and none holding a message
+    (messages are placed on one word, after the choice), is a choice that concerns no one
+    else.  Only an `exhaustive` enumeration is split this way.
+
+    Returns
+    -------
+    dict
+        The others' words (:func:`others`) to the robot's words among which it may choose.
+
+    Examples
+    --------
+    >>> from cosmop.automata import DFA
+    >>> k = GlobalMission.from_dfa(DFA.from_transitions(
+    ...     "a", [("a", "pick(R1,O1)", "b"), ("b", "drop(R1,O1,W1)", "c"), ("b", "drop(R1,O1,W2)", "c")],
+    ...     marked=["c"]))
+    >>> list(own_choices(alternatives(k), "R1", k).values())
+    [(('pick(R1,O1)', 'drop(R1,O1,W1)'), ('pick(R1,O1)', 'drop(R1,O1,W2)'))]
+    """
+    if not found.exhaustive:
+        return {}
+    groups: dict[tuple, list[tuple[str, ...]]] = {}
+    for alt in found.items:
+        groups.setdefault(others(alt, robot), []).append(alt.words[robot])
+    out = {}
+    for rest, words in groups.items():
+        events = [[mission.events[e] for e in w] for w in words]
+        picks = {frozenset(e.obj for e in w if e.kind == "pick") for w in events}
+        if len(words) > 1 and len(picks) == 1 and not any(e.is_message for w in events for e in w):
+            out[rest] = tuple(words)
+    return out
+
+
+def others(alt: Alternative, robot: str) -> Words:
+    """The words of every robot but `robot` in `alt`, in team order."""
+    return tuple(w for r, w in alt.words.items() if r != robot)
 
 
 def _step(factors, columns, state: tuple, name: str) -> tuple | None:

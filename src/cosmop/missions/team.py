@@ -136,7 +136,8 @@ class TeamVerdict:
         if self.blocking is not None:
             return "the robots' messages can deadlock: " + " ".join(self.blocking)
         if self.counterexample is not None:
-            return "the robots' missions can violate the global mission: " + " ".join(self.counterexample)
+            word = " ".join(self.counterexample) or "(no event at all)"
+            return f"the robots' missions can violate the global mission: {word}"
         return None
 
 

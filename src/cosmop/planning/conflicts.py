@@ -382,6 +382,7 @@ class _Schedule:
         eps = 1e-3
         self.ctx = ctx = z3.Context()
         self.solver = z3.Solver(ctx=ctx)
+        self.solver.set("ctrl_c", False)  # Ctrl-C is Python's (KeyboardInterrupt), not "unknown"
         self.solver.set("rlimit", rlimit)
         self.start = {
             (r, k): z3.Real(f"s_{r}_{k}", ctx) for r, n in horizons.items() for k in range(1, n + 1)
@@ -611,6 +612,14 @@ def detours(conflict: Conflict, fixed: Mapping[str, Sequence[BaseGeometry]]) -> 
     Avoiding the other side must leave the mover's fixed places -- its start, the poses it picks
     from, its home, given in `fixed` by robot (regions already grown) -- free.
     """
+    return [(robot, keep) for _, robot, keep in ranked_detours(conflict, fixed)]
+
+
+def ranked_detours(
+    conflict: Conflict, fixed: Mapping[str, Sequence[BaseGeometry]]
+) -> list[tuple[int, str, Occupancy]]:
+    """:func:`detours` with each way's rank: 0 a drive around something staying for good, 1 a
+    drive around something passing, 2 goods dropped elsewhere."""
     out = []
     for mover, keep in ((conflict.a, conflict.b), (conflict.b, conflict.a)):
         if not mover.movable or mover.first is None:
@@ -620,7 +629,7 @@ def detours(conflict: Conflict, fixed: Mapping[str, Sequence[BaseGeometry]]) -> 
             continue
         drive = mover.first == mover.last
         out.append((0 if drive and keep.last is None else 1 if drive else 2, robot, keep))
-    return [(robot, keep) for _, robot, keep in sorted(out, key=lambda o: o[0])]
+    return sorted(out, key=lambda o: o[0])
 
 
 def fixed_places(items: Sequence[Occupancy]) -> dict[str, list[BaseGeometry]]:

@@ -20,6 +20,14 @@ before it (GoTo, and requests for objects the robot neither carries, places nor 
 This is the paper's encoding with its typo fixed (pick ends with PickUp, not DropOff), and it
 ends the trace at the last event.
 
+A local mission that branches is a DFA :math:`(Q, \\Sigma, \\delta, q_0, F)` over the
+robot's events instead (:func:`automaton_parts`): an integer :math:`q` holds its state per
+instant and an integer :math:`\\epsilon` the mission event the step performs (0: none).  A step
+that performs :math:`e` satisfies :math:`e`'s goal (the same goals as the until chain) and
+moves :math:`q` along :math:`\\delta(\\cdot, e)`; a step that performs none is GoTo or Req and
+keeps :math:`q`; PickUp, DropOff and Res happen only as mission events; the last instant has
+:math:`q \\in F`.  A sequence's DFA (a chain) gives the same plans as its until chain.
+
 The paper's :math:`\\phi_{carry}` (an object's position changes only when it is dropped) is
 part of every primitive's frame condition: GoTo, PickUp, Req and Res keep every position,
 and DropOff moves only the object it drops.
@@ -38,6 +46,7 @@ from types import MappingProxyType
 
 import shapely
 
+from cosmop.automata import DFA
 from cosmop.logic import FALSE, TRUE, Always, Formula, Implies, Next, Not, Until, Var, conj, disj, eq
 from cosmop.missions.events import Event
 from cosmop.planning.plan import State
@@ -98,6 +107,9 @@ class RobotProblem:
         the scenario's initial pose.
     unrequestable : frozenset of str
         Objects the robot may not ask for (nobody can move them, or asking deadlocks the team).
+    automaton : DFA, optional
+        A branching local mission: `mission` is then its alphabet (as events) and a plan may
+        perform any word of its marked language (:func:`automaton_parts`).
 
     Notes
     -----
@@ -113,6 +125,7 @@ class RobotProblem:
     primitives: Mapping[str, Primitive] | None = None
     start: State | None = None
     unrequestable: frozenset[str] = frozenset()
+    automaton: DFA | None = None
     actions: tuple[Action, ...] = field(init=False)
 
     def __post_init__(self) -> None:
@@ -156,6 +169,16 @@ class RobotProblem:
     @property
     def pi(self) -> Var:
         return Var("pi", "int")
+
+    @property
+    def state(self) -> Var:
+        """:math:`q`, the state of the mission automaton (branching missions only)."""
+        return Var("q", "int")
+
+    @property
+    def performed(self) -> Var:
+        """:math:`\\epsilon`, the mission event the step performs: 1 + its index in `mission`, 0 none."""
+        return Var("event", "int")
 
     def obj(self, obj: str) -> ObjectVars:
         return ObjectVars.named(obj)
@@ -493,6 +516,49 @@ def mission_formula(p: RobotProblem, events: Sequence[Event] | None = None) -> F
     return phase
 
 
+def automaton_parts(p: RobotProblem) -> list[tuple[str, Formula]]:
+    """The branching local mission ``p.automaton`` over the instants (see the module docstring).
+
+    With :math:`g_e` the goal of event :math:`e` (:func:`_goal`), the parts are, for every
+    instant :math:`k` (and :math:`k + 1` when it exists)
+
+    * :math:`\\epsilon_0 = 0 \\wedge q_0 = q_0^{K}` or, for an event :math:`e` defined at
+      :math:`q_0^{K}`, :math:`\\epsilon_0 = e \\wedge g_e \\wedge q_0 = \\delta(q_0^{K}, e)`;
+    * :math:`\\epsilon_{k+1} = e \\rightarrow g_e(k+1) \\wedge \\bigvee_{s} (q_k = s \\wedge
+      q_{k+1} = \\delta(s, e))` over the states where :math:`e` is defined;
+    * :math:`\\epsilon_{k+1} = 0 \\rightarrow q_{k+1} = q_k \\wedge \\pi_{k+1} \\in
+      \\{GoTo, Req\\}`;
+    * at the last instant :math:`q_K \\in F`.
+
+    So the events the plan performs, in order, form a word that takes the automaton to a
+    marked state; no other PickUp, DropOff or Res is possible (they are mission events only).
+    """
+    dfa = p.automaton
+    assert dfa is not None
+    q, ev = p.state, p.performed
+    columns = dfa.event_index()
+    moves = []
+    for i, event in enumerate(p.mission):
+        j = columns[event.name]
+        edges = [(s, int(dfa.delta[s, j])) for s in range(dfa.n_states) if dfa.delta[s, j] >= 0]
+        goal = _goal(p, event)[1]
+        along = disj(q.eq(s) & q.next().eq(t) for s, t in edges)
+        moves.append(Implies(Next(ev.eq(i + 1)), Next(goal) & along))
+    idle = Implies(Next(ev.eq(0)), q.next().eq(q) & Next(p.requests_except(None)))
+    some = Next(disj(ev.eq(c) for c in range(len(p.mission) + 1)))
+    first = [ev.eq(0) & q.eq(dfa.initial)]
+    for i, event in enumerate(p.mission):
+        target = int(dfa.delta[dfa.initial, columns[event.name]])
+        if target >= 0:
+            first.append(ev.eq(i + 1) & _goal(p, event)[1] & q.eq(target))
+    final = disj(q.eq(int(f)) for f in range(dfa.n_states) if dfa.marked[f])
+    return [
+        ("mission: first instant", disj(first)),
+        ("mission: steps", Always(Implies(Next(TRUE), conj([*moves, idle, some])))),
+        ("mission: complete at the end", Always(Implies(Not(Next(TRUE)), final))),
+    ]
+
+
 def initial_state(p: RobotProblem) -> Formula:
     """Instant 0: the scenario's poses and positions, nothing carried or away, no primitive.
 
@@ -527,6 +593,8 @@ def specification(p: RobotProblem, events: Sequence[Event] | None = None) -> lis
     for action in p.actions:
         for name, effect in p.primitives[action.primitive].parts(p, action.obj):
             parts.append((name, Always(Implies(Next(p.pi.eq(action.code)), effect))))
+    if p.automaton is not None and events is None:
+        return parts + automaton_parts(p)
     parts.append(("mission", mission_formula(p, events)))
     return parts
 

@@ -10,8 +10,15 @@ bound until unsat (a request costs another robot's time, DESIGN.md).  If no K up
 works, the mission is searched prefix by prefix for the first event that cannot be reached.
 An unsat core over the specification's named parts, at the bound, names what blocks it.
 
+A branching local mission (a DFA over the robot's events) is solved the same way with the
+automaton in the formula (:func:`cosmop.planning.specification.automaton_parts`): the first
+satisfiable K is the shortest plan over *every* word of its marked language, the fewest
+requests among those, and the plan records the word it performs.
+
 Every Z3 solver gets a resource limit (``rlimit``), so the same input always gives the same
-answer on any machine.
+answer on any machine.  A horizon the solver cannot decide within it ends the search: the
+result is infeasible with a reason that says so (shorter horizons were proved impossible, and
+nothing is claimed beyond).
 """
 
 from __future__ import annotations
@@ -20,10 +27,13 @@ import time
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
+import numpy as np
 import z3
 
+from cosmop.automata import DFA
+from cosmop.automata.operations import project, trim
 from cosmop.logic import IncrementalUnrolling, Signature, Unrolling, conj
-from cosmop.missions.events import Event
+from cosmop.missions.events import Event, parse_event
 from cosmop.planning.messages import answer_early, place_mission_messages, strip_messages, wait_early
 from cosmop.planning.plan import ObjectState, RobotPlan, State, Step
 from cosmop.planning.reach import unreachable
@@ -81,6 +91,9 @@ class Synthesis:
 
 def _solver(rlimit: int, ctx: z3.Context) -> z3.Solver:
     s = z3.Solver(ctx=ctx)
+    # Z3 would take Ctrl-C for itself and answer "unknown", like a spent resource limit: leave
+    # it to Python, which raises KeyboardInterrupt when the check returns
+    s.set("ctrl_c", False)
     s.set("rlimit", rlimit)
     s.set("random_seed", 0)
     return s
@@ -95,6 +108,9 @@ def _plan(
     p: RobotProblem, unrolling: Unrolling | IncrementalUnrolling, model: z3.ModelRef
 ) -> tuple[RobotPlan, tuple[str, ...]]:
     trace = unrolling.trace(model)
+    word = p.mission
+    if p.automaton is not None:  # the events the steps perform, in order
+        word = tuple(p.mission[int(s["event"]) - 1] for s in trace if int(s["event"]) > 0)
     steps, requested = [], []
     for state in trace[1:]:
         action = decode(p, int(state["pi"]))
@@ -116,7 +132,7 @@ def _plan(
                 objects,
             )
         )
-    return RobotPlan.from_steps([e.name for e in p.mission], steps), tuple(requested)
+    return RobotPlan.from_steps([e.name for e in word], steps), tuple(requested)
 
 
 def _count_requests(p: RobotProblem, unrolling: Unrolling | IncrementalUnrolling) -> z3.ArithRef:
@@ -138,7 +154,7 @@ def _feasible_at(p: RobotProblem, events: tuple[Event, ...], K: int, rlimit: int
 def synthesize(
     scene: Scene,
     robot: str,
-    mission: Iterable[Event | str],
+    mission: Iterable[Event | str] | DFA,
     *,
     requests: bool = True,
     max_horizon: int = 16,
@@ -154,8 +170,10 @@ def synthesize(
     ----------
     scene : Scene
     robot : str
-    mission : iterable of Event or str
-        The local mission as a sequence of events.
+    mission : iterable of Event or str, or DFA
+        The local mission: a sequence of events, or a DFA over the robot's events whose
+        marked words are the ways it may complete (a branching mission; the plan performs
+        one of them, found by the solver).
     requests : bool
         Allow Req (asking another robot to move an object away).
     max_horizon : int
@@ -183,16 +201,23 @@ def synthesize(
     put in afterwards (:func:`cosmop.planning.messages.place_mission_messages`).
     """
     t0 = time.perf_counter()
-    full = events_of(mission)
-    events = strip_messages(full)
-    walled_off = unreachable(scene, robot, events, start.robot[:2] if start is not None else None)
+    origin = start.robot[:2] if start is not None else None
+    if isinstance(mission, DFA):
+        automaton, walled_off = _plannable(scene, robot, mission, origin)
+        full = events = tuple(parse_event(e) for e in automaton.alphabet)
+        lower = _fewest_steps(automaton, events)
+    else:
+        automaton, full = None, events_of(mission)
+        events = strip_messages(full)
+        walled_off = unreachable(scene, robot, events, origin)
+        lower = sum(1 for e in events if e.kind != "return")  # each such event takes a step
     if walled_off is not None:  # no horizon can do it: say so without the solver
         return Synthesis(robot, False, None, None, reason=walled_off, solve_s=time.perf_counter() - t0)
-    p = RobotProblem(scene, robot, events, requests, start=start, unrequestable=frozenset(unrequestable))
+    forbid = frozenset(unrequestable)
+    p = RobotProblem(scene, robot, events, requests, start=start, unrequestable=forbid, automaton=automaton)
     formula = conj(f for _, f in specification(p))
     signature = Signature.of(formula)
     checks = 0
-    lower = sum(1 for e in events if e.kind != "return")  # each such event takes a step
     grow: IncrementalUnrolling | None = None
     unsat: list[int] = []
     for K in range(lower, max_horizon + 1):
@@ -212,8 +237,21 @@ def synthesize(
             s.add(u.encode(formula))
         checks += 1
         verdict = s.check(*assumptions)
-        if verdict == z3.unknown:
-            raise RuntimeError(f"Z3 gave up at K={K} for {robot} ({s.reason_unknown()}); raise rlimit")
+        if verdict == z3.unknown:  # no answer within the resource limit: say so, claim nothing more
+            why = (
+                f"{robot}: the solver gave up at K={K} ({s.reason_unknown()}, resource limit {rlimit}); "
+                f"no plan of at most {K - 1} steps exists, longer ones were not searched"
+            )
+            return Synthesis(
+                robot,
+                False,
+                None,
+                None,
+                reason=why,
+                solve_s=time.perf_counter() - t0,
+                checks=checks,
+                unsat_horizons=tuple(unsat),
+            )
         if verdict != z3.sat:
             unsat.append(K)
             continue
@@ -235,7 +273,7 @@ def synthesize(
         plan = answer_early(plan)
         if start is None:  # where a robot waits for answers: before it drives (no start state mid-run)
             plan = wait_early(scene, robot, plan)
-        plan = place_mission_messages(scene, robot, plan, full, start)
+        plan = place_mission_messages(scene, robot, plan, plan.events if automaton else full, start)
         return Synthesis(
             robot,
             True,
@@ -246,7 +284,9 @@ def synthesize(
             checks=checks,
             unsat_horizons=tuple(unsat),
         )
-    if explain:
+    if explain and automaton is not None:
+        reason, blocking = _explain_automaton(p, max_horizon, rlimit)
+    elif explain:
         reason, blocking = _explain(p, events, max_horizon, rlimit)
     else:
         reason, blocking = f"no plan of at most {max_horizon} steps", ()
@@ -263,6 +303,58 @@ def synthesize(
     )
 
 
+def _plannable(
+    scene: Scene, robot: str, dfa: DFA, origin: tuple[float, float] | None
+) -> tuple[DFA, str | None]:
+    """The branching mission without messages (planned afterwards) and events walls rule out.
+
+    Messages are projected away.  An event :func:`~cosmop.planning.reach.unreachable` proves
+    impossible loses its transitions, and the automaton is trimmed; if no marked word is left,
+    the reason names the events ruled out.
+    """
+    moving = [e for e in dfa.alphabet if not parse_event(e).is_message]
+    if len(moving) < len(dfa.alphabet):
+        dfa = project(dfa, moving)
+    delta = dfa.delta.copy()
+    why = []
+    for j, name in enumerate(dfa.alphabet):
+        reason = unreachable(scene, robot, (parse_event(name),), origin)
+        if reason is not None:
+            delta[:, j] = -1
+            why.append(reason)
+    dfa = trim(DFA(dfa.alphabet, delta, dfa.initial, dfa.marked))
+    used = [j for j in range(dfa.n_events) if (dfa.delta[:, j] >= 0).any()]
+    dfa = DFA(tuple(dfa.alphabet[j] for j in used), dfa.delta[:, used], dfa.initial, dfa.marked)
+    if not dfa.marked.any():
+        reasons = "; ".join(why) if why else "its mission has no complete word"
+        return dfa, f"{robot} can complete no word of its mission: {reasons}"
+    return dfa, None
+
+
+def _fewest_steps(dfa: DFA, events: tuple[Event, ...]) -> int:
+    """Fewest steps of any plan: the fewest non-return events on a marked word (0-1 search)."""
+    weight = [0 if e.kind == "return" else 1 for e in events]
+    best = np.full(dfa.n_states, np.iinfo(np.int64).max, dtype=np.int64)
+    best[dfa.initial] = 0
+    todo = [dfa.initial]
+    while todo:  # Bellman-Ford rounds: the automaton is small
+        nxt = []
+        for s in todo:
+            for j, t in enumerate(dfa.delta[s]):
+                if t >= 0 and best[s] + weight[j] < best[t]:
+                    best[t] = best[s] + weight[j]
+                    nxt.append(int(t))
+        todo = nxt
+    return int(best[dfa.marked].min(initial=best.max()))  # no marked state: walled off, unused
+
+
+def _explain_automaton(p: RobotProblem, K: int, rlimit: int) -> tuple[str, tuple[str, ...]]:
+    """Why no word of a branching mission can be planned within ``K`` steps (an unsat core)."""
+    blocking = _core(p, specification(p), K, rlimit)
+    what = ", ".join(blocking) if blocking else "the primitives' constraints"
+    return f"{p.robot} cannot complete any word of its mission within {K} steps; blocked by: {what}", blocking
+
+
 def _explain(p: RobotProblem, events: tuple[Event, ...], K: int, rlimit: int) -> tuple[str, tuple[str, ...]]:
     """The first event no plan of length ``<= K`` reaches, and an unsat core naming what blocks it."""
     for i in range(1, len(events) + 1):
@@ -270,8 +362,17 @@ def _explain(p: RobotProblem, events: tuple[Event, ...], K: int, rlimit: int) ->
             break
     else:  # every prefix alone is feasible (cannot happen for the whole mission): report the last
         i = len(events)
-    prefix = events[:i]
-    parts = specification(p, prefix)
+    blocking = _core(p, specification(p, events[:i]), K, rlimit)
+    what = ", ".join(blocking) if blocking else "the primitives' constraints"
+    return (
+        f"{p.robot} cannot reach {events[i - 1].name} (event {i} of its mission) within {K} steps; "
+        f"blocked by: {what}",
+        blocking,
+    )
+
+
+def _core(p: RobotProblem, parts: list[tuple[str, object]], K: int, rlimit: int) -> tuple[str, ...]:
+    """The obstacles in an unsat core of `parts` at horizon `K` (walls, objects, handling room)."""
     ctx = z3.Context()
     u = Unrolling(Signature.of(conj(f for _, f in parts)), K, ctx=ctx)
     s = _solver(rlimit, ctx)
@@ -289,12 +390,7 @@ def _explain(p: RobotProblem, events: tuple[Event, ...], K: int, rlimit: int) ->
             for n in core
             if n.startswith(("wall", "object", "gripper", "room from")) or " dropped clear of " in n
         )
-    what = ", ".join(blocking) if blocking else "the primitives' constraints"
-    return (
-        f"{p.robot} cannot reach {events[i - 1].name} (event {i} of its mission) within {K} steps; "
-        f"blocked by: {what}",
-        blocking,
-    )
+    return blocking
 
 
 __all__ = ["NONE", "Synthesis", "synthesize"]

@@ -27,11 +27,11 @@ from cosmop.planning.conflicts import (
     Conflict,
     ConflictSettings,
     conflicts,
-    detours,
     fixed_places,
     is_ordered,
     occupancies,
     order_conflicts,
+    ranked_detours,
 )
 from cosmop.planning.messages import merge_drives, place_edges, split_drives
 from cosmop.planning.plan import PlanMessage, RobotPlan, State
@@ -82,8 +82,9 @@ class TeamSafety:
         return not self.unresolved
 
     def detours(self, conflict: Conflict) -> list:
-        """Who can be re-planned around `conflict` (:func:`~cosmop.planning.conflicts.detours`)."""
-        return detours(conflict, self.fixed)
+        """Who can be re-planned around `conflict`, best first, each with its rank
+        (:func:`~cosmop.planning.conflicts.ranked_detours`): ``(rank, robot, what to avoid)``."""
+        return ranked_detours(conflict, self.fixed)
 
 
 def durations(

@@ -1,0 +1,90 @@
+"""Output paths are checked before any work: a missing folder, a folder named as a file, a file
+named as a folder are exit 2 with one line naming the option, and nothing is written."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from cosmop.cli import app
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENARIO = str(ROOT / "examples" / "01_warehouse_2x2" / "scenario.yaml")
+runner = CliRunner()
+
+
+def _commands(tmp: Path) -> list[tuple[list[str], str, Path]]:
+    missing = tmp / "no-such-folder"
+    return [
+        (["plan", SCENARIO, "-o", str(missing / "plan.json")], "-o", missing),
+        (["plan", SCENARIO, "-o", str(tmp / "p.json"), "--png", str(missing / "p.png")], "--png", missing),
+        (["simulate", SCENARIO, "--summary", str(missing / "s.json")], "--summary", missing),
+        (["simulate", SCENARIO, "--trace", str(missing / "t.json")], "--trace", missing),
+        (["view", SCENARIO, "-o", str(missing / "v.html")], "-o", missing),
+    ]
+
+
+@pytest.mark.parametrize("index", range(5))
+def test_an_output_in_a_missing_folder_is_refused_before_any_work(tmp_path, index):
+    command, option, missing = _commands(tmp_path)[index]
+    result = runner.invoke(app, command)
+    assert result.exit_code == 2, result.output
+    assert result.stderr.count("\n") == 1 and "Traceback" not in result.stderr
+    assert f"{option}: the folder {missing} does not exist" in result.stderr
+    assert list(tmp_path.iterdir()) == []  # nothing written, not even the plan of a later output
+
+
+def test_a_folder_is_not_a_file_and_a_file_is_not_a_folder(tmp_path):
+    result = runner.invoke(app, ["plan", SCENARIO, "-o", str(tmp_path)])
+    assert result.exit_code == 2 and "-o: is a folder; expected the path of a file" in result.stderr
+    file = tmp_path / "taken"
+    file.write_text("x")
+    result = runner.invoke(app, ["decompose", SCENARIO, "--dot", str(file)])
+    assert result.exit_code == 2 and "--dot: is a file; expected a folder" in result.stderr
+    assert file.read_text() == "x"
+
+
+def test_an_interrupt_waits_for_outputs_that_belong_together():
+    import os
+    import signal
+
+    from cosmop.io import uninterrupted
+
+    done = []
+    with pytest.raises(KeyboardInterrupt), uninterrupted():
+        os.kill(os.getpid(), signal.SIGINT)  # Ctrl-C between the two writes
+        done.append("trace")
+        done.append("summary")
+    assert done == ["trace", "summary"]
+
+
+def test_the_program_answers_ctrl_c_with_one_line_and_130(tmp_path):
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    command = [
+        sys.executable,
+        "-m",
+        "cosmop",
+        "plan",
+        str(ROOT / "examples" / "02_warehouse_10x10" / "scenario.yaml"),
+    ]
+    proc = subprocess.Popen(
+        [*command, "-o", str(tmp_path / "plan.json")],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,  # its own process group, as a terminal's Ctrl-C reaches it
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
+    time.sleep(4.0)  # planning, with its worker processes
+    os.killpg(proc.pid, signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert err.strip().splitlines()[-1] == "interrupted" and "Traceback" not in err
+    assert not (tmp_path / "plan.json").exists()
