@@ -39,12 +39,11 @@ def _timed(fn, repeat: int):
 
 def rooms(seed: int, repeat: int) -> dict:
     sys.path.insert(0, str(ROOT / "tests"))
-    from rooms import branching_words, room
-
     from cosmop.automata import DFA
     from cosmop.planning.checker import check_robot_plan
     from cosmop.planning.synthesis import synthesize
     from cosmop.scenario import parse_scenario
+    from rooms import branching_words, room
 
     scene = parse_scenario(room(seed)).scene
     words = branching_words()
@@ -85,9 +84,11 @@ def chain(repeat: int) -> dict:
 
     seq, seq_s = _timed(lambda: plan(False), repeat)
     auto, auto_s = _timed(lambda: plan(True), repeat)
-    same = all(
-        (seq[r].horizon, sorted(seq[r].requests)) == (auto[r].horizon, sorted(auto[r].requests)) for r in words
-    )
+
+    def answer(res):
+        return res.horizon, sorted(res.requests)
+
+    same = all(answer(seq[r]) == answer(auto[r]) for r in words)
     return {
         "workload": "chain",
         "robots": len(words),
