@@ -221,8 +221,8 @@ def test_two_robots_never_give_way_around_each_other_in_one_round():
     from cosmop.pipeline import _give_way
 
     # R1's and R2's goods on one dock spot (either may drop elsewhere), and R2's drive through
-    # R1's good (only R2 may move, the best kind of detour): R2 drives around, R1 keeps its
-    # plan, and the dock spot waits for the next round (R2's new plan may settle it)
+    # R1's good (only R2 may move, the best kind of detour): R2 drives around; R1 avoiding R2
+    # at the dock spot would make the two avoid each other, so that waits for the next round
     spot = _Conflict("goods on one spot", ("R1", "R2"))
     drive = _Conflict("R2 drives through O1", ("R2", "R1"))
     safety = _Safety(
@@ -231,9 +231,12 @@ def test_two_robots_never_give_way_around_each_other_in_one_round():
     assert _give_way(safety, [spot, drive]) == {"R2": [(drive, "O1's spot")]}
     # when R2 cannot keep clear, R1 gives way where it can, R2 keeps its plan
     assert _give_way(safety, [spot, drive], {"R2"}) == {"R1": [(spot, "O2's spot")]}
-    # a third robot's conflict with R1 (which R2 avoids) also waits
+    # a third robot's conflict with R1 goes ahead: no two robots avoid each other
     other = _Conflict("R3 and R1", ("R3", "R1"))
     safety.ways[other] = [(1, "R1", "R3's drive"), (1, "R3", "R1's drive")]
-    assert _give_way(safety, [spot, drive, other]) == {"R2": [(drive, "O1's spot")]}
+    assert _give_way(safety, [spot, drive, other]) == {
+        "R2": [(drive, "O1's spot")],
+        "R1": [(other, "R3's drive")],
+    }
     # alone, a conflict goes ahead with its best way
     assert _give_way(safety, [spot]) == {"R1": [(spot, "O2's spot")]}

@@ -562,23 +562,23 @@ def _give_way(
     """Who gives way in which of `conflicts`: ``robot -> [(conflict, space to avoid)]``.
 
     Each conflict's best way (:meth:`TeamSafety.detours`), the conflicts with the best ways
-    first, except that a robot avoids only the space of one that keeps its plan this round
-    (else the space it avoids may move): when the best way would re-plan a robot another one
-    avoids, or have it avoid a robot being re-planned, the conflict waits for the next round
-    (when nothing else moves, it goes ahead).  Robots in `exclude` keep their plans.
+    first, except that two robots never avoid each other in one round (each would wall itself
+    off from the other's old places, both may be shut out, as two goods meant for one dock
+    spot were): such a conflict waits for the next round, when the other's new plan may have
+    settled it.  Robots in `exclude` keep their plans.
     """
     moves: dict[str, list] = {}
-    keepers: set[str] = set()
+    avoids: set[tuple[str, str | None]] = set()
     best = {
         c: next(((n, r, k) for n, r, k in safety.detours(c) if r not in exclude), None) for c in conflicts
     }
     for conflict in sorted((c for c in best if best[c] is not None), key=lambda c: best[c][0]):
         _, robot, keep = best[conflict]
         keeper = next((r for r in conflict.robots if r != robot), None)
-        if moves and (robot in keepers or keeper in moves):
-            continue  # it would re-plan a robot around one that is re-planned too: next round
+        if (keeper, robot) in avoids:
+            continue  # the two would avoid each other: next round
         moves.setdefault(robot, []).append((conflict, keep))
-        keepers.add(keeper)
+        avoids.add((robot, keeper))
     return moves
 
 
