@@ -132,9 +132,7 @@ def check_bag_target(bag: Path) -> None:
             f"error: {bag}: exists; expected a new directory for the bag (never overwritten)", err=True
         )
         raise typer.Exit(2)
-    if not bag.parent.is_dir():
-        typer.echo(f"error: {bag}: its parent directory does not exist", err=True)
-        raise typer.Exit(2)
+    check_writable(bag, "--bag", folder=True)  # its folder exists and is writable
 
 
 def write_bag_and_report(scene, trace, bag: Path, plans, rate: float | None, scene_rate: float) -> None:

@@ -21,6 +21,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 import shapely
 
+from cosmop.squares import square
+from cosmop.units import UnitSystem, show_length, shown
+
 if TYPE_CHECKING:  # the scenario module calls this one while it builds a scene
     from cosmop.scenario import Scene
 
@@ -61,11 +64,9 @@ class _Body:
     y: float
     field: tuple
 
-    def words(self, scale: float, unit: str) -> str:
-        return (
-            f"{self.kind} {self.ident} ({self.size / scale:g} {unit} square at "
-            f"({self.x / scale:g}, {self.y / scale:g}))"
-        )
+    def words(self, units: UnitSystem) -> str:
+        at = f"({shown(self.x, units):g}, {shown(self.y, units):g})"
+        return f"{self.kind} {self.ident} ({show_length(self.size, units)} square at {at})"
 
 
 def _bodies(scene: Scene) -> list[_Body]:
@@ -84,16 +85,15 @@ def _bodies(scene: Scene) -> list[_Body]:
     return out
 
 
-def overlaps(scene: Scene, *, scale: float = 1.0, unit: str = "mm") -> list[Overlap]:
+def overlaps(scene: Scene, *, units: UnitSystem = "mm") -> list[Overlap]:
     """Every overlap between the scene's bodies, and between a body and a wall.
 
     Parameters
     ----------
     scene : Scene
         In millimetres.
-    scale, unit : float, str
-        How to show lengths in messages: ``value / scale`` followed by `unit` (1000 and ``"m"``
-        for a file written in metres).
+    units : {"mm", "m"}
+        The units the file was written in: lengths in messages are shown in them.
 
     Returns
     -------
@@ -105,7 +105,7 @@ def overlaps(scene: Scene, *, scale: float = 1.0, unit: str = "mm") -> list[Over
     --------
     >>> from cosmop.scenario import MovableObject, Robot, Scene, Wall
     >>> scene = Scene((Wall((0, -1000), (0, 1000)),), {"R1": Robot("R1", 400, (150, 0, 0))},
-    ...               {"O1": MovableObject("O1", 100, (350, 0))})
+    ...               {"O1": MovableObject("O1", 100, (400, 0))})  # O1 touches R1: allowed
     >>> [o.describe() for o in overlaps(scene)]  # doctest: +NORMALIZE_WHITESPACE
     ['robot R1 (400 mm square at (150, 0)) overlaps wall [[0, -1000], [0, 1000]]; bodies may touch
       but not overlap']
@@ -117,28 +117,19 @@ def overlaps(scene: Scene, *, scale: float = 1.0, unit: str = "mm") -> list[Over
     xy = np.array([(b.x, b.y) for b in bodies])
     found: dict[int, list[str]] = {}
     if scene.obstacles:
-        half = size / 2.0 - TOUCH
-        boxes = shapely.box(xy[:, 0] - half, xy[:, 1] - half, xy[:, 0] + half, xy[:, 1] + half)
+        boxes = square(xy[:, 0], xy[:, 1], size - 2.0 * TOUCH)  # shapely builds them all at once
         walls = [shapely.LineString([w.start, w.end]) for w in scene.obstacles]
         hits = shapely.STRtree(walls).query(boxes, predicate="intersects")
         for i, j in sorted(zip(hits[0].tolist(), hits[1].tolist(), strict=True)):
-            wall = scene.obstacles[j]
-            ends = [[round(v / scale, 9) for v in p] for p in (wall.start, wall.end)]
-            text = str([[_num(v) for v in p] for p in ends]).replace("'", "")
-            found.setdefault(i, []).append(f"wall {text}")
+            ends = ", ".join(f"[{shown(x, units):g}, {shown(y, units):g}]" for x, y in walls[j].coords)
+            found.setdefault(i, []).append(f"wall [{ends}]")
     reach = (size[:, None] + size[None, :]) / 2.0 - TOUCH
     apart = np.abs(xy[:, None, :] - xy[None, :, :])
     clash = (apart[..., 0] < reach) & (apart[..., 1] < reach)
     person = np.array([b.kind == "person" for b in bodies])
     clash &= ~(person[:, None] & person[None, :])  # people walk through one another in the simulation
     for i, j in zip(*np.nonzero(np.tril(clash, k=-1)), strict=True):
-        found.setdefault(int(i), []).append(bodies[int(j)].words(scale, unit))
+        found.setdefault(int(i), []).append(bodies[int(j)].words(units))
     return [
-        Overlap(bodies[i].field, bodies[i].words(scale, unit), other)
-        for i in sorted(found)
-        for other in found[i]
+        Overlap(bodies[i].field, bodies[i].words(units), other) for i in sorted(found) for other in found[i]
     ]
-
-
-def _num(value: float) -> str:
-    return f"{value:g}"

@@ -52,7 +52,7 @@ from cosmop._frozen import reduce_frozen
 from cosmop.errors import EventSyntaxError, ScenarioError
 from cosmop.io import read_text
 from cosmop.missions.events import ID_PATTERN, Event, parse_event
-from cosmop.units import SCENARIO_UNITS, default_dynamics, localize, scene_to_internal
+from cosmop.units import SCENARIO_UNITS, default_dynamics, localize, scene_to_internal, show_length
 
 __all__ = [
     "SCENARIO_VERSION",
@@ -1059,8 +1059,7 @@ class _Builder:
         """A physically possible scene: no body overlaps a wall or another body at the start."""
         from cosmop.physics import overlaps
 
-        metres = self.units == "m"
-        found = overlaps(scene, scale=1000.0 if metres else 1.0, unit="m" if metres else "mm")
+        found = overlaps(scene, units=self.units)
         if found:
             self.fail(found[0].field, found[0].describe())
 
@@ -1292,13 +1291,13 @@ class _Builder:
 
     def check_holds(self, path: _Path, obj: MovableObject, workspace: str, scene: Scene) -> None:
         """A drop's workspace can hold the object: as wide and as deep, with a place clear of walls."""
-        ws, size = scene.workspaces[workspace], self.length(obj.size)
+        ws, size = scene.workspaces[workspace], show_length(obj.size, self.units)
         if not ws.is_point and min(ws.x[1] - ws.x[0], ws.y[1] - ws.y[0]) < obj.size:
+            width, depth = (show_length(hi - lo, self.units) for lo, hi in (ws.x, ws.y))
             self.fail(
                 path,
-                f"workspace {workspace} ({self.length(ws.x[1] - ws.x[0])} x {self.length(ws.y[1] - ws.y[0])})"
-                f" cannot hold {obj.id} (a {size} square); expected a workspace at least as wide and deep "
-                "as its goods",
+                f"workspace {workspace} ({width} x {depth}) cannot hold {obj.id} (a {size} square); "
+                "expected a workspace at least as wide and deep as its goods",
             )
         if not _fits(scene, obj, ws):
             self.fail(
@@ -1306,10 +1305,6 @@ class _Builder:
                 f"workspace {workspace} is too small for {obj.id} ({size}): no drop position "
                 "in it keeps the object clear of the walls",
             )
-
-    def length(self, mm: float) -> str:
-        """A length of the built scene (mm) in the file's units, with its unit."""
-        return f"{mm / 1000.0:g} m" if self.units == "m" else f"{mm:g} mm"
 
 
 def _known(group: str, ids: Mapping[str, Any]) -> str:

@@ -59,6 +59,16 @@ def m_from_mm(value: float) -> float:
     return value / _MM_PER_M
 
 
+def shown(mm: float, units: UnitSystem) -> float:
+    """A length of the internal scene (mm) as the file wrote it (mm, or m for ``units: m``)."""
+    return m_from_mm(mm) if units == "m" else mm
+
+
+def show_length(mm: float, units: UnitSystem) -> str:
+    """A length of the internal scene (mm) in the file's units, with the unit (``"0.4 m"``)."""
+    return f"{shown(mm, units):g} {'m' if units == 'm' else 'mm'}"
+
+
 def _deg_from_rad(value: float) -> float:
     return round(math.degrees(value), 9) + 0.0
 
