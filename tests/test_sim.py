@@ -82,16 +82,17 @@ def _run_seed(job):
     return result.completed, result.contacts_while_moving, all(delivered.values()), len(result.contacts)
 
 
-def test_200_seeded_runs_with_people_crossing(people_2x2):
+def test_seeded_runs_with_people_crossing(people_2x2):
+    # a sample of 30 seeds; benchmarks/sweep_people.py runs 200
     scenario, plans = people_2x2
-    jobs = [(scenario, plans, seed) for seed in range(200)]
+    jobs = [(scenario, plans, seed) for seed in range(30)]
     with multiprocessing.get_context("fork").Pool(2) as pool:
         outcomes = pool.map(_run_seed, jobs)
     assert all(completed for completed, _, _, _ in outcomes)
     assert sum(moving for _, moving, _, _ in outcomes) == 0
     assert all(delivered for _, _, delivered, _ in outcomes)
     # The people did meet the robots (they walk into standing ones): the test is not vacuous.
-    assert sum(contacts for _, _, _, contacts in outcomes) > 200
+    assert sum(contacts for _, _, _, contacts in outcomes) > len(jobs)
 
 
 def test_person_in_the_doorway_makes_r1_wait():

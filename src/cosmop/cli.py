@@ -34,7 +34,7 @@ from cosmop.missions.mission import GlobalMission, sequence_of
 from cosmop.missions.team import verify_team
 from cosmop.missions.verification import verify as run_verify
 from cosmop.planning.checker import check_plan
-from cosmop.planning.plan import load_plan
+from cosmop.planning.plan import MAX_STEPS, load_plan
 from cosmop.scenario import Scenario, load_scenario
 
 __all__ = ["EXIT_INPUT_ERROR", "app", "main"]
@@ -319,6 +319,7 @@ def plan(
         typer.Option(
             help="Longest plan tried per robot (steps) [default: 16, or 3 per mission event + 6 if more]",
             min=0,
+            max=MAX_STEPS,
             show_default=False,
         ),
     ] = None,

@@ -43,7 +43,7 @@ from cosmop.missions.mission import GlobalMission, sequence_of
 from cosmop.missions.team import TeamVerdict, blocking_word, check_words
 from cosmop.planning.checker import CheckReport, check_plan
 from cosmop.planning.conflicts import ConflictSettings
-from cosmop.planning.plan import Coordination, PlanMessage, PlanSet, RobotPlan
+from cosmop.planning.plan import MAX_STEPS, Coordination, PlanMessage, PlanSet, RobotPlan
 from cosmop.planning.realisation import event_instants
 from cosmop.planning.synthesis import DEFAULT_RLIMIT, Synthesis, synthesize
 from cosmop.planning.teamsafety import TeamSafety, make_team_safe
@@ -143,8 +143,8 @@ def _leave_interrupts() -> None:
 def default_horizon(events: tuple[Event, ...]) -> int:
     """The longest plan tried for a mission when the caller sets none: 16, or 3 steps per
     mission event plus 6 when that is more (a robot with several deliveries needs the room;
-    detours around the others' places add steps)."""
-    return max(16, 3 * sum(1 for e in events if not e.is_message) + 6)
+    detours around the others' places add steps), never more than a plan file may hold."""
+    return min(MAX_STEPS, max(16, 3 * sum(1 for e in events if not e.is_message) + 6))
 
 
 class _Planner:

@@ -28,9 +28,9 @@ if the path is only its start point).
 mapping; both return an immutable :class:`Scenario` or raise
 :class:`~cosmop.errors.ScenarioError` naming the file, the field and what was expected.
 
-The YAML dialect is close to YAML 1.2's core schema: only ``true``/``false`` are booleans
-(``yes``, ``no``, ``on``, ``off``, ``y``, ``n`` stay text), integers are decimal, dates stay
-text, and a key repeated inside one mapping is an error instead of silently overriding.
+The file is read by :func:`cosmop.reading.load_yaml`: a YAML dialect close to YAML 1.2's core
+schema, in which a key repeated inside one mapping is an error, with bounds on nesting, size
+(aliases expanded) and integer length, so a hostile file is answered quickly and clearly.
 """
 
 from __future__ import annotations
@@ -41,20 +41,25 @@ import re
 from collections import Counter
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields, replace
+from fractions import Fraction
 from pathlib import Path
 from types import MappingProxyType, NoneType, UnionType
 from typing import Annotated, Any, Literal, NoReturn, Union, get_args, get_origin
 
-import yaml
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError, field_validator
 
 from cosmop._frozen import reduce_frozen
 from cosmop.errors import EventSyntaxError, ScenarioError
 from cosmop.io import read_text
 from cosmop.missions.events import ID_PATTERN, Event, parse_event
-from cosmop.units import SCENARIO_UNITS, default_dynamics, localize, scene_to_internal, show_length
+from cosmop.reading import FieldPath, Marks, format_path, load_yaml
+from cosmop.units import SCENARIO_UNITS, default_dynamics, localize, scene_to_internal, show_length, shown
 
 __all__ = [
+    "LENGTH_GRID",
+    "MAX_DFA_STATES",
+    "MAX_LENGTH",
+    "MAX_TASK_EVENTS",
     "SCENARIO_VERSION",
     "Delivery",
     "DfaSpec",
@@ -69,7 +74,21 @@ __all__ = [
     "Workspace",
     "load_scenario",
     "parse_scenario",
+    "planned_lengths",
 ]
+
+LENGTH_GRID = Fraction(1, 1000)
+"""Every length the planner uses (walls, poses, positions, sizes, workspaces) is a multiple of
+this many millimetres (a micrometre); plans are exact on it."""
+
+MAX_LENGTH = 1e9
+"""The largest length or coordinate, in mm (1000 km)."""
+
+MAX_DFA_STATES = 2000
+"""Most states an explicit mission DFA may list (its minimisation is quadratic at worst)."""
+
+MAX_TASK_EVENTS = 100
+"""Most events one robot's task list may hold (its shortest plan is searched up to 3 per event)."""
 
 SCENARIO_VERSION = 1
 """The scenario file format version this module reads (an optional top-level ``version`` key)."""
@@ -352,20 +371,34 @@ class Scene:
         for name in ("robots", "objects", "workspaces", "humans"):
             object.__setattr__(self, name, _frozen_mapping(getattr(self, name)))
 
-    def blocked(self, half: float, slack: float = 0.5):
+    def blocked(
+        self, half: float, slack: float = 0.5, within: tuple[float, float, float, float] | None = None
+    ):
         """Where the centre of an axis-aligned square of half-side `half` (mm) overlaps a wall.
 
         Each wall grown by the square exactly (the convex hull of the square at both ends),
         less `slack` mm: touching stays free, and so does a gap exactly as wide as the square
         (the walls are shrunk one by one, so that gap is not closed by their union).  A shapely
-        geometry (empty without walls).
+        geometry (empty without walls).  Given ``within = (xmin, ymin, xmax, ymax)``, only the
+        walls whose grown shape can meet that box are taken (the answer is the same inside it).
         """
         import shapely
 
         from cosmop.squares import swept_square
 
+        walls = self.obstacles
+        if within is not None:
+            x0, y0, x1, y1 = within
+            walls = tuple(
+                w
+                for w in walls
+                if min(w.start[0], w.end[0]) - half <= x1
+                and max(w.start[0], w.end[0]) + half >= x0
+                and min(w.start[1], w.end[1]) - half <= y1
+                and max(w.start[1], w.end[1]) + half >= y0
+            )
         side = 2.0 * (half - slack)
-        return shapely.unary_union([swept_square(w.start, w.end, side) for w in self.obstacles])
+        return shapely.unary_union([swept_square(w.start, w.end, side) for w in walls])
 
 
 @dataclass(frozen=True)
@@ -509,133 +542,6 @@ class Scenario:
     scene: Scene
     mission: Mission
     source: Path | None = None
-
-
-# ----------------------------------------------------------------------------------------------
-# YAML: a YAML-1.2-like loader that reports duplicate keys and remembers where things are
-# ----------------------------------------------------------------------------------------------
-
-_TAG = "tag:yaml.org,2002:"
-_REPLACED_TAGS = {_TAG + "bool", _TAG + "int", _TAG + "float", _TAG + "timestamp", _TAG + "value"}
-
-
-class _ScenarioLoader(yaml.SafeLoader):
-    """SafeLoader with core-schema scalars: booleans are only true/false, ints are decimal."""
-
-
-_ScenarioLoader.yaml_implicit_resolvers = {
-    first: [(tag, regexp) for tag, regexp in resolvers if tag not in _REPLACED_TAGS]
-    for first, resolvers in yaml.SafeLoader.yaml_implicit_resolvers.items()
-}
-_ScenarioLoader.add_implicit_resolver(
-    _TAG + "bool", re.compile(r"^(?:true|True|TRUE|false|False|FALSE)$"), list("tTfF")
-)
-_ScenarioLoader.add_implicit_resolver(_TAG + "int", re.compile(r"^[-+]?[0-9]+$"), list("-+0123456789"))
-_ScenarioLoader.add_implicit_resolver(
-    _TAG + "float",
-    re.compile(
-        r"^(?:[-+]?(?:\.[0-9]+|[0-9]+(?:\.[0-9]*)?)(?:[eE][-+]?[0-9]+)?"
-        r"|[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN))$"
-    ),
-    list("-+0123456789."),
-)
-
-
-def _construct_int(loader: _ScenarioLoader, node: yaml.ScalarNode) -> int:
-    text = loader.construct_scalar(node)
-    if re.fullmatch(r"[-+]?[0-9]+", text):
-        return int(text, 10)  # "012" is twelve, not YAML 1.1's octal ten
-    try:  # an explicit !!int tag: accept YAML 1.1's other notations (0x1F, 0o17, ...)
-        return yaml.SafeLoader.construct_yaml_int(loader, node)
-    except ValueError:
-        raise yaml.constructor.ConstructorError(
-            None, None, f"{text!r} is not an integer", node.start_mark
-        ) from None
-
-
-_ScenarioLoader.add_constructor(_TAG + "int", _construct_int)
-
-_Path = tuple[str | int, ...]
-_Marks = dict[_Path, tuple[int, int]]
-
-
-def _load_yaml(text: str, file: str) -> tuple[Any, _Marks]:
-    """Parse YAML text; return the data and the (line, column) of every field path."""
-    loader = _ScenarioLoader(text)
-    try:
-        node = loader.get_single_node()
-        marks: _Marks = {}
-        if node is not None:
-            _index_nodes(loader, node, (), marks, set(), file)
-        data = loader.construct_document(node) if node is not None else None
-    except yaml.MarkedYAMLError as err:
-        mark = err.problem_mark or err.context_mark
-        problem = err.problem or err.context or "malformed YAML"
-        if err.context and err.problem:
-            problem = f"{problem} ({err.context})"
-        raise ScenarioError(
-            f"invalid YAML: {problem}",
-            file=file,
-            line=None if mark is None else mark.line + 1,
-            column=None if mark is None else mark.column + 1,
-        ) from None
-    except yaml.YAMLError as err:
-        raise ScenarioError(f"invalid YAML: {err}", file=file) from None
-    finally:
-        loader.dispose()
-    return data, marks
-
-
-def _index_nodes(
-    loader: _ScenarioLoader, node: yaml.Node, path: _Path, marks: _Marks, visited: set[int], file: str
-) -> None:
-    """Record the position of every field and reject keys repeated within one mapping."""
-    if id(node) in visited:  # an alias of an anchored node: already indexed
-        return
-    visited.add(id(node))
-    if isinstance(node, yaml.SequenceNode):
-        for index, item in enumerate(node.value):
-            marks.setdefault((*path, index), _position(item))
-            _index_nodes(loader, item, (*path, index), marks, visited, file)
-    elif isinstance(node, yaml.MappingNode):
-        first_seen: dict[Any, int] = {}
-        for key_node, value_node in node.value:
-            if key_node.tag == _TAG + "merge":  # "<<: *anchor": merged keys may be overridden
-                _index_nodes(loader, value_node, path, {}, visited, file)
-                continue
-            if not isinstance(key_node, yaml.ScalarNode):
-                continue  # complex keys: the constructor rejects unhashable ones
-            key = loader.construct_object(key_node, deep=True)
-            line, column = _position(key_node)
-            if key in first_seen:
-                raise ScenarioError(
-                    f"duplicate key {key!r} (first defined on line {first_seen[key]}); "
-                    "every key and id must appear once in its mapping",
-                    file=file,
-                    field=_format_path((*path, key)),
-                    line=line,
-                    column=column,
-                )
-            first_seen[key] = line
-            marks.setdefault((*path, key), (line, column))
-            _index_nodes(loader, value_node, (*path, key), marks, visited, file)
-
-
-def _position(node: yaml.Node) -> tuple[int, int]:
-    return node.start_mark.line + 1, node.start_mark.column + 1
-
-
-def _format_path(path: _Path) -> str:
-    """``("scene", "robots", "R1", "pose", 0)`` -> ``scene.robots.R1.pose[0]``."""
-    text = ""
-    for part in path:
-        if isinstance(part, int) and not isinstance(part, bool):
-            text += f"[{part}]"
-        elif isinstance(part, str) and re.fullmatch(r"[A-Za-z0-9_-]+", part):
-            text += f".{part}" if text else part
-        else:
-            text += f"[{part!r}]"
-    return text
 
 
 # ----------------------------------------------------------------------------------------------
@@ -842,7 +748,7 @@ def _unwrap(annotation: Any) -> Any:
             return annotation
 
 
-def _model_at(path: _Path) -> type[BaseModel] | None:
+def _model_at(path: FieldPath) -> type[BaseModel] | None:
     """The pydantic model describing the mapping at `path`, if that position is a model."""
     annotation: Any = _ScenarioModel
     for part in path:
@@ -866,7 +772,7 @@ def _describe_keys(model: type[BaseModel]) -> str:
     return "a mapping with keys " + ", ".join(keys)
 
 
-def _expected_at(loc: _Path) -> tuple[_Path, str | None]:
+def _expected_at(loc: FieldPath) -> tuple[FieldPath, str | None]:
     """The field to report for an error at `loc`, and what is expected there."""
     for length in range(len(loc), -1, -1):
         prefix = loc[:length]
@@ -887,7 +793,7 @@ def _matches(pattern: str, part: str | int) -> bool:
     return pattern == "*" or pattern == part
 
 
-def _lookup(data: Any, path: _Path) -> tuple[bool, Any]:
+def _lookup(data: Any, path: FieldPath) -> tuple[bool, Any]:
     for part in path:
         if isinstance(data, Mapping):
             if part not in data:
@@ -919,14 +825,14 @@ def _show(value: Any) -> str:
 class _Builder:
     """Validates one scenario mapping and builds the :class:`Scenario`."""
 
-    def __init__(self, data: Any, file: str | None, marks: _Marks | None) -> None:
+    def __init__(self, data: Any, file: str | None, marks: Marks | None) -> None:
         self.data = data
         self.file = file
         self.marks = marks or {}
         units = data.get("units") if isinstance(data, Mapping) else None
         self.units = units if units in SCENARIO_UNITS else "mm"  # the words of its messages
 
-    def fail(self, path: _Path, expected: str) -> NoReturn:
+    def fail(self, path: FieldPath, expected: str) -> NoReturn:
         line = column = None
         for length in range(len(path), 0, -1):
             if path[:length] in self.marks:
@@ -935,7 +841,7 @@ class _Builder:
         raise ScenarioError(
             localize(expected, self.units),
             file=self.file,
-            field=_format_path(path) if path else None,
+            field=format_path(path) if path else None,
             line=line,
             column=column,
         )
@@ -960,14 +866,14 @@ class _Builder:
             )[1]
             self._structure_error(first)
 
-    def _line_of(self, loc: _Path) -> float:
+    def _line_of(self, loc: FieldPath) -> float:
         for length in range(len(loc), 0, -1):
             if loc[:length] in self.marks:
                 return self.marks[loc[:length]][0]
         return math.inf
 
     def _structure_error(self, error: Mapping[str, Any]) -> NoReturn:
-        loc: _Path = tuple(error["loc"])
+        loc: FieldPath = tuple(error["loc"])
         kind = error["type"]
         if "[key]" in loc:
             cut = loc.index("[key]")
@@ -996,12 +902,13 @@ class _Builder:
         if model.version is not None and model.version != SCENARIO_VERSION:
             self.fail(("version",), f"expected {_EXPECTED[('version',)]}, got {model.version}")
         scene = scene_to_internal(self.build_scene(model.scene), model.units or "mm")
+        self.check_precision(scene)
         self.check_bodies(scene)
         mission = self.build_mission(model.mission, scene)
         return Scenario(name=model.name, scene=scene, mission=mission, source=source)
 
     def build_scene(self, model: _SceneModel) -> Scene:
-        owner_of_id: dict[str, _Path] = {}
+        owner_of_id: dict[str, FieldPath] = {}
         kinds = {
             "robots": "a robot",
             "objects": "an object",
@@ -1017,7 +924,7 @@ class _Builder:
                     other = owner_of_id[ident]
                     self.fail(
                         path,
-                        f"id {ident!r} is already used by {kinds[other[1]]} ({_format_path(other)}); "
+                        f"id {ident!r} is already used by {kinds[other[1]]} ({format_path(other)}); "
                         "ids must be unique across robots, objects, workspaces and humans",
                     )
                 owner_of_id[ident] = path
@@ -1054,6 +961,23 @@ class _Builder:
             humans=humans,
             dynamics=dynamics,
         )
+
+    def check_precision(self, scene: Scene) -> None:
+        """Every length the planner uses lies on the :data:`LENGTH_GRID` and within :data:`MAX_LENGTH`."""
+        grid = f"{shown(float(LENGTH_GRID), self.units):f}".rstrip("0") + (
+            " m" if self.units == "m" else " mm"
+        )
+        for path, value in planned_lengths(scene):
+            if abs(value) > MAX_LENGTH:
+                self.fail(
+                    path, f"expected a length of at most {show_length(MAX_LENGTH, self.units)}, got {value:g}"
+                )
+            if (Fraction(repr(float(value))) / LENGTH_GRID).denominator != 1:
+                shown_value = f"{shown(value, self.units):.12g}"
+                self.fail(
+                    path,
+                    f"expected a multiple of {grid} (plans are exact to a micrometre), got {shown_value}",
+                )
 
     def check_bodies(self, scene: Scene) -> None:
         """A physically possible scene: no body overlaps a wall or another body at the start."""
@@ -1166,11 +1090,17 @@ class _Builder:
         if not tasks:
             self.fail(("mission", "tasks"), "expected a task list for at least one robot, got none")
         result = {}
-        mover: dict[str, _Path] = {}  # the first task that moves each object
+        mover: dict[str, FieldPath] = {}  # the first task that moves each object
         for robot, steps in tasks.items():
             if robot not in scene.robots:
                 self.fail(
                     ("mission", "tasks", robot), f"unknown robot {robot!r}; {_known('robots', scene.robots)}"
+                )
+            if len(steps) > MAX_TASK_EVENTS:
+                self.fail(
+                    ("mission", "tasks", robot),
+                    f"a task list of {len(steps)} events; at most {MAX_TASK_EVENTS} per robot are planned "
+                    "(split the mission into several runs)",
                 )
             events = []
             for index, text in enumerate(steps):
@@ -1188,7 +1118,7 @@ class _Builder:
                     if first[2] != robot:
                         self.fail(
                             path,
-                            f"{event.obj} is already moved by {first[2]} ({_format_path(first)}); one robot "
+                            f"{event.obj} is already moved by {first[2]} ({format_path(first)}); one robot "
                             "moves each object in a task list (a relay between robots needs an order: "
                             "write the mission as a dfa)",
                         )
@@ -1200,7 +1130,7 @@ class _Builder:
         base = ("mission", "dfa")
         listed = self.unique_states((*base, "states"), model.states) if model.states is not None else None
 
-        def known(path: _Path, state: str, role: str) -> None:
+        def known(path: FieldPath, state: str, role: str) -> None:
             if listed is not None and state not in listed:
                 self.fail(path, f"unknown {role} state {state!r}; it is not in mission.dfa.states")
 
@@ -1229,6 +1159,12 @@ class _Builder:
             order.setdefault(target)
             transitions.append((source, event, target))
         states = tuple(order)
+        if len(states) > MAX_DFA_STATES:
+            self.fail(
+                base,
+                f"a DFA of {len(states):,} states; at most {MAX_DFA_STATES:,} are read "
+                "(write a large mission as tasks or deliveries: they are composed, not listed)",
+            )
 
         if model.marked is None:
             marked = states
@@ -1258,7 +1194,7 @@ class _Builder:
             )
         return spec
 
-    def unique_states(self, path: _Path, states: list[str]) -> tuple[str, ...]:
+    def unique_states(self, path: FieldPath, states: list[str]) -> tuple[str, ...]:
         seen: dict[str, int] = {}
         for index, state in enumerate(states):
             if state in seen:
@@ -1266,13 +1202,13 @@ class _Builder:
             seen[state] = index
         return tuple(states)
 
-    def parse(self, path: _Path, text: str, robot: str | None) -> Event:
+    def parse(self, path: FieldPath, text: str, robot: str | None) -> Event:
         try:
             return parse_event(text, robot=robot)
         except EventSyntaxError as err:
             self.fail(path, str(err))
 
-    def check_references(self, path: _Path, event: Event, scene: Scene) -> None:
+    def check_references(self, path: FieldPath, event: Event, scene: Scene) -> None:
         for robot in sorted(event.owners):
             if robot not in scene.robots:
                 self.fail(path, f"unknown robot {robot!r} in {event.name}; {_known('robots', scene.robots)}")
@@ -1289,7 +1225,7 @@ class _Builder:
         if event.kind == "drop":
             self.check_holds(path, scene.objects[event.obj], event.workspace, scene)
 
-    def check_holds(self, path: _Path, obj: MovableObject, workspace: str, scene: Scene) -> None:
+    def check_holds(self, path: FieldPath, obj: MovableObject, workspace: str, scene: Scene) -> None:
         """A drop's workspace can hold the object: as wide and as deep, with a place clear of walls."""
         ws, size = scene.workspaces[workspace], show_length(obj.size, self.units)
         if not ws.is_point and min(ws.x[1] - ws.x[0], ws.y[1] - ws.y[0]) < obj.size:
@@ -1318,6 +1254,26 @@ def _known(group: str, ids: Mapping[str, Any]) -> str:
 # ----------------------------------------------------------------------------------------------
 
 
+def planned_lengths(scene: Scene):
+    """``(field path, length in mm)`` of every coordinate and size the planner encodes."""
+    for i, wall in enumerate(scene.obstacles):
+        for j, point in enumerate((wall.start, wall.end)):
+            for k in (0, 1):
+                yield ("scene", "obstacles", i, j, k), point[k]
+    for rid, robot in scene.robots.items():
+        yield ("scene", "robots", rid, "size"), robot.size
+        for k in (0, 1):
+            yield ("scene", "robots", rid, "pose", k), robot.pose[k]
+    for oid, obj in scene.objects.items():
+        yield ("scene", "objects", oid, "size"), obj.size
+        for k in (0, 1):
+            yield ("scene", "objects", oid, "position", k), obj.position[k]
+    for wid, ws in scene.workspaces.items():
+        for key in ("x", "y", "point"):
+            for k, value in enumerate(getattr(ws, key) or ()):
+                yield ("scene", "workspaces", wid, key, k), value
+
+
 def _fits(scene: Scene, obj: MovableObject, workspace: Workspace) -> bool:
     """Whether some position in `workspace` holds `obj`'s square clear of every wall (touching allowed)."""
     import shapely
@@ -1326,7 +1282,7 @@ def _fits(scene: Scene, obj: MovableObject, workspace: Workspace) -> bool:
         places = shapely.Point(*workspace.point)
     else:
         places = shapely.box(workspace.x[0], workspace.y[0], workspace.x[1], workspace.y[1])
-    return not places.difference(scene.blocked(obj.size / 2.0)).is_empty
+    return not places.difference(scene.blocked(obj.size / 2.0, within=places.bounds)).is_empty
 
 
 def _reachable(initial: str, transitions) -> set[str]:
@@ -1388,5 +1344,5 @@ def load_scenario(path: str | os.PathLike[str]) -> Scenario:
     """
     file = os.fspath(path)
     text = read_text(path, ScenarioError, "a scenario file")
-    data, marks = _load_yaml(text, file)
+    data, marks = load_yaml(text, file, ScenarioError)
     return _Builder(data, file, marks).build(Path(path))

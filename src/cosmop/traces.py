@@ -9,7 +9,6 @@ A trace is JSON: ``format``, ``scenario``, ``units`` (absent in older files: mm,
 
 from __future__ import annotations
 
-import json
 import math
 import os
 from collections.abc import Mapping
@@ -17,6 +16,7 @@ from typing import Any
 
 from cosmop.errors import CosmopInputError
 from cosmop.io import read_text
+from cosmop.reading import load_json
 from cosmop.units import check_units_field
 
 __all__ = ["TRACE_FORMAT", "TraceError", "check_trace", "load_trace", "message_label"]
@@ -92,10 +92,7 @@ def load_trace(path: str | os.PathLike[str]) -> dict[str, Any]:
     """Read and check a ``cosmop.trace/1`` file (see :func:`check_trace`)."""
     file = os.fspath(path)
     text = read_text(path, TraceError, "a trace file")
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as err:
-        raise TraceError(f"invalid JSON: {err.msg}", file=file, line=err.lineno, column=err.colno) from None
+    data = load_json(text, file, TraceError)
     return check_trace(data, file)
 
 

@@ -26,10 +26,10 @@ from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
-import yaml
 
 from cosmop.io import read_text
 from cosmop.maps.grid import MapError, OccupancyGrid
+from cosmop.reading import load_yaml
 
 __all__ = ["read_pgm", "read_ros_map"]
 
@@ -152,10 +152,7 @@ def read_ros_map(
         not a PGM; the error names the file and the field.
     """
     file = os.fspath(path)
-    try:
-        doc = yaml.safe_load(read_text(path, MapError, "a ROS map YAML file"))
-    except yaml.YAMLError as err:
-        raise MapError(f"invalid YAML: {err}", file=file) from None
+    doc, _ = load_yaml(read_text(path, MapError, "a ROS map YAML file"), file, MapError)
     if not isinstance(doc, dict):
         raise MapError("expected a mapping with image, resolution and origin", file=file)
     image = doc.get("image")

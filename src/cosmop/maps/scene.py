@@ -20,6 +20,7 @@ from cosmop.maps.cover import Rect, boundary_walls, rectangle_cover, rectangle_w
 from cosmop.maps.grid import MapError, OccupancyGrid
 from cosmop.maps.movingai import read_movingai
 from cosmop.maps.rosmap import read_ros_map
+from cosmop.reading import load_yaml
 from cosmop.units import m_from_mm
 
 __all__ = ["ImportedMap", "import_map", "scenario_text"]
@@ -135,10 +136,7 @@ def _number(value: float, units: str) -> int | float:
 
 def _load_template(path: str | os.PathLike[str]) -> dict[str, Any]:
     file = os.fspath(path)
-    try:
-        data = yaml.load(read_text(path, MapError, "a scenario file"), Loader=yaml.SafeLoader)
-    except yaml.YAMLError as err:
-        raise MapError(f"invalid YAML: {err}", file=file) from None
+    data, _ = load_yaml(read_text(path, MapError, "a scenario file"), file, MapError)
     if not isinstance(data, dict) or not isinstance(data.get("scene"), dict):
         raise MapError("expected a scenario with a scene mapping to take robots and mission from", file=file)
     return data

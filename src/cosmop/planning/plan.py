@@ -60,12 +60,14 @@ from cosmop._frozen import reduce_frozen
 from cosmop.errors import CosmopInputError, EventSyntaxError
 from cosmop.io import read_text, write_atomic
 from cosmop.missions.events import ID_PATTERN, Event, parse_event
+from cosmop.reading import FieldPath, format_path, load_json
 from cosmop.units import INTERNAL_UNITS, check_units_field
 
 if TYPE_CHECKING:
     from cosmop.scenario import Scene
 
 __all__ = [
+    "MAX_STEPS",
     "MESSAGE_PRIMITIVES",
     "MESSAGE_REASONS",
     "OBJECT_PRIMITIVES",
@@ -87,6 +89,9 @@ __all__ = [
 
 PLAN_FORMAT = "cosmop.plan/1"
 """The value of the ``format`` field of the plan files this module reads and writes."""
+
+MAX_STEPS = 1000
+"""Most steps one robot's plan may have (a plan file with more is refused; no horizon goes beyond)."""
 
 PRIMITIVES = ("GoTo", "PickUp", "DropOff", "Req", "Res")
 """The motion primitives, in the paper's order :math:`\\pi^1, \\dots, \\pi^5`."""
@@ -713,12 +718,7 @@ def load_plan(path: str | os.PathLike[str]) -> PlanSet:
     text = read_text(path, PlanError, "a plan file")
     if not text.strip():
         raise PlanError("the file is empty; expected a cosmop.plan/1 JSON object", file=file)
-    try:
-        data = json.loads(text, object_pairs_hook=_no_duplicates, parse_constant=_no_constant)
-    except json.JSONDecodeError as err:
-        raise PlanError(f"invalid JSON: {err.msg}", file=file, line=err.lineno, column=err.colno) from None
-    except _JsonContentError as err:
-        raise PlanError(f"invalid JSON: {err}", file=file) from None
+    data = load_json(text, file, PlanError, object_pairs_hook=_no_duplicates)
     return PlanSet.from_dict(data, file=file)
 
 
@@ -727,21 +727,13 @@ def load_plan(path: str | os.PathLike[str]) -> PlanSet:
 # ----------------------------------------------------------------------------------------------
 
 
-class _JsonContentError(ValueError):
-    pass
-
-
 def _no_duplicates(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
     result: dict[str, Any] = {}
     for key, value in pairs:
         if key in result:
-            raise _JsonContentError(f"duplicate key {key!r}; every key and id must appear once in its object")
+            raise ValueError(f"duplicate key {key!r}; every key and id must appear once in its object")
         result[key] = value
     return result
-
-
-def _no_constant(name: str) -> Any:
-    raise _JsonContentError(f"{name} is not a number; coordinates must be finite")
 
 
 def _describe(value: Any) -> str:
@@ -754,32 +746,16 @@ def _describe(value: Any) -> str:
     return type(value).__name__
 
 
-_Path = tuple[str | int, ...]
-
-
-def _format_path(path: _Path) -> str | None:
-    """``("robots", "R1", "steps", 3, "primitive")`` -> ``robots.R1.steps[3].primitive``."""
-    text = ""
-    for part in path:
-        if isinstance(part, int):
-            text += f"[{part}]"
-        elif re.fullmatch(r"[A-Za-z0-9_-]+", part):
-            text += f".{part}" if text else part
-        else:
-            text += f"[{part!r}]"
-    return text or None
-
-
 class _Reader:
     """Builds a PlanSet from parsed JSON, raising PlanError with the file and field path."""
 
     def __init__(self, file: str | None) -> None:
         self.file = file
 
-    def fail(self, path: _Path, expected: str) -> PlanError:
-        return PlanError(expected, file=self.file, field=_format_path(path))
+    def fail(self, path: FieldPath, expected: str) -> PlanError:
+        return PlanError(expected, file=self.file, field=format_path(path))
 
-    def mapping(self, value: Any, path: _Path, required: tuple[str, ...], optional: tuple[str, ...] = ()):
+    def mapping(self, value: Any, path: FieldPath, required: tuple[str, ...], optional: tuple[str, ...] = ()):
         if not isinstance(value, dict):
             raise self.fail(path, f"expected a JSON object, got {_describe(value)}")
         for key in required:
@@ -793,30 +769,30 @@ class _Reader:
                 )
         return value
 
-    def string(self, value: Any, path: _Path, what: str = "text") -> str:
+    def string(self, value: Any, path: FieldPath, what: str = "text") -> str:
         if not isinstance(value, str):
             raise self.fail(path, f"expected {what}, got {_describe(value)}")
         return value
 
-    def ident(self, value: Any, path: _Path, what: str) -> str:
+    def ident(self, value: Any, path: FieldPath, what: str) -> str:
         text = self.string(value, path, f"{what} id")
         if not _ID_RE.match(text):
             raise self.fail(path, f"{text!r} is not a valid {what} id (expected {ID_PATTERN})")
         return text
 
-    def boolean(self, value: Any, path: _Path) -> bool:
+    def boolean(self, value: Any, path: FieldPath) -> bool:
         if not isinstance(value, bool):
             raise self.fail(path, f"expected true or false, got {_describe(value)}")
         return value
 
-    def number(self, value: Any, path: _Path) -> float:
+    def number(self, value: Any, path: FieldPath) -> float:
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise self.fail(path, f"expected a number, got {_describe(value)}")
         if not math.isfinite(value):
             raise self.fail(path, f"expected a finite number, got {value!r}")
         return float(value)
 
-    def numbers(self, value: Any, path: _Path, names: tuple[str, ...], units: str) -> tuple[float, ...]:
+    def numbers(self, value: Any, path: FieldPath, names: tuple[str, ...], units: str) -> tuple[float, ...]:
         wanted = f"a list [{', '.join(names)}] ({units})"
         if not isinstance(value, list):
             raise self.fail(path, f"expected {wanted}, got {_describe(value)}")
@@ -870,7 +846,7 @@ class _Reader:
         }
         return PlanSet(scenario, feasible, robots, pairs, reason, messages, allocation)
 
-    def message(self, value: Any, path: _Path) -> PlanMessage:
+    def message(self, value: Any, path: FieldPath) -> PlanMessage:
         item = self.mapping(value, path, ("event", "kind", "protects"), ("sender", "receiver", "place"))
         text = self.string(item["event"], (*path, "event"), "a message such as 'msg(R1,R2,t1)'")
         try:
@@ -893,7 +869,7 @@ class _Reader:
             place = self.numbers(place, (*path, "place"), ("x_min", "y_min", "x_max", "y_max"), "mm")
         return PlanMessage(event.name, kind, protects, place)
 
-    def coordination(self, value: Any, path: _Path) -> Coordination:
+    def coordination(self, value: Any, path: FieldPath) -> Coordination:
         item = self.mapping(value, path, ("object", "requester", "responder"))
         obj = self.ident(item["object"], (*path, "object"), "object")
         requester = self.ident(item["requester"], (*path, "requester"), "robot")
@@ -904,7 +880,7 @@ class _Reader:
             )
         return Coordination(obj, requester, responder)
 
-    def robot_plan(self, value: Any, path: _Path, robot: str) -> RobotPlan:
+    def robot_plan(self, value: Any, path: FieldPath, robot: str) -> RobotPlan:
         item = self.mapping(value, path, ("mission", "horizon", "steps"))
         mission_data = item["mission"]
         if not isinstance(mission_data, list):
@@ -923,6 +899,8 @@ class _Reader:
         steps_data = item["steps"]
         if not isinstance(steps_data, list):
             raise self.fail((*path, "steps"), f"expected a list of steps, got {_describe(steps_data)}")
+        if len(steps_data) > MAX_STEPS:
+            raise self.fail((*path, "steps"), f"{len(steps_data)} steps; a plan has at most {MAX_STEPS:,}")
         if horizon != len(steps_data):
             raise self.fail(
                 (*path, "horizon"),
@@ -931,7 +909,7 @@ class _Reader:
         steps = tuple(self.step(s, (*path, "steps", i)) for i, s in enumerate(steps_data))
         return RobotPlan(tuple(mission), horizon, steps)
 
-    def step(self, value: Any, path: _Path) -> Step:
+    def step(self, value: Any, path: FieldPath) -> Step:
         item = self.mapping(value, path, ("primitive", "robot", "objects"), ("object", "message"))
         primitive = item["primitive"]
         if primitive not in PRIMITIVES:
@@ -975,7 +953,7 @@ class _Reader:
             raise self.fail((*path, "object"), f"{obj!r} is not among the step's objects ({listed})")
         return Step(primitive, obj, robot, objects, message)
 
-    def step_message(self, item: dict, path: _Path, primitive: str) -> str | None:
+    def step_message(self, item: dict, path: FieldPath, primitive: str) -> str | None:
         """The step's ``message`` (a msg event of a Req or Res), or None."""
         message = item.get("message")
         if message is None:

@@ -3,7 +3,9 @@
 Section IV of the paper.  The state at instant ``k`` (Section IV-C) is the robot's pose
 :math:`q_r = (x, y, \\alpha)`, every object's :math:`q_b^j = (x, y, p, a)` (position, carried,
 away) and the primitive :math:`\\pi` taken between ``k-1`` and ``k`` (``NONE`` at instant 0).
-Positions are integers in mm, headings integers in degrees, as in the paper.
+Positions are integers in mm, headings integers in degrees, as in the paper, unless the scene
+needs finer poses (an odd side, a half-millimetre coordinate): then positions are exact
+rationals (:func:`position_sort`).
 
 Each primitive is a small object with a name and an ``effect``: the constraint relating
 :math:`q` and :math:`\\bigcirc q` when :math:`\\bigcirc\\pi` is that primitive.  The
@@ -47,7 +49,21 @@ from types import MappingProxyType
 import shapely
 
 from cosmop.automata import DFA
-from cosmop.logic import FALSE, TRUE, Always, Formula, Implies, Next, Not, Until, Var, conj, disj, eq
+from cosmop.logic import (
+    FALSE,
+    TRUE,
+    Always,
+    Formula,
+    Implies,
+    Next,
+    Not,
+    Until,
+    Var,
+    conj,
+    disj,
+    eq,
+    to_fraction,
+)
 from cosmop.missions.events import Event
 from cosmop.planning.plan import State
 from cosmop.planning.regions import HalfPlane, wall_regions
@@ -58,12 +74,30 @@ PRIMITIVE_NAMES = ("GoTo", "PickUp", "DropOff", "Req", "Res")
 
 
 def _num(value: float) -> Fraction:
-    return Fraction(value).limit_denominator(10**6)
+    return to_fraction(value)  # exact: a scenario's lengths lie on a micrometre grid
+
+
+def position_sort(scene: Scene, start: State | None = None) -> str:
+    """The sort of the position variables: ``"int"`` (whole mm, the paper's) or ``"real"``.
+
+    Walls and rectangular workspaces only bound positions (inequalities), so they never force
+    a fractional pose; the poses a primitive forces are the start and home poses, the pick and
+    drop poses (an object's position minus the two half-sides), point workspaces and, given a
+    `start` state, where the robot and the objects are in it.  When all of those are whole
+    millimetres, integers lose no plan; otherwise (an object of side 101 mm, a good at
+    x = 0.5 mm) positions are exact rationals, so that no plan is lost to rounding.
+    """
+    numbers = [v for r in scene.robots.values() for v in (r.size / 2, *r.pose[:2])]
+    numbers += [v for o in scene.objects.values() for v in (o.size / 2, *o.position)]
+    numbers += [v for w in scene.workspaces.values() if w.is_point for v in w.point]
+    if start is not None:  # a plan from a given state (mid-run) starts exactly there
+        numbers += [*start.robot[:2], *(v for o in start.objects.values() for v in o.position)]
+    return "int" if all(_num(v).denominator == 1 for v in numbers) else "real"
 
 
 @dataclass(frozen=True)
 class ObjectVars:
-    """CLTLB(D) variables of one object: position (int mm), carried and away (bool)."""
+    """CLTLB(D) variables of one object: position (mm, :func:`position_sort`), carried, away (bool)."""
 
     x: Var
     y: Var
@@ -71,9 +105,9 @@ class ObjectVars:
     away: Var
 
     @classmethod
-    def named(cls, obj: str) -> ObjectVars:
+    def named(cls, obj: str, sort: str = "int") -> ObjectVars:
         return cls(
-            Var(f"{obj}.x", "int"), Var(f"{obj}.y", "int"), Var(f"{obj}.p", "bool"), Var(f"{obj}.a", "bool")
+            Var(f"{obj}.x", sort), Var(f"{obj}.y", sort), Var(f"{obj}.p", "bool"), Var(f"{obj}.a", "bool")
         )
 
 
@@ -127,6 +161,7 @@ class RobotProblem:
     unrequestable: frozenset[str] = frozenset()
     automaton: DFA | None = None
     actions: tuple[Action, ...] = field(init=False)
+    sort: str = field(init=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "mission", tuple(self.mission))
@@ -134,6 +169,7 @@ class RobotProblem:
         object.__setattr__(self, "primitives", MappingProxyType(dict(primitives)))
         acts = [(prim.name, obj) for prim in self.primitives.values() for obj in prim.targets(self)]
         object.__setattr__(self, "actions", tuple(Action(name, o, i + 1) for i, (name, o) in enumerate(acts)))
+        object.__setattr__(self, "sort", position_sort(self.scene, self.start))
 
     @property
     def own_objects(self) -> tuple[str, ...]:
@@ -156,11 +192,11 @@ class RobotProblem:
     # -- variables -----------------------------------------------------------------------------
     @property
     def x(self) -> Var:
-        return Var("x", "int")
+        return Var("x", self.sort)
 
     @property
     def y(self) -> Var:
-        return Var("y", "int")
+        return Var("y", self.sort)
 
     @property
     def h(self) -> Var:
@@ -181,7 +217,7 @@ class RobotProblem:
         return Var("event", "int")
 
     def obj(self, obj: str) -> ObjectVars:
-        return ObjectVars.named(obj)
+        return ObjectVars.named(obj, self.sort)
 
     @property
     def side(self) -> Fraction:

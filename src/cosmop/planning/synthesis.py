@@ -45,7 +45,7 @@ from cosmop.planning.specification import (
     request_codes,
     specification,
 )
-from cosmop.scenario import Scene
+from cosmop.scenario import MAX_TASK_EVENTS, Scene
 
 DEFAULT_RLIMIT = 50_000_000
 
@@ -211,6 +211,15 @@ def synthesize(
         events = strip_messages(full)
         walled_off = unreachable(scene, robot, events, origin)
         lower = sum(1 for e in events if e.kind != "return")  # each such event takes a step
+    if walled_off is None and automaton is None and len(events) > MAX_TASK_EVENTS:
+        walled_off = (
+            f"{robot}'s mission has {len(events)} events; at most {MAX_TASK_EVENTS} are planned at once"
+        )
+    if walled_off is None and lower > max_horizon:
+        walled_off = (
+            f"{robot}'s mission needs at least {lower} steps, more than the longest plan searched "
+            f"({max_horizon} steps)"
+        )
     if walled_off is not None:  # no horizon can do it: say so without the solver
         return Synthesis(robot, False, None, None, reason=walled_off, solve_s=time.perf_counter() - t0)
     forbid = frozenset(unrequestable)

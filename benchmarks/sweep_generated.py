@@ -1,0 +1,145 @@
+"""Do the plans that ``cosmop plan`` calls feasible execute?  A seeded sweep (issue 12, point 5).
+
+Each seed draws a scene: a square room of 6 to 9 m with 1 to 4 random axis-aligned inner walls,
+2 to 5 robots (side 400 mm), one good per robot (side 100 mm) and one 600 x 600 mm dock per
+robot; robot *i* picks good *i*, drops it in dock *i* and returns.  Positions lie on a 100 mm
+grid; a draw the loader refuses (a body overlapping a wall or another body, a dock that cannot
+hold its good) is drawn again from the same seed's generator, so every seed gives a valid scene.
+
+Each scene is planned (``cosmop plan``) and, when feasible, simulated from that plan
+(``cosmop simulate --plan``) as a user runs them, one fresh process each.  A row records the
+plan's verdict, whether the run completed, the contacts while moving, the simulated and wall
+times.  Writes ``results/sweep_generated.json``.
+
+Usage: ``python benchmarks/sweep_generated.py [--seeds 0:200] [--timeout 600]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import random
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import yaml
+
+from _harness import save_results
+from cosmop.errors import ScenarioError
+from cosmop.scenario import parse_scenario
+
+GRID = 100
+
+
+def _spot(rng: random.Random, half: int, margin: int) -> list[int]:
+    return [rng.randrange(-half + margin, half - margin + 1, GRID) for _ in range(2)]
+
+
+def draw(rng: random.Random) -> dict:
+    """One candidate scene (may be physically impossible; :func:`scene` filters)."""
+    half = rng.choice([3000, 3500, 4000, 4500])
+    walls = [
+        [[-half, -half], [half, -half]],
+        [[half, -half], [half, half]],
+        [[half, half], [-half, half]],
+        [[-half, half], [-half, -half]],
+    ]
+    for _ in range(rng.randint(1, 4)):
+        x, y = _spot(rng, half, 500)
+        length = rng.randrange(1000, 3001, GRID)
+        end = [min(x + length, half), y] if rng.random() < 0.5 else [x, min(y + length, half)]
+        walls.append([[x, y], end])
+    n = rng.randint(2, 5)
+    robots = {f"R{i}": {"size": 400, "pose": [*_spot(rng, half, 300), 0]} for i in range(1, n + 1)}
+    objects = {f"O{i}": {"size": 100, "position": _spot(rng, half, 400)} for i in range(1, n + 1)}
+    workspaces = {}
+    for i in range(1, n + 1):
+        x, y = _spot(rng, half, 700)
+        workspaces[f"W{i}"] = {"x": [x, x + 600], "y": [y, y + 600]}
+    tasks = {f"R{i}": [f"pick O{i}", f"drop O{i} at W{i}", "return"] for i in range(1, n + 1)}
+    return {
+        "name": "generated",
+        "scene": {"obstacles": walls, "robots": robots, "objects": objects, "workspaces": workspaces},
+        "mission": {"tasks": tasks},
+    }
+
+
+def scene(seed: int) -> dict:
+    """The first physically possible draw of `seed`'s generator."""
+    rng = random.Random(seed)
+    while True:
+        data = draw(rng)
+        try:
+            parse_scenario(data)
+        except ScenarioError:
+            continue
+        data["name"] = f"generated-{seed}"
+        return data
+
+
+def run_seed(seed: int, timeout: float, folder: Path) -> dict:
+    data = scene(seed)
+    path = folder / f"scene_{seed}.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False, default_flow_style=None))
+    plan, summary = folder / f"plan_{seed}.json", folder / f"summary_{seed}.json"
+    cosmop = [sys.executable, "-m", "cosmop"]
+    row = {"seed": seed, "robots": len(data["scene"]["robots"]), "walls": len(data["scene"]["obstacles"])}
+    start = time.perf_counter()
+    try:
+        planned = subprocess.run(
+            [*cosmop, "plan", str(path), "-o", str(plan)], capture_output=True, timeout=timeout
+        )
+    except subprocess.TimeoutExpired:
+        return row | {"plan": "timeout", "plan_s": timeout}
+    row |= {"plan": {0: "feasible", 1: "infeasible"}.get(planned.returncode, f"exit {planned.returncode}")}
+    row["plan_s"] = round(time.perf_counter() - start, 2)
+    if planned.returncode != 0:
+        return row
+    start = time.perf_counter()
+    try:
+        sim = subprocess.run(
+            [*cosmop, "simulate", str(path), "--plan", str(plan), "--summary", str(summary)],
+            capture_output=True,
+            timeout=timeout,
+        )
+    except subprocess.TimeoutExpired:
+        return row | {"completed": False, "sim": "timeout"}
+    row["sim_s"] = round(time.perf_counter() - start, 2)
+    if not summary.exists():
+        return row | {"completed": False, "sim": f"exit {sim.returncode}"}
+    result = json.loads(summary.read_text())
+    return row | {
+        "completed": bool(result["completed"]),
+        "contacts_while_moving": result["contacts_while_moving"],
+        "sim_time_s": result["sim_time_s"],
+        "replans": result["replans"],
+        "sim": f"exit {sim.returncode}",
+    }
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--seeds", default="0:200", help="first:last (exclusive)")
+    parser.add_argument("--timeout", type=float, default=600.0)
+    args = parser.parse_args(argv)
+    first, last = (int(v) for v in args.seeds.split(":"))
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for seed in range(first, last):
+            rows.append(run_seed(seed, args.timeout, Path(tmp)))
+            print(json.dumps(rows[-1]), flush=True)
+    save_results("sweep_generated", rows)
+    feasible = [r for r in rows if r["plan"] == "feasible"]
+    done = [r for r in feasible if r.get("completed")]
+    print(
+        f"{len(rows)} scenes: {len(feasible)} feasible, {len(done)} completed in simulation, "
+        f"{sum(r.get('contacts_while_moving', 0) for r in feasible)} contacts while moving"
+    )
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

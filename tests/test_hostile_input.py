@@ -1,0 +1,274 @@
+"""Hostile input: every file is answered with a result or a clean input error, never a crash.
+
+The bounds of :mod:`cosmop.reading` (nesting, expanded size, text and integer length, control
+characters) are tested one by one; hypothesis then mutates real scenario and plan files (text
+edits and structure edits) and requires that loading, and checking what loads, ends in a
+result or a :class:`~cosmop.errors.CosmopInputError`.  A few hostile files go through the
+command line to see exit 2, one line and no traceback.  The whole catalogue, with times and
+memory, is ``benchmarks/fuzz_inputs.py``.
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+import yaml
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from cosmop.errors import CosmopInputError, ScenarioError
+from cosmop.planning.checker import check_plan
+from cosmop.planning.plan import MAX_STEPS, PlanError, PlanSet, load_plan
+from cosmop.planning.synthesis import synthesize
+from cosmop.reading import MAX_DEPTH, MAX_DIGITS, MAX_NODES, MAX_TEXT, load_json, load_yaml
+from cosmop.scenario import MAX_DFA_STATES, MAX_TASK_EVENTS, load_scenario, parse_scenario
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLE = ROOT / "examples" / "01_warehouse_2x2" / "scenario.yaml"
+PLAN = ROOT / "tests" / "data" / "plan_2x2.json"  # cosmop plan of EXAMPLE
+SCENARIO_TEXT = EXAMPLE.read_text()
+
+
+def _yaml_error(text: str) -> ScenarioError:
+    with pytest.raises(ScenarioError) as info:
+        load_yaml(text, "f.yaml", ScenarioError)
+    return info.value
+
+
+# -- the bounds one by one --------------------------------------------------------------------
+
+
+def test_nesting_deeper_than_the_bound_is_refused_at_its_line():
+    err = _yaml_error("a:\n  b: " + "[" * (MAX_DEPTH + 5) + "]" * (MAX_DEPTH + 5) + "\n")
+    assert f"more than {MAX_DEPTH} levels" in str(err)
+    assert err.line == 2
+    load_yaml("a: " + "[" * (MAX_DEPTH - 1) + "]" * (MAX_DEPTH - 1), "f.yaml", ScenarioError)
+
+
+def test_an_alias_bomb_is_refused_without_expanding_it():
+    items = ['&a0 ["lol","lol","lol","lol","lol","lol","lol","lol","lol"]']
+    items += [f"&a{i + 1} [" + ",".join([f"*a{i}"] * 9) + "]" for i in range(9)]  # 9**10 values
+    err = _yaml_error("name: [" + ", ".join(items) + "]\n")
+    assert f"more than {MAX_NODES:,} values" in str(err)
+
+
+def test_aliases_within_the_bound_still_work():
+    data, _ = load_yaml("a: &p [1, 2]\nb: *p\n", "f.yaml", ScenarioError)
+    assert data == {"a": [1, 2], "b": [1, 2]}
+
+
+def test_an_alias_to_a_value_that_contains_it_is_refused():
+    assert "refers to a value that contains it" in str(_yaml_error("a: &x [1, *x]\n"))
+
+
+def test_long_text_and_long_integers_are_refused():
+    assert f"at most {MAX_TEXT:,}" in str(_yaml_error("name: " + "x" * (MAX_TEXT + 1)))
+    assert f"at most {MAX_DIGITS}" in str(_yaml_error("size: " + "9" * (MAX_DIGITS + 1)))
+    assert f"at most {MAX_DIGITS}" in str(_yaml_error("size: !!int " + "9" * (MAX_DIGITS + 1)))
+
+
+@pytest.mark.parametrize("char", ["\x00", "\x07", "\x1b", "\x7f", "\ufffe"])
+def test_control_characters_are_refused_with_their_position(char):
+    err = _yaml_error(f"name: ok\nscene: a{char}b\n")
+    assert f"U+{ord(char):04X}" in str(err)
+    assert (err.line, err.column) == (2, 9)
+
+
+def test_json_bounds():
+    for text, words in [
+        ("[" * (MAX_DEPTH + 1) + "]" * (MAX_DEPTH + 1), "levels deep"),
+        ("[" * 5000 + "]" * 5000, "levels deep"),  # past Python's own recursion limit
+        ("[" + "9" * 5000 + "]", f"at most {MAX_DIGITS}"),
+        ("[NaN]", "not a number"),
+        ("[1e999]", "must be finite"),
+        ('{"a": 1, "a": 2}', "duplicate key"),
+    ]:
+        hook = None if "duplicate" not in words else _no_repeats
+        with pytest.raises(PlanError, match=words):
+            load_json(text, "p.json", PlanError, object_pairs_hook=hook)
+
+
+def _no_repeats(pairs):
+    keys = [k for k, _ in pairs]
+    if len(set(keys)) != len(keys):
+        raise ValueError("duplicate key")
+    return dict(pairs)
+
+
+def test_a_task_list_longer_than_the_bound_is_refused(tmp_path):
+    long = ", ".join(["pick O1, drop O1 at W1"] * (MAX_TASK_EVENTS // 2 + 1))
+    path = tmp_path / "long.yaml"
+    path.write_text(SCENARIO_TEXT.replace("R1: [pick O1, drop O1 at W1, return]", f"R1: [{long}]"))
+    with pytest.raises(ScenarioError, match=f"at most {MAX_TASK_EVENTS} per robot") as info:
+        load_scenario(path)
+    assert info.value.field == "mission.tasks.R1"
+
+
+def test_a_dfa_larger_than_the_bound_is_refused():
+    data = yaml.safe_load(SCENARIO_TEXT)
+    events = ["pick(R1,O1)", "drop(R1,O1,W1)"]
+    chain = [[f"s{i}", events[i % 2], f"s{i + 1}"] for i in range(MAX_DFA_STATES)]
+    data["mission"] = {"dfa": {"initial": "s0", "transitions": chain}}
+    with pytest.raises(ScenarioError, match=f"at most {MAX_DFA_STATES:,} are read") as info:
+        parse_scenario(data)
+    assert info.value.field == "mission.dfa"
+
+
+def test_a_mission_beyond_the_horizon_is_infeasible_at_once_without_the_solver():
+    scene = _SCENARIO.scene
+    word = ["pick(R1,O1)", "drop(R1,O1,W1)"] * 30  # 60 steps at least
+    result = synthesize(scene, "R1", word, max_horizon=20)
+    assert not result.feasible
+    assert "needs at least 60 steps" in result.reason and "(20 steps)" in result.reason
+    result = synthesize(scene, "R1", word * 2, max_horizon=MAX_STEPS)  # 120 events: never nested
+    assert not result.feasible and f"at most {MAX_TASK_EVENTS} are planned" in result.reason
+
+
+def test_a_plan_longer_than_the_bound_is_refused():
+    data = json.loads(PLAN.read_text())
+    plan = data["robots"]["R1"]
+    plan["steps"] = plan["steps"] + [plan["steps"][-1]] * MAX_STEPS
+    plan["horizon"] = len(plan["steps"])
+    with pytest.raises(PlanError, match="at most 1,000") as info:
+        PlanSet.from_dict(data)
+    assert info.value.field == "robots.R1.steps"
+
+
+# -- property-based fuzzing of real files -----------------------------------------------------
+
+_YAML_BITS = st.sampled_from(
+    ["[", "]", "{", "}", ":", ",", "-", " ", "\n", "&a", "*a", "!!int", "'", '"', "#", "0", "1e400", "-", "x"]
+)
+# 120 examples per test in the suite; COSMOP_FUZZ_EXAMPLES=5000 for a long hunt
+_FUZZ = settings(
+    max_examples=int(os.environ.get("COSMOP_FUZZ_EXAMPLES", "120")),
+    suppress_health_check=[HealthCheck.too_slow],
+)
+
+
+@_FUZZ
+@given(st.data())
+def test_mutated_scenario_text_loads_or_says_why(tmp_path_factory, data):
+    text = SCENARIO_TEXT
+    for _ in range(data.draw(st.integers(1, 4))):
+        at = data.draw(st.integers(0, len(text)))
+        cut = data.draw(st.integers(0, 12))
+        text = text[:at] + "".join(data.draw(st.lists(_YAML_BITS, max_size=6))) + text[at + cut :]
+    path = tmp_path_factory.mktemp("fuzz") / "scenario.yaml"
+    path.write_text(text)
+    try:
+        load_scenario(path)
+    except ScenarioError as err:
+        assert err.file == str(path)
+
+
+_LEAVES = st.one_of(
+    st.none(),
+    st.booleans(),
+    st.integers(-(10**40), 10**40),
+    st.floats(allow_nan=False),
+    st.text(max_size=8),
+    st.lists(st.integers(-5, 5), max_size=4),
+)
+
+
+def _paths(value, path=()):
+    yield path
+    if isinstance(value, dict):
+        for key, item in value.items():
+            yield from _paths(item, (*path, key))
+    elif isinstance(value, list):
+        for index, item in enumerate(value):
+            yield from _paths(item, (*path, index))
+
+
+def _replace(value, path, new):
+    if not path:
+        return new
+    parent = value
+    for part in path[:-1]:
+        parent = parent[part]
+    parent[path[-1]] = new
+    return value
+
+
+# every form of scene and mission: tasks, people, deliveries, a DFA, ordering messages
+_SCENARIO_DATAS = [
+    yaml.safe_load((ROOT / "examples" / name / "scenario.yaml").read_text())
+    for name in ("01_warehouse_2x2", "03_people_2x2", "05_deliveries", "06_choice_dfa", "08_ordered")
+]
+_PLAN_DATA = json.loads(PLAN.read_text())
+_SCENARIO = load_scenario(EXAMPLE)
+
+
+@_FUZZ
+@given(st.data())
+def test_mutated_scenario_structure_validates_or_says_why(data):
+    mutated = copy.deepcopy(data.draw(st.sampled_from(_SCENARIO_DATAS)))
+    for _ in range(data.draw(st.integers(1, 3))):
+        path = data.draw(st.sampled_from(list(_paths(mutated))))
+        mutated = _replace(mutated, path, data.draw(_LEAVES))
+    try:
+        parse_scenario(mutated, "fuzz.yaml")
+    except ScenarioError as err:
+        assert err.file == "fuzz.yaml"
+
+
+@_FUZZ
+@given(st.data())
+def test_mutated_plan_reads_and_checks_or_says_why(data):
+    mutated = copy.deepcopy(_PLAN_DATA)
+    for _ in range(data.draw(st.integers(1, 3))):
+        path = data.draw(st.sampled_from(list(_paths(mutated))))
+        mutated = _replace(mutated, path, data.draw(_LEAVES))
+    try:
+        plan = PlanSet.from_dict(mutated, "fuzz.json")
+    except PlanError as err:
+        assert err.file == "fuzz.json"
+        return
+    report = check_plan(_SCENARIO, plan)
+    assert report.ok or report.violations
+
+
+@_FUZZ
+@given(st.binary(max_size=64), st.integers(0, 4000))
+def test_plan_text_with_spliced_bytes_reads_or_says_why(tmp_path_factory, junk, at):
+    text = PLAN.read_bytes()
+    path = tmp_path_factory.mktemp("fuzz") / "plan.json"
+    path.write_bytes(text[:at] + junk + text[at:])
+    try:
+        load_plan(path)
+    except CosmopInputError as err:
+        assert err.file == str(path)
+
+
+# -- through the command line -----------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("name", "text"),
+    [
+        ("nul", SCENARIO_TEXT.replace("warehouse-2x2", "ware\x00house")),
+        ("deep", SCENARIO_TEXT + "extra: " + "[" * 5000 + "]" * 5000 + "\n"),
+        ("digits", SCENARIO_TEXT.replace("size: 100,", "size: " + "9" * 5000 + ",")),
+    ],
+)
+def test_hostile_scenarios_exit_2_with_one_line(tmp_path, name, text):
+    path = tmp_path / f"{name}.yaml"
+    path.write_text(text)
+    run = subprocess.run(
+        [sys.executable, "-m", "cosmop", "plan", str(path), "-o", str(tmp_path / "p.json")],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert run.returncode == 2, run.stderr
+    assert "Traceback" not in run.stderr + run.stdout
+    assert run.stderr.strip().count("\n") == 0 and str(path) in run.stderr
+    assert not (tmp_path / "p.json").exists()
