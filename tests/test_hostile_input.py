@@ -80,25 +80,21 @@ def test_control_characters_are_refused_with_their_position(char):
     assert (err.line, err.column) == (2, 9)
 
 
-def test_json_bounds():
+def test_json_bounds(tmp_path):
     for text, words in [
         ("[" * (MAX_DEPTH + 1) + "]" * (MAX_DEPTH + 1), "levels deep"),
         ("[" * 5000 + "]" * 5000, "levels deep"),  # past Python's own recursion limit
         ("[" + "9" * 5000 + "]", f"at most {MAX_DIGITS}"),
         ("[NaN]", "not a number"),
         ("[1e999]", "must be finite"),
-        ('{"a": 1, "a": 2}', "duplicate key"),
     ]:
-        hook = None if "duplicate" not in words else _no_repeats
         with pytest.raises(PlanError, match=words):
-            load_json(text, "p.json", PlanError, object_pairs_hook=hook)
-
-
-def _no_repeats(pairs):
-    keys = [k for k, _ in pairs]
-    if len(set(keys)) != len(keys):
-        raise ValueError("duplicate key")
-    return dict(pairs)
+            load_json(text, "p.json", PlanError)
+    # the plan reader's refusal of a repeated key (its object hook) becomes the same one-line error
+    path = tmp_path / "p.json"
+    path.write_text('{"a": 1, "a": 2}')
+    with pytest.raises(PlanError, match="duplicate key 'a'"):
+        load_plan(path)
 
 
 def test_a_task_list_longer_than_the_bound_is_refused(tmp_path):

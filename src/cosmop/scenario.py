@@ -74,7 +74,6 @@ __all__ = [
     "Workspace",
     "load_scenario",
     "parse_scenario",
-    "planned_lengths",
 ]
 
 LENGTH_GRID = Fraction(1, 1000)
@@ -967,7 +966,7 @@ class _Builder:
         grid = f"{shown(float(LENGTH_GRID), self.units):f}".rstrip("0") + (
             " m" if self.units == "m" else " mm"
         )
-        for path, value in planned_lengths(scene):
+        for path, value in _planned_lengths(scene):
             if abs(value) > MAX_LENGTH:
                 self.fail(
                     path, f"expected a length of at most {show_length(MAX_LENGTH, self.units)}, got {value:g}"
@@ -1254,7 +1253,7 @@ def _known(group: str, ids: Mapping[str, Any]) -> str:
 # ----------------------------------------------------------------------------------------------
 
 
-def planned_lengths(scene: Scene):
+def _planned_lengths(scene: Scene):
     """``(field path, length in mm)`` of every coordinate and size the planner encodes."""
     for i, wall in enumerate(scene.obstacles):
         for j, point in enumerate((wall.start, wall.end)):
