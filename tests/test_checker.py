@@ -161,6 +161,23 @@ def test_a_message_nobody_sends_is_a_violation() -> None:
     assert any("never sends" in v.message for v in report.violations)
 
 
+def test_a_request_nobody_answers_is_a_violation() -> None:
+    # R1 keeps its Req(O2), but the away(O2,R1,R2) that R2 would answer is gone from the file
+    plans = coordinated()
+    safe = make_team_safe(SCENE, plans.robots)
+    robots = {
+        r: dataclasses.replace(p, mission=tuple(e for e in p.mission if not e.startswith("away(")))
+        for r, p in safe.plans.items()
+    }
+    r1 = robots["R1"]
+    unasked = dataclasses.replace(plans, robots=robots, messages=safe.messages, coordination=())
+    report = check_plan(SCENARIO, unasked)
+    instant = next(k for k, s in enumerate(r1.steps, 1) if s.primitive == "Req" and s.object == "O2")
+    (v,) = [v for v in report.violations if "no robot answers" in v.message]
+    assert (v.robot, v.instant, v.rule) == ("R1", instant, "message")
+    assert not report.ok
+
+
 def test_messages_that_wait_on_each_other_deadlock() -> None:
     # R1 waits for R2's message before sending its own, R2 waits for R1's first: nobody moves
     r1 = plans_with_messages("R1", [("Req", "msg(R2,R1,a)"), ("Res", "msg(R1,R2,b)")])

@@ -9,7 +9,9 @@ import pytest
 import cosmop.planning.synthesis as synthesis_module
 from cosmop.errors import ScenarioError
 from cosmop.missions.events import Event
+from cosmop.planning.checker import check_robot_plan
 from cosmop.planning.reach import unreachable
+from cosmop.planning.specification import MOTION_MARGIN
 from cosmop.planning.synthesis import synthesize
 from cosmop.scenario import load_scenario, parse_scenario
 
@@ -48,9 +50,20 @@ def test_a_wall_without_a_door_is_proved_at_once():
 
 
 def test_a_door_exactly_one_robot_wide_stays_open():
+    # touching both door posts is geometry the exact planner allows (margin 0) ...
     scene = _scene([[[0, -2000], [0, -200]], [[0, 200], [0, 2000]]])  # 400 mm door, 400 mm robot
     assert unreachable(scene, "R1", PICK) is None
-    assert synthesize(scene, "R1", PICK, max_horizon=12).feasible
+    assert synthesize(scene, "R1", PICK, max_horizon=12, margin=0).feasible
+    # ... but no controller drives through it: by default a motion keeps its margin between its ends
+    assert not synthesize(scene, "R1", PICK, max_horizon=12).feasible
+
+
+def test_a_door_with_the_margin_on_both_sides_is_planned():
+    side = 400 + 2 * MOTION_MARGIN
+    scene = _scene([[[0, -2000], [0, -side / 2]], [[0, side / 2], [0, 2000]]])
+    result = synthesize(scene, "R1", PICK, max_horizon=12)
+    assert result.feasible
+    assert not check_robot_plan(scene, "R1", result.plan)
 
 
 def test_a_drop_out_of_reach_is_named():

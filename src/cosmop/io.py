@@ -17,20 +17,29 @@ def uninterrupted():
     """Hold Ctrl-C (SIGINT) back while the block runs; it arrives, if pressed, right after.
 
     For outputs that belong together (a run's summary and its trace): each is written
-    atomically, and together they are written all or nothing.  Outside the main thread, or
-    where signals cannot be masked, the block runs as it is.
+    atomically, and together they are written all or nothing.  The signal is caught by a
+    handler that only notes it (Python runs handlers in the main thread, whichever thread the
+    system delivers the signal to, so a progress bar's thread cannot let it through), and the
+    previous handler is called with it after the block.  Outside the main thread the block
+    runs as it is.
     """
     import signal
     import threading
 
-    if not hasattr(signal, "pthread_sigmask") or threading.current_thread() is not threading.main_thread():
+    if threading.current_thread() is not threading.main_thread():
         yield
         return
-    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    pressed: list[tuple[int, object]] = []
+    old = signal.signal(signal.SIGINT, lambda number, frame: pressed.append((number, frame)))
     try:
         yield
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        signal.signal(signal.SIGINT, old)
+        if pressed:
+            if callable(old):
+                old(*pressed[0])
+            elif old == signal.default_int_handler or old == signal.SIG_DFL:
+                raise KeyboardInterrupt
 
 
 def check_writable(path: str | os.PathLike[str] | None, option: str, *, folder: bool = False) -> None:

@@ -587,9 +587,13 @@ def _detour(planner, current, moves, settings, replans) -> tuple[dict[str, Synth
 
     Returns the new syntheses and, for each robot that failed, its first conflict and why."""
     saved = dict(planner.obstacles)
+    objects = frozenset(planner.scenario.scene.objects)
     for robot, items in moves.items():
         walls = tuple(w for _, keep in items for w in _walls_around(keep.region, settings))
         planner.obstacles[robot] = planner.obstacles.get(robot, ()) + walls
+        # the requests are settled: a detour may ask only for what the robot already asks for
+        asked = {e.obj for e in current[robot] if e.kind == "away" and e.receiver == robot}
+        planner.forbidden[robot] = planner.forbidden.get(robot, frozenset()) | (objects - asked)
         replans.append(f"{robot} re-planned around the space it shares: {items[0][0].describe()}")
     fresh = planner.run({robot: current[robot] for robot in moves})
     failed = {}

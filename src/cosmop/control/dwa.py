@@ -399,7 +399,7 @@ def _escape_ok(
 ):
     """Whether each arc's worst case keeps clear: held for one cycle, then braking to a stop.
 
-    The robot reaches speed ``V`` linearly within :math:`\varepsilon`, then brakes with
+    The robot reaches speed ``V`` linearly within :math:`\\varepsilon`, then brakes with
     :math:`-b` with the turn rate held; at every sampled instant :math:`t` its square must be
     farther from each obstacle than :math:`V_o t` plus the distance it covers between samples.
     This is passive safety checked directly along one arc, used when ``safe`` (which covers

@@ -24,7 +24,7 @@ obstacles; the condition holds obstacle by obstacle, so walls and resting object
 :math:`V_o = 0` and people their top speed.
 
 In the condition :math:`V_o` only bounds how far the obstacle can come during the robot's
-stopping horizon :math:`T = \varepsilon + (v + A\varepsilon)/b`: the term is
+stopping horizon :math:`T = \\varepsilon + (v + A\\varepsilon)/b`: the term is
 :math:`V_o T`.  Another robot of the team shares its speed :math:`v_o` and acceleration
 limit :math:`A_o` (the robots talk over the message bus), so within :math:`T` it moves at most
 :math:`v_o T + A_o T^2/2`; :func:`obstacle_speed` gives the matching
@@ -63,7 +63,7 @@ def stopping_margin(v, speed_bound, dynamics: Dynamics):
 
 
 def stopping_horizon(v, dynamics: Dynamics):
-    """:math:`T = \varepsilon + (v + A\varepsilon)/b`: the latest time a robot at `v` stands still, s."""
+    """:math:`T = \\varepsilon + (v + A\\varepsilon)/b`: the latest time a robot at `v` stands still, s."""
     a, b, eps = dynamics.acceleration, dynamics.braking, dynamics.cycle
     return eps + (v + a * eps) / b
 

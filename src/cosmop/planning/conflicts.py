@@ -67,10 +67,14 @@ class ConflictSettings:
     segment : float
         Drives longer than this (mm) are cut into pieces before ordering, so that a robot waits
         only until another has passed the place they share (default 1500).
+    rest : float
+        How far (mm) a standing robot may be off its planned pose (the simulator stops within
+        its goal tolerance, 15 mm): goods another robot moves keep this from where it stands.
     """
 
     clearance: float = 100.0
     segment: float = math.inf
+    rest: float = 20.0
 
 
 @dataclass(frozen=True)
@@ -140,9 +144,18 @@ class Conflict:
 
 
 def _robot_occupancies(
-    robot: str, plan: RobotPlan, start: State, side: float, home: Sequence[float], grow: float = 0.0
+    robot: str,
+    plan: RobotPlan,
+    start: State,
+    side: float,
+    home: Sequence[float],
+    grow: float = 0.0,
+    rest: float = 0.0,
 ) -> list[Occupancy]:
-    """Where `robot` stands (merged over steps that keep its pose) and what its GoTo steps sweep."""
+    """Where `robot` stands (merged over steps that keep its pose) and what its GoTo steps sweep.
+
+    A standing robot's body, which goods keep clear of, is its square grown by `rest`.
+    """
     K = plan.horizon
     poses = [start.robot, *(s.robot for s in plan.steps)]
     party = frozenset((robot,))
@@ -170,7 +183,7 @@ def _robot_occupancies(
                 last,
                 f"{robot} standing at {_point((x, y))} {where}",
                 not fixed,
-                square(x, y, side - grow),
+                square(x, y, side - grow + 2 * rest),
             )
         )
         k = end + 1
@@ -268,12 +281,13 @@ def occupancies(
     `starts` gives the robots' states at the start when it is not the scenario (mid-run), and
     `positions` where the objects are then (``None``: carried).
     """
-    grow = (settings or ConflictSettings()).clearance
+    settings = settings or ConflictSettings()
+    grow = settings.clearance
     out: list[Occupancy] = []
     for robot, plan in plans.items():
         start = (starts or {}).get(robot) or initial_state(scene, robot)
         size, home = scene.robots[robot].size + grow, scene.robots[robot].pose
-        out += _robot_occupancies(robot, plan, start, size, home, grow)
+        out += _robot_occupancies(robot, plan, start, size, home, grow, settings.rest)
     objects, problems = _object_occupancies(scene, plans, precedence, positions)
     return out + objects, problems
 

@@ -23,7 +23,7 @@ from cosmop.missions.precedence import Precedence
 from cosmop.missions.team import check_words
 from cosmop.planning.conflicts import ConflictSettings, conflicts, is_ordered, occupancies
 from cosmop.planning.plan import PlanSet, RobotPlan
-from cosmop.planning.realisation import message_links
+from cosmop.planning.realisation import message_links, unanswered_requests
 from cosmop.planning.report import Violation
 from cosmop.scenario import Scenario
 
@@ -58,6 +58,16 @@ def _messages(plan: PlanSet, plans: Mapping[str, RobotPlan]) -> list[Violation]:
                     f"{link.receiver}'s plan never waits for it",
                 )
             )
+    for robot, instant, obj in unanswered_requests(plans):
+        out.append(
+            _violation(
+                robot,
+                instant,
+                "message",
+                f"{robot} waits at instant {instant} for {obj} to be moved away, but its mission has "
+                f"no away({obj},{robot},...) event left: no robot answers, it would wait forever",
+            )
+        )
     used = {link.event for link in links if link.event.startswith("msg(")}
     listed = {m.event for m in plan.messages}
     for name in sorted(used - listed):

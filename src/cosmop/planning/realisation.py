@@ -23,10 +23,18 @@ from collections.abc import Mapping, Sequence
 from cosmop.errors import EventSyntaxError
 from cosmop.missions.events import Event, parse_event
 from cosmop.missions.precedence import Link
-from cosmop.planning.plan import RobotPlan, State, initial_state
+from cosmop.planning.plan import RobotPlan, State, Step, initial_state
 from cosmop.scenario import Scene
 
-__all__ = ["TOLERANCE", "at_pose", "event_instants", "holds_at", "message_links", "step_primitive"]
+__all__ = [
+    "TOLERANCE",
+    "at_pose",
+    "event_instants",
+    "holds_at",
+    "message_links",
+    "step_primitive",
+    "unanswered_requests",
+]
 
 TOLERANCE = 1e-6
 """Tolerance of numeric equality, mm or degrees."""
@@ -129,6 +137,42 @@ def _events(plan: RobotPlan) -> list[Event]:
         return []
 
 
+def _message_steps(robot: str, plan: RobotPlan) -> list[tuple[int, Step, Event | None]]:
+    """The plan's Req and Res steps (instant after each) with the message each sends or awaits.
+
+    A step that names its ``message`` is that message; a ``Req(O)`` or ``Res(O)`` is the next
+    ``away`` event of O in the mission with the robot in that role (``None`` when none is left).
+    """
+    pending = [e for e in _events(plan) if e.kind == "away"]
+    out = []
+    for k, step in enumerate(plan.steps, 1):
+        if step.primitive not in ("Req", "Res"):
+            continue
+        if step.message is not None:
+            out.append((k, step, parse_event(step.message)))
+            continue
+        role = "receiver" if step.primitive == "Req" else "sender"
+        event = next((e for e in pending if e.obj == step.object and getattr(e, role) == robot), None)
+        if event is not None:
+            pending.remove(event)
+        out.append((k, step, event))
+    return out
+
+
+def unanswered_requests(plans: Mapping[str, RobotPlan]) -> list[tuple[str, int, str]]:
+    """``(robot, instant, object)`` of every ``Req(O)`` whose mission has no ``away`` left for it.
+
+    No robot's plan answers such a request (an answer is an ``away`` event of both missions),
+    so in joint execution the robot would wait there for ever.
+    """
+    return [
+        (robot, k, str(step.object))
+        for robot, plan in plans.items()
+        for k, step, event in _message_steps(robot, plan)
+        if event is None and step.primitive == "Req"
+    ]
+
+
 def message_links(plans: Mapping[str, RobotPlan]) -> list[Link]:
     """Every message of the plans with the steps that send and await it.
 
@@ -139,20 +183,10 @@ def message_links(plans: Mapping[str, RobotPlan]) -> list[Link]:
     sends: dict[str, tuple[str, int]] = {}
     waits: dict[str, tuple[str, int]] = {}
     for robot, plan in plans.items():
-        pending = [e for e in _events(plan) if e.kind == "away"]
-        for k, step in enumerate(plan.steps, 1):
-            if step.primitive not in ("Req", "Res"):
-                continue
-            if step.message is not None:
-                event = parse_event(step.message)
-            else:  # the next away event of this object and role in the mission
-                role = "receiver" if step.primitive == "Req" else "sender"
-                event = next((e for e in pending if e.obj == step.object and getattr(e, role) == robot), None)
-                if event is None:
-                    continue
-                pending.remove(event)
-            table = waits if step.primitive == "Req" else sends
-            table.setdefault(event.name, (robot, k))
+        for k, step, event in _message_steps(robot, plan):
+            if event is not None:
+                table = waits if step.primitive == "Req" else sends
+                table.setdefault(event.name, (robot, k))
     out = []
     for name in sorted(set(sends) | set(waits)):
         event = parse_event(name)

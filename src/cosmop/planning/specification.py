@@ -45,6 +45,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from fractions import Fraction
 from types import MappingProxyType
+from typing import Any
 
 import shapely
 
@@ -93,6 +94,17 @@ def position_sort(scene: Scene, start: State | None = None) -> str:
     if start is not None:  # a plan from a given state (mid-run) starts exactly there
         numbers += [*start.robot[:2], *(v for o in start.objects.values() for v in o.position)]
     return "int" if all(_num(v).denominator == 1 for v in numbers) else "real"
+
+
+MOTION_MARGIN = Fraction(20)
+"""mm a straight motion keeps from walls and resting objects, except where it starts or ends.
+
+The plan may let a robot touch a wall or an object (a docking pose touches its object, a home
+may touch a wall), but a controller cannot drive a robot *along* a face it touches: it stops a
+cycle's braking distance short, a few millimetres off, and every move along the face then cuts
+into it.  A motion therefore either stays this far from every obstacle, or approaches a
+touching pose from this far away, or leaves one to this far away; sliding along a face within
+the margin is not a plan."""
 
 
 @dataclass(frozen=True)
@@ -144,6 +156,9 @@ class RobotProblem:
     automaton : DFA, optional
         A branching local mission: `mission` is then its alphabet (as events) and a plan may
         perform any word of its marked language (:func:`automaton_parts`).
+    margin : Fraction
+        mm a GoTo keeps from walls and resting objects between its ends (default
+        :data:`MOTION_MARGIN`; 0 lets a motion slide along what it touches).
 
     Notes
     -----
@@ -160,6 +175,7 @@ class RobotProblem:
     start: State | None = None
     unrequestable: frozenset[str] = frozenset()
     automaton: DFA | None = None
+    margin: Fraction = MOTION_MARGIN
     actions: tuple[Action, ...] = field(init=False)
     sort: str = field(init=False)
 
@@ -380,8 +396,90 @@ def _objects_static(
     return _static(*out)
 
 
+STEEPNESS = 4
+"""A motion that ends touching a face comes 1 mm closer to it per at most this many mm along it
+(it meets the face at 14 degrees or more).  A shallow approach would hold the robot within a
+millimetre or two of the face for a long way, which a controller cannot follow any better than
+a slide.  A departure needs no such bound: the executor first creeps straight out from the
+exact pose it stands on, and the motion then gains the margin from there."""
+
+
+@dataclass(frozen=True)
+class _Face:
+    """The closed half-plane :math:`a x + b y \\ge c` of robot centres on one side of an obstacle.
+
+    ``c`` is a number, or a term in a resting object's position.  :meth:`away` and
+    :meth:`along` measure a displacement across and along the boundary, in the same scale.
+    """
+
+    a: Fraction
+    b: Fraction
+    c: Any
+
+    def holds(self, x, y) -> Formula:
+        return self.a * x + self.b * y >= self.c
+
+    def away(self, dx, dy):
+        return self.a * dx + self.b * dy
+
+    def along(self, dx, dy):
+        return self.a * dy - self.b * dx
+
+
+def _apart(x, y, faces: Sequence[tuple[_Face, _Face]]) -> Formula:
+    """A straight motion from :math:`(x, y)` to :math:`\\bigcirc(x, y)` clear of one obstacle.
+
+    `faces` pairs each side on which a square touching the obstacle may lie with the same side
+    moved away by the margin (which lies inside it).  Both ends lie on one side (then so does
+    the swept hull: it is convex), and the motion either ends at the margin or beyond (it
+    keeps it, or departs from touching), or starts there and approaches the side's boundary at
+    least :data:`STEEPNESS` steep.  The gap is never held near zero along the way.
+    """
+    nx, ny = x.next(), y.next()
+    dx, dy = nx - x, ny - y
+    out = []
+    for touch, far in faces:
+        if far is touch:
+            out.append(touch.holds(x, y) & touch.holds(nx, ny))
+            continue
+        gain, along = touch.away(dx, dy), touch.along(dx, dy)
+        steep = (along <= -STEEPNESS * gain) & (-along <= -STEEPNESS * gain)
+        out.append((touch.holds(x, y) & far.holds(nx, ny)) | (far.holds(x, y) & touch.holds(nx, ny) & steep))
+    return disj(out)
+
+
+def _wall_sides(p: RobotProblem, wall, name: str) -> list[tuple[_Face, _Face]]:
+    """The four sides of a wall for the robot's square, touching and at the margin."""
+    touching = [_Face(h.a, h.b, h.c) for h in wall_regions(wall.start, wall.end, p.side, name)]
+    if not p.margin:
+        return list(zip(touching, touching, strict=True))
+    grown = [_Face(h.a, h.b, h.c) for h in wall_regions(wall.start, wall.end, p.side + 2 * p.margin, name)]
+    return list(zip(touching, grown, strict=True))
+
+
+def _object_sides(v: ObjectVars, d: Fraction, m: Fraction) -> list[tuple[_Face, _Face]]:
+    """Left, right, below and above an object at centre distance `d` (touching) and `d + m`."""
+    one, zero = Fraction(1), Fraction(0)
+
+    def sides(e: Fraction) -> list[_Face]:
+        return [
+            _Face(-one, zero, e - v.x),
+            _Face(one, zero, v.x + e),
+            _Face(zero, -one, e - v.y),
+            _Face(zero, one, v.y + e),
+        ]
+
+    touching = sides(d)
+    return list(zip(touching, sides(d + m) if m else touching, strict=True))
+
+
 class GoTo(Primitive):
-    """Move in a straight line; never overlap a wall or a resting object (touching allowed)."""
+    """Move in a straight line; never overlap a wall or a resting object, never slide along one.
+
+    Touching is allowed at either end of the motion; otherwise it keeps
+    :attr:`RobotProblem.margin`, departs from touching to it, or approaches from it steeply
+    (:data:`MOTION_MARGIN`, :data:`STEEPNESS`, :func:`_apart`).
+    """
 
     name = "GoTo"
 
@@ -392,23 +490,11 @@ class GoTo(Primitive):
         x, y = p.x, p.y
         out = [("GoTo keeps the objects", _objects_static(p))]
         for i, wall in enumerate(p.scene.obstacles):
-            regions = wall_regions(wall.start, wall.end, p.side, f"wall {i}")
-            out.append(
-                (
-                    f"wall {i} {[list(wall.start), list(wall.end)]}",
-                    disj(_half_plane(h, x, y) & _half_plane(h, x.next(), y.next()) for h in regions),
-                )
-            )
+            sides = _wall_sides(p, wall, f"wall {i}")
+            out.append((f"wall {i} {[list(wall.start), list(wall.end)]}", _apart(x, y, sides)))
         for o in p.scene.objects:
             v, d = p.obj(o), p.clearance(o)
-            clear = disj(
-                [
-                    (x <= v.x - d) & (x.next() <= v.x - d),
-                    (x >= v.x + d) & (x.next() >= v.x + d),
-                    (y <= v.y - d) & (y.next() <= v.y - d),
-                    (y >= v.y + d) & (y.next() >= v.y + d),
-                ]
-            )
+            clear = _apart(x, y, _object_sides(v, d, p.margin))
             out.append((f"object {o}", Implies(~v.carried & ~v.away, clear)))
         return out
 

@@ -26,6 +26,7 @@ from __future__ import annotations
 import time
 from collections.abc import Iterable
 from dataclasses import dataclass, field
+from fractions import Fraction
 
 import numpy as np
 import z3
@@ -38,6 +39,7 @@ from cosmop.planning.messages import answer_early, place_mission_messages, strip
 from cosmop.planning.plan import ObjectState, RobotPlan, State, Step
 from cosmop.planning.reach import unreachable
 from cosmop.planning.specification import (
+    MOTION_MARGIN,
     NONE,
     RobotProblem,
     decode,
@@ -163,6 +165,7 @@ def synthesize(
     start: State | None = None,
     explain: bool = True,
     unrequestable: frozenset[str] = frozenset(),
+    margin: float = MOTION_MARGIN,
 ) -> Synthesis:
     """The shortest safe plan of motion primitives for one robot's local mission.
 
@@ -190,6 +193,9 @@ def synthesize(
         ``reason``); a replan that only needs yes or no skips it.
     unrequestable : frozenset of str
         Objects the plan may not request.
+    margin : float
+        mm a motion keeps from walls and resting objects between its ends
+        (:data:`~cosmop.planning.specification.MOTION_MARGIN`; 0 allows sliding along them).
 
     Returns
     -------
@@ -223,7 +229,16 @@ def synthesize(
     if walled_off is not None:  # no horizon can do it: say so without the solver
         return Synthesis(robot, False, None, None, reason=walled_off, solve_s=time.perf_counter() - t0)
     forbid = frozenset(unrequestable)
-    p = RobotProblem(scene, robot, events, requests, start=start, unrequestable=forbid, automaton=automaton)
+    p = RobotProblem(
+        scene,
+        robot,
+        events,
+        requests,
+        start=start,
+        unrequestable=forbid,
+        automaton=automaton,
+        margin=Fraction(margin),
+    )
     formula = conj(f for _, f in specification(p))
     signature = Signature.of(formula)
     checks = 0

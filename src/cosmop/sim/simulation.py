@@ -7,13 +7,18 @@ control cycle :math:`\\varepsilon` (the scenario's ``dynamics.cycle``):
     drives with the passive-safe dynamic window (:mod:`cosmop.control.dwa`) along a global path
     (:mod:`cosmop.control.paths`) to the step's waypoint.  A waypoint followed by another
     ``GoTo`` is passed within ``pass_tolerance``; the last one of a run is reached within
-    ``goal_tolerance`` and turned to its heading within ``heading_tolerance``.
+    ``goal_tolerance`` and turned to its heading within ``heading_tolerance``.  A plan may
+    start or end a motion touching a wall or resting object (never slide along one:
+    :data:`cosmop.planning.specification.MOTION_MARGIN`); the robot first creeps straight out
+    to ``leave_gap``, and the last few millimetres onto a final pose that touches something
+    are crept, with the docking controller.
 ``PickUp`` / ``DropOff``
     dock: the docking pose (the object's x minus :math:`d = (l_r + l_o)/2`, its y, heading 0;
     or the plan's pose for a drop) is closed at ``dock_speed`` by the docking controller (a
     fine alignment of at most ``dock_tolerance``, which the unicycle model abstracts), then the
-    gripper works for ``handling_time``.  After a drop the robot turns away from the object
-    and backs off ``release_gap`` straight, so that it never drives along an object it touches.
+    gripper works for ``handling_time``.  After a drop the robot stays where the plan has it
+    (a robot that waits there keeps the clearances the plan was ordered with) and creeps out
+    when it next drives, so that it never drives along the object it touches.
     A carried object rides on its robot, inside the robot's square, as in the plan model where
     a carried object takes no room.
 ``Req``
@@ -22,9 +27,10 @@ control cycle :math:`\\varepsilon` (the scenario's ``dynamics.cycle``):
     executed exactly as written: the messages that keep robots apart sit where the plan put
     them (:mod:`cosmop.planning.teamsafety`).
 
-Robots are unicycles: each cycle the robot holds an acceleration in :math:`[-b, A]` and a turn
-rate in :math:`[-\\Omega, \\Omega]`.  The footprint is the scenario's axis-aligned square, so a
-turn on the spot moves no part of it; *moving* means a translational speed above zero.
+Robots are unicycles: each cycle the robot holds a turn rate in :math:`[-\\Omega, \\Omega]` and
+speeds up at most at :math:`A` or brakes at :math:`-b` until it has the speed it was given.
+The footprint is the scenario's axis-aligned square, so a turn on the spot moves no part of
+it; *moving* means a translational speed above zero.
 
 The safety monitor records every contact -- a robot's square touching a wall, a resting
 object, another robot or a person -- and whether the robot was moving then.  Passive safety
@@ -98,15 +104,17 @@ class SimSettings:
         Largest offset (mm) from a docking pose that the docking controller closes; farther
         away, the robot first drives there.
     dock_speed : float
-        Speed of the docking controller, mm/s (at most one cycle's braking, :math:`b\varepsilon`).
+        Speed of the docking controller, mm/s (at most one cycle's braking, :math:`b\\varepsilon`).
     reach : float
         How far (mm) the gripper reaches: a pick-up whose docking is blocked closer than this
         to its pose still picks the object up.  A drop waits for the exact pose: the object
         goes exactly where the plan puts it (in its workspace).
     handling_time : float
         Seconds the gripper needs to pick up or drop off.
-    release_gap : float
-        How far (mm) a robot backs off from an object it has dropped before it drives on.
+    leave_gap : float
+        Gap (mm) to walls and resting objects that a robot creeps out to, straight, before it
+        drives off a pose that touches them (a plan's motion leaves such a pose to at least
+        :data:`~cosmop.planning.specification.MOTION_MARGIN`).
     detour_time : float
         Seconds without progress after which a driving robot plans its global path again,
         around the robots that block it and have the right of way (less path left).
@@ -132,7 +140,7 @@ class SimSettings:
     dock_speed: float = 50.0
     reach: float = 20.0
     handling_time: float = 1.0
-    release_gap: float = 30.0
+    leave_gap: float = 10.0
     detour_time: float = 3.0
     stall_time: float = 12.0
     stall_progress: float = 50.0
@@ -368,7 +376,7 @@ class _Agent:
         self.since = 0.0  # time of the last progress
         self.waiting = False
         self.answered: dict[str, int] = {}  # Res sent per object
-        self.leave: float | None = None  # heading that backs off from a dropped object
+        self.exit: tuple[float, float] | bool | None = None  # where it creeps out of touch (False: none)
 
     @property
     def done(self) -> bool:
@@ -582,10 +590,14 @@ class _World:
         event = next((e for e in wanted if e.name not in done), None)
         if event is not None:
             self.events.append((round(self.t, 6), agent.id, event.name))
-        if agent.done and any(e.kind == "return" for e in agent.mission):
+            done.add(event.name)
+        # ``return`` holds as soon as the robot is home with the events before it done (as in
+        # the plan: messages it sends from home come after it)
+        pending = next((e for e in agent.mission if e.name not in done), None)
+        if pending is not None and pending.kind == "return":
             home = self.scenario.scene.robots[agent.id].pose
             if math.dist(self.pose[agent.index, :2], home[:2]) <= self.settings.goal_tolerance + 1e-6:
-                self.events.append((round(self.t, 6), agent.id, f"return({agent.id})"))
+                self.events.append((round(self.t, 6), agent.id, pending.name))
 
     def received(self, agent: _Agent, step: Step) -> bool:
         """Whether the message a ``Req`` step waits for has been sent."""
@@ -642,6 +654,7 @@ def _decide(world: _World, agent: _Agent) -> tuple[str, Any]:
         agent.stage = None
         agent.waiting = False
         agent.path = None
+        agent.exit = None
     return brake
 
 
@@ -657,6 +670,10 @@ def _goto(world: _World, agent: _Agent, step: Step) -> tuple[str, Any] | None:
         origin = agent.anchor[1]
     else:
         origin = agent.steps[agent.k - 1].robot if agent.k > 0 else None
+    if agent.exit is not False:  # at the start, and after creeping back onto the plan's segment
+        action = _get_out(world, agent, goal)
+        if action is not None:
+            return action
     return _drive(world, agent, goal, final, heading=final, origin=origin)
 
 
@@ -700,6 +717,7 @@ def _reseat(world: _World, agent: _Agent) -> tuple[str, Any] | None:
     heading = math.atan2(ty - sy, tx - sx)
     if math.dist(world.pose[i, :2], (sx, sy)) <= 1e-9 and abs(_wrap(heading - world.pose[i, 2])) <= 1e-9:
         agent.seat = None
+        agent.exit = None  # the segment's start may touch what the segment leaves: creep out first
         agent.path = GlobalPath(agent.path.points[1:], agent.path.margin)
         agent.since = world.t
         return None
@@ -734,6 +752,10 @@ def _drive(
         agent.since = world.t
     dist = math.hypot(goal[0] - xy[0], goal[1] - xy[1])
     tolerance = s.goal_tolerance if final else s.pass_tolerance
+    if final and agent.phase == "drive" and dist > tolerance:
+        action = _get_in(world, agent, goal, dist)
+        if action is not None:
+            return action
     if agent.phase == "drive" and dist <= tolerance:
         if not final:
             return None
@@ -750,8 +772,9 @@ def _drive(
         return ("move", (0.0, w))
     if agent.seat is not None:
         action = _reseat(world, agent)
-        if action is not None:
-            return action
+        if action is not None:  # (waiting for someone to pass counts towards a stall)
+            waited = action[0] == "move" and world.t - agent.since > s.stall_time
+            return (_stall(world, agent) or action) if waited else action
     target, left = agent.path.lookahead((float(xy[0]), float(xy[1])), s.dwa.lookahead)
     agent.left = left
     if left < agent.best - s.stall_progress:
@@ -760,13 +783,37 @@ def _drive(
     elif world.t - agent.since > s.detour_time and world.t >= agent.detour_until:
         _detour(world, agent, goal)
     elif world.t - agent.since > s.stall_time:
-        _stalled(world, agent)
-        agent.since = world.t
-        agent.best = math.inf
-        if agent.phase == "start":
-            return _decide(world, agent)
+        action = _stall(world, agent)
+        if action is not None:
+            return action
     stop = left if final else math.inf
     return ("drive", (target, stop, agent.room))
+
+
+def _stall(world: _World, agent: _Agent) -> tuple[str, Any] | None:
+    """No progress for ``stall_time``: replan (:func:`_stalled`); a new plan's first decision."""
+    _stalled(world, agent)
+    agent.since = world.t
+    agent.best = math.inf
+    return _decide(world, agent) if agent.phase == "start" else None
+
+
+def _get_in(world: _World, agent: _Agent, goal: tuple[float, ...], dist: float) -> tuple[str, Any] | None:
+    """The last few millimetres onto a final pose beside a wall or resting object: creep there.
+
+    The dynamic window stops a braking distance short of what it approaches, and a pose that
+    touches something (a docking pose, a home against a wall) lies right there; within
+    ``dock_tolerance`` of it the docking creep, straight and exact, takes over when its way is
+    clear (``None`` otherwise: the window drives on).
+    """
+    s = world.settings
+    i = agent.index
+    if dist > s.dock_tolerance or float(world.static_gaps(goal[:2], world.half[i])[0]) >= s.leave_gap:
+        return None
+    pose = (goal[0], goal[1], math.degrees(float(world.pose[i, 2])))
+    if not _dock_safe(world, i, agent, pose):
+        return None
+    return _brake(world, i) if world.v[i] > 0 else ("dock", pose)
 
 
 def _detour(world: _World, agent: _Agent, goal: tuple[float, float, float]) -> None:
@@ -848,59 +895,73 @@ def _handle(world: _World, agent: _Agent, step: Step) -> tuple[str, Any] | None:
             return None
         world.obj_pos[j] = _drop_spot(world, agent, step, j)
         world.carried_by[j] = -1
-        agent.grip = j  # touching it until the robot has backed off
-        agent.stage = "release"
-    if agent.stage == "release":
-        return _release(world, agent, j)
+        agent.grip = j  # touching it where the plan stands, until it creeps out (_get_out)
+        return None
     return ("move", (0.0, 0.0))
 
 
-def _release(world: _World, agent: _Agent, j: int) -> tuple[str, Any] | None:
-    """Leave a dropped object: turn away from it and back off straight.
+_EXIT_HEADINGS = np.radians(np.arange(0.0, 360.0, 5.0))
+_EXIT_REACH = 80  # mm: how far a way out is looked for
 
-    The heading is chosen once, among those facing away from the object (it lies at +x), as the
-    straight move that opens the gap to every wall and resting object it touches fastest (a
-    drop pose may touch a wall as well), so the robot never slides along anything it touches;
-    robots and people are checked as in docking.
+
+def _way_out(world: _World, i: int, toward: np.ndarray, gap: float) -> tuple[float, float] | None:
+    """The nearest point straight out from robot `i` at `gap` (mm) from everything static, or ``None``.
+
+    Headings every 5 degrees and distances every millimetre up to :data:`_EXIT_REACH` are
+    tried; the way to the point must not touch a wall or resting object.  Of the points within
+    2 mm of the nearest, the one most towards `toward` is taken.
+    """
+    xy, half = world.pose[i, :2], float(world.half[i])
+    units = np.column_stack([np.cos(_EXIT_HEADINGS), np.sin(_EXIT_HEADINGS)])
+    steps = np.arange(1.0, _EXIT_REACH + 1.0)
+    points = xy[None, None, :] + steps[:, None, None] * units[None, :, :]  # (distance, heading, 2)
+    flat = points.reshape(-1, 2)
+    # never touching on the way (the first millimetre already opens every gap that is shut):
+    # creeping along a face it touches would be a contact while moving
+    clear = (world.static_gaps(flat, half) > _TOUCH).reshape(len(steps), len(units))
+    room = (world.static_gaps(flat, half) >= gap).reshape(clear.shape)
+    good = np.logical_and.accumulate(clear, axis=0) & room
+    if not good.any():
+        return None
+    first = np.where(good.any(axis=0), good.argmax(axis=0), len(steps))
+    distance = np.where(first < len(steps), steps[np.minimum(first, len(steps) - 1)], np.inf)
+    aim = np.asarray(toward, dtype=float) - xy
+    towards = units @ (aim / max(float(np.hypot(*aim)), 1e-9))
+    best = int(np.argmin(np.where(distance <= distance.min() + 2.0, -towards, np.inf)))
+    x, y = points[first[best], best]
+    return (float(x), float(y))
+
+
+def _creep(world: _World, agent: _Agent, point: tuple[float, float]) -> tuple[str, Any]:
+    """The docking creep straight to `point`, keeping the heading; brake or wait when needed."""
+    i = agent.index
+    if world.v[i] > 0:
+        return _brake(world, i)
+    pose = (point[0], point[1], math.degrees(float(world.pose[i, 2])))
+    if _dock_safe(world, i, agent, pose):
+        return ("dock", pose)
+    return ("move", (0.0, 0.0))  # something passes: wait for it
+
+
+def _get_out(world: _World, agent: _Agent, goal: tuple[float, float, float]) -> tuple[str, Any] | None:
+    """Before driving off a pose that touches a wall or resting object, creep clear of it.
+
+    A plan may start a motion touching what it then leaves (a docking pose, a home against a
+    wall), and a controller cannot drive off along a face it touches: it first creeps straight
+    out (:func:`_way_out`, towards the goal where it can) to ``leave_gap`` from everything
+    static.  ``None`` when there is nothing to leave or once out.
     """
     s = world.settings
     i = agent.index
-    sep = box_gaps(world.pose[i, :2], world.half[i], np.array([[*world.obj_pos[j], world.obj_half[j]]]))
-    brake = _brake(world, i)
-    if float(sep[0]) >= s.release_gap:
-        if world.v[i] > 0:
-            return brake
-        agent.grip = None
-        agent.leave = None
+    half = world.half[i]
+    if agent.exit is None:
+        agent.exit = False
+        if float(world.static_gaps(world.pose[i, :2], half)[0]) < s.leave_gap:
+            agent.exit = _way_out(world, i, np.asarray(goal[:2]), s.leave_gap) or False
+    if agent.exit is False or math.dist(world.pose[i, :2], agent.exit) <= 1e-9:
+        agent.exit = False
         return None
-    if agent.leave is None:
-        agent.leave = _leave_heading(world, i)
-    error = float(_wrap(agent.leave - world.pose[i, 2]))
-    if abs(error) > 1e-6:
-        if world.v[i] > 0:
-            return brake
-        return ("move", (0.0, max(-world.limits[i, 3], min(world.limits[i, 3], error / world.dt))))
-    if not _dock_safe(world, i, agent, _ahead(world, i, s.release_gap + 10.0)):
-        return brake
-    return ("move", (s.dock_speed, 0.0))
-
-
-def _leave_heading(world: _World, i: int) -> float:
-    """The heading (rad) away from +x whose straight move opens the static gaps best."""
-    headings = np.radians(np.arange(95.0, 270.0, 5.0))
-    units = np.column_stack([np.cos(headings), np.sin(headings)])
-    xy = world.pose[i, :2]
-    near = world.static_gaps(xy[None, :] + 2.0 * units, world.half[i])
-    far = world.static_gaps(xy[None, :] + 40.0 * units, world.half[i])
-    now = float(world.static_gaps(xy, world.half[i])[0])
-    score = np.where(near > now - 1e-9, far, -np.inf)  # opening at once, then as wide as possible
-    return float(headings[int(np.argmax(score))])
-
-
-def _ahead(world: _World, i: int, distance: float) -> tuple[float, float, float]:
-    """The pose `distance` mm straight ahead of robot `i`."""
-    x, y, h = world.pose[i]
-    return (float(x + distance * math.cos(h)), float(y + distance * math.sin(h)), 0.0)
+    return _creep(world, agent, agent.exit)
 
 
 def _drop_spot(world: _World, agent: _Agent, step: Step, j: int) -> np.ndarray:
@@ -1058,7 +1119,7 @@ def _recoordinate(world: _World, agent: _Agent, new: RobotPlan, start: State) ->
         other.steps = other.steps[: other.k] + list(plan.steps)
         other.mission = list(done) + [parse_event(e) for e in plan.mission]
         if other is agent or (other.k < len(other.steps) and other.steps[other.k] != current):
-            other.phase, other.stage, other.path = "start", None, None
+            other.phase, other.stage, other.path, other.exit = "start", None, None, None
         if other is agent:  # its new plan starts where it stood, rounded to the millimetre
             other.anchor = (other.k, start.robot)
     added = [m.event for m in result.messages]
@@ -1072,7 +1133,13 @@ def _recoordinate(world: _World, agent: _Agent, new: RobotPlan, start: State) ->
 
 
 def _integrate(world: _World, v_cmd: np.ndarray, w_cmd: np.ndarray, docks: dict[int, tuple]) -> np.ndarray:
-    """Move every robot for one cycle: constant acceleration towards `v_cmd` and turn rate.
+    """Move every robot for one cycle towards the speed `v_cmd`, turning at `w_cmd`.
+
+    A robot slows down by braking at :math:`-b` until it reaches the commanded speed, then holds
+    it (the control passive safety assumes: a stop from :math:`v < b\\varepsilon` takes
+    :math:`v^2/2b`, not the :math:`v\\varepsilon/2` of a ramp spread over the cycle); it speeds
+    up at a constant acceleration over the cycle (at most :math:`A`).  The distance of each
+    sub-step is exact; its heading is the sub-step's midpoint heading.
 
     Returns each robot's translational speed at the end of the cycle, mm/s: what the monitor
     calls moving.  A docking creep is a stop-and-go no faster than one cycle's braking, so the
@@ -1083,14 +1150,23 @@ def _integrate(world: _World, v_cmd: np.ndarray, w_cmd: np.ndarray, docks: dict[
     v0 = world.v
     v1 = np.clip(v_cmd, np.maximum(0.0, v0 - brk * dt), v0 + acc * dt)
     v1 = np.minimum(v1, world.limits[:, 0])
+    slowing = v1 < v0
+    reached = np.where(slowing, (v0 - v1) / np.maximum(brk, 1e-9), dt)  # when v1 is reached, s
+
+    def covered(t: float) -> np.ndarray:
+        """Distance (mm) from the cycle's start to time `t` within it."""
+        ramp = v0 * t + (v1 - v0) * t * t / (2.0 * dt)
+        tb = np.minimum(t, reached)
+        braked = v0 * tb - brk * tb * tb / 2.0 + v1 * np.maximum(t - reached, 0.0)
+        return np.where(slowing, braked, ramp)
+
     start = world.pose[:, :2].copy()
     n = 4
-    for k in range(n):  # midpoint rule on sub-steps: exact enough for 0.1 s cycles
-        tm = (k + 0.5) / n
-        v = v0 + (v1 - v0) * tm
+    for k in range(n):
+        step = covered((k + 1) * dt / n) - covered(k * dt / n)
         theta = world.pose[:, 2] + w_cmd * dt / (2 * n)
-        world.pose[:, 0] += v * np.cos(theta) * dt / n
-        world.pose[:, 1] += v * np.sin(theta) * dt / n
+        world.pose[:, 0] += step * np.cos(theta)
+        world.pose[:, 1] += step * np.sin(theta)
         world.pose[:, 2] += w_cmd * dt / n
     world.pose[:, 2] = _wrap(world.pose[:, 2])
     world.v = v1
@@ -1323,7 +1399,7 @@ def footprint_overlaps(
 
 
 def _dock_safe(world: _World, i: int, agent: _Agent, target: tuple | None = None) -> bool:
-    """Passive safety of a slow docking or release move, with the gripper's object left out.
+    """Passive safety of a slow docking creep, with the gripper's object left out.
 
     Moving obstacles (robots, people) need the paper's ``safe`` at the creep speed.  Towards a
     docking `target` the creep is a straight move that stops exactly on it, so walls and

@@ -1,0 +1,49 @@
+"""Plans that ``plan`` calls feasible execute: a sample of the generated-scenes sweep (issue 12, point 5).
+
+``benchmarks/sweep_generated.py`` draws 200 seeded scenes (2 to 5 robots, random walls) and
+runs each as a user does; this is a sample of 10 of its seeds, in this process, chosen among
+those whose plans once stalled in simulation (a pose flush against a wall, a pick pose reached
+along the object's face, a drop next to a waiting robot, a request nobody answered).
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import sys
+from pathlib import Path
+
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+
+from cosmop.pipeline import plan_team
+from cosmop.scenario import parse_scenario
+from cosmop.sim import SimSettings, simulate
+from sweep_generated import scene
+
+SEEDS = (1, 2, 16, 41, 52, 53, 99, 125, 161, 186)
+
+
+def _run(seed: int) -> tuple[int, bool, bool, int]:
+    scenario = parse_scenario(scene(seed))
+    team = plan_team(scenario, workers=1)
+    if not team.plans.feasible:
+        return seed, False, False, 0
+    result = simulate(scenario, team.plans, settings=SimSettings(max_time=600))
+    delivered = all(result.objects_in_workspaces(scenario, team.plans).values())
+    return seed, True, result.completed and delivered, result.contacts_while_moving
+
+
+@pytest.fixture(scope="module")
+def outcomes():
+    with multiprocessing.get_context("fork").Pool(2) as pool:
+        return pool.map(_run, SEEDS)
+
+
+def test_every_sampled_scene_is_planned_and_completes(outcomes):
+    assert [seed for seed, feasible, *_ in outcomes if not feasible] == []
+    assert [seed for seed, _, completed, *_ in outcomes if not completed] == []
+
+
+def test_no_robot_moves_while_touching_anything(outcomes):
+    assert sum(moving for *_, moving in outcomes) == 0
