@@ -7,7 +7,8 @@ control cycle :math:`\\varepsilon` (the scenario's ``dynamics.cycle``):
     drives with the passive-safe dynamic window (:mod:`cosmop.control.dwa`) along a global path
     (:mod:`cosmop.control.paths`) to the step's waypoint.  A waypoint followed by another
     ``GoTo`` is passed within ``pass_tolerance``; the last one of a run is reached within
-    ``goal_tolerance`` and turned to its heading within ``heading_tolerance``.  A plan may
+    ``goal_tolerance`` and turned to its heading within ``heading_tolerance``, and so is one
+    from which the plan approaches a pose that touches something (not turned).  A plan may
     start or end a motion touching a wall or resting object (never slide along one:
     :data:`cosmop.planning.specification.MOTION_MARGIN`); the robot first creeps straight out
     to ``leave_gap``, and the last few millimetres onto a final pose that touches something
@@ -664,8 +665,14 @@ def _brake(world: _World, i: int) -> tuple[str, Any]:
 
 
 def _goto(world: _World, agent: _Agent, step: Step) -> tuple[str, Any] | None:
-    final = agent.k + 1 >= len(agent.steps) or agent.steps[agent.k + 1].primitive != "GoTo"
+    last = agent.k + 1 >= len(agent.steps) or agent.steps[agent.k + 1].primitive != "GoTo"
     goal = step.robot
+    # a waypoint from which the plan approaches a pose that touches something is reached, not
+    # passed: cutting its corner would cut into what that pose touches
+    stop = last or bool(
+        world.static_gaps(agent.steps[agent.k + 1].robot[:2], world.half[agent.index])[0]
+        < world.settings.leave_gap
+    )
     if agent.anchor is not None and agent.anchor[0] == agent.k:  # a replan's first step
         origin = agent.anchor[1]
     else:
@@ -674,7 +681,7 @@ def _goto(world: _World, agent: _Agent, step: Step) -> tuple[str, Any] | None:
         action = _get_out(world, agent, goal)
         if action is not None:
             return action
-    return _drive(world, agent, goal, final, heading=final, origin=origin)
+    return _drive(world, agent, goal, stop, heading=last, origin=origin)
 
 
 def _route(world: _World, i: int, goal: tuple, origin: tuple | None) -> tuple[GlobalPath, tuple | None]:
