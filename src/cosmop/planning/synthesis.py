@@ -26,14 +26,13 @@ from __future__ import annotations
 import time
 from collections.abc import Iterable
 from dataclasses import dataclass, field
-from fractions import Fraction
 
 import numpy as np
 import z3
 
 from cosmop.automata import DFA
 from cosmop.automata.operations import project, trim
-from cosmop.logic import IncrementalUnrolling, Signature, Unrolling, conj
+from cosmop.logic import IncrementalUnrolling, Signature, Unrolling, conj, to_fraction
 from cosmop.missions.events import Event, parse_event
 from cosmop.planning.messages import answer_early, place_mission_messages, strip_messages, wait_early
 from cosmop.planning.plan import ObjectState, RobotPlan, State, Step
@@ -237,7 +236,7 @@ def synthesize(
         start=start,
         unrequestable=forbid,
         automaton=automaton,
-        margin=Fraction(margin),
+        margin=to_fraction(margin),
     )
     formula = conj(f for _, f in specification(p))
     signature = Signature.of(formula)

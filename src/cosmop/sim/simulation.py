@@ -728,12 +728,7 @@ def _reseat(world: _World, agent: _Agent) -> tuple[str, Any] | None:
         agent.path = GlobalPath(agent.path.points[1:], agent.path.margin)
         agent.since = world.t
         return None
-    if world.v[i] > 0:
-        return _brake(world, i)
-    pose = (sx, sy, math.degrees(heading))
-    if _dock_safe(world, i, agent, pose):
-        return ("dock", pose)
-    return ("move", (0.0, 0.0))  # something passes: wait for it
+    return _creep(world, agent, (sx, sy), heading)
 
 
 def _drive(
@@ -925,9 +920,8 @@ def _way_out(world: _World, i: int, toward: np.ndarray, gap: float) -> tuple[flo
     flat = points.reshape(-1, 2)
     # never touching on the way (the first millimetre already opens every gap that is shut):
     # creeping along a face it touches would be a contact while moving
-    clear = (world.static_gaps(flat, half) > _TOUCH).reshape(len(steps), len(units))
-    room = (world.static_gaps(flat, half) >= gap).reshape(clear.shape)
-    good = np.logical_and.accumulate(clear, axis=0) & room
+    gaps = world.static_gaps(flat, half).reshape(len(steps), len(units))
+    good = np.logical_and.accumulate(gaps > _TOUCH, axis=0) & (gaps >= gap)
     if not good.any():
         return None
     first = np.where(good.any(axis=0), good.argmax(axis=0), len(steps))
@@ -939,12 +933,16 @@ def _way_out(world: _World, i: int, toward: np.ndarray, gap: float) -> tuple[flo
     return (float(x), float(y))
 
 
-def _creep(world: _World, agent: _Agent, point: tuple[float, float]) -> tuple[str, Any]:
-    """The docking creep straight to `point`, keeping the heading; brake or wait when needed."""
+def _creep(
+    world: _World, agent: _Agent, point: tuple[float, float], heading: float | None = None
+) -> tuple[str, Any]:
+    """The docking creep straight to `point`, turning to `heading` (rad; default: keep it);
+    brake first, or wait while something passes."""
     i = agent.index
     if world.v[i] > 0:
         return _brake(world, i)
-    pose = (point[0], point[1], math.degrees(float(world.pose[i, 2])))
+    turn = float(world.pose[i, 2]) if heading is None else heading
+    pose = (point[0], point[1], math.degrees(turn))
     if _dock_safe(world, i, agent, pose):
         return ("dock", pose)
     return ("move", (0.0, 0.0))  # something passes: wait for it
