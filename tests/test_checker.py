@@ -113,14 +113,14 @@ def test_r1_plan_with_request_is_valid() -> None:
         "DropOff(O1)",
         "GoTo",
     ]
-    assert plan.steps[5].objects["O1"].position == (-1250.0, 2000.0)
+    assert plan.steps[5].objects["O1"].position == (-1250.0, 2050.0)
     assert check_robot_plan(SCENE, "R1", plan) == []
 
 
 def test_r2_plan_alone_is_valid_with_two_gotos_home() -> None:
     plan = r2_plan()
     assert plan.horizon == 6
-    assert plan.steps[3].objects["O2"].position == (1480.0, 2000.0)
+    assert plan.steps[3].objects["O2"].position == (1250.0, 2050.0)  # dropped facing north
     assert check_robot_plan(SCENE, "R2", plan) == []
 
 
@@ -219,24 +219,24 @@ def test_goto_crossing_a_wall() -> None:
     plan = r1_plan(replaced(R1_ACTIONS, 3, ("GoTo", (-900, -200, 0))))
     v = only(check_robot_plan(SCENE, "R1", plan), "wall", 5)
     assert v.robot == "R1"
-    assert v.message.startswith("R1 at instant 5: GoTo from (-900, -200) to (-1500, 2000) crosses wall ")
+    assert v.message.startswith("R1 at instant 5: GoTo from (-900, -200) to (-1500, 2050) crosses wall ")
     assert "[[-1000,0],[1000,0]]" in v.message
 
 
 def test_goto_crossing_the_wall_by_a_tenth_of_a_millimetre() -> None:
     # R2 goes home past the inner wall's end (1000, 0); 0.1 mm further left and its square cuts it
-    actions = [(p, (1199.9, *x[1:])) if p == "GoTo" and x[0] == 1230 else (p, x) for p, x in R2_ACTIONS]
+    actions = [(p, (1199.9, *x[1:])) if p == "GoTo" and x[0] == 1250 else (p, x) for p, x in R2_ACTIONS]
     v = only(check_robot_plan(SCENE, "R2", r2_plan(actions)), "wall", 5)
-    assert "GoTo from (1199.9, 2000) to (1199.9, -2000) crosses wall [[-1000,0],[1000,0]]" in v.message
+    assert "GoTo from (1199.9, 1800) to (1199.9, -2000) crosses wall [[-1000,0],[1000,0]]" in v.message
 
 
 def test_touching_a_wall_exactly_is_allowed() -> None:
     # R2's square passes the inner wall's end point with its left edge exactly on it (x = 1000),
     # and slides along the bottom wall (its lower edge on y = -2500) on the way home.
-    actions = [(p, (1200, *x[1:])) if p == "GoTo" and x[0] == 1230 else (p, x) for p, x in R2_ACTIONS]
+    actions = [(p, (1200, *x[1:])) if p == "GoTo" and x[0] == 1250 else (p, x) for p, x in R2_ACTIONS]
     actions = [*actions[:-1], ("GoTo", (-2000, -2300, 0)), ("GoTo", (-2300, -2300, 0)), actions[-1]]
     plan = r2_plan(actions)
-    assert plan.steps[3].objects["O2"].position == (1450.0, 2000.0)
+    assert plan.steps[3].objects["O2"].position == (1200.0, 2050.0)
     assert check_robot_plan(SCENE, "R2", plan) == []
 
 
@@ -305,14 +305,43 @@ def test_picking_from_the_wrong_pose() -> None:
     v = only(check_robot_plan(SCENE, "R1", r1_plan(actions)), "pick-pose", 3)
     assert v.message == (
         "R1 at instant 3, PickUp(O1): the robot is at (1740, -1000), but picking O1 at (2000, -1000) "
-        "requires standing in front of it at (1750, -1000) (d = 250 mm)"
+        "at heading 0° requires standing in front of it at (1750, -1000) (d = 250 mm)"
     )
 
 
-def test_picking_at_the_wrong_heading() -> None:
+def test_picking_facing_another_side_needs_that_sides_pose() -> None:
+    # facing north (90°) from the west pose: the pose of heading 90 is below O1
     actions = replaced(R1_ACTIONS, 1, ("GoTo", (1750, -1000, 90)))
     v = only(check_robot_plan(SCENE, "R1", r1_plan(actions)), "pick-pose", 3)
-    assert "heading is 90°" in v.message
+    assert "at heading 90° requires standing in front of it at (2000, -1250)" in v.message
+
+
+@pytest.mark.parametrize("heading", [45, 10, 300])
+def test_picking_at_a_heading_that_faces_no_side(heading: float) -> None:
+    actions = replaced(R1_ACTIONS, 1, ("GoTo", (1750, -1000, heading)))
+    v = only(check_robot_plan(SCENE, "R1", r1_plan(actions)), "pick-pose", 3)
+    assert f"heading is {heading}°" in v.message and "0°, 90°, 180° or 270°" in v.message
+
+
+@pytest.mark.parametrize(
+    ("pose", "heading"), [((2250, -1000), 180), ((2000, -1250), 90), ((2000, -750), 270), ((2000, -750), -90)]
+)
+def test_picking_from_each_free_side_is_valid(pose, heading) -> None:
+    # O1's east, south and north sides are free: no request is needed from there
+    actions = [
+        ("GoTo", (pose[0], -1500, 0)),
+        ("GoTo", (*pose, heading)),
+        ("PickUp", "O1"),
+        ("GoTo", (pose[0], -1500, 0)),
+        ("GoTo", (-1500, -200, 0)),
+        *R1_ACTIONS[4:],
+    ]
+    if pose[1] > -1000:  # from the north: go round O1's east side, not through O2
+        actions = [("GoTo", (2250, -1500, 0)), ("GoTo", (2250, -750, 0)), *actions[1:]]
+        actions[4] = ("GoTo", (2250, -750, 0))
+        actions.insert(5, ("GoTo", (2250, -1500, 0)))
+    plan = r1_plan(actions, ["pick(R1,O1)", "drop(R1,O1,W1)", "return(R1)"])
+    assert check_robot_plan(SCENE, "R1", plan) == []
 
 
 def test_headings_compare_modulo_360_and_positions_within_tolerance() -> None:
@@ -388,23 +417,27 @@ def test_dropping_through_a_wall() -> None:
 
 
 def test_dropping_outside_the_workspace() -> None:
-    # drop pose 70 mm further right: O2 lands at x = 1550 > 1500
-    actions = replaced(R2_ACTIONS, 2, ("GoTo", (1300, 2000, 0)))
+    # drop pose 250 mm further right: O2's centre lands on W2's edge x = 1500, half of it outside
+    actions = replaced(R2_ACTIONS, 2, ("GoTo", (1500, 1800, 90)))
     v = only(check_robot_plan(SCENE, "R2", r2_plan(actions)), "mission", None)
     assert v.message == (
         "R2: mission event drop(R2,O2,W2) (2nd of 3) is not realised: there is no DropOff(O2) that "
         "leaves O2 in W2 after instant 2 (pick(R2,O2)); DropOff(O2) at instant 4 leaves it at "
-        "(1550, 2000), outside W2 (x in [1000, 1500], y in [2000, 2500]) "
+        "(1500, 2050), not wholly inside W2 (x in [1000, 1500], y in [2000, 2500]) (size 100) "
         "(so return(R2) cannot be matched either)"
     )
 
 
-def test_dropping_on_the_workspace_boundary_counts() -> None:
-    actions = replaced(R2_ACTIONS, 2, ("GoTo", (1250, 2000, 0)))
-    actions = replaced(actions, 4, ("GoTo", (1250, -2000, 0)))
+@pytest.mark.parametrize(
+    ("at", "inside"), [((1450, 2050), True), ((1451, 2050), False), ((1200, 2049), False)]
+)
+def test_dropping_wholly_inside_the_workspace_boundary_counts(at, inside: bool) -> None:
+    # O2's square (side 100) may touch W2's edges from inside, not cross them
+    actions = replaced(R2_ACTIONS, 2, ("GoTo", (at[0], at[1] - 250, 90)))
+    actions = replaced(actions, 4, ("GoTo", (at[0], -2000, 0)))
     plan = r2_plan(actions)
-    assert plan.steps[3].objects["O2"].position == (1500.0, 2000.0)
-    assert check_robot_plan(SCENE, "R2", plan) == []
+    assert plan.steps[3].objects["O2"].position == at
+    assert [v.rule for v in check_robot_plan(SCENE, "R2", plan)] == ([] if inside else ["mission"])
 
 
 def test_dropping_at_a_point_workspace() -> None:
@@ -434,7 +467,7 @@ def test_dropping_at_a_point_workspace() -> None:
         [("GoTo", (750, 0, 0)), ("PickUp", "O1"), ("GoTo", (1000, 501, 0)), ("DropOff", "O1")],
     )
     v = only(check_robot_plan(scenario.scene, "R1", bad), "mission", None)
-    assert "outside W1 (the point (1250, 500))" in v.message
+    assert "not on W1 (the point (1250, 500))" in v.message
 
 
 def test_picking_through_a_wall() -> None:
@@ -460,10 +493,10 @@ def test_picking_through_a_wall() -> None:
 
 def test_dropoff_must_put_the_object_in_front_of_the_robot() -> None:
     plan = r1_plan()
-    plan = edit_object(plan, 6, "O1", position=(-1250, 2010))
-    plan = edit_object(plan, 7, "O1", position=(-1250, 2010))
+    plan = edit_object(plan, 6, "O1", position=(-1240, 2060))
+    plan = edit_object(plan, 7, "O1", position=(-1240, 2060))
     v = only(check_robot_plan(SCENE, "R1", plan), "drop-pose", 6)
-    assert "O1 is put at (-1250, 2010), but a robot at (-1500, 2000) puts it" in v.message
+    assert "O1 is put at (-1240, 2060), but a robot at (-1500, 2050) facing 0° puts it" in v.message
 
 
 def test_dropping_what_is_not_carried() -> None:
@@ -482,7 +515,8 @@ def test_request_while_standing_in_the_pick_pose() -> None:
     v = only(check_robot_plan(SCENE, "R1", r1_plan(actions)), "req-room", 2)
     assert v.message == (
         "R1 at instant 2, Req(O2): the requester at (1650, -1000) stands in the way of a robot picking O2 "
-        "from (1650, -1000); request from a pose that leaves that square free"
+        "from (1650, -1000) (heading 0°), (1900, -1250) (heading 90°), (1900, -750) (heading 270°); "
+        "request from a pose that leaves the pick pose on each of its sides free"
     )
 
 
@@ -492,12 +526,14 @@ def test_request_while_standing_in_the_pick_pose() -> None:
         (1250, -1000, True),
         (1250.5, -1000, False),
         (1300, -1000, False),
-        (1650, -1400, True),
-        (1650, -1399, False),
+        (1650, -1400, False),
+        (1900, -1650, True),
+        (1900, -1649, False),
     ],
 )
 def test_request_room_touching_is_allowed(x: float, y: float, ok: bool) -> None:
-    # the pick pose of O2 is (1650, -1000), square x 1450..1850, y -1200..-800
+    # O2's west pick pose is (1650, -1000), square x 1450..1850, y -1200..-800; its south pose
+    # (1900, -1250), square x 1700..2100, y -1450..-1050
     actions = [("GoTo", (x, y, 0)), *R1_ACTIONS]
     violations = [v for v in check_robot_plan(SCENE, "R1", r1_plan(actions)) if v.instant == 2]
     assert [v.rule for v in violations] == ([] if ok else ["req-room"])
@@ -539,7 +575,7 @@ def test_missing_return() -> None:
     v = only(check_robot_plan(SCENE, "R2", r2_plan(R2_ACTIONS[:-1])), "mission", None)
     assert v.message == (
         "R2: mission event return(R2) (3rd of 3) is not realised: the robot is never at its initial pose "
-        "(-2000, -2000, 0°) after instant 4 (drop(R2,O2,W2)); the last pose is (1230, -2000, 0°): add a "
+        "(-2000, -2000, 0°) after instant 4 (drop(R2,O2,W2)); the last pose is (1250, -2000, 0°): add a "
         "GoTo back to the initial pose"
     )
 

@@ -79,7 +79,7 @@ def test_violations_exit_1_with_a_table(tmp_path: Path) -> None:
     out = result.stdout
     for fragment in ("violations of crossing.json", "robot", "instant", "rule", "problem", "R1", "wall"):
         assert fragment in out
-    assert "GoTo from (-900, -200) to (-1500, 2000) crosses wall" in out
+    assert "GoTo from (-900, -200) to (-1500, 2050) crosses wall" in out
     assert out.strip().splitlines()[-1] == "plan invalid: 1 violation in 14 steps checked"
 
 
@@ -93,7 +93,7 @@ def test_violations_json(tmp_path: Path) -> None:
     assert violation["robot"] == "R1"
     assert violation["instant"] == 5
     assert violation["rule"] == "wall"
-    assert violation["message"].startswith("R1 at instant 5: GoTo from (-900, -200) to (-1500, 2000)")
+    assert violation["message"].startswith("R1 at instant 5: GoTo from (-900, -200) to (-1500, 2050)")
 
 
 def test_bad_plan_file_exits_2_naming_file_and_field(tmp_path: Path) -> None:

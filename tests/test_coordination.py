@@ -19,6 +19,7 @@ from cosmop.missions.verification import verify
 from cosmop.planning.checker import check_robot_plan
 from cosmop.planning.synthesis import synthesize
 from cosmop.scenario import load_scenario
+from paper_rules import west_only
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -64,7 +65,7 @@ def test_two_by_two_gets_one_pair():
 
 @pytest.fixture(scope="module")
 def ten():
-    sc = load_scenario(ROOT / "examples" / "02_warehouse_10x10" / "scenario.yaml")
+    sc = west_only(load_scenario(ROOT / "examples" / "02_warehouse_10x10" / "scenario.yaml"))
     sequences, requests = plan_requests(sc)
     return sc, sequences, coordinate(sequences, requests)
 

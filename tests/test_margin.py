@@ -30,7 +30,8 @@ def _scene():
                     [[-600, 1500], [-600, 300]],
                 ],
                 "robots": {"R1": {"size": 400, "pose": [-1800, 0, 0]}},
-                "objects": {"O1": {"size": 100, "position": [500, -1300]}},
+                # the paper's west side only: from the others the plan slides along nothing
+                "objects": {"O1": {"size": 100, "position": [500, -1300], "sides": ["west"]}},
                 "workspaces": {"W1": {"x": [700, 1300], "y": [500, 1100]}},
             },
             "mission": {"tasks": {"R1": ["pick O1", "drop O1 at W1", "return"]}},

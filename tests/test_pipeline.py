@@ -44,6 +44,8 @@ def test_example_1_coordinated():
 def test_a_blocking_object_nobody_picks_is_refused():
     data = yaml.safe_load(EXAMPLE.read_text())
     data["mission"]["tasks"] = {"R1": data["mission"]["tasks"]["R1"]}  # nobody moves O2 any more
+    for obj in data["scene"]["objects"].values():  # the paper's rule: from the west side only
+        obj["sides"] = ["west"]
     result = plan_team(parse_scenario(data))
     assert not result.plans.feasible
     assert (

@@ -190,7 +190,7 @@ def test_state_at_an_instant() -> None:
     assert plan.state(0, initial) is initial
     assert plan.state(1) == State((-2000, -1000, 0), plan.steps[0].objects)
     assert plan.state(3).objects["O1"].carried
-    assert plan.state(6).objects["O1"] == ObjectState((-1250, 2000), carried=False, away=False)
+    assert plan.state(6).objects["O1"] == ObjectState((-1250, 2050), carried=False, away=False)
     assert plan.state(7).robot == initial.robot
     with pytest.raises(ValueError, match="instant 0 is the scenario"):
         plan.state(0)
@@ -220,7 +220,7 @@ def test_to_text_is_one_line_per_step() -> None:
     assert len(lines) == plan.horizon == 7
     assert lines[0] == "1  Req(O2)      robot (-2000, -1000, 0°)  away: O2"
     assert lines[2] == "3  PickUp(O1)   robot (1750, -1000, 0°)  carrying O1; away: O2"
-    assert lines[5] == "6  DropOff(O1)  robot (-1500, 2000, 0°)  O1 at (-1250, 2000); away: O2"
+    assert lines[5] == "6  DropOff(O1)  robot (-1500, 2050, 0°)  O1 at (-1250, 2050); away: O2"
 
 
 def test_plan_set_text() -> None:

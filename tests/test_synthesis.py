@@ -3,7 +3,9 @@
 Reproduced: in Example 1, R2's shortest plan has 6 steps; R1 is infeasible without requests
 (the reason names O2), and its shortest plan with requests has 7 steps with Req(O2) first.
 Minimality: no plan of length K - 1 exists.  In the 10x10 example every robot gets a checked
-shortest plan whose requests form the coordination structure of DESIGN.md.
+shortest plan whose requests form the coordination structure of DESIGN.md.  These results
+hold under the paper's rule that goods are handled from their west side (:func:`west_only`);
+from any side R1 needs no request at all.
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ from cosmop.planning.checker import check_robot_plan
 from cosmop.planning.specification import RobotProblem, events_of, specification
 from cosmop.planning.synthesis import synthesize
 from cosmop.scenario import load_scenario
+from paper_rules import west_only
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -40,6 +43,7 @@ def test_r2_shortest_plan_has_six_steps(small):
 
 
 def test_r1_needs_o2_moved_away(small):
+    small = west_only(small)
     alone = synthesize(small.scene, "R1", small.mission.tasks["R1"], requests=False, max_horizon=8)
     assert not alone.feasible and alone.plan is None
     assert "pick(R1,O1)" in alone.reason
@@ -73,6 +77,7 @@ def test_requests_are_never_for_own_objects(small):
 
 
 def test_every_robot_of_the_10x10_example_gets_a_checked_shortest_plan(big):
+    big = west_only(big)
     expected = {
         "R1": {"O2", "O3"},
         "R2": {"O3"},
@@ -137,9 +142,14 @@ def test_no_pick_through_a_wall():
     assert res.feasible and check_robot_plan(open_scene.scene, "R1", res.plan) == []
     # a short wall exactly on the object's left edge, between the pick pose and the object
     walled = _one_robot_scene([[[950, -40], [950, 40]]])
-    blocked = synthesize(walled.scene, "R1", walled.mission.tasks["R1"], max_horizon=8)
+    blocked = synthesize(west_only(walled).scene, "R1", walled.mission.tasks["R1"], max_horizon=8)
     assert not blocked.feasible
     assert any(name.startswith("gripper clear of wall 4") for name in blocked.blocking), blocked.blocking
+    # from any side: picked from another side, never through the wall
+    around = synthesize(walled.scene, "R1", walled.mission.tasks["R1"], max_horizon=8)
+    assert around.feasible and check_robot_plan(walled.scene, "R1", around.plan) == []
+    pick = next(s for s in around.plan.steps if s.primitive == "PickUp")
+    assert pick.robot[2] in (90, 180, 270)
 
 
 def test_a_robot_without_a_mission_gets_an_empty_plan(small):
@@ -151,3 +161,21 @@ def test_a_solver_that_gives_up_is_reported_not_raised(small):
     res = synthesize(small.scene, "R1", small.mission.tasks["R1"], rlimit=2_000)
     assert not res.feasible and res.plan is None
     assert "the solver gave up" in res.reason and "resource limit 2000" in res.reason
+
+
+def test_a_horizon_too_short_is_named_as_the_cause_not_the_walls(small):
+    res = synthesize(small.scene, "R1", small.mission.tasks["R1"], max_horizon=3)
+    assert not res.feasible and res.blocking == ()
+    assert "even with no wall or object in the way" in res.reason and "horizon 3" in res.reason
+
+
+def test_the_reason_names_a_minimal_set_of_obstacles_and_the_sides_tried(small):
+    scene = west_only(small).scene
+    res = synthesize(scene, "R1", small.mission.tasks["R1"], requests=False, max_horizon=8)
+    # O2 alone explains it: no wall is needed for the contradiction
+    assert res.blocking == ("room from O2 while handling O1",)
+    assert res.reason.endswith("blocked by: room from O2 while handling O1 (sides of O1 tried: west)")
+    # at K = 6 the inner wall and O2 are named; the outer walls far from the route never are
+    res = synthesize(small.scene, "R1", small.mission.tasks["R1"], max_horizon=6)
+    assert not res.feasible and 0 < len(res.blocking) <= 3
+    assert not any(b.startswith("wall 0") or b.startswith("wall 1") for b in res.blocking)

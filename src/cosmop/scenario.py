@@ -49,6 +49,7 @@ from typing import Annotated, Any, Literal, NoReturn, Union, get_args, get_origi
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError, field_validator
 
 from cosmop._frozen import reduce_frozen
+from cosmop.docking import SIDES
 from cosmop.errors import EventSyntaxError, ScenarioError
 from cosmop.io import read_text
 from cosmop.missions.events import ID_PATTERN, Event, parse_event
@@ -182,11 +183,26 @@ class MovableObject:
         Side of the square, mm (> 0).
     position : tuple of float
         Initial centre ``(x, y)``, mm.
+    sides : tuple of str, optional
+        The sides a robot may stand on to pick it up or drop it off (``"west"``, ``"south"``,
+        ``"east"``, ``"north"``; default all four).  Goods on a shelf that opens to the north
+        say ``("north",)``; the paper's robots use the west side only.
     """
 
     id: str
     size: float
     position: Point
+    sides: tuple[str, ...] = tuple(SIDES)
+
+    def __post_init__(self) -> None:
+        unknown = [s for s in self.sides if s not in SIDES]
+        if unknown or not self.sides:
+            raise ValueError(f"object {self.id}: sides must be a non-empty subset of {list(SIDES)}")
+
+    @property
+    def headings(self) -> tuple[int, ...]:
+        """The docking headings (degrees) from which it is handled, one per side, in order."""
+        return tuple(sorted(SIDES[s] for s in set(self.sides)))
 
 
 @dataclass(frozen=True)
@@ -226,6 +242,37 @@ class Workspace:
         if self.point is not None:
             return self.point
         return ((self.x[0] + self.x[1]) / 2.0, (self.y[0] + self.y[1]) / 2.0)
+
+    @property
+    def ranges(self) -> tuple[Point, Point]:
+        """``(x range, y range)`` (mm); a point workspace gives ranges of zero width."""
+        if self.point is not None:
+            return (self.point[0], self.point[0]), (self.point[1], self.point[1])
+        return self.x, self.y
+
+    def centres(self, size: float) -> Workspace:
+        """Where the centre of a square of side `size` (mm) lies when the whole square is inside.
+
+        A rectangle shrinks by ``size / 2`` on every side; a point workspace is its own answer
+        (it names the object's position exactly).
+
+        Raises
+        ------
+        ValueError
+            If the rectangle is narrower or shallower than `size`: it cannot hold the square.
+
+        Examples
+        --------
+        >>> Workspace("W", x=(0, 500), y=(0, 300)).centres(100)
+        Workspace(id='W', x=(50.0, 450.0), y=(50.0, 250.0), point=None)
+        """
+        if self.point is not None:
+            return self
+        half = size / 2.0
+        x, y = (self.x[0] + half, self.x[1] - half), (self.y[0] + half, self.y[1] - half)
+        if x[0] > x[1] or y[0] > y[1]:
+            raise ValueError(f"workspace {self.id} cannot hold a square of side {size:g} mm")
+        return Workspace(self.id, x=x, y=y)
 
     def contains(self, x: float, y: float, tol: float = 0.0) -> bool:
         """Whether the position ``(x, y)`` lies in the workspace (boundary included).
@@ -598,6 +645,9 @@ class _RobotModel(_Model):
 class _ObjectModel(_Model):
     size: _Positive
     position: _Pair
+    sides: Annotated[list[Literal["west", "south", "east", "north"]], Field(min_length=1, max_length=4)] = (
+        list(SIDES)
+    )
 
 
 class _WorkspaceModel(_Model):
@@ -683,9 +733,13 @@ _EXPECTED: dict[tuple[str, ...], str] = {
     ("scene", "robots"): "a non-empty mapping from robot ids to {size, pose}",
     ("scene", "robots", "*", "size"): "a positive number (side of the square robot, mm)",
     ("scene", "robots", "*", "pose"): "a pose [x, y, heading]: three numbers (mm, mm, degrees)",
-    ("scene", "objects"): "a mapping from object ids to {size, position}",
+    ("scene", "objects"): "a mapping from object ids to {size, position, sides (optional)}",
     ("scene", "objects", "*", "size"): "a positive number (side of the square object, mm)",
     ("scene", "objects", "*", "position"): "a position [x, y]: two numbers (mm)",
+    ("scene", "objects", "*", "sides"): (
+        "a non-empty list of the sides a robot may handle it from: west, south, east, north"
+    ),
+    ("scene", "objects", "*", "sides", "#"): "one of west, south, east, north",
     ("scene", "workspaces"): "a mapping from workspace ids to {x: [lo, hi], y: [lo, hi]} or {point: [x, y]}",
     ("scene", "workspaces", "*"): "{x: [lo, hi], y: [lo, hi]} or {point: [x, y]}",
     ("scene", "workspaces", "*", "x"): _RANGE,
@@ -949,7 +1003,10 @@ class _Builder:
             for ident, r in model.robots.items()
         }
         self.check_cycles(robots, dynamics)
-        objects = {ident: MovableObject(ident, o.size, o.position) for ident, o in model.objects.items()}
+        objects = {
+            ident: MovableObject(ident, o.size, o.position, tuple(dict.fromkeys(o.sides)))
+            for ident, o in model.objects.items()
+        }
         workspaces = {ident: self.build_workspace(ident, w) for ident, w in model.workspaces.items()}
         humans = {ident: self.build_human(ident, h) for ident, h in model.humans.items()}
         return Scene(
@@ -1275,12 +1332,9 @@ def _planned_lengths(scene: Scene):
 
 def _fits(scene: Scene, obj: MovableObject, workspace: Workspace) -> bool:
     """Whether some position in `workspace` holds `obj`'s square clear of every wall (touching allowed)."""
-    import shapely
+    from cosmop.squares import rectangle  # shapely: loaded only when a drop is checked
 
-    if workspace.is_point:
-        places = shapely.Point(*workspace.point)
-    else:
-        places = shapely.box(workspace.x[0], workspace.y[0], workspace.x[1], workspace.y[1])
+    places = rectangle(*workspace.centres(obj.size).ranges)
     return not places.difference(scene.blocked(obj.size / 2.0, within=places.bounds)).is_empty
 
 

@@ -8,15 +8,52 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
-from shapely import Polygon, box
+from shapely import LineString, Point, Polygon, box
 
-__all__ = ["square", "swept_square"]
+from cosmop.docking import DOCKING_HEADINGS, facing
+
+__all__ = ["docking_places", "rectangle", "square", "swept_square"]
 
 
 def square(x: float, y: float, side: float) -> Polygon:
     """The axis-aligned square of side `side` centred at ``(x, y)`` (mm)."""
     half = side / 2.0
     return box(x - half, y - half, x + half, y + half)
+
+
+def docking_places(
+    x: Iterable[float], y: Iterable[float], gap: float, headings: Iterable[int] = DOCKING_HEADINGS
+) -> list[Point | LineString | Polygon]:
+    """Robot centres that dock, from any of `headings` (:data:`DOCKING_HEADINGS`), to an object
+    whose centre lies in the rectangle ``x[0] <= x <= x[1]``, ``y[0] <= y <= y[1]`` (mm; equal
+    bounds: a point).
+
+    One place per heading: the rectangle moved by :math:`-d\\,(\\cos h, \\sin h)`, `gap` being
+    :math:`d`.
+
+    Examples
+    --------
+    >>> [p.wkt for p in docking_places((0, 0), (0, 0), 250)]
+    ['POINT (-250 0)', 'POINT (0 -250)', 'POINT (250 0)', 'POINT (0 250)']
+    """
+    (x0, x1), (y0, y1) = x, y
+    out = []
+    for heading in headings:
+        ux, uy = facing(heading)
+        dx, dy = -gap * ux, -gap * uy
+        out.append(rectangle((x0 + dx, x1 + dx), (y0 + dy, y1 + dy)))
+    return out
+
+
+def rectangle(x: Iterable[float], y: Iterable[float]) -> Point | LineString | Polygon:
+    """The closed rectangle ``x[0] <= x <= x[1]``, ``y[0] <= y <= y[1]`` (mm), as a point or a
+    segment when it has no width or no height (a zero-area polygon would intersect nothing)."""
+    (x0, x1), (y0, y1) = x, y
+    if x0 == x1 and y0 == y1:
+        return Point(x0, y0)
+    if x0 == x1 or y0 == y1:
+        return LineString([(x0, y0), (x1, y1)])
+    return box(x0, y0, x1, y1)
 
 
 def swept_square(start: Iterable[float], end: Iterable[float], side: float) -> Polygon:

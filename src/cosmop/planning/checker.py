@@ -16,19 +16,23 @@ pose, every object at its scenario position, neither carried nor away):
     the robot's squares at the two positions -- overlaps no wall segment and no square of an
     object that is neither carried nor away in state :math:`k-1`.
 ``PickUp(O)``
-    The pose is unchanged, the heading is 0° and the robot stands in front of O:
-    :math:`(x, y) = (O.x - d, O.y)`. Before, nothing is carried and O is not away; after, O
-    and only O is carried. Positions and away flags are unchanged. The gripper does not reach
-    through a wall: no wall overlaps the union of the robot's and O's squares.
+    The pose is unchanged, the heading :math:`h` is one of O's docking headings (0°, 90°, 180°
+    or 270°: it stands on O's west, south, east or north side, those O allows) and the robot
+    faces O, touching it: :math:`(x, y) = (O.x, O.y) - d\\,(\\cos h, \\sin h)`. Before, nothing
+    is carried and O is not away; after, O and only O is carried. Positions and away flags are
+    unchanged. The gripper does not reach through a wall: no wall overlaps the union of the
+    robot's and O's squares.
 ``DropOff(O)``
-    The pose is unchanged and the heading is 0°. Before, O is the only carried object; after,
-    nothing is carried and O lies at :math:`(x + d, y)`. Other positions and all away flags
+    The pose is unchanged and the heading :math:`h` is one of O's docking headings. Before, O
+    is the only carried object; after, nothing is carried and O lies in front,
+    at :math:`(x, y) + d\\,(\\cos h, \\sin h)`. Other positions and all away flags
     are unchanged. O's square overlaps no wall and no other object that is neither carried
     nor away, and the gripper does not reach through a wall (as for ``PickUp``).
 ``Req(O)``
     The pose, positions and carried flags are unchanged; O's away flag goes from false to
-    true, the others are unchanged. The requester leaves room for whoever picks O: its square
-    does not overlap the square of side :math:`l` centred at :math:`(O.x - d, O.y)`.
+    true, the others are unchanged. The requester leaves room for whoever picks O, from any
+    side O allows: its square overlaps none of the squares of side :math:`l` centred at the
+    poses that pick O.
 ``Res(O)``
     Nothing changes, and O is carried before and after.
 
@@ -38,9 +42,10 @@ keeps the position where it was picked up. Numbers are compared with a tolerance
 
 The plan's ``mission`` must be realised in order: there are instants
 :math:`0 \\le i_1 < i_2 < \\dots` with event *m* holding at :math:`i_m` -- ``pick(R,O)``: step
-*i* is ``PickUp(O)``; ``drop(R,O,W)``: step *i* is ``DropOff(O)`` and O's position in state *i*
-lies in W; ``return(R)``: the pose in state *i* is the initial pose; ``away(O,A,B)``: step *i*
-is ``Req(O)`` for the requester A, ``Res(O)`` for the responder B.
+*i* is ``PickUp(O)``; ``drop(R,O,W)``: step *i* is ``DropOff(O)`` and O's square in state *i*
+lies wholly in W (a point W: O's centre is that point); ``return(R)``: the pose in state *i*
+is the initial pose; ``away(O,A,B)``: step *i* is ``Req(O)`` for the requester A, ``Res(O)``
+for the responder B.
 
 :func:`check_plan` adds the checks that involve the whole plan set: the plan names the
 scenario, every robot exists, a task-list mission is contained in each robot's plan (the
@@ -55,6 +60,7 @@ from typing import Any
 from shapely.geometry import LineString
 from shapely.geometry.base import BaseGeometry
 
+from cosmop.docking import DOCKING_HEADINGS, docking_pose, in_front
 from cosmop.errors import EventSyntaxError
 from cosmop.missions.events import Event, parse_event
 from cosmop.planning.joint import check_team
@@ -115,6 +121,17 @@ def _points_eq(p: Iterable[float], q: Iterable[float]) -> bool:
 def _angle_eq(a: float, b: float) -> bool:
     diff = (a - b) % 360.0
     return min(diff, 360.0 - diff) <= TOLERANCE
+
+
+def _or(words: Iterable[str]) -> str:
+    """``a``, ``a or b``, ``a, b or c``."""
+    words = list(words)
+    return words[0] if len(words) == 1 else f"{', '.join(words[:-1])} or {words[-1]}"
+
+
+def _docking_heading(heading: float) -> int | None:
+    """The docking heading (:data:`~cosmop.squares.DOCKING_HEADINGS`) `heading` equals, or ``None``."""
+    return next((h for h in DOCKING_HEADINGS if _angle_eq(heading, h)), None)
 
 
 def _pose_eq(p: Iterable[float], q: Iterable[float]) -> bool:
@@ -266,14 +283,20 @@ class _RobotChecker:
                 )
                 self.add(k, flag, f"the {flag} flag of {oid} changes from {_yes(old)} to {_yes(new)}; {why}")
 
-    def heading_zero(self, k: int, cur: State, rule: str, verb: str) -> None:
-        if not _angle_eq(cur.robot[2], 0.0):
+    def docking(self, k: int, cur: State, oid: str, rule: str, verb: str) -> int | None:
+        """The docking heading of the robot at instant `k`; a violation and ``None`` if it has none."""
+        heading = _docking_heading(cur.robot[2])
+        allowed = self.scene.objects[oid].headings
+        if heading is None or heading not in allowed:
+            sides = self.scene.objects[oid].sides
             self.add(
                 k,
                 rule,
-                f"the robot's heading is {_fmt(cur.robot[2])}°, but objects are {verb} at heading 0° "
-                "(facing +x)",
+                f"the robot's heading is {_fmt(cur.robot[2])}°, but {oid} is {verb} facing one of its "
+                f"sides {', '.join(sides)}: at heading {_or(f'{h}°' for h in allowed)}",
             )
+            return None
+        return heading
 
     def resting(self, state: State, exclude: str | None = None) -> Iterable[tuple[str, Any]]:
         """Objects neither carried nor away in `state`, with their squares."""
@@ -338,18 +361,19 @@ class _RobotChecker:
     def pickup(self, k: int, step: Step, prev: State, cur: State) -> None:
         oid = step.object
         self.robot_static(k, prev, cur)
-        self.heading_zero(k, cur, "pick-pose", "picked up")
+        heading = self.docking(k, cur, oid, "pick-pose", "picked up")
         ox, oy = prev.objects[oid].position
         d = self.gap(oid)
         x, y, _ = cur.robot
-        if not (_eq(x, ox - d) and _eq(y, oy)):
+        pose = None if heading is None else docking_pose((ox, oy), d, heading)
+        if pose is not None and not _points_eq((x, y), pose):
             self.add(
                 k,
                 "pick-pose",
-                f"the robot is at {_point((x, y))}, but picking {oid} at {_point((ox, oy))} requires "
-                f"standing in front of it at {_point((ox - d, oy))} (d = {_fmt(d)} mm)",
+                f"the robot is at {_point((x, y))}, but picking {oid} at {_point((ox, oy))} at heading "
+                f"{heading}° requires standing in front of it at {_point(pose)} (d = {_fmt(d)} mm)",
             )
-        else:
+        elif pose is not None:
             self.reach(k, oid, cur, (ox, oy))
         carried_before = [o for o, s in prev.objects.items() if s.carried]
         if carried_before:
@@ -378,7 +402,7 @@ class _RobotChecker:
     def dropoff(self, k: int, step: Step, prev: State, cur: State) -> None:
         oid = step.object
         self.robot_static(k, prev, cur)
-        self.heading_zero(k, cur, "drop-pose", "dropped off")
+        heading = self.docking(k, cur, oid, "drop-pose", "dropped off")
         if not prev.objects[oid].carried:
             self.add(
                 k, "carried", f"{oid} is not carried at instant {k - 1}, so there is nothing to drop off"
@@ -394,13 +418,14 @@ class _RobotChecker:
         d = self.gap(oid)
         x, y, _ = cur.robot
         where = cur.objects[oid].position
-        in_front = _points_eq(where, (x + d, y))
-        if not in_front:
+        front = None if heading is None else in_front((x, y), d, heading)
+        placed = front is not None and _points_eq(where, front)
+        if front is not None and not placed:
             self.add(
                 k,
                 "drop-pose",
-                f"{oid} is put at {_point(where)}, but a robot at {_point((x, y))} puts it in front of "
-                f"itself at {_point((x + d, y))} (d = {_fmt(d)} mm)",
+                f"{oid} is put at {_point(where)}, but a robot at {_point((x, y))} facing {heading}° puts "
+                f"it in front of itself at {_point(front)} (d = {_fmt(d)} mm)",
             )
         self.positions_static(k, prev, cur, moved=oid)
         self.flags_static(k, prev, cur, "away")
@@ -414,7 +439,7 @@ class _RobotChecker:
                     "wall",
                     f"{oid} dropped at {_point(where)} overlaps wall {_wall_text(wall)}; drop it elsewhere",
                 )
-        if in_front:
+        if placed:
             self.reach(k, oid, cur, where, skip=crossed)
         for other, other_shape in self.resting(cur, exclude=oid):
             if overlaps(other_shape, shape):
@@ -438,12 +463,15 @@ class _RobotChecker:
         ox, oy = prev.objects[oid].position
         d = self.gap(oid)
         x, y, _ = cur.robot
-        if overlaps(square(x, y, self.side), square(ox - d, oy, self.side)):
+        poses = [(h, docking_pose((ox, oy), d, h)) for h in self.scene.objects[oid].headings]
+        blocked = [(h, p) for h, p in poses if overlaps(square(x, y, self.side), square(*p, self.side))]
+        if blocked:
+            where = ", ".join(f"{_point(p)} (heading {h}°)" for h, p in blocked)
             self.add(
                 k,
                 "req-room",
                 f"the requester at {_point((x, y))} stands in the way of a robot picking {oid} from "
-                f"{_point((ox - d, oy))}; request from a pose that leaves that square free",
+                f"{where}; request from a pose that leaves the pick pose on each of its sides free",
             )
 
     def res(self, k: int, step: Step, prev: State, cur: State) -> None:
@@ -543,7 +571,7 @@ class _RobotChecker:
                     text += (
                         f"; DropOff({event.obj}) at instant {i} leaves it at "
                         f"{_point(step.objects[event.obj].position)}, "
-                        f"outside {_workspace_text(self.scene, event.workspace)}"
+                        f"{_outside(self.scene, event.obj, event.workspace)}"
                     )
         elif event.kind == "return" and self.plan.horizon:
             text += f"; the last pose is {_pose(self.states[-1].robot)}: add a GoTo back to the initial pose"
@@ -551,6 +579,13 @@ class _RobotChecker:
         if remaining:
             text += f" (so {', '.join(remaining)} cannot be matched either)"
         return text
+
+
+def _outside(scene: Scene, oid: str, wid: str) -> str:
+    """Words for an object left where the drop's workspace does not hold it."""
+    if scene.workspaces[wid].is_point:
+        return f"not on {_workspace_text(scene, wid)}"
+    return f"not wholly inside {_workspace_text(scene, wid)} (size {_fmt(scene.objects[oid].size)})"
 
 
 def _workspace_text(scene: Scene, wid: str) -> str:

@@ -57,6 +57,7 @@ from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
 from cosmop._frozen import reduce_frozen
+from cosmop.docking import in_front
 from cosmop.errors import CosmopInputError, EventSyntaxError
 from cosmop.io import read_text, write_atomic
 from cosmop.missions.events import ID_PATTERN, Event, parse_event
@@ -236,7 +237,8 @@ def successor(
     """The step that applies a primitive's nominal effect to `state` (no rule is checked).
 
     ``GoTo`` moves the robot to `to`; ``PickUp(O)`` marks O carried; ``DropOff(O)`` puts O at
-    :math:`(x + d, y)` in front of the robot, :math:`d = (l + b)/2`, and marks it not carried;
+    :math:`(x, y) + d\\,(\\cos h, \\sin h)` in front of the robot facing :math:`h` (a docking
+    heading: 0, 90, 180 or 270 degrees), :math:`d = (l + b)/2`, and marks it not carried;
     ``Req(O)`` marks O away; ``Res(O)`` changes nothing. Whether the step is allowed is the
     business of :func:`cosmop.planning.checker.check_robot_plan`.
 
@@ -271,10 +273,20 @@ def successor(
         objects[obj] = ObjectState(objects[obj].position, carried=True, away=objects[obj].away)
     elif primitive == "DropOff":
         gap = (scene.robots[robot_id].size + scene.objects[obj].size) / 2.0
-        objects[obj] = ObjectState((robot[0] + gap, robot[1]), carried=False, away=objects[obj].away)
+        objects[obj] = ObjectState(_ahead(robot, gap), carried=False, away=objects[obj].away)
     elif primitive == "Req":
         objects[obj] = ObjectState(objects[obj].position, carried=objects[obj].carried, away=True)
     return Step(primitive, obj, robot, objects)
+
+
+def _ahead(pose: Pose, gap: float) -> tuple[float, float]:
+    """The point `gap` mm ahead of `pose`: exact at a docking heading, in floats at any other
+    (a plan written by hand may drop at 45 degrees; the checker names that, not this)."""
+    try:
+        return in_front(pose, gap, pose[2])
+    except ValueError:
+        turn = math.radians(pose[2])
+        return pose[0] + gap * math.cos(turn), pose[1] + gap * math.sin(turn)
 
 
 def plan_from_actions(

@@ -6,9 +6,11 @@ robot's *free space* here is the set of centres where its square overlaps no wal
 allowed), objects ignored; its *component* is the part connected to where the robot starts.  A
 plan moves the robot only inside that component (a straight GoTo never crosses a wall), so:
 
-* ``pick(R,O)`` needs the pick pose :math:`(o_x - d, o_y)` in it (:math:`d` the centre distance
-  at which robot and object touch, PickUp's pose);
-* ``drop(R,O,W)`` needs a pose :math:`(w_x - d, w_y)`, :math:`(w_x, w_y) \\in W`, in it.
+* ``pick(R,O)`` needs one of the four pick poses :math:`o - d\\,(\\cos h, \\sin h)`,
+  :math:`h \\in \\{0, 90, 180, 270\\}`, in it (:math:`d` the centre distance at which robot and
+  object touch, PickUp's pose);
+* ``drop(R,O,W)`` needs a pose :math:`w - d\\,(\\cos h, \\sin h)` in it, :math:`w` a centre that
+  puts O wholly inside W.
 
 If not, the event is unreachable at any horizon.  Ignoring objects only enlarges the free
 space, and the walls are grown by the exact Minkowski sum with the square, less half a
@@ -22,8 +24,10 @@ from collections.abc import Sequence
 
 import shapely
 
+from cosmop.docking import SIDES, docking_pose
 from cosmop.missions.events import Event
 from cosmop.scenario import Scene
+from cosmop.squares import docking_places
 
 __all__ = ["unreachable"]
 
@@ -62,22 +66,31 @@ def unreachable(
             continue
         d = (body.size + scene.objects[event.obj].size) / 2.0
         if event.kind == "pick":
-            ox, oy = scene.objects[event.obj].position
-            where = shapely.Point(ox - d, oy)
-            what = f"its pick pose ({ox - d:g}, {oy:g})"
+            obj = scene.objects[event.obj]
+            poses = [docking_pose(obj.position, d, h) for h in obj.headings]
+            where = shapely.MultiPoint(poses)
+            sides = ", ".join(
+                f"{side} ({x:g}, {y:g})" for side, (x, y) in zip(_named(obj), poses, strict=True)
+            )
+            what = f"its pick poses on the sides tried: {sides}"
         else:
-            ws = scene.workspaces[event.workspace]
-            if ws.is_point:
-                where = shapely.Point(ws.point[0] - d, ws.point[1])
-            else:
-                where = shapely.box(ws.x[0] - d, ws.y[0], ws.x[1] - d, ws.y[1])
+            obj = scene.objects[event.obj]
+            centres = scene.workspaces[event.workspace].centres(obj.size)
+            where = shapely.union_all(docking_places(*centres.ranges, d, obj.headings))
             what = f"any pose that drops {event.obj} in {event.workspace}"
+            what += f" (sides tried: {', '.join(_named(obj))})"
         if not component.intersects(where):
             return (
                 f"{robot} cannot reach {event.name} (event {i} of its mission) at any horizon: "
                 f"walls separate its start ({x0:g}, {y0:g}) from {what}"
             )
     return None
+
+
+def _named(obj) -> list[str]:
+    """The object's sides in the order of its docking headings."""
+    by_heading = {heading: side for side, heading in SIDES.items()}
+    return [by_heading[h] for h in obj.headings]
 
 
 def _component(scene: Scene, half: float, start: tuple[float, float]):

@@ -5,7 +5,7 @@ with event *m* holding at :math:`i_m` (a ``return``, a pose rather than a step, 
 same instant as the event before it) --
 
 * ``pick(R,O)``: step *i* is ``PickUp(O)``;
-* ``drop(R,O,W)``: step *i* is ``DropOff(O)`` and O's position after it lies in W;
+* ``drop(R,O,W)``: step *i* is ``DropOff(O)`` and O's square after it lies wholly in W;
 * ``return(R)``: the pose at instant *i* is the robot's initial pose in the scenario;
 * ``away(O,A,B)``: step *i* is ``Req(O)`` for the requester A, ``Res(O)`` for the responder B;
 * ``msg(S,R,tag)``: step *i* is ``Res`` carrying the message for the sender S, ``Req`` carrying
@@ -84,7 +84,8 @@ def holds_at(
         return False
     if event.kind == "drop":
         obj = step.objects.get(event.obj)
-        return obj is not None and scene.workspaces[event.workspace].contains(*obj.position, TOLERANCE)
+        where = scene.workspaces[event.workspace].centres(scene.objects[event.obj].size)
+        return obj is not None and where.contains(*obj.position, TOLERANCE)
     return True
 
 

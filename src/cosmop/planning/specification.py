@@ -50,6 +50,7 @@ from typing import Any
 import shapely
 
 from cosmop.automata import DFA
+from cosmop.docking import facing
 from cosmop.logic import (
     FALSE,
     TRUE,
@@ -69,6 +70,7 @@ from cosmop.missions.events import Event
 from cosmop.planning.plan import State
 from cosmop.planning.regions import HalfPlane, wall_regions
 from cosmop.scenario import Scene
+from cosmop.squares import docking_places
 
 NONE = 0
 PRIMITIVE_NAMES = ("GoTo", "PickUp", "DropOff", "Req", "Res")
@@ -265,6 +267,25 @@ class RobotProblem:
         return (_num(self.scene.objects[obj].size) + self.side) / 2
 
 
+def _less(term, amount: Fraction):
+    """``term - amount``, leaving `term` as it is when `amount` is zero (a smaller formula)."""
+    return term if amount == 0 else term - amount
+
+
+def _docked(p: RobotProblem, obj: str, ox, oy, d: Fraction) -> Formula:
+    """The robot faces `obj` at ``(ox, oy)`` square on, from one of its sides, touching it.
+
+    :math:`\\bigvee_{h \\in H} \\alpha = h \\wedge (x, y) = (o_x, o_y) - d\\,(\\cos h, \\sin h)`,
+    :math:`H` the object's docking headings (:attr:`~cosmop.scenario.MovableObject.headings`, a
+    subset of 0, 90, 180, 270); the terms are exact.
+    """
+    out = []
+    for heading in p.scene.objects[obj].headings:
+        ux, uy = facing(heading)
+        out.append(p.h.eq(heading) & p.x.eq(_less(ox, d * ux)) & p.y.eq(_less(oy, d * uy)))
+    return disj(out)
+
+
 def _static(*vars_: Var) -> Formula:
     return conj(v.next().eq(v) if v.sort != "bool" else eq(v.next(), v) for v in vars_)
 
@@ -361,21 +382,19 @@ def _drop_places(p: RobotProblem, obj: str) -> list | None:
     places = []
     for e in p.mission:
         if e.kind == "drop" and e.obj == obj:
-            ws = p.scene.workspaces[e.workspace]
-            if ws.is_point:
-                places.append(shapely.Point(ws.point[0] - d, ws.point[1]))
-            else:
-                places.append(shapely.box(ws.x[0] - d, ws.y[0], ws.x[1] - d, ws.y[1]))
+            ws = p.scene.workspaces[e.workspace].centres(p.scene.objects[obj].size)
+            places += docking_places(*ws.ranges, d, p.scene.objects[obj].headings)
     return places or None
 
 
 def _pick_places(p: RobotProblem, obj: str) -> list | None:
-    """Robot centres that pick `obj` up: in front of where it starts or is dropped."""
+    """Robot centres that pick `obj` up: facing where it starts or is dropped, from any side."""
     at = _resting(p, obj)
     if at is None:
         return None
     d = float(p.clearance(obj))
-    return [shapely.Point(at[0] - d, at[1]), *(_drop_places(p, obj) or [])]
+    here = docking_places((at[0], at[0]), (at[1], at[1]), d, p.scene.objects[obj].headings)
+    return [*here, *(_drop_places(p, obj) or [])]
 
 
 def _robot_static(p: RobotProblem) -> Formula:
@@ -500,7 +519,7 @@ class GoTo(Primitive):
 
 
 class PickUp(Primitive):
-    """Pick ``obj`` up from in front of it, facing it (heading 0), carrying nothing."""
+    """Pick ``obj`` up carrying nothing, facing one of its sides and touching it (:func:`_docked`)."""
 
     name = "PickUp"
 
@@ -513,13 +532,14 @@ class PickUp(Primitive):
             [~p.obj(o).carried for o in p.scene.objects]
             + [p.obj(o).carried.next() if o == obj else ~p.obj(o).carried.next() for o in p.scene.objects]
         )
-        pose = p.h.eq(0) & p.y.eq(v.y) & p.x.eq(v.x - d) & ~v.away
+        pose = _docked(p, obj, v.x, v.y, d) & ~v.away
         out = [(f"PickUp {obj}", _robot_static(p) & carry & pose & _objects_static(p, carried=False))]
         return out + _gripper_clear(p, obj, v.x, v.y) + _handling_room(p, obj, _pick_places(p, obj))
 
 
 class DropOff(Primitive):
-    """Leave the carried ``obj`` in front of the robot, never onto a wall or another object."""
+    """Leave the carried ``obj`` in front of the robot (any docking heading, :func:`_docked`), never
+    onto a wall or another object."""
 
     name = "DropOff"
 
@@ -530,7 +550,7 @@ class DropOff(Primitive):
         v, d = p.obj(obj), p.clearance(obj)
         held = conj(p.obj(o).carried if o == obj else ~p.obj(o).carried for o in p.scene.objects)
         released = conj(~p.obj(o).carried.next() for o in p.scene.objects)
-        place = p.h.eq(0) & v.x.next().eq(p.x + d) & v.y.next().eq(p.y)
+        place = _docked(p, obj, v.x.next(), v.y.next(), d)
         rest = _objects_static(p, carried=False, skip=obj) & _static(v.away)
         out = [(f"DropOff {obj}", _robot_static(p) & held & released & place & rest)]
         out += _gripper_clear(p, obj, v.x.next(), v.y.next()) + _handling_room(p, obj, _drop_places(p, obj))
@@ -561,7 +581,7 @@ class DropOff(Primitive):
 
 
 class Req(Primitive):
-    """Ask for ``obj`` to be moved away and wait; stand clear of the pose that picks it."""
+    """Ask for ``obj`` to be moved away and wait, clear of every pose that picks it (each side)."""
 
     name = "Req"
 
@@ -578,8 +598,12 @@ class Req(Primitive):
             & _objects_static(p, away=False)
             & _objects_static(p, positions=False, carried=False, skip=obj)
         )
-        room = disj([p.x <= v.x - d - side, p.x >= v.x - d + side, p.y <= v.y - side, p.y >= v.y + side])
-        return [(f"Req {obj}", _robot_static(p) & flags & room)]
+        room = []
+        for heading in p.scene.objects[obj].headings:  # the helper picks from a side of its choosing
+            ux, uy = facing(heading)
+            px, py = _less(v.x, d * ux), _less(v.y, d * uy)
+            room.append(disj([p.x <= px - side, p.x >= px + side, p.y <= py - side, p.y >= py + side]))
+        return [(f"Req {obj}", _robot_static(p) & flags & conj(room))]
 
 
 class Res(Primitive):
@@ -605,7 +629,7 @@ def _goal(p: RobotProblem, event: Event) -> tuple[Formula, Formula]:
         return p.requests_except(event.obj), p.is_action("PickUp", event.obj)
     if event.kind == "drop":
         v = p.obj(event.obj)
-        ws = p.scene.workspaces[event.workspace]
+        ws = p.scene.workspaces[event.workspace].centres(p.scene.objects[event.obj].size)
         if ws.point is not None:
             inside = v.x.eq(_num(ws.point[0])) & v.y.eq(_num(ws.point[1]))
         else:

@@ -372,48 +372,86 @@ def _fewest_steps(dfa: DFA, events: tuple[Event, ...]) -> int:
 
 
 def _explain_automaton(p: RobotProblem, K: int, rlimit: int) -> tuple[str, tuple[str, ...]]:
-    """Why no word of a branching mission can be planned within ``K`` steps (an unsat core)."""
+    """Why no word of a branching mission can be planned within ``K`` steps (a minimal core)."""
     blocking = _core(p, specification(p), K, rlimit)
-    what = ", ".join(blocking) if blocking else "the primitives' constraints"
-    return f"{p.robot} cannot complete any word of its mission within {K} steps; blocked by: {what}", blocking
+    head = f"{p.robot} cannot complete any word of its mission within {K} steps"
+    return _because(head, blocking, K), blocking or ()
 
 
 def _explain(p: RobotProblem, events: tuple[Event, ...], K: int, rlimit: int) -> tuple[str, tuple[str, ...]]:
-    """The first event no plan of length ``<= K`` reaches, and an unsat core naming what blocks it."""
+    """The first event no plan of length ``<= K`` reaches, and a minimal core naming what blocks it."""
     for i in range(1, len(events) + 1):
         if not any(_feasible_at(p, events[:i], k, rlimit) for k in range(1, K + 1)):
             break
     else:  # every prefix alone is feasible (cannot happen for the whole mission): report the last
         i = len(events)
     blocking = _core(p, specification(p, events[:i]), K, rlimit)
+    event = events[i - 1]
+    head = f"{p.robot} cannot reach {event.name} (event {i} of its mission) within {K} steps"
+    reason = _because(head, blocking, K)
+    if event.kind in ("pick", "drop") and blocking:
+        sides = p.scene.objects[event.obj].sides
+        reason += f" (sides of {event.obj} tried: {', '.join(sides)})"
+    return reason, blocking or ()
+
+
+def _because(head: str, blocking: tuple[str, ...] | None, K: int) -> str:
+    if blocking is None:
+        return (
+            f"{head}, even with no wall or object in the way: the mission needs more steps than "
+            f"the horizon {K} (raise --max-horizon)"
+        )
     what = ", ".join(blocking) if blocking else "the primitives' constraints"
-    return (
-        f"{p.robot} cannot reach {events[i - 1].name} (event {i} of its mission) within {K} steps; "
-        f"blocked by: {what}",
-        blocking,
-    )
+    return f"{head}; blocked by: {what}"
 
 
-def _core(p: RobotProblem, parts: list[tuple[str, object]], K: int, rlimit: int) -> tuple[str, ...]:
-    """The obstacles in an unsat core of `parts` at horizon `K` (walls, objects, handling room)."""
+def _is_obstacle(name: str) -> bool:
+    """Whether a specification part keeps the robot or a good off a wall or an object."""
+    return name.startswith(("wall", "object", "gripper", "room from")) or " dropped clear of " in name
+
+
+def _core(p: RobotProblem, parts: list[tuple[str, object]], K: int, rlimit: int) -> tuple[str, ...] | None:
+    """A minimal set of obstacle parts of `parts` that leaves no plan of ``K`` steps.
+
+    Every other part (the initial state, the primitives' effects, the mission) is asserted;
+    each obstacle part is guarded by a literal.  ``None`` when even no obstacle leaves a plan:
+    then the horizon, not the scene, is the cause.  Otherwise the solver's core is shrunk by
+    deletion (drop one part; if still unsat, keep it dropped): no part of the answer can be
+    left out.  A check that spends its resource limit keeps the part (a larger core, never a
+    wrong one).  ``()`` when the solver cannot tell.
+    """
     ctx = z3.Context()
     u = Unrolling(Signature.of(conj(f for _, f in parts)), K, ctx=ctx)
     s = _solver(rlimit, ctx)
-    names = {}
+    names: dict[str, str] = {}
+    guards = []
     for j, (name, f) in enumerate(parts):
-        label = z3.Bool(f"part{j}", ctx)
-        names[str(label)] = name
-        s.assert_and_track(u.encode(f), label)
-    blocking: tuple[str, ...] = ()
+        if _is_obstacle(name):
+            label = z3.Bool(f"part{j}", ctx)
+            names[str(label)] = name
+            guards.append(label)
+            s.add(z3.Implies(label, u.encode(f)))
+        else:
+            s.add(u.encode(f))
     if s.check() == z3.unsat:
-        core = [names[str(c)] for c in s.unsat_core()]
-        # obstacles only: the primitives' own effects and the mission are in every core
-        blocking = tuple(
-            n
-            for n in core
-            if n.startswith(("wall", "object", "gripper", "room from")) or " dropped clear of " in n
-        )
-    return blocking
+        return None
+    if s.check(*guards) != z3.unsat:
+        return ()
+    core = _in_order(guards, s.unsat_core())
+    k = 0
+    while k < len(core):
+        trial = core[:k] + core[k + 1 :]
+        if s.check(*trial) == z3.unsat:
+            core = _in_order(trial, s.unsat_core())
+        else:
+            k += 1
+    return tuple(names[str(c)] for c in core)
+
+
+def _in_order(guards: list, core) -> list:
+    """The guards that are in `core`, in the order of `guards` (a deterministic answer)."""
+    kept = {str(c) for c in core}
+    return [g for g in guards if str(g) in kept]
 
 
 __all__ = ["NONE", "Synthesis", "synthesize"]

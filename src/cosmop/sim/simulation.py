@@ -14,12 +14,13 @@ control cycle :math:`\\varepsilon` (the scenario's ``dynamics.cycle``):
     to ``leave_gap``, and the last few millimetres onto a final pose that touches something
     are crept, with the docking controller.
 ``PickUp`` / ``DropOff``
-    dock: the docking pose (the object's x minus :math:`d = (l_r + l_o)/2`, its y, heading 0;
-    or the plan's pose for a drop) is closed at ``dock_speed`` by the docking controller (a
-    fine alignment of at most ``dock_tolerance``, which the unicycle model abstracts), then the
-    gripper works for ``handling_time``.  After a drop the robot stays where the plan has it
-    (a robot that waits there keeps the clearances the plan was ordered with) and creeps out
-    when it next drives, so that it never drives along the object it touches.
+    dock: the docking pose (facing the object from the plan's side, touching it:
+    :func:`cosmop.squares.docking_pose`; the plan's pose for a drop) is closed at
+    ``dock_speed`` by the docking controller (a fine alignment of at most ``dock_tolerance``,
+    which the unicycle model abstracts), then the gripper works for ``handling_time``.  After
+    a drop the robot stays where the plan has it (a robot that waits there keeps the
+    clearances the plan was ordered with) and creeps out when it next drives, so that it never
+    drives along the object it touches.
     A carried object rides on its robot, inside the robot's square, as in the plan model where
     a carried object takes no room.
 ``Req``
@@ -57,6 +58,7 @@ from cosmop.control.dwa import DwaSettings, dwa_commands, robot_gaps
 from cosmop.control.geometry import box_gaps, point_segment_linf, segment_array
 from cosmop.control.paths import GlobalPath, plan_path, straight_path
 from cosmop.control.safety import is_safe, obstacle_speed, stopping_horizon, stopping_margin
+from cosmop.docking import docking_pose, in_front
 from cosmop.io import write_atomic
 from cosmop.missions.events import Event, parse_event
 from cosmop.planning.plan import ObjectState, PlanSet, RobotPlan, State, Step, initial_state
@@ -343,7 +345,8 @@ class SimResult:
             for event in plan.events:
                 if event.kind == "drop":
                     (x, y), by = self.objects[event.obj]
-                    ws = scenario.scene.workspaces[event.workspace]
+                    size = scenario.scene.objects[event.obj].size
+                    ws = scenario.scene.workspaces[event.workspace].centres(size)
                     out[event.obj] = by is None and ws.contains(x, y, 1e-6)
         return out
 
@@ -575,11 +578,14 @@ class _World:
             wanted = [e for e in agent.mission if e.kind == "pick" and e.obj == step.object]
         elif step.primitive == "DropOff":
             x, y = self.obj_pos[self.oids.index(step.object)]
-            workspaces = self.scenario.scene.workspaces
+            scene = self.scenario.scene
+            size = scene.objects[step.object].size
             wanted = [
                 e
                 for e in agent.mission
-                if e.kind == "drop" and e.obj == step.object and workspaces[e.workspace].contains(x, y, 1e-6)
+                if e.kind == "drop"
+                and e.obj == step.object
+                and scene.workspaces[e.workspace].centres(size).contains(x, y, 1e-6)
             ]
         elif step.primitive == "Req":
             wanted = [e for e in agent.mission if e.name in self.inbox and e.receiver == agent.id]
@@ -857,11 +863,11 @@ def _handle(world: _World, agent: _Agent, step: Step) -> tuple[str, Any] | None:
     i = agent.index
     j = world.oids.index(step.object)
     gap = world.half[i] + world.obj_half[j]
-    if step.primitive == "PickUp":
-        ox, oy = world.obj_pos[j]
-        dock = (float(ox - gap), float(oy), 0.0)
+    heading = float(step.robot[2]) % 360.0
+    if step.primitive == "PickUp":  # where the object is now, from the side the plan faces
+        dock = (*map(float, docking_pose(world.obj_pos[j], gap, heading)), heading)
     else:
-        dock = (float(step.robot[0]), float(step.robot[1]), 0.0)
+        dock = (float(step.robot[0]), float(step.robot[1]), heading)
     if agent.stage is None:
         offset = math.hypot(dock[0] - world.pose[i, 0], dock[1] - world.pose[i, 1])
         agent.stage = "dock" if offset <= s.dock_tolerance else "approach"
@@ -876,7 +882,7 @@ def _handle(world: _World, agent: _Agent, step: Step) -> tuple[str, Any] | None:
         if world.v[i] > 0:
             return _brake(world, i)
         offset = math.hypot(dock[0] - world.pose[i, 0], dock[1] - world.pose[i, 1])
-        error = abs(float(_wrap(-world.pose[i, 2])))
+        error = abs(float(_wrap(math.radians(heading) - world.pose[i, 2])))
         there = offset < 1e-9 and error < 1e-9
         if not there and _dock_safe(world, i, agent, dock):
             return ("dock", dock)
@@ -975,7 +981,8 @@ def _drop_spot(world: _World, agent: _Agent, step: Step, j: int) -> np.ndarray:
     if planned is not None:
         return np.array(planned.position, dtype=float)
     i = agent.index
-    return np.array([world.pose[i, 0] + world.half[i] + world.obj_half[j], world.pose[i, 1]])
+    front = in_front(world.pose[i], world.half[i] + world.obj_half[j], float(step.robot[2]) % 360.0)
+    return np.array(front, dtype=float)
 
 
 def _drop_clear(world: _World, i: int, j: int, spot: np.ndarray) -> bool:
