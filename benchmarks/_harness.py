@@ -57,3 +57,52 @@ def generator_main(doc: str, build, sizes: tuple[str, ...], argv: list[str] | No
     args = parser.parse_args(argv)
     emit_scenario(build(*(getattr(args, name) for name in sizes), args.seed), args.output)
     return 0
+
+
+def plan_and_simulate(data: dict, stem: Path, timeout: float, max_time: float | None = None) -> dict:
+    """Plan a scenario and simulate its plan as a user does: ``cosmop plan``, then ``cosmop
+    simulate --plan``, one fresh process each; files at ``stem`` + suffix.
+
+    The row: ``plan`` (feasible, infeasible, timeout, exit N), ``plan_s`` (wall seconds, process
+    start and file writing included), ``added`` (tasks the planner added), and when feasible
+    ``completed``, ``contacts_while_moving``, ``sim_time_s``, ``replans``, ``drops``, ``sim_s``,
+    ``sim``.  `max_time` is the simulated seconds allowed (default: the simulator's).
+    """
+    path, plan, summary = (stem.with_name(stem.name + s) for s in (".yaml", "_plan.json", "_summary.json"))
+    path.write_text(yaml.safe_dump(data, sort_keys=False, default_flow_style=None))
+    cosmop = [sys.executable, "-m", "cosmop"]
+    start = time.perf_counter()
+    try:
+        planned = subprocess.run(
+            [*cosmop, "plan", str(path), "-o", str(plan)], capture_output=True, timeout=timeout
+        )
+    except subprocess.TimeoutExpired:
+        return {"plan": "timeout", "plan_s": timeout}
+    row = {"plan": {0: "feasible", 1: "infeasible"}.get(planned.returncode, f"exit {planned.returncode}")}
+    row["plan_s"] = round(time.perf_counter() - start, 2)
+    if plan.exists():
+        row["added"] = len(json.loads(plan.read_text()).get("added", []))
+    if planned.returncode != 0:
+        return row
+    start = time.perf_counter()
+    try:
+        sim = subprocess.run(
+            [*cosmop, "simulate", str(path), "--plan", str(plan), "--summary", str(summary)]
+            + ([] if max_time is None else ["--max-time", str(max_time)]),
+            capture_output=True,
+            timeout=timeout,
+        )
+    except subprocess.TimeoutExpired:
+        return row | {"completed": False, "sim": "timeout"}
+    row["sim_s"] = round(time.perf_counter() - start, 2)
+    if not summary.exists():
+        return row | {"completed": False, "sim": f"exit {sim.returncode}"}
+    result = json.loads(summary.read_text())
+    return row | {
+        "completed": bool(result["completed"]),
+        "contacts_while_moving": result["contacts_while_moving"],
+        "sim_time_s": result["sim_time_s"],
+        "replans": result["replans"],
+        "drops": sum(1 for e in result["events"] if e["event"].startswith("drop(")),
+        "sim": f"exit {sim.returncode}",
+    }

@@ -19,15 +19,10 @@ from __future__ import annotations
 import argparse
 import json
 import random
-import subprocess
-import sys
 import tempfile
-import time
 from pathlib import Path
 
-import yaml
-
-from _harness import save_results
+from _harness import plan_and_simulate, save_results
 from cosmop.errors import ScenarioError
 from cosmop.scenario import parse_scenario
 
@@ -82,42 +77,8 @@ def scene(seed: int) -> dict:
 
 def run_seed(seed: int, timeout: float, folder: Path) -> dict:
     data = scene(seed)
-    path = folder / f"scene_{seed}.yaml"
-    path.write_text(yaml.safe_dump(data, sort_keys=False, default_flow_style=None))
-    plan, summary = folder / f"plan_{seed}.json", folder / f"summary_{seed}.json"
-    cosmop = [sys.executable, "-m", "cosmop"]
     row = {"seed": seed, "robots": len(data["scene"]["robots"]), "walls": len(data["scene"]["obstacles"])}
-    start = time.perf_counter()
-    try:
-        planned = subprocess.run(
-            [*cosmop, "plan", str(path), "-o", str(plan)], capture_output=True, timeout=timeout
-        )
-    except subprocess.TimeoutExpired:
-        return row | {"plan": "timeout", "plan_s": timeout}
-    row |= {"plan": {0: "feasible", 1: "infeasible"}.get(planned.returncode, f"exit {planned.returncode}")}
-    row["plan_s"] = round(time.perf_counter() - start, 2)
-    if planned.returncode != 0:
-        return row
-    start = time.perf_counter()
-    try:
-        sim = subprocess.run(
-            [*cosmop, "simulate", str(path), "--plan", str(plan), "--summary", str(summary)],
-            capture_output=True,
-            timeout=timeout,
-        )
-    except subprocess.TimeoutExpired:
-        return row | {"completed": False, "sim": "timeout"}
-    row["sim_s"] = round(time.perf_counter() - start, 2)
-    if not summary.exists():
-        return row | {"completed": False, "sim": f"exit {sim.returncode}"}
-    result = json.loads(summary.read_text())
-    return row | {
-        "completed": bool(result["completed"]),
-        "contacts_while_moving": result["contacts_while_moving"],
-        "sim_time_s": result["sim_time_s"],
-        "replans": result["replans"],
-        "sim": f"exit {sim.returncode}",
-    }
+    return row | plan_and_simulate(data, folder / f"scene_{seed}", timeout)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -5,6 +5,11 @@ from __future__ import annotations
 import random
 
 
+def box_walls(x0: float, y0: float, x1: float, y1: float) -> list[list[list[float]]]:
+    """The four wall segments of the rectangle ``[x0, x1] x [y0, y1]`` (mm), as scenario data."""
+    return [[[x0, y0], [x1, y0]], [[x1, y0], [x1, y1]], [[x1, y1], [x0, y1]], [[x0, y1], [x0, y0]]]
+
+
 def room(seed: int) -> dict:
     """A walled room with one robot, two goods and three docks placed at random (seeded)."""
     rng = random.Random(seed)

@@ -18,6 +18,7 @@ from cosmop.planning.synthesis import synthesize
 from cosmop.scenario import parse_scenario
 from cosmop.sim.simulation import SimSettings, simulate
 from cosmop.squares import docking_places
+from rooms import box_walls
 
 
 def _bay(sides=None, workspace=None):
@@ -30,10 +31,7 @@ def _bay(sides=None, workspace=None):
             "name": "north-bay",
             "scene": {
                 "obstacles": [
-                    [[-2000, -1500], [2000, -1500]],
-                    [[2000, -1500], [2000, 1500]],
-                    [[2000, 1500], [-2000, 1500]],
-                    [[-2000, 1500], [-2000, -1500]],
+                    *box_walls(-2000, -1500, 2000, 1500),
                     [[750, -1500], [750, -500]],  # the bay: 500 wide, open at the top
                     [[1250, -1500], [1250, -500]],
                 ],

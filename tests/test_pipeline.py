@@ -41,17 +41,18 @@ def test_example_1_coordinated():
     }
 
 
-def test_a_blocking_object_nobody_picks_is_refused():
+def test_a_blocking_object_nobody_picks_is_set_aside_by_the_requester():
     data = yaml.safe_load(EXAMPLE.read_text())
     data["mission"]["tasks"] = {"R1": data["mission"]["tasks"]["R1"]}  # nobody moves O2 any more
     for obj in data["scene"]["objects"].values():  # the paper's rule: from the west side only
         obj["sides"] = ["west"]
     result = plan_team(parse_scenario(data))
-    assert not result.plans.feasible
-    assert (
-        "R1 needs O2 moved away" in result.plans.reason
-        and "no robot's mission picks O2" in result.plans.reason
-    )
+    assert result.plans.feasible and result.report.ok
+    (task,) = result.plans.added
+    assert (task.robot, task.object) == ("R1", "O2") and "no mission moves it" in task.why
+    # without the request R1 has no plan (the paper's R1 needs O2 gone), so it moves O2 itself
+    assert not any("without requesting O2" in r for r in result.replans)
+    assert result.plans.robots["R1"].mission[:2] == ("pick(R1,O2)", "drop(R1,O2,aside_O2)")
 
 
 def test_worker_processes_do_not_change_the_result():

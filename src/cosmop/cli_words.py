@@ -72,6 +72,9 @@ def plan_verdict(plans: Any, verification: Any) -> str:
             f"; {messages} message{'s' if messages != 1 else ''} make robots take turns where their routes "
             "or the mission's order need it"
         )
+    for task in getattr(plans, "added", ()):
+        x, y = task.point
+        order += f"; {task.robot} sets {task.object} down at ({x:g}, {y:g}), a task no mission names"
     proven = (
         "and together they do exactly the team mission (proven)"
         if verification is not None and verification.holds

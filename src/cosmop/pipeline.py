@@ -26,7 +26,7 @@ import multiprocessing
 import os
 import signal
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from concurrent.futures import Executor, ProcessPoolExecutor
 from dataclasses import dataclass, replace
 from types import MappingProxyType
@@ -41,15 +41,19 @@ from cosmop.missions.decomposition import decompose
 from cosmop.missions.events import Event, parse_event
 from cosmop.missions.mission import GlobalMission, sequence_of
 from cosmop.missions.team import TeamVerdict, blocking_word, check_words
+from cosmop.planning.aside import ROOM, place_aside
 from cosmop.planning.checker import CheckReport, check_plan
 from cosmop.planning.conflicts import ConflictSettings
-from cosmop.planning.plan import MAX_STEPS, Coordination, PlanMessage, PlanSet, RobotPlan
+from cosmop.planning.plan import MAX_STEPS, AddedTask, Coordination, PlanMessage, PlanSet, RobotPlan
 from cosmop.planning.realisation import event_instants
 from cosmop.planning.synthesis import DEFAULT_RLIMIT, Synthesis, synthesize
 from cosmop.planning.teamsafety import TeamSafety, make_team_safe
 from cosmop.scenario import Scenario, Scene, Wall
+from cosmop.squares import square
 
 __all__ = ["TeamResult", "plan_team"]
+
+_AROUND = ConflictSettings(clearance=2 * ROOM)  # walls around goods set aside: ROOM off them
 
 PHASES = ("decompose", "allocate", "synthesize", "coordinate", "conflicts", "verify", "check")
 """The phases whose seconds :attr:`TeamResult.phases` records."""
@@ -109,6 +113,7 @@ class _Job:
     max_horizon: int
     rlimit: int
     unrequestable: frozenset[str] = frozenset()
+    explain: bool = True  # an infeasible answer says why (costs more solver calls)
 
 
 def _automaton_key(dfa: DFA) -> tuple:
@@ -125,6 +130,7 @@ def _synthesize(job: _Job) -> Synthesis:
         max_horizon=job.max_horizon,
         rlimit=job.rlimit,
         unrequestable=job.unrequestable,
+        explain=job.explain,
     )
 
 
@@ -158,18 +164,20 @@ class _Planner:
         self.rlimit = rlimit
         self.phases = phases
         self.forbidden: dict[str, frozenset[str]] = {}
+        self.added: list[AddedTask] = []  # goods moved aside; their places extend the scenario
         self.obstacles: dict[str, tuple[Wall, ...]] = {}
         self.cache: dict[tuple, Synthesis] = {}  # the same question is never solved twice
 
-    def key(self, robot: str, events: tuple[Event, ...] | DFA) -> tuple:
+    def key(self, robot: str, events: tuple[Event, ...] | DFA, explain: bool = True) -> tuple:
         mission = _automaton_key(events) if isinstance(events, DFA) else tuple(events)
-        return (robot, mission, self.forbidden.get(robot, frozenset()), self.obstacles.get(robot, ()))
+        restrictions = (self.forbidden.get(robot, frozenset()), self.obstacles.get(robot, ()))
+        return (robot, mission, *restrictions, *(() if explain else ("unexplained",)))
 
     def remember(self, robot: str, events: tuple[Event, ...], forbidden: frozenset[str], result: Synthesis):
         """Keep `result` as the answer for `events` with `forbidden` (one it answers exactly)."""
         self.cache[(robot, tuple(events), forbidden, self.obstacles.get(robot, ()))] = result
 
-    def job(self, robot: str, events: tuple[Event, ...] | DFA) -> _Job:
+    def job(self, robot: str, events: tuple[Event, ...] | DFA, explain: bool = True) -> _Job:
         scene = self.scenario.scene
         extra = self.obstacles.get(robot, ())
         if extra:
@@ -179,16 +187,19 @@ class _Planner:
         mission = tuple(parse_event(e) for e in events.alphabet) if branching else tuple(events)
         horizon = self.max_horizon if self.max_horizon is not None else default_horizon(mission)
         forbidden = self.forbidden.get(robot, frozenset())
-        return _Job(scene, robot, events if branching else mission, horizon, self.rlimit, forbidden)
+        return _Job(scene, robot, events if branching else mission, horizon, self.rlimit, forbidden, explain)
 
-    def run(self, jobs: Mapping[str, tuple[Event, ...]]) -> dict[str, Synthesis]:
+    def run(self, jobs: Mapping[str, tuple[Event, ...]], explain: bool = True) -> dict[str, Synthesis]:
+        """Each robot's synthesis; with `explain` false an infeasible one only says so (trials)."""
         t0 = time.perf_counter()
-        out: dict[str, Synthesis] = {
-            robot: self.cache[self.key(robot, events)]
-            for robot, events in jobs.items()
-            if self.key(robot, events) in self.cache
-        }
-        work = {robot: self.job(robot, events) for robot, events in jobs.items() if robot not in out}
+        out: dict[str, Synthesis] = {}
+        for robot, events in jobs.items():
+            hit = self.cache.get(self.key(robot, events))  # an explained answer serves every call
+            if hit is None and not explain:
+                hit = self.cache.get(self.key(robot, events, explain=False))
+            if hit is not None:
+                out[robot] = hit
+        work = {robot: self.job(robot, events, explain) for robot, events in jobs.items() if robot not in out}
         if self.executor is None or len(work) < 2:
             for robot, job in work.items():
                 out[robot] = _synthesize(job)
@@ -201,7 +212,7 @@ class _Planner:
                 if self.on_robot is not None:
                     self.on_robot(robot, out[robot])
         for robot, events in jobs.items():
-            self.cache[self.key(robot, events)] = out[robot]
+            self.cache[self.key(robot, events, explain=explain or out[robot].feasible)] = out[robot]
         self.phases["synthesize"] += time.perf_counter() - t0
         return {robot: out[robot] for robot in jobs}
 
@@ -331,8 +342,8 @@ def _loop(
             base, results, planner, max_iterations, reasons, replans
         )
     safety, plans = None, {r: res.plan for r, res in results.items() if res.plan is not None}
-    if not reasons:
-        safety = _make_safe(scenario, current, results, planner, settings, reasons, replans)
+    if not reasons:  # the scenario with the places of goods set aside, if any
+        safety = _make_safe(planner.scenario, current, results, planner, settings, reasons, replans)
         plans = dict(safety.plans)
     verdict = None
     if not reasons:
@@ -351,6 +362,7 @@ def _loop(
         reason="; ".join(reasons) if reasons else None,
         messages=tuple(messages) if not reasons else (),
         allocation=choice.alternative.movers(mission) if choice and choice.alternative else {},
+        added=tuple(planner.added),
     )
     t0 = time.perf_counter()
     report = check_plan(scenario, plan_set)
@@ -410,14 +422,14 @@ def _coordinate_requests(
     replans: list[str],
 ) -> tuple[Coordinated | None, dict[str, tuple[Event, ...]], int, bool]:
     """Turn requests into away messages until no plan asks for anything new (step 3)."""
-    scene = planner.scenario.scene
     current, coordinated, iterations = dict(base), None, 0
-    asked: dict[str, list[tuple[str, int]]] = {r: [] for r in base}
+    asked: dict[str, list[tuple[str, int]]] | None = {r: [] for r in base}
     while True:
         if any(not res.feasible for res in results.values()):
             reasons += [res.reason for res in results.values() if not res.feasible]
             return coordinated, current, iterations, False
         t0 = time.perf_counter()
+        scene = planner.scenario.scene  # with the places of goods moved aside so far
         requests = {
             r: [(o, _base_index(current[r], i)) for o, i in _requests(res.plan, r, scene, current[r])]
             for r, res in results.items()
@@ -433,7 +445,15 @@ def _coordinate_requests(
         planner.phases["coordinate"] += time.perf_counter() - t0
         forbid = _bad_requests(coordinated)
         if forbid:
-            if not _forbid(forbid, base, results, planner, reasons, replans):
+            # when goods nobody moves are asked for, a failed trial leads to a helper: no reasons
+            why_not = _forbid(forbid, base, results, planner, replans, explain=not coordinated.unanswered)
+            if why_not and coordinated.unanswered:  # nobody moves what blocks: give it a helper
+                why_not = _move_aside(
+                    coordinated.unanswered, requests, base, current, results, planner, replans
+                )
+                asked = None  # the same requests now have a responder: coordinate them again
+            if why_not:
+                reasons.extend(why_not)
                 return coordinated, current, iterations, False
             continue
         changed = {r: events for r, events in coordinated.sequences.items() if events != current[r]}
@@ -467,32 +487,131 @@ def _forbid(
     base: dict[str, tuple[Event, ...]],
     results: dict[str, Synthesis],
     planner: _Planner,
-    reasons: list[str],
     replans: list[str],
-) -> bool:
-    """Re-plan robots without the requests of the first option that leaves them a plan; False
-    (with the reasons of every option) if none does."""
+    explain: bool = True,
+) -> list[str]:
+    """Re-plan robots without the requests of the first option that leaves them a plan; the
+    reasons of every option if none does (``[]``: done; with `explain` false, reasons without
+    the solver's why)."""
     why_not: list[str] = []
     for forbid in options:
         saved = dict(planner.forbidden)
         for robot, why in forbid.items():
             planner.forbidden[robot] = planner.forbidden.get(robot, frozenset()) | frozenset(why)
-        fresh = planner.run({r: base[r] for r in forbid})
+        fresh = planner.run({r: base[r] for r in forbid}, explain=explain)
         failed = [(r, res) for r, res in fresh.items() if not res.feasible]
         if not failed:
             results.update(fresh)
             for robot, why in forbid.items():
                 asked = ", ".join(sorted(why))
                 replans.append(f"{robot} re-planned without requesting {asked}: {'; '.join(why.values())}")
-            return True
+            return []
         planner.forbidden = saved
         for robot, res in failed:
             for obj, why in sorted(forbid[robot].items()):
                 why_not.append(
                     f"{robot} needs {obj} moved away, but {why}; without that request: {res.reason}"
                 )
-    reasons.extend(why_not or ["the requests cannot be answered"])
-    return False
+    return why_not or ["the requests cannot be answered"]
+
+
+def _move_aside(
+    unanswered: Iterable[tuple[str, str]],
+    requests: Mapping[str, list[tuple[str, int]]],
+    base: dict[str, tuple[Event, ...]],
+    current: dict[str, tuple[Event, ...]],
+    results: dict[str, Synthesis],
+    planner: _Planner,
+    replans: list[str],
+) -> list[str]:
+    """Give goods that block a robot, and that no mission moves, a helper that sets them aside.
+
+    The paper's re-allocation: the requester itself is tried first (no message needed), then
+    the other robots, those whose plans end soonest first.  The helper's mission gains
+    ``pick`` and ``drop`` of the goods at a free place (:func:`cosmop.planning.aside.place_aside`)
+    -- for the requester right before the event its request prepares (before the pick it is
+    carrying from, if any), for another robot at its start, and the requester's request is then
+    answered like any other (``away``).  Returns the reasons, per goods and robot tried, when
+    some goods find no helper (``[]``: every one found one).
+    """
+    why_not = []
+    for obj, requester in unanswered:
+        if any(task.object == obj for task in planner.added):
+            continue  # another requester's helper moves it already: the next round answers this one
+        index = next((i for o, i in requests.get(requester, ()) if o == obj), 0)
+        plans = {r: res.plan for r, res in results.items() if res.plan is not None}
+        others = sorted((r for r in base if r != requester), key=lambda r: (_length(plans.get(r)), r))
+        for helper in (requester, *others):  # trials first: a failed one need not say why
+            outcome = _set_aside(obj, requester, helper, index, plans, base, planner, explain=False)
+            if isinstance(outcome, str):
+                continue
+            task, events, result = outcome
+            planner.added.append(task)
+            base[helper] = current[helper] = events
+            results[helper] = result
+            # the others never see the goods move (their models keep them where they were):
+            # from now on their plans keep out of the place, as from a wall
+            walls = _walls_around(square(*task.point, planner.scenario.scene.objects[obj].size), _AROUND)
+            for other in base:
+                if other != helper:
+                    planner.obstacles[other] = planner.obstacles.get(other, ()) + walls
+            replans.append(f"{helper} sets {obj} down at ({task.point[0]:g}, {task.point[1]:g}): {task.why}")
+            break
+        else:
+            tried = [
+                f"{helper}: {_set_aside(obj, requester, helper, index, plans, base, planner)}"
+                for helper in (requester, *others)
+            ]
+            why_not.append(
+                f"{requester} needs {obj} moved away, but no mission moves it and no robot can set it "
+                f"aside ({'; '.join(tried)})"
+            )
+    return why_not
+
+
+def _set_aside(obj, requester, helper, index, plans, base, planner, explain: bool = True) -> tuple | str:
+    """``(task, mission, synthesis)`` of `helper` with the goods set aside added to its
+    mission, or why it cannot."""
+    scene = planner.scenario.scene
+    moved = {t.object: replace(scene.objects[t.object], position=t.point) for t in planner.added}
+    point = place_aside(replace(scene, objects={**scene.objects, **moved}), obj, helper, plans)
+    if point is None:
+        return f"no free place near {obj} that it can dock to"
+    workspace = next(
+        w for n in itertools.count() if (w := f"aside_{obj}" + (f"_{n}" if n else "")) not in scene.workspaces
+    )
+    how = (
+        "does it itself"
+        if helper == requester
+        else f"moves it and tells {requester} (of the robots that can, its plan ends soonest)"
+    )
+    why = f"{requester} needs {obj} moved out of its way and no mission moves it; {helper} {how}"
+    task = AddedTask(helper, obj, workspace, point, why)
+    events = _with_task(base[helper], task, index if helper == requester else 0)
+    saved = planner.scenario
+    planner.scenario = PlanSet(saved.name, True, added=(task,)).extend(saved)
+    result = planner.run({helper: events}, explain=explain)[helper]
+    if not result.feasible:
+        planner.scenario = saved
+        return f"cannot move it ({result.reason})"
+    return task, events, result
+
+
+def _length(plan: RobotPlan | None) -> int:
+    return plan.horizon if plan is not None else MAX_STEPS
+
+
+def _with_task(events: tuple[Event, ...], task: AddedTask, at: int) -> tuple[Event, ...]:
+    """`events` with the task's pick and drop inserted at `at`, or earlier, before the pick of
+    goods the robot still carries there (it carries one thing at a time)."""
+    carrying = None
+    for k, event in enumerate(events[:at]):
+        if event.kind == "pick":
+            carrying = k
+        elif event.kind == "drop" and carrying is not None and events[carrying].obj == event.obj:
+            carrying = None
+    at = carrying if carrying is not None else at
+    return (*events[:at], *task.events, *events[at:])
 
 
 def _make_safe(

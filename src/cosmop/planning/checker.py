@@ -643,7 +643,9 @@ def check_plan(scenario: Scenario, plan: PlanSet) -> CheckReport:
     also name the scenario; when the mission is given as task lists and the plan is feasible,
     every robot with tasks has a plan whose mission contains its tasks in order, with only
     ``away`` events added; every ``away`` event of a mission has its coordination pair, and
-    every pair appears in the missions of the requester and the responder.
+    every pair appears in the missions of the requester and the responder.  The plan's added
+    tasks (goods moved out of a robot's way) extend the scene by their places and the task
+    lists by their two events; their places must not reuse a workspace id of the scenario.
 
     Parameters
     ----------
@@ -658,8 +660,19 @@ def check_plan(scenario: Scenario, plan: PlanSet) -> CheckReport:
         ``ok`` when there is no violation; ``checked_steps`` counts the steps of the robots of
         the scene.
     """
+    violations: list[Violation] = [
+        Violation(
+            t.robot,
+            None,
+            "mission",
+            f"{t.robot}: the added task sets {t.object} down at {t.workspace}, but the scenario has a "
+            f"workspace {t.workspace} already; name the place anew",
+        )
+        for t in plan.added
+        if t.workspace in scenario.scene.workspaces
+    ]
+    scenario = plan.extend(scenario)
     scene = scenario.scene
-    violations: list[Violation] = []
     if plan.scenario != scenario.name:
         violations.append(
             Violation(
@@ -676,8 +689,14 @@ def check_plan(scenario: Scenario, plan: PlanSet) -> CheckReport:
             checked += robot_plan.horizon
     tasks = scenario.mission.tasks
     if tasks is not None and plan.feasible:
-        for robot_id, sequence in tasks.items():
-            violations.extend(_check_tasks(robot_id, sequence, plan.robots.get(robot_id)))
+        added = {}
+        for task in plan.added:
+            added.setdefault(task.robot, set()).update(task.events)
+        for robot_id in sorted(set(tasks) | set(added), key=str):
+            sequence = tasks.get(robot_id, ())
+            violations.extend(
+                _check_tasks(robot_id, sequence, plan.robots.get(robot_id), added.get(robot_id, set()))
+            )
     violations.extend(_check_coordination(plan))
     if not plan.feasible:
         violations.append(
@@ -695,10 +714,13 @@ def _parsed(plan: RobotPlan) -> list[Event] | None:
         return None  # reported by check_robot_plan
 
 
-def _check_tasks(robot_id: str, sequence: tuple[Event, ...], plan: RobotPlan | None) -> list[Violation]:
-    if not sequence:
+def _check_tasks(
+    robot_id: str, sequence: tuple[Event, ...], plan: RobotPlan | None, extra: set[Event]
+) -> list[Violation]:
+    """The plan's mission holds the tasks in order, adding only messages and the `extra` events."""
+    if not sequence and not extra:
         return []
-    tasks = ", ".join(e.name for e in sequence)
+    tasks = ", ".join(e.name for e in sequence) or "none"
     if plan is None:
         return [
             Violation(
@@ -729,7 +751,18 @@ def _check_tasks(robot_id: str, sequence: tuple[Event, ...], plan: RobotPlan | N
             ]
         matched.add(position)
         position += 1
-    added = [e.name for i, e in enumerate(events) if i not in matched and not e.is_message]
+    missing = sorted(e.name for e in extra if e not in events)
+    if missing:
+        return [
+            Violation(
+                robot_id,
+                None,
+                "mission",
+                f"{robot_id}: the plan file adds a task for {robot_id}, but its mission lacks "
+                f"{', '.join(missing)}",
+            )
+        ]
+    added = [e.name for i, e in enumerate(events) if i not in matched and not e.is_message and e not in extra]
     if added:
         return [
             Violation(

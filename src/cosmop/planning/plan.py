@@ -21,7 +21,9 @@ A plan set holds, for every robot, a sequence of motion primitives and the state
       },
       "coordination": [{"object": "O2", "requester": "R1", "responder": "R2"}],
       "messages": [{"event": "msg(R2,R1,clear1)", "sender": "R2", "receiver": "R1", "kind": "conflict",
-                    "protects": "...", "place": [x_min, y_min, x_max, y_max]}]
+                    "protects": "...", "place": [x_min, y_min, x_max, y_max]}],
+      "added": [{"robot": "R1", "object": "C9", "workspace": "aside_C9", "point": [x, y],
+                 "why": "..."}]
     }
 
 ``steps[k-1]`` is instant *k*: the primitive taken between *k-1* and *k* and the whole state
@@ -34,8 +36,10 @@ instead: ``{"primitive": "Res", "object": null, "message": "msg(R2,R1,clear1)", 
 sent by S right after its previous step, ``Req`` with the same message waits in R's plan
 until it has been sent.  ``messages`` lists every such message with what it protects (an order
 the mission requires, or a place two robots' plans share: then ``place`` is its bounding box,
-mm).  An infeasible scenario still has a plan file, with ``"feasible": false`` and a
-``"reason"``.
+mm).  ``added`` lists the tasks the planner added that no mission names: goods that block a
+robot and that nobody moves are picked by ``robot`` and set down at ``point`` (mm), which the
+plan's events call ``workspace`` (a point workspace that exists only in this plan file).  An
+infeasible scenario still has a plan file, with ``"feasible": false`` and a ``"reason"``.
 
 :func:`load_plan` and :meth:`PlanSet.from_dict` validate the shape of a plan and raise
 :class:`PlanError` naming the file, the field (e.g. ``robots.R1.steps[3].primitive``) and what
@@ -52,7 +56,7 @@ import math
 import os
 import re
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
@@ -65,7 +69,7 @@ from cosmop.reading import FieldPath, format_path, load_json
 from cosmop.units import INTERNAL_UNITS, check_units_field
 
 if TYPE_CHECKING:
-    from cosmop.scenario import Scene
+    from cosmop.scenario import Scenario, Scene
 
 __all__ = [
     "MAX_STEPS",
@@ -74,6 +78,7 @@ __all__ = [
     "OBJECT_PRIMITIVES",
     "PLAN_FORMAT",
     "PRIMITIVES",
+    "AddedTask",
     "Coordination",
     "ObjectState",
     "PlanError",
@@ -590,6 +595,55 @@ class PlanMessage:
 
 
 @dataclass(frozen=True)
+class AddedTask:
+    """A task no mission names, added by the planner: goods moved out of a robot's way.
+
+    Parameters
+    ----------
+    robot : str
+        The robot that moves them (its mission gains ``pick(robot,object)`` and
+        ``drop(robot,object,workspace)``).
+    object : str
+        The goods that block.
+    workspace : str
+        The id of the place they are set down at, a point workspace of this plan file only.
+    point : tuple of float
+        That place, ``(x, y)`` mm: the goods' centre after the drop.
+    why : str
+        In words: whose way they block and why this robot moves them.
+    """
+
+    __reduce__ = reduce_frozen  # picklable for worker processes
+
+    robot: str
+    object: str
+    workspace: str
+    point: tuple[float, float]
+    why: str
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "point", _floats(self.point, 2, "a point"))
+
+    @property
+    def events(self) -> tuple[Event, Event]:
+        """The two mission events the task adds to its robot's mission."""
+        return (
+            Event("pick", self.robot, self.object),
+            Event("drop", self.robot, self.object, workspace=self.workspace),
+        )
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON form: ``{"robot", "object", "workspace", "point", "why"}``."""
+        return {
+            "robot": self.robot,
+            "object": self.object,
+            "workspace": self.workspace,
+            "point": [_num(v) for v in self.point],
+            "why": self.why,
+        }
+
+
+@dataclass(frozen=True)
 class PlanSet:
     """The plans of all robots for one scenario (the content of a ``cosmop.plan/1`` file).
 
@@ -609,6 +663,8 @@ class PlanSet:
         The messages (``msg`` events) the plans send and wait for, with what each protects.
     allocation : Mapping[str, str], optional
         When the mission let the planner choose: the chosen robot by object (or task).
+    added : tuple of AddedTask
+        Tasks the planner added that no mission names (goods moved out of a robot's way).
 
     Raises
     ------
@@ -625,8 +681,10 @@ class PlanSet:
     reason: str | None = None
     messages: tuple[PlanMessage, ...] = ()
     allocation: Mapping[str, str] = field(default_factory=dict)
+    added: tuple[AddedTask, ...] = ()
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "added", tuple(self.added))
         if not isinstance(self.robots, MappingProxyType):
             object.__setattr__(self, "robots", MappingProxyType(dict(self.robots)))
         object.__setattr__(self, "coordination", tuple(self.coordination))
@@ -655,7 +713,23 @@ class PlanSet:
         data["messages"] = [message.to_dict() for message in self.messages]
         if self.allocation:
             data["allocation"] = dict(self.allocation)
+        if self.added:
+            data["added"] = [task.to_dict() for task in self.added]
         return data
+
+    def extend(self, scenario: Scenario) -> Scenario:
+        """`scenario` with the places of the added tasks as point workspaces.
+
+        A place whose id the scenario already has is left out: the checker names that clash.
+        """
+        from cosmop.scenario import Workspace  # a plan file never needs the loader otherwise
+
+        scene = scenario.scene
+        new = {t.workspace: Workspace(t.workspace, point=t.point) for t in self.added}
+        new = {wid: ws for wid, ws in new.items() if wid not in scene.workspaces}
+        if not new:
+            return scenario
+        return replace(scenario, scene=replace(scene, workspaces={**scene.workspaces, **new}))
 
     @classmethod
     def from_dict(cls, data: Any, file: str | os.PathLike[str] | None = None) -> PlanSet:
@@ -705,6 +779,9 @@ class PlanSet:
             lines.append(f"coordination: {pair.responder} moves {pair.object} away for {pair.requester}")
         for message in self.messages:
             lines.append(f"message {message.event} ({message.kind}): {message.protects}")
+        for task in self.added:
+            x, y = task.point
+            lines.append(f"added: {task.robot} sets {task.object} down at ({x:g}, {y:g}): {task.why}")
         return "\n".join(lines)
 
 
@@ -820,7 +897,7 @@ class _Reader:
             data,
             (),
             ("format", "scenario", "feasible", "robots"),
-            ("coordination", "reason", "messages", "allocation", "units"),
+            ("coordination", "reason", "messages", "allocation", "units", "added"),
         )
         if (problem := check_units_field(root.get("units"))) is not None:
             raise self.fail(("units",), problem)
@@ -856,7 +933,21 @@ class _Reader:
         allocation = {
             key: self.ident(value, ("allocation", key), "robot") for key, value in allocation_data.items()
         }
-        return PlanSet(scenario, feasible, robots, pairs, reason, messages, allocation)
+        added_data = root.get("added", [])
+        if not isinstance(added_data, list):
+            raise self.fail(("added",), f"expected a list, got {_describe(added_data)}")
+        added = tuple(self.added_task(item, ("added", i)) for i, item in enumerate(added_data))
+        return PlanSet(scenario, feasible, robots, pairs, reason, messages, allocation, added)
+
+    def added_task(self, value: Any, path: FieldPath) -> AddedTask:
+        item = self.mapping(value, path, ("robot", "object", "workspace", "point", "why"))
+        return AddedTask(
+            self.ident(item["robot"], (*path, "robot"), "robot"),
+            self.ident(item["object"], (*path, "object"), "object"),
+            self.ident(item["workspace"], (*path, "workspace"), "workspace"),
+            self.numbers(item["point"], (*path, "point"), ("x", "y"), "mm"),
+            self.string(item["why"], (*path, "why"), "the reason, as text"),
+        )
 
     def message(self, value: Any, path: FieldPath) -> PlanMessage:
         item = self.mapping(value, path, ("event", "kind", "protects"), ("sender", "receiver", "place"))

@@ -29,7 +29,7 @@ from cosmop.missions.events import Event
 from cosmop.scenario import Scene
 from cosmop.squares import docking_places
 
-__all__ = ["unreachable"]
+__all__ = ["free_component", "unreachable"]
 
 _SLACK = 0.5  # mm the grown walls are shrunk by: touching and one-robot-wide passages stay free
 
@@ -58,7 +58,7 @@ def unreachable(
     body = scene.robots[robot]
     half = body.size / 2.0
     x0, y0 = start if start is not None else body.pose[:2]
-    component = _component(scene, half, (x0, y0))
+    component = free_component(scene, half, (x0, y0))
     if component is None:
         return None
     for i, event in enumerate(events, 1):
@@ -93,8 +93,12 @@ def _named(obj) -> list[str]:
     return [by_heading[h] for h in obj.headings]
 
 
-def _component(scene: Scene, half: float, start: tuple[float, float]):
-    """The free space of a square of half-side `half` connected to `start` (``None``: unknown)."""
+def free_component(scene: Scene, half: float, start: tuple[float, float]):
+    """The centres of a square of half-side `half` (mm) that overlaps no wall, connected to `start`.
+
+    A shapely polygon (objects ignored; touching allowed), or ``None`` when `start` itself is
+    inside a wall.
+    """
     blocked = scene.blocked(half, _SLACK)
     # a frame around everything: walls, objects, workspaces and the start
     points = [start, *(o.position for o in scene.objects.values())]

@@ -143,13 +143,20 @@ def _count_requests(p: RobotProblem, unrolling: Unrolling | IncrementalUnrolling
     )
 
 
-def _feasible_at(p: RobotProblem, events: tuple[Event, ...], K: int, rlimit: int) -> bool:
+def _feasible_within(p: RobotProblem, events: tuple[Event, ...], K: int, rlimit: int) -> bool:
+    """Whether some plan of at most ``K`` steps realises `events` (one solver, the horizon grown)."""
     formula = conj(f for _, f in specification(p, events))
     ctx = z3.Context()
-    u = Unrolling(Signature.of(formula), K, ctx=ctx)
-    s = _solver(rlimit, ctx)
-    s.add(u.encode(formula))
-    return s.check() == z3.sat
+    grow, s = None, _solver(rlimit, ctx)
+    for k in range(max(1, sum(1 for e in events if e.kind != "return")), K + 1):
+        if grow is None:
+            grow = IncrementalUnrolling(Signature.of(formula), k, ctx=ctx)
+            s.add(grow.require(formula))
+        else:
+            s.add(grow.extend(k))
+        if s.check(grow.end) == z3.sat:
+            return True
+    return False
 
 
 def synthesize(
@@ -381,7 +388,7 @@ def _explain_automaton(p: RobotProblem, K: int, rlimit: int) -> tuple[str, tuple
 def _explain(p: RobotProblem, events: tuple[Event, ...], K: int, rlimit: int) -> tuple[str, tuple[str, ...]]:
     """The first event no plan of length ``<= K`` reaches, and a minimal core naming what blocks it."""
     for i in range(1, len(events) + 1):
-        if not any(_feasible_at(p, events[:i], k, rlimit) for k in range(1, K + 1)):
+        if not _feasible_within(p, events[:i], K, rlimit):
             break
     else:  # every prefix alone is feasible (cannot happen for the whole mission): report the last
         i = len(events)

@@ -232,6 +232,9 @@ class SimResult:
         a pick when the gripper closes, a drop when the object lies in its workspace, a return
         when the robot ends its plan at home, a message when it is sent (and again when it is
         received).
+    added : tuple of str
+        The events of the tasks the planner added (:attr:`PlanSet.added
+        <cosmop.planning.plan.PlanSet.added>`): goods moved out of a robot's way.
     """
 
     scenario: str
@@ -252,11 +255,18 @@ class SimResult:
     human_ids: tuple[str, ...] = ()
     object_ids: tuple[str, ...] = ()
     events: tuple[tuple[float, str, str], ...] = ()
+    added: tuple[str, ...] = ()
     replan_log: tuple[dict[str, Any], ...] = ()
 
     def executed_word(self) -> tuple[str, ...]:
-        """The mission events the run realised, in time order (messages left out)."""
-        return tuple(name for _, _, name in sorted(self.events) if not name.startswith(("msg(", "away(")))
+        """The mission events the run realised, in time order (messages and the events of tasks
+        the planner added, :attr:`added`, left out: no mission names them)."""
+        skip = set(self.added)
+        return tuple(
+            name
+            for _, _, name in sorted(self.events)
+            if not name.startswith(("msg(", "away(")) and name not in skip
+        )
 
     @property
     def contacts_while_moving(self) -> int:
@@ -340,6 +350,7 @@ class SimResult:
 
     def objects_in_workspaces(self, scenario: Scenario, plans: PlanSet) -> dict[str, bool]:
         """For every drop event of the plans' missions: is its object in its workspace now?"""
+        scenario = plans.extend(scenario)
         out = {}
         for plan in plans.robots.values():
             for event in plan.events:
@@ -1276,7 +1287,7 @@ def simulate(
     if not plans.feasible:
         raise ValueError(f"the plan set is infeasible: {plans.reason}")
     wall0 = time.perf_counter()
-    world = _World(scenario, plans, seed, settings)
+    world = _World(plans.extend(scenario), plans, seed, settings)  # with the places of added tasks
     R, H, n_obj = len(world.rids), len(world.walkers), len(world.oids)
     n_max = math.ceil(settings.max_time / world.dt)
     rec: dict[str, list] = {
@@ -1383,6 +1394,7 @@ def simulate(
         human_ids=world.hids,
         object_ids=world.oids,
         events=tuple(world.events),
+        added=tuple(e.name for task in plans.added for e in task.events),
         replan_log=tuple(world.replan_log),
     )
 
