@@ -7,7 +7,7 @@ A scenario file (format version 1) is YAML::
       obstacles: [[[-2500, -2500], [2500, -2500]], ...]   # wall segments [[x1, y1], [x2, y2]]
       dynamics:   {max_speed: 750, acceleration: 300, braking: 500, turn_rate: 100, cycle: 0.1}
       robots:     {R1: {size: 400, pose: [-2000, -1000, 0]}, ...}   # x, y, heading
-      objects:    {O1: {size: 100, position: [2000, -1000]}, ...}
+      objects:    {O1: {size: 100, position: [2000, -1000]}, O2: {..., sides: [north]}, ...}
       workspaces: {W1: {x: [-1500, -1000], y: [2000, 2500]}, W3: {point: [-4250, 4000]}}
       humans:     {H1: {size: 400, speed: 600, path: [[0, -1500], [0, -2200, 5]]}, ...}
     mission:
@@ -22,7 +22,9 @@ all robots share one control ``cycle``. The optional ``humans`` are people the r
 control: each walks along its ``path`` of points ``[x, y]`` or ``[x, y, dwell]`` (standing
 ``dwell`` seconds on arriving there) and repeats it, unless ``loop: false``; a person given a
 ``walk: {x: [lo, hi], y: [lo, hi]}`` area roams there at random once its path ends (at once,
-if the path is only its start point).
+if the path is only its start point).  An object's optional ``sides`` are the sides a robot
+may stand on to pick it up or drop it off (``west``, ``south``, ``east``, ``north``; all four
+by default).
 
 :func:`load_scenario` reads such a file and :func:`parse_scenario` validates an already-parsed
 mapping; both return an immutable :class:`Scenario` or raise
