@@ -47,14 +47,15 @@ def test_a_folder_is_not_a_file_and_a_file_is_not_a_folder(tmp_path):
 
 
 def test_an_interrupt_waits_for_outputs_that_belong_together():
-    import os
     import signal
 
     from cosmop.io import uninterrupted
 
     done = []
     with pytest.raises(KeyboardInterrupt), uninterrupted():
-        os.kill(os.getpid(), signal.SIGINT)  # Ctrl-C between the two writes
+        # Ctrl-C between the two writes, raised in this thread: os.kill may hand it to another
+        # thread of the test process, which notes it only after the block has ended
+        signal.raise_signal(signal.SIGINT)
         done.append("trace")
         done.append("summary")
     assert done == ["trace", "summary"]

@@ -16,6 +16,8 @@ DOCKING_HEADINGS = (0, 90, 180, 270)
 """Headings (degrees) from which a robot picks up or drops off an object: it faces one of the
 object's four sides, square on, and the two squares touch."""
 
+_SLACK = 1e-6  # degrees: the exact checker's tolerance, so a plan it accepts docks here too
+
 _UNITS = {0: (0, 1), 90: (1, 0), 180: (0, -1), 270: (-1, 0)}  # heading -> (sin, cos) exactly
 
 SIDES = {"west": 0, "south": 90, "east": 180, "north": 270}
@@ -24,7 +26,8 @@ object: on the west side it faces east (+x, heading 0, the paper's only way)."""
 
 
 def facing(heading: float) -> tuple[int, int]:
-    """The exact unit vector ``(cos h, sin h)`` of a docking heading `h` (degrees, modulo 360).
+    """The exact unit vector ``(cos h, sin h)`` of a docking heading `h` (degrees, modulo 360,
+    within 1e-6).
 
     Raises
     ------
@@ -37,7 +40,7 @@ def facing(heading: float) -> tuple[int, int]:
     ((0, 1), (0, -1))
     """
     h = round(heading) % 360
-    if abs(heading - round(heading)) > 1e-9 or h not in _UNITS:
+    if abs(heading - round(heading)) > _SLACK or h not in _UNITS:
         raise ValueError(f"a robot docks at a heading in {DOCKING_HEADINGS} degrees, not {heading:g}")
     sin, cos = _UNITS[h]
     return cos, sin

@@ -15,7 +15,7 @@ control cycle :math:`\\varepsilon` (the scenario's ``dynamics.cycle``):
     are crept, with the docking controller.
 ``PickUp`` / ``DropOff``
     dock: the docking pose (facing the object from the plan's side, touching it:
-    :func:`cosmop.squares.docking_pose`; the plan's pose for a drop) is closed at
+    :func:`cosmop.docking.docking_pose`; the plan's pose for a drop) is closed at
     ``dock_speed`` by the docking controller (a fine alignment of at most ``dock_tolerance``,
     which the unicycle model abstracts), then the gripper works for ``handling_time``.  After
     a drop the robot stays where the plan has it (a robot that waits there keeps the
