@@ -52,12 +52,16 @@ def test_an_interrupt_waits_for_outputs_that_belong_together():
     from cosmop.io import uninterrupted
 
     done = []
-    with pytest.raises(KeyboardInterrupt), uninterrupted():
-        # Ctrl-C between the two writes, raised in this thread: os.kill may hand it to another
-        # thread of the test process, which notes it only after the block has ended
-        signal.raise_signal(signal.SIGINT)
-        done.append("trace")
-        done.append("summary")
+    # as in a terminal: a suite started in the background inherits SIGINT ignored, and then
+    # Ctrl-C is rightly ignored after the block too
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        with pytest.raises(KeyboardInterrupt), uninterrupted():
+            signal.raise_signal(signal.SIGINT)  # Ctrl-C between the two writes
+            done.append("trace")
+            done.append("summary")
+    finally:
+        signal.signal(signal.SIGINT, previous)
     assert done == ["trace", "summary"]
 
 
