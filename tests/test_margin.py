@@ -8,6 +8,7 @@ from cosmop.planning.regions import wall_regions
 from cosmop.planning.specification import MOTION_MARGIN, STEEPNESS
 from cosmop.planning.synthesis import synthesize
 from cosmop.scenario import parse_scenario
+from rooms import box_walls
 
 MISSION = (
     Event("pick", "R1", obj="O1"),
@@ -22,13 +23,7 @@ def _scene():
         {
             "name": "margin",
             "scene": {
-                "obstacles": [
-                    [[-2000, -1500], [2000, -1500]],
-                    [[2000, -1500], [2000, 1500]],
-                    [[2000, 1500], [-2000, 1500]],
-                    [[-2000, 1500], [-2000, -1500]],
-                    [[-600, 1500], [-600, 300]],
-                ],
+                "obstacles": [*box_walls(-2000, -1500, 2000, 1500), [[-600, 1500], [-600, 300]]],
                 "robots": {"R1": {"size": 400, "pose": [-1800, 0, 0]}},
                 # the paper's west side only: from the others the plan slides along nothing
                 "objects": {"O1": {"size": 100, "position": [500, -1300], "sides": ["west"]}},

@@ -187,8 +187,9 @@ class MovableObject:
         Initial centre ``(x, y)``, mm.
     sides : tuple of str, optional
         The sides a robot may stand on to pick it up or drop it off (``"west"``, ``"south"``,
-        ``"east"``, ``"north"``; default all four).  Goods on a shelf that opens to the north
-        say ``("north",)``; the paper's robots use the west side only.
+        ``"east"``, ``"north"``; default all four), kept once each in the order of their
+        headings.  Goods on a shelf that opens to the north say ``("north",)``; the paper's
+        robots use the west side only.
     """
 
     id: str
@@ -200,11 +201,12 @@ class MovableObject:
         unknown = [s for s in self.sides if s not in SIDES]
         if unknown or not self.sides:
             raise ValueError(f"object {self.id}: sides must be a non-empty subset of {list(SIDES)}")
+        object.__setattr__(self, "sides", tuple(sorted(set(self.sides), key=SIDES.__getitem__)))
 
     @property
     def headings(self) -> tuple[int, ...]:
         """The docking headings (degrees) from which it is handled, one per side, in order."""
-        return tuple(sorted(SIDES[s] for s in set(self.sides)))
+        return tuple(SIDES[s] for s in self.sides)
 
 
 @dataclass(frozen=True)
@@ -1006,7 +1008,7 @@ class _Builder:
         }
         self.check_cycles(robots, dynamics)
         objects = {
-            ident: MovableObject(ident, o.size, o.position, tuple(dict.fromkeys(o.sides)))
+            ident: MovableObject(ident, o.size, o.position, tuple(o.sides))
             for ident, o in model.objects.items()
         }
         workspaces = {ident: self.build_workspace(ident, w) for ident, w in model.workspaces.items()}

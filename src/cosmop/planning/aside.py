@@ -21,7 +21,7 @@ solver, the conflict step and the exact checker, like every other plan.
 from __future__ import annotations
 
 import itertools
-from collections.abc import Iterable, Mapping
+from collections.abc import Mapping
 
 import numpy as np
 import shapely
@@ -30,7 +30,7 @@ from cosmop.docking import docking_pose
 from cosmop.planning.plan import RobotPlan
 from cosmop.planning.reach import free_component
 from cosmop.scenario import Scene
-from cosmop.squares import square, swept_square
+from cosmop.squares import rectangle, square, swept_square
 
 __all__ = ["ROOM", "place_aside"]
 
@@ -43,7 +43,7 @@ _RINGS = 40  # candidate rings around the goods (pitch: their side)
 
 
 def place_aside(
-    scene: Scene, obj: str, helper: str, plans: Mapping[str, RobotPlan], robots: Iterable[str] = ()
+    scene: Scene, obj: str, helper: str, plans: Mapping[str, RobotPlan]
 ) -> tuple[float, float] | None:
     """The free place nearest to `obj` where `helper` can set it down, or ``None``.
 
@@ -57,8 +57,6 @@ def place_aside(
         The robot that will move them (its start and size decide where it can dock).
     plans : Mapping[str, RobotPlan]
         The robots' current plans; the place keeps clear of every area they sweep.
-    robots : iterable of str
-        Further robots whose start squares must stay free (default: every robot of the scene).
 
     Returns
     -------
@@ -68,7 +66,7 @@ def place_aside(
     goods = scene.objects[obj]
     side, (ox, oy) = goods.size, goods.position
     body = scene.robots[helper]
-    keep_off = _keep_off(scene, obj, plans, robots)
+    keep_off = _keep_off(scene, obj, plans)
     steps = np.arange(-_RINGS, _RINGS + 1) * side
     dx, dy = np.meshgrid(steps, steps)
     order = np.argsort(np.hypot(dx, dy), axis=None, kind="stable")
@@ -89,20 +87,15 @@ def place_aside(
     return None
 
 
-def _keep_off(scene: Scene, obj: str, plans: Mapping[str, RobotPlan], robots: Iterable[str]):
+def _keep_off(scene: Scene, obj: str, plans: Mapping[str, RobotPlan]):
     """Everything the set-down goods' grown square must not overlap (one shapely geometry)."""
     parts = [shapely.LineString([w.start, w.end]) for w in scene.obstacles]
-    parts += [
-        shapely.box(ws.x[0], ws.y[0], ws.x[1], ws.y[1]) for ws in scene.workspaces.values() if not ws.is_point
-    ]
-    parts += [shapely.Point(ws.point) for ws in scene.workspaces.values() if ws.is_point]
+    parts += [rectangle(*ws.ranges) for ws in scene.workspaces.values()]
     reach = max((r.size for r in scene.robots.values()), default=0.0)
     for oid, other in scene.objects.items():
         if oid != obj:  # every side of the others stays free to dock at
             parts.append(square(*other.position, other.size + 2 * reach))
-    for rid in tuple(robots) or tuple(scene.robots):
-        robot = scene.robots[rid]
-        parts.append(square(*robot.pose[:2], robot.size))
+    parts += [square(*robot.pose[:2], robot.size) for robot in scene.robots.values()]
     for rid, plan in plans.items():
         size = scene.robots[rid].size
         poses = [scene.robots[rid].pose, *(step.robot for step in plan.steps)]

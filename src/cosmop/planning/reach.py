@@ -24,7 +24,7 @@ from collections.abc import Sequence
 
 import shapely
 
-from cosmop.docking import SIDES, docking_pose
+from cosmop.docking import docking_pose
 from cosmop.missions.events import Event
 from cosmop.scenario import Scene
 from cosmop.squares import docking_places
@@ -69,28 +69,20 @@ def unreachable(
             obj = scene.objects[event.obj]
             poses = [docking_pose(obj.position, d, h) for h in obj.headings]
             where = shapely.MultiPoint(poses)
-            sides = ", ".join(
-                f"{side} ({x:g}, {y:g})" for side, (x, y) in zip(_named(obj), poses, strict=True)
-            )
+            sides = ", ".join(f"{side} ({x:g}, {y:g})" for side, (x, y) in zip(obj.sides, poses, strict=True))
             what = f"its pick poses on the sides tried: {sides}"
         else:
             obj = scene.objects[event.obj]
             centres = scene.workspaces[event.workspace].centres(obj.size)
             where = shapely.union_all(docking_places(*centres.ranges, d, obj.headings))
             what = f"any pose that drops {event.obj} in {event.workspace}"
-            what += f" (sides tried: {', '.join(_named(obj))})"
+            what += f" (sides tried: {', '.join(obj.sides)})"
         if not component.intersects(where):
             return (
                 f"{robot} cannot reach {event.name} (event {i} of its mission) at any horizon: "
                 f"walls separate its start ({x0:g}, {y0:g}) from {what}"
             )
     return None
-
-
-def _named(obj) -> list[str]:
-    """The object's sides in the order of its docking headings."""
-    by_heading = {heading: side for side, heading in SIDES.items()}
-    return [by_heading[h] for h in obj.headings]
 
 
 def free_component(scene: Scene, half: float, start: tuple[float, float]):

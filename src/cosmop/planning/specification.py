@@ -272,18 +272,21 @@ def _less(term, amount: Fraction):
     return term if amount == 0 else term - amount
 
 
-def _docked(p: RobotProblem, obj: str, ox, oy, d: Fraction) -> Formula:
-    """The robot faces `obj` at ``(ox, oy)`` square on, from one of its sides, touching it.
-
-    :math:`\\bigvee_{h \\in H} \\alpha = h \\wedge (x, y) = (o_x, o_y) - d\\,(\\cos h, \\sin h)`,
-    :math:`H` the object's docking headings (:attr:`~cosmop.scenario.MovableObject.headings`, a
-    subset of 0, 90, 180, 270); the terms are exact.
-    """
+def _docking_poses(p: RobotProblem, obj: str, ox, oy, d: Fraction) -> list[tuple[int, Any, Any]]:
+    """``(h, x, y)``: the robot centre that faces `obj` at ``(ox, oy)`` from heading ``h``, touching
+    it, :math:`(o_x, o_y) - d\\,(\\cos h, \\sin h)`, for each of the object's docking headings
+    (:attr:`~cosmop.scenario.MovableObject.headings`); exact terms."""
     out = []
     for heading in p.scene.objects[obj].headings:
         ux, uy = facing(heading)
-        out.append(p.h.eq(heading) & p.x.eq(_less(ox, d * ux)) & p.y.eq(_less(oy, d * uy)))
-    return disj(out)
+        out.append((heading, _less(ox, d * ux), _less(oy, d * uy)))
+    return out
+
+
+def _docked(p: RobotProblem, obj: str, ox, oy, d: Fraction) -> Formula:
+    """The robot faces `obj` at ``(ox, oy)`` square on, from one of its sides, touching it:
+    :math:`\\bigvee_h \\alpha = h \\wedge (x, y)` is the pose of :func:`_docking_poses`."""
+    return disj(p.h.eq(h) & p.x.eq(x) & p.y.eq(y) for h, x, y in _docking_poses(p, obj, ox, oy, d))
 
 
 def _static(*vars_: Var) -> Formula:
@@ -598,11 +601,10 @@ class Req(Primitive):
             & _objects_static(p, away=False)
             & _objects_static(p, positions=False, carried=False, skip=obj)
         )
-        room = []
-        for heading in p.scene.objects[obj].headings:  # the helper picks from a side of its choosing
-            ux, uy = facing(heading)
-            px, py = _less(v.x, d * ux), _less(v.y, d * uy)
-            room.append(disj([p.x <= px - side, p.x >= px + side, p.y <= py - side, p.y >= py + side]))
+        room = [  # clear of every pose that picks it: the helper picks from a side of its choosing
+            disj([p.x <= px - side, p.x >= px + side, p.y <= py - side, p.y >= py + side])
+            for _, px, py in _docking_poses(p, obj, v.x, v.y, d)
+        ]
         return [(f"Req {obj}", _robot_static(p) & flags & conj(room))]
 
 
