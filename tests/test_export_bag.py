@@ -139,3 +139,20 @@ def test_simulate_writes_a_bag_and_refuses_an_existing_directory_before_any_work
     again = runner.invoke(app, [*args, "--summary", str(tmp_path / "s.json")])
     assert again.exit_code == 2 and "exists" in again.stderr
     assert not (tmp_path / "s.json").exists()  # refused before simulating
+
+
+def test_a_timed_plan_stamps_each_pose_with_its_expected_time(tmp_path):
+    from dataclasses import replace
+
+    from cosmop.planning.timing import itinerary
+
+    scenario, plans, result = run_2x2()
+    timed = replace(plans, itinerary=itinerary(scenario.scene, plans.robots))
+    write_bag(scenario.scene, result.trace(), tmp_path / "run", plans=timed)
+    path = read_bag(tmp_path / "run")["/R1/plan"][0][2]
+    stamps = [p.header.stamp.sec + p.header.stamp.nanosec / 1e9 for p in path.poses]
+    steps = plans.robots["R1"].steps
+    expected = [0.0] + [
+        timed.itinerary.slot("R1", k)[1] for k, s in enumerate(steps, 1) if s.primitive == "GoTo"
+    ]
+    assert stamps == pytest.approx(expected, abs=1e-9) and stamps[-1] > 0

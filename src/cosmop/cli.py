@@ -383,11 +383,13 @@ def plan(
                 style="green" if v.holds else "red",
             )
         )
-        if safety is not None and safety.makespan_alone > 0:
+        itinerary = result.plans.itinerary
+        if safety is not None and itinerary is not None and itinerary.makespan > 0:
             console.print(
                 Text(
-                    f"expected time to finish: {safety.makespan:.0f} s (each robot alone: at most "
-                    f"{safety.makespan_alone:.0f} s)"
+                    f"expected time to finish: {itinerary.makespan:.0f} s (each robot alone: at most "
+                    f"{safety.makespan_alone:.0f} s); the plan file gives every step its expected "
+                    "start and end"
                 )
             )
     if result.allocation is not None and result.allocation.alternative is not None:
@@ -529,7 +531,7 @@ def simulate(
                 save_animation(loaded.scene, result.trace(), path, plans=plans, speed=speed, size=size)
     console = _stdout()
     table = Table(title=Text(f"simulation of {loaded.name} (seed {seed})"), header_style="bold")
-    for column in ("robot", "pose [mm, deg]", "distance", "finished"):
+    for column in ("robot", "pose [mm, deg]", "distance", "finished", "done at (planned)"):
         table.add_column(column)
     finished = result.finished
     for rid, (pose, dist) in result.robots.items():
@@ -538,15 +540,18 @@ def simulate(
             f"{pose[0]:.0f}, {pose[1]:.0f}, {pose[2]:.0f}",
             f"{dist / 1000:.1f} m",
             "yes" if finished[rid] else Text("no", style="red"),
+            _done_at(result.steps.get(rid, ()), finished[rid]),
         )
     console.print(table)
     delivered = result.objects_in_workspaces(loaded, plans)
     ok = result.completed and result.contacts_while_moving == 0
     speed = result.sim_time_s / max(result.wall_time_s, 1e-9)
+    planned = result.makespan["planned"]
     console.print(
         Text(
             f"{'completed' if result.completed else 'not completed'} in {result.sim_time_s:.1f} s simulated "
-            f"({result.wall_time_s:.1f} s, {speed:.0f}x real time); "
+            + (f"(planned {planned:.1f} s; " if planned is not None else "(")
+            + f"{result.wall_time_s:.1f} s, {speed:.0f}x real time); "
             f"objects in place {sum(delivered.values())}/{len(delivered)}; contacts {len(result.contacts)}, "
             f"while moving {result.contacts_while_moving}; messages {len(result.messages)}; "
             f"replans {result.replans}",
@@ -554,6 +559,14 @@ def simulate(
         )
     )
     raise typer.Exit(0 if ok else 1)
+
+
+def _done_at(rows, finished: bool) -> str:
+    """When a robot ended its plan in the run, and when its itinerary expected it: ``64.7 s (46.1 s)``."""
+    realised = rows[-1].realised[1] if finished and rows and rows[-1].realised else None
+    planned = max((r.planned[1] for r in rows if r.planned is not None), default=None)
+    done = f"{realised:.1f} s" if realised is not None else "-"
+    return f"{done} ({planned:.1f} s)" if planned is not None else done
 
 
 def _plan_table(scenario: Scenario, result) -> Table:

@@ -48,6 +48,7 @@ from cosmop.planning.plan import MAX_STEPS, AddedTask, Coordination, PlanMessage
 from cosmop.planning.realisation import event_instants
 from cosmop.planning.synthesis import DEFAULT_RLIMIT, Synthesis, synthesize
 from cosmop.planning.teamsafety import TeamSafety, make_team_safe
+from cosmop.planning.timing import itinerary
 from cosmop.scenario import Scenario, Scene, Wall
 from cosmop.squares import square
 
@@ -363,6 +364,7 @@ def _loop(
         messages=tuple(messages) if not reasons else (),
         allocation=choice.alternative.movers(mission) if choice and choice.alternative else {},
         added=tuple(planner.added),
+        itinerary=itinerary(planner.scenario.scene, plans) if not reasons else None,
     )
     t0 = time.perf_counter()
     report = check_plan(scenario, plan_set)

@@ -10,7 +10,9 @@ and y left, metres, radians, orientations as quaternions; each robot's body fram
 ``/<robot>/pose`` (``geometry_msgs/msg/PoseStamped``)
     every drawn frame, the robot's pose in ``map``.
 ``/<robot>/plan`` (``nav_msgs/msg/Path``)
-    once, at the start: the planned path (the initial pose, then every GoTo's pose).
+    once, at the start: the planned path (the initial pose, then every GoTo's pose); when the
+    plan file has an itinerary, each pose is stamped with the time the robot is expected to
+    reach it (a timed path), else with the start.
 ``/scene`` (``visualization_msgs/msg/MarkerArray``)
     every scene frame: walls, workspaces, objects, people, robot bodies with their labels and
     what each carries, and an arrow from sender to receiver for 2 s after each message.
@@ -130,12 +132,19 @@ def _ns(t: float, start_ns: int) -> int:
     return start_ns + round(t * 1e9)
 
 
-def _plan_path(ros: _Ros, scene: Scene, plans: PlanSet, rid: str, ns: int) -> Any | None:
+def _plan_path(ros: _Ros, scene: Scene, plans: PlanSet, rid: str, ns: int, start_ns: int) -> Any | None:
+    """The plan's path, published at `ns`; its poses stamped with their expected times, if any."""
     plan, robot = plans.robots.get(rid), scene.robots.get(rid)
     if plan is None or robot is None:
         return None
-    poses = [robot.pose] + [step.robot for step in plan.steps if step.primitive == "GoTo"]
-    return ros.t["nav_msgs/msg/Path"](header=ros.header(ns), poses=[ros.pose_stamped(ns, p) for p in poses])
+    times = plans.itinerary.times.get(rid) if plans.itinerary is not None else None
+    stamped = [(ns, robot.pose)] + [
+        (_ns(times[k][1], start_ns) if times else ns, step.robot)
+        for k, step in enumerate(plan.steps)
+        if step.primitive == "GoTo"
+    ]
+    poses = [ros.pose_stamped(stamp, pose) for stamp, pose in stamped]
+    return ros.t["nav_msgs/msg/Path"](header=ros.header(ns), poses=poses)
 
 
 def _write(writer: Any, ros: _Ros, connections: dict, counts: dict, topic: str, ns: int, msg: Any) -> None:
@@ -156,7 +165,7 @@ def _write_all(
     first_ns = _ns(float(frames[0]["t"]), start_ns)
     if plans is not None:
         for rid in robot_ids:
-            path = _plan_path(ros, scene, plans, rid, first_ns)
+            path = _plan_path(ros, scene, plans, rid, first_ns, start_ns)
             if path is not None:
                 _write(writer, ros, connections, counts, f"/{rid}/plan", first_ns, path)
     markers = SceneMarkers(ros, scene, robot_ids, trace.get("messages") or [])

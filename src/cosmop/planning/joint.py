@@ -11,15 +11,17 @@ A plan set is sound for the team, beyond each robot's plan being sound alone, wh
   :mod:`cosmop.planning.conflicts`): no execution puts two robots, or a robot and goods that
   another robot moves, in one place at one time;
 * every complete run of the team is a complete word of the global mission, whatever its form
-  (``mission``, :func:`cosmop.missions.team.verify_team`).
+  (``mission``, :func:`cosmop.missions.team.verify_team`);
+* the itinerary, when the plan file has one, keeps the messages' order (``itinerary``): no
+  ``Req`` is timed to end before the ``Res`` that sends its message.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 
 from cosmop.missions.mission import GlobalMission
-from cosmop.missions.precedence import Precedence
+from cosmop.missions.precedence import Link, Precedence
 from cosmop.missions.team import check_words
 from cosmop.planning.conflicts import ConflictSettings, conflicts, is_ordered, occupancies
 from cosmop.planning.plan import PlanSet, RobotPlan
@@ -99,6 +101,7 @@ def check_team(
             )
         )
         return violations
+    violations += _itinerary(plan, links)
     items, problems = occupancies(scene, plans, precedence, settings)
     violations += [_violation(None, None, "conflict", text) for text in problems]
     for conflict in conflicts(items):
@@ -116,3 +119,27 @@ def check_team(
     if not verdict.holds:
         violations.append(_violation(None, None, "mission", f"{verdict.reason()}"))
     return violations
+
+
+def _itinerary(plan: PlanSet, links: Sequence[Link]) -> list[Violation]:
+    """Every awaited message is timed to be sent before its wait ends (1 ms of rounding)."""
+    it = plan.itinerary
+    if it is None:
+        return []
+    out = []
+    for link in links:
+        if link.send is None or link.wait is None or not {link.sender, link.receiver} <= set(it.times):
+            continue
+        sent = it.slot(link.sender, link.send)[1]
+        waited = it.slot(link.receiver, link.wait)[1]
+        if waited < sent - 1e-3:
+            out.append(
+                _violation(
+                    link.receiver,
+                    link.wait,
+                    "itinerary",
+                    f"the itinerary has {link.receiver} stop waiting for {link.event} at {waited:g} s "
+                    f"(instant {link.wait}), but {link.sender} sends it at {sent:g} s (instant {link.send})",
+                )
+            )
+    return out

@@ -38,8 +38,10 @@ until it has been sent.  ``messages`` lists every such message with what it prot
 the mission requires, or a place two robots' plans share: then ``place`` is its bounding box,
 mm).  ``added`` lists the tasks the planner added that no mission names: goods that block a
 robot and that nobody moves are picked by ``robot`` and set down at ``point`` (mm), which the
-plan's events call ``workspace`` (a point workspace that exists only in this plan file).  An
-infeasible scenario still has a plan file, with ``"feasible": false`` and a ``"reason"``.
+plan's events call ``workspace`` (a point workspace that exists only in this plan file).
+``start`` and ``end`` (s, on every step or on none) are the step's expected times, the plan
+set's :class:`Itinerary`.  An infeasible scenario still has a plan file, with ``"feasible":
+false`` and a ``"reason"``.
 
 :func:`load_plan` and :meth:`PlanSet.from_dict` validate the shape of a plan and raise
 :class:`PlanError` naming the file, the field (e.g. ``robots.R1.steps[3].primitive``) and what
@@ -80,6 +82,7 @@ __all__ = [
     "PRIMITIVES",
     "AddedTask",
     "Coordination",
+    "Itinerary",
     "ObjectState",
     "PlanError",
     "PlanMessage",
@@ -510,10 +513,15 @@ class RobotPlan:
             "steps": [step.to_dict() for step in self.steps],
         }
 
-    def to_text(self) -> str:
-        """The plan for people: one line per step, ``k  primitive  robot (x, y, heading°)  notes``."""
+    def to_text(self, times: Iterable[tuple[float, float]] | None = None) -> str:
+        """The plan for people: one line per step, ``k  primitive  robot (x, y, heading°)  notes``,
+        with the step's expected ``start-end`` seconds after `k` when `times` are given."""
         width = len(str(self.horizon))
-        return "\n".join(f"{k:>{width}}  {step.to_text()}" for k, step in enumerate(self.steps, 1))
+        slots = [f"{a:7.1f}-{b:<7.1f}s  " for a, b in times] if times is not None else [""] * self.horizon
+        return "\n".join(
+            f"{k:>{width}}  {slot}{step.to_text()}"
+            for k, (step, slot) in enumerate(zip(self.steps, slots, strict=True), 1)
+        )
 
 
 @dataclass(frozen=True)
@@ -644,6 +652,72 @@ class AddedTask:
 
 
 @dataclass(frozen=True)
+class Itinerary:
+    """When every step of a plan set is expected to start and end: the plans as a schedule.
+
+    Times are seconds from the moment the whole team starts (every robot at instant 0 at time
+    0).  A step starts when its robot's previous step ends; a ``Req`` ends when its message has
+    been sent, so the waiting shows as the ``Req``'s length.  The estimates come from
+    :func:`cosmop.planning.timing.itinerary`; a plan file shares them per step (``"start"``,
+    ``"end"``) so that other systems can reserve space and time, as fleet traffic schedules do.
+
+    Parameters
+    ----------
+    times : Mapping[str, sequence of (float, float)]
+        Per robot, ``(start, end)`` of its steps, instants 1 to K in order (s).
+
+    Raises
+    ------
+    ValueError
+        If a time is negative or not finite, a step ends before it starts, or starts before
+        its robot's previous step ends.
+
+    Examples
+    --------
+    >>> it = Itinerary({"R1": [(0.0, 2.5), (2.5, 4.0)], "R2": [(0.0, 1.0)]})
+    >>> it.slot("R1", 2), it.end("R1"), it.makespan
+    ((2.5, 4.0), 4.0, 4.0)
+    """
+
+    __reduce__ = reduce_frozen  # picklable for worker processes
+
+    times: Mapping[str, tuple[tuple[float, float], ...]]
+
+    def __post_init__(self) -> None:
+        times = {}
+        for robot, slots in self.times.items():
+            slots = tuple((float(a), float(b)) for a, b in slots)
+            previous = 0.0
+            for k, (a, b) in enumerate(slots, 1):
+                if not (math.isfinite(a) and math.isfinite(b)) or a < 0.0:
+                    raise ValueError(f"{robot}, instant {k}: times are finite seconds >= 0, got ({a}, {b})")
+                if b < a or a < previous:
+                    raise ValueError(
+                        f"{robot}, instant {k}: a step starts after its robot's previous step ends "
+                        f"({previous:g} s) and ends after it starts, got ({a:g}, {b:g})"
+                    )
+                previous = b
+            times[robot] = slots
+        object.__setattr__(self, "times", MappingProxyType(times))
+
+    def slot(self, robot: str, k: int) -> tuple[float, float]:
+        """``(start, end)`` of `robot`'s instant `k` (1..K), s."""
+        if not 1 <= k <= len(self.times[robot]):
+            raise IndexError(f"{robot} has no instant {k}")
+        return self.times[robot][k - 1]
+
+    def end(self, robot: str) -> float:
+        """When `robot` is expected to have done its whole plan, s (0 for an empty plan)."""
+        slots = self.times[robot]
+        return slots[-1][1] if slots else 0.0
+
+    @property
+    def makespan(self) -> float:
+        """When the whole team is expected to be done, s."""
+        return max((self.end(r) for r in self.times), default=0.0)
+
+
+@dataclass(frozen=True)
 class PlanSet:
     """The plans of all robots for one scenario (the content of a ``cosmop.plan/1`` file).
 
@@ -665,11 +739,15 @@ class PlanSet:
         When the mission let the planner choose: the chosen robot by object (or task).
     added : tuple of AddedTask
         Tasks the planner added that no mission names (goods moved out of a robot's way).
+    itinerary : Itinerary, optional
+        When each step is expected to start and end (s); in the file, each step's ``start``
+        and ``end``.
 
     Raises
     ------
     ValueError
-        If `feasible` is false and no `reason` is given.
+        If `feasible` is false and no `reason` is given, or the itinerary's robots or numbers
+        of steps differ from the plans'.
     """
 
     __reduce__ = reduce_frozen  # picklable for worker processes
@@ -682,9 +760,14 @@ class PlanSet:
     messages: tuple[PlanMessage, ...] = ()
     allocation: Mapping[str, str] = field(default_factory=dict)
     added: tuple[AddedTask, ...] = ()
+    itinerary: Itinerary | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "added", tuple(self.added))
+        if self.itinerary is not None:
+            sizes = {r: len(slots) for r, slots in self.itinerary.times.items()}
+            if sizes != {r: p.horizon for r, p in self.robots.items()}:
+                raise ValueError("the itinerary must time every step of every plan, and nothing else")
         if not isinstance(self.robots, MappingProxyType):
             object.__setattr__(self, "robots", MappingProxyType(dict(self.robots)))
         object.__setattr__(self, "coordination", tuple(self.coordination))
@@ -709,6 +792,12 @@ class PlanSet:
         if self.reason is not None:
             data["reason"] = self.reason
         data["robots"] = {robot: plan.to_dict() for robot, plan in self.robots.items()}
+        if self.itinerary is not None:  # each step says when it is expected: an itinerary
+            for robot, plan in data["robots"].items():
+                plan["steps"] = [
+                    _timed(step, slot)
+                    for step, slot in zip(plan["steps"], self.itinerary.times[robot], strict=True)
+                ]
         data["coordination"] = [pair.to_dict() for pair in self.coordination]
         data["messages"] = [message.to_dict() for message in self.messages]
         if self.allocation:
@@ -774,7 +863,8 @@ class PlanSet:
             lines.append(f"reason: {self.reason}")
         for robot, plan in self.robots.items():
             lines.append(f"{robot} ({plan.horizon} steps): {', '.join(plan.mission) or 'no mission'}")
-            lines.extend("  " + line for line in plan.to_text().splitlines())
+            times = self.itinerary.times[robot] if self.itinerary is not None else None
+            lines.extend("  " + line for line in plan.to_text(times).splitlines())
         for pair in self.coordination:
             lines.append(f"coordination: {pair.responder} moves {pair.object} away for {pair.requester}")
         for message in self.messages:
@@ -913,10 +1003,12 @@ class _Reader:
             raise self.fail(
                 ("robots",), f"expected a JSON object of plans by robot id, got {_describe(robots_data)}"
             )
-        robots = {}
+        robots, times = {}, {}
         for robot, plan in robots_data.items():
             self.ident(robot, ("robots", robot), "robot")
             robots[robot] = self.robot_plan(plan, ("robots", robot), robot)
+            times[robot] = self.slots(plan["steps"], ("robots", robot, "steps"))
+        itinerary = self.itinerary(times)
         pairs_data = root.get("coordination", [])
         if not isinstance(pairs_data, list):
             raise self.fail(("coordination",), f"expected a list, got {_describe(pairs_data)}")
@@ -937,7 +1029,47 @@ class _Reader:
         if not isinstance(added_data, list):
             raise self.fail(("added",), f"expected a list, got {_describe(added_data)}")
         added = tuple(self.added_task(item, ("added", i)) for i, item in enumerate(added_data))
-        return PlanSet(scenario, feasible, robots, pairs, reason, messages, allocation, added)
+        return PlanSet(scenario, feasible, robots, pairs, reason, messages, allocation, added, itinerary)
+
+    def slots(self, steps: list, path: FieldPath) -> tuple[tuple[float, float], ...] | None:
+        """The steps' ``start`` and ``end`` (s), checked in order; None when no step has them."""
+        if not steps:
+            return ()
+        if not any(isinstance(step, dict) and ("start" in step or "end" in step) for step in steps):
+            return None
+        out, previous = [], 0.0
+        for i, step in enumerate(steps):
+            for key in ("start", "end"):
+                if key not in step:
+                    raise self.fail(
+                        (*path, i), f"missing field {key!r}; timed steps all have 'start' and 'end' (s)"
+                    )
+            start = self.number(step["start"], (*path, i, "start"))
+            end = self.number(step["end"], (*path, i, "end"))
+            if start < previous:
+                raise self.fail(
+                    (*path, i, "start"),
+                    f"expected a time (s) >= {previous:g}, when the step before ends (or 0), got {start:g}",
+                )
+            if end < start:
+                raise self.fail(
+                    (*path, i, "end"), f"expected a time (s) >= the step's start {start:g}, got {end:g}"
+                )
+            out.append((start, end))
+            previous = end
+        return tuple(out)
+
+    def itinerary(self, times: Mapping[str, tuple | None]) -> Itinerary | None:
+        """The plan set's itinerary: every robot's steps timed, or none of them."""
+        if not any(times.values()):  # nothing timed (a robot without steps has no times either way)
+            return None
+        missing = next((r for r, slots in times.items() if slots is None), None)
+        if missing is not None:
+            raise self.fail(
+                ("robots", missing, "steps"),
+                "expected 'start' and 'end' (s) on every step, as the other robots' steps have them",
+            )
+        return Itinerary(times)
 
     def added_task(self, value: Any, path: FieldPath) -> AddedTask:
         item = self.mapping(value, path, ("robot", "object", "workspace", "point", "why"))
@@ -1013,7 +1145,9 @@ class _Reader:
         return RobotPlan(tuple(mission), horizon, steps)
 
     def step(self, value: Any, path: FieldPath) -> Step:
-        item = self.mapping(value, path, ("primitive", "robot", "objects"), ("object", "message"))
+        item = self.mapping(
+            value, path, ("primitive", "robot", "objects"), ("object", "message", "start", "end")
+        )
         primitive = item["primitive"]
         if primitive not in PRIMITIVES:
             raise self.fail(
@@ -1094,6 +1228,12 @@ def _pretty(value: Any, level: int = 0, width: int = 100) -> str:
         return "{\n" + ",\n".join(items) + "\n" + end + "}"
     items = [pad + _pretty(item, level + 1, width) for item in value]
     return "[\n" + ",\n".join(items) + "\n" + end + "]"
+
+
+def _timed(step: dict[str, Any], slot: tuple[float, float]) -> dict[str, Any]:
+    """A step's JSON form with its expected ``start`` and ``end`` (s) after what it does."""
+    head = {key: step[key] for key in ("primitive", "object", "message") if key in step}
+    return {**head, "start": _num(slot[0]), "end": _num(slot[1]), **step}
 
 
 def _num(value: float) -> int | float:

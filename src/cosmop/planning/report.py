@@ -26,6 +26,7 @@ RULES: Mapping[str, str] = {
     "message": "a message is sent but never awaited, awaited but never sent, or by the wrong robot",
     "deadlock": "the plans' messages can deadlock the team",
     "conflict": "two robots' plans use one place with no message ordering them",
+    "itinerary": "the plan's times have a robot stop waiting for a message before it is sent",
     "infeasible": "the plan file marks the scenario infeasible",
 }
 """The rule identifiers of :class:`Violation`, with what each one means."""

@@ -36,10 +36,10 @@ from cosmop.planning.conflicts import (
 from cosmop.planning.messages import merge_drives, place_edges, split_drives
 from cosmop.planning.plan import PlanMessage, RobotPlan, State
 from cosmop.planning.realisation import message_links
-from cosmop.planning.timing import ExecutionModel, step_durations
+from cosmop.planning.timing import durations, start_pose
 from cosmop.scenario import Scene
 
-__all__ = ["TeamSafety", "durations", "make_team_safe"]
+__all__ = ["TeamSafety", "make_team_safe"]
 
 
 @dataclass(frozen=True)
@@ -85,25 +85,6 @@ class TeamSafety:
         """Who can be re-planned around `conflict`, best first, each with its rank
         (:func:`~cosmop.planning.conflicts.ranked_detours`): ``(rank, robot, what to avoid)``."""
         return ranked_detours(conflict, self.fixed)
-
-
-def durations(
-    scene: Scene,
-    plans: Mapping[str, RobotPlan],
-    model: ExecutionModel | None = None,
-    starts: Mapping[str, State] | None = None,
-) -> dict[str, list[float]]:
-    """Expected seconds of every step of every plan (:func:`cosmop.planning.timing.step_durations`)."""
-    return {
-        r: step_durations(p, _pose(scene, r, starts), scene.robots[r].dynamics, model)
-        for r, p in plans.items()
-    }
-
-
-def _pose(scene: Scene, robot: str, starts: Mapping[str, State] | None) -> tuple[float, float, float]:
-    """Where `robot` starts: its state in `starts`, else the scenario's pose."""
-    state = (starts or {}).get(robot)
-    return state.robot if state is not None else scene.robots[robot].pose
 
 
 def _reduce(
@@ -186,7 +167,9 @@ def make_team_safe(
     settings = settings or ConflictSettings()
     waypoints = {r: {(s.robot[0], s.robot[1]) for s in p.steps} for r, p in plans.items()}
     plans = {
-        r: split_drives(p, _pose(scene, r, starts), settings.segment, _roomy(scene, r, settings.clearance))
+        r: split_drives(
+            p, start_pose(scene, r, starts), settings.segment, _roomy(scene, r, settings.clearance)
+        )
         for r, p in plans.items()
     }
     horizons = {r: p.horizon for r, p in plans.items()}

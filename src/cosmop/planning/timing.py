@@ -25,12 +25,23 @@ The estimates order events; they are not a promise.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 
-from cosmop.planning.plan import RobotPlan
-from cosmop.scenario import Dynamics
+from cosmop.missions.precedence import Precedence
+from cosmop.planning.plan import Itinerary, RobotPlan, State
+from cosmop.planning.realisation import message_links
+from cosmop.scenario import Dynamics, Scene
 
-__all__ = ["ExecutionModel", "drive_time", "step_durations", "turn_time"]
+__all__ = [
+    "ExecutionModel",
+    "drive_time",
+    "durations",
+    "itinerary",
+    "start_pose",
+    "step_durations",
+    "turn_time",
+]
 
 
 @dataclass(frozen=True)
@@ -141,3 +152,78 @@ def _close(run: list, out: list[float], dynamics: Dynamics) -> None:
     whole = sum(lengths)
     for (index, _, _), length in zip(run, lengths, strict=True):
         out[index] = total * (length / whole if whole > 0 else 1.0 / len(run))
+
+
+def start_pose(
+    scene: Scene, robot: str, starts: Mapping[str, State] | None = None
+) -> tuple[float, float, float]:
+    """Where `robot` starts: its state in `starts`, else the scenario's pose (mm, degrees)."""
+    state = (starts or {}).get(robot)
+    return state.robot if state is not None else scene.robots[robot].pose
+
+
+def durations(
+    scene: Scene,
+    plans: Mapping[str, RobotPlan],
+    model: ExecutionModel | None = None,
+    starts: Mapping[str, State] | None = None,
+) -> dict[str, list[float]]:
+    """Expected seconds of every step of every plan (:func:`step_durations`), by robot."""
+    return {
+        r: step_durations(p, start_pose(scene, r, starts), scene.robots[r].dynamics, model)
+        for r, p in plans.items()
+    }
+
+
+def itinerary(
+    scene: Scene,
+    plans: Mapping[str, RobotPlan],
+    model: ExecutionModel | None = None,
+    starts: Mapping[str, State] | None = None,
+) -> Itinerary:
+    """When every step of a team's plans is expected to start and end, messages included.
+
+    Every robot starts at time 0.  Step *k* of robot *r* starts when its step *k-1* ends,
+    :math:`s_{r,k} = e_{r,k-1}` (:math:`e_{r,0} = 0`), and ends after its expected duration
+    :math:`d_{r,k}` (:func:`step_durations`) -- a ``Req`` not before its message has been sent:
+    :math:`e_{r,k} = \\max(s_{r,k} + d_{r,k}, e_{q,j})` where step *j* of robot *q* is the
+    ``Res`` that sends it.  That is the earliest schedule of the plans' partial order
+    (:class:`~cosmop.missions.precedence.Precedence`), the one robots that never wait longer
+    than they must follow.  Times are rounded to the millisecond.
+
+    Parameters
+    ----------
+    scene : Scene
+    plans : Mapping[str, RobotPlan]
+        Every robot's plan; their messages must not deadlock.
+    model : ExecutionModel, optional
+    starts : Mapping[str, State], optional
+        Where robots start, if not at the scenario's poses.
+
+    Returns
+    -------
+    Itinerary
+
+    Raises
+    ------
+    ValueError
+        If a ``Req`` waits for a message that is never sent, or the messages wait in a cycle.
+    """
+    order = Precedence(
+        {r: p.horizon for r, p in plans.items()},
+        message_links(plans),
+        (),
+        durations(scene, plans, model, starts),
+    )
+    if not order.complete:
+        stuck = ", ".join(f"{r} at instant {k}" for r, k in order.stuck.items())
+        raise ValueError(f"the plans' messages deadlock ({stuck}); they have no itinerary")
+    return Itinerary(
+        {
+            r: tuple(
+                (round(float(order.started[r][k]), 3), round(float(order.finish[r][k]), 3))
+                for k in range(1, p.horizon + 1)
+            )
+            for r, p in plans.items()
+        }
+    )

@@ -3,7 +3,8 @@
 :func:`simulate` runs a ``cosmop.plan/1`` plan set in the scenario's world
 (:mod:`cosmop.sim.simulation`); people walk their paths (:mod:`cosmop.sim.humans`); a stalled
 robot replans its remaining mission from where it is (:mod:`cosmop.sim.replan`).  The result
-carries the ``cosmop.sim/1`` summary and the ``cosmop.trace/1`` trace.
+carries the ``cosmop.sim/1`` summary, with every step's planned and realised times
+(:mod:`cosmop.sim.timing`), and the ``cosmop.trace/1`` trace.
 """
 
 from cosmop.sim.replan import replan, sensed_scene
@@ -17,6 +18,7 @@ from cosmop.sim.simulation import (
     footprint_overlaps,
     simulate,
 )
+from cosmop.sim.timing import StepTimes
 
 __all__ = [
     "SIM_FORMAT",
@@ -25,6 +27,7 @@ __all__ = [
     "Message",
     "SimResult",
     "SimSettings",
+    "StepTimes",
     "footprint_overlaps",
     "replan",
     "sensed_scene",

@@ -61,12 +61,14 @@ from cosmop.control.safety import is_safe, obstacle_speed, stopping_horizon, sto
 from cosmop.docking import docking_pose, in_front
 from cosmop.io import write_atomic
 from cosmop.missions.events import Event, parse_event
-from cosmop.planning.plan import ObjectState, PlanSet, RobotPlan, State, Step, initial_state
+from cosmop.planning.plan import Itinerary, ObjectState, PlanSet, RobotPlan, State, Step, initial_state
 from cosmop.planning.realisation import event_instants
+from cosmop.planning.timing import itinerary
 from cosmop.scenario import Scenario
 from cosmop.sim.humans import Walker
 from cosmop.sim.recoordinate import Remaining, recoordinate
 from cosmop.sim.replan import replan
+from cosmop.sim.timing import StepTimes, carry_instants, step_times
 from cosmop.units import INTERNAL_UNITS
 
 __all__ = [
@@ -235,6 +237,9 @@ class SimResult:
     added : tuple of str
         The events of the tasks the planner added (:attr:`PlanSet.added
         <cosmop.planning.plan.PlanSet.added>`): goods moved out of a robot's way.
+    steps : Mapping[str, tuple of StepTimes]
+        Every robot's steps with their planned (the plan set's itinerary) and realised start
+        and end (:mod:`cosmop.sim.timing`).
     """
 
     scenario: str
@@ -257,6 +262,7 @@ class SimResult:
     events: tuple[tuple[float, str, str], ...] = ()
     added: tuple[str, ...] = ()
     replan_log: tuple[dict[str, Any], ...] = ()
+    steps: Mapping[str, tuple[StepTimes, ...]] = field(default_factory=dict)
 
     def executed_word(self) -> tuple[str, ...]:
         """The mission events the run realised, in time order (messages and the events of tasks
@@ -267,6 +273,17 @@ class SimResult:
             for _, _, name in sorted(self.events)
             if not name.startswith(("msg(", "away(")) and name not in skip
         )
+
+    @property
+    def makespan(self) -> dict[str, float | None]:
+        """When the team was expected to be done (``planned``, s) and was (``realised``; ``None``
+        for a run that did not complete)."""
+        planned = [r.planned[1] for rows in self.steps.values() for r in rows if r.planned is not None]
+        realised = [r.realised[1] for rows in self.steps.values() for r in rows if r.realised is not None]
+        return {
+            "planned": round(max(planned), 3) if planned else None,
+            "realised": round(max(realised, default=0.0), 3) if self.completed else None,
+        }
 
     @property
     def contacts_while_moving(self) -> int:
@@ -290,6 +307,8 @@ class SimResult:
             "messages": [m.to_dict() for m in self.messages],
             "events": [{"t": t, "robot": r, "event": e} for t, r, e in self.events],
             "replan_log": list(self.replan_log),
+            "makespan": self.makespan,
+            "itinerary": {rid: [row.to_dict() for row in rows] for rid, rows in self.steps.items()},
             "objects": {
                 oid: {"position": [round(p[0], 3), round(p[1], 3)], "carried_by": by}
                 for oid, (p, by) in self.objects.items()
@@ -376,6 +395,9 @@ class _Agent:
         self.steps = list(steps)
         self.mission = list(mission)
         self.k = 0  # the step being executed
+        self.instants: list[int | None] = list(range(1, len(self.steps) + 1))  # in the plan file
+        self.began = 0.0  # when the current step started, s
+        self.log: list[tuple[int | None, str, float, float]] = []  # the steps done: instant, label, times
         self.phase = "start"  # of driving: start, drive, turn
         self.stage: str | None = None  # of docking: approach, dock, handle
         self.path: GlobalPath | None = None
@@ -665,6 +687,8 @@ def _decide(world: _World, agent: _Agent) -> tuple[str, Any]:
             action = None
         if action is not None:
             return action
+        agent.log.append((agent.instants[agent.k], step.label, agent.began, world.t))
+        agent.began = world.t
         agent.k += 1  # the step is done
         world.record(agent, step)
         agent.left = 0.0
@@ -1139,6 +1163,9 @@ def _recoordinate(world: _World, agent: _Agent, new: RobotPlan, start: State) ->
         )
         plan = result.plans[other.id]
         current = other.steps[other.k] if other.k < len(other.steps) else None
+        kept = [] if other is agent else other.steps[other.k :]  # a new plan's steps were never planned
+        carried = carry_instants(kept, other.instants[other.k :], plan.steps)
+        other.instants = other.instants[: other.k] + carried
         other.steps = other.steps[: other.k] + list(plan.steps)
         other.mission = list(done) + [parse_event(e) for e in plan.mission]
         if other is agent or (other.k < len(other.steps) and other.steps[other.k] != current):
@@ -1396,7 +1423,22 @@ def simulate(
         events=tuple(world.events),
         added=tuple(e.name for task in plans.added for e in task.events),
         replan_log=tuple(world.replan_log),
+        steps=step_times(
+            {rid: [s.label for s in p.steps] for rid, p in plans.robots.items()},
+            _planned_times(world, plans),
+            {a.id: a.log for a in world.agents},
+        ),
     )
+
+
+def _planned_times(world: _World, plans: PlanSet) -> Itinerary | None:
+    """The plan set's itinerary, or the expected one for a plan file without times."""
+    if plans.itinerary is not None:
+        return plans.itinerary
+    try:
+        return itinerary(world.scenario.scene, plans.robots)
+    except ValueError:  # messages that deadlock: no schedule to compare with
+        return None
 
 
 def footprint_overlaps(
