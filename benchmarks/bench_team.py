@@ -11,8 +11,8 @@ Three workloads, each in a fresh subprocess:
   messages added, the time of the conflict step against synthesis, re-plans, and the simulated
   run (complete? contacts while moving?).
 
-``python benchmarks/bench_team.py [--sizes 10,20,50] [--seed S] [--max-time S]`` writes
-``results/team.json``.
+``python benchmarks/bench_team.py [--sizes 10,20,50] [--seed S] [--max-time S] [--out NAME]``
+writes ``results/team.json`` (or ``results/NAME.json``).
 """
 
 from __future__ import annotations
@@ -133,6 +133,7 @@ def main() -> int:
     parser.add_argument("--sizes", default="10,20,50")
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--max-time", type=float, default=3600.0)
+    parser.add_argument("--out", default="team", help="results/OUT.json (default: team)")
     parser.add_argument("--child", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child:
@@ -149,7 +150,7 @@ def main() -> int:
         row = child_row(__file__, "--child", job, "--seed", str(args.seed), "--max-time", str(args.max_time))
         rows.append(row)
         print(json.dumps(row), flush=True)
-    save_results("team", rows)
+    save_results(args.out, rows)
     return 0
 
 
