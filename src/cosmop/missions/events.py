@@ -211,7 +211,7 @@ def parse_event(text: str, robot: str | None = None) -> Event:
     Examples
     --------
     >>> parse_event("drop(R1, O1, W1)")
-    Event(kind='drop', robot='R1', obj='O1', workspace='W1', responder=None)
+    Event(kind='drop', robot='R1', obj='O1', workspace='W1', responder=None, tag=None)
     >>> parse_event("drop O1 at W1", robot="R1") == parse_event("R1dO1aW1")
     True
     """
