@@ -57,6 +57,10 @@ class DwaSettings:
         leave without closing in.
     turn_in_place : float
         Heading error (degrees) above which the robot turns on the spot instead of driving.
+    progress_weight, heading_weight, clearance_weight, speed_weight : float
+        Weights of an arc's score: progress towards the target (relative to the best the
+        window allows), heading towards it at the arc's end, clearance (up to ``clearance``
+        or ``personal_space``) and speed (relative to the top speed).
     """
 
     speeds: int = 5

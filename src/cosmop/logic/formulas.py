@@ -508,7 +508,13 @@ def sum_of(items: Iterable[object]) -> LinExpr:
 
 @_node
 class Max(Expr):
-    """The term :math:`\\max(a, b)` of two linear expressions (encoded with ``ite``)."""
+    """The term :math:`\\max(a, b)` of two linear expressions (encoded with ``ite``).
+
+    Attributes
+    ----------
+    left, right : LinExpr
+        :math:`a` and :math:`b`.
+    """
 
     left: LinExpr
     right: LinExpr
@@ -530,7 +536,13 @@ class Max(Expr):
 
 @_node
 class Min(Expr):
-    """The term :math:`\\min(a, b)` of two linear expressions (encoded with ``ite``)."""
+    """The term :math:`\\min(a, b)` of two linear expressions (encoded with ``ite``).
+
+    Attributes
+    ----------
+    left, right : LinExpr
+        :math:`a` and :math:`b`.
+    """
 
     left: LinExpr
     right: LinExpr
@@ -677,6 +689,13 @@ class Shifted(Formula, Expr):
     """The arithmetic temporal term :math:`\\bigcirc^{o} x`: variable ``var`` at ``k + offset``.
 
     For a Boolean variable it is an atomic formula, for a numeric one an arithmetic term.
+
+    Attributes
+    ----------
+    var : Var
+        The variable :math:`x`.
+    offset : int
+        :math:`o`, instants ahead (negative: back).
     """
 
     var: Var
@@ -710,7 +729,13 @@ class Shifted(Formula, Expr):
 
 @_node
 class BoolConst(Formula):
-    """The constant :data:`TRUE` or :data:`FALSE`."""
+    """The constant :data:`TRUE` or :data:`FALSE`.
+
+    Attributes
+    ----------
+    value : bool
+        Which of the two.
+    """
 
     value: bool
 
@@ -799,6 +824,14 @@ def ne(left: object, right: object) -> Not:
 
 @_node
 class _Unary(Formula):
+    """A connective of one operand.
+
+    Attributes
+    ----------
+    arg : Formula
+        The operand :math:`\\phi`.
+    """
+
     arg: Formula
 
     def __post_init__(self) -> None:
@@ -816,6 +849,14 @@ class _Unary(Formula):
 
 @_node
 class _Binary(Formula):
+    """A connective of two operands.
+
+    Attributes
+    ----------
+    left, right : Formula
+        The operands :math:`\\phi` and :math:`\\psi`.
+    """
+
     left: Formula
     right: Formula
 
@@ -919,6 +960,14 @@ class Since(_Binary):
 
 @_node(init=False)
 class _NAry(Formula):
+    """A connective of any number of operands.
+
+    Attributes
+    ----------
+    args : tuple of Formula
+        The operands :math:`\\phi_i`, in order.
+    """
+
     args: tuple[Formula, ...]
 
     def __init__(self, *args: object) -> None:

@@ -48,7 +48,8 @@ _NEVER: Node = ("", -1)  # the source of a message nobody sends
 class Link:
     """A message between two plans: sent by ``sender`` at instant ``send`` (its ``Res``),
     awaited by ``receiver`` at instant ``wait`` (its ``Req``); ``send`` is ``None`` if no plan
-    sends it, ``wait`` ``None`` if no plan waits for it."""
+    sends it, ``wait`` ``None`` if no plan waits for it.  ``event`` is the message's name
+    (``msg(S,R,tag)`` or ``away(O,A,B)``)."""
 
     event: str
     sender: str

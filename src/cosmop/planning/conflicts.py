@@ -117,7 +117,13 @@ class Occupancy:
 
 @dataclass(frozen=True)
 class Conflict:
-    """Two occupancies of different robots whose regions overlap."""
+    """Two occupancies of different robots whose regions overlap.
+
+    Attributes
+    ----------
+    a, b : Occupancy
+        The two occupancies; "``a`` before ``b``" is one way of ordering them.
+    """
 
     a: Occupancy
     b: Occupancy

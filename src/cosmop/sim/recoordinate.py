@@ -49,7 +49,21 @@ class Remaining:
 
 @dataclass(frozen=True)
 class Recoordination:
-    """The result of :func:`recoordinate`: the new rest of every robot's plan, or why not."""
+    """The result of :func:`recoordinate`: the new rest of every robot's plan, or why not.
+
+    Attributes
+    ----------
+    accepted : bool
+        Whether the new plan could be ordered with the others' rests.
+    plans : Mapping[str, RobotPlan]
+        Every robot's rest of plan, with the new messages in place (when accepted).
+    messages : tuple of PlanMessage
+        The messages added.
+    dropped : tuple of str
+        The conflict messages of the old plans that the new order replaces.
+    reason : str, optional
+        Why not, when not accepted.
+    """
 
     accepted: bool
     plans: Mapping[str, RobotPlan]

@@ -22,13 +22,24 @@ Box = tuple[float, float, float, float]  # x0, y0, x1, y1 in display pixels
 
 @dataclass
 class Label:
-    """A text to place near the data point ``(x, y)``; extra keyword arguments go to ``annotate``."""
+    """A text to place near a data point.
+
+    Attributes
+    ----------
+    x, y : float
+        The data point.
+    text : str
+    style : dict
+        Extra keyword arguments for matplotlib's ``annotate``.
+    center : bool
+        Try the point itself first (ids inside workspaces and robots).
+    """
 
     x: float
     y: float
     text: str
     style: dict[str, Any]
-    center: bool = False  # try on the point itself first (ids inside workspaces and robots)
+    center: bool = False
 
 
 def _overlaps(a: Box, b: Box) -> bool:
