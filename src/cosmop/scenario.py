@@ -278,6 +278,15 @@ class Workspace:
             raise ValueError(f"workspace {self.id} cannot hold a square of side {size:g} mm")
         return Workspace(self.id, x=x, y=y)
 
+    def holds(self, x: float, y: float, size: float, tol: float = 0.0) -> bool:
+        """Whether a square of side `size` (mm) centred at ``(x, y)`` lies wholly inside, within
+        `tol` mm (a point workspace: the centre is the point): :meth:`centres` contains it.
+
+        >>> Workspace("W", x=(0, 500), y=(0, 300)).holds(460, 100, 100)
+        False
+        """
+        return self.centres(size).contains(x, y, tol)
+
     def contains(self, x: float, y: float, tol: float = 0.0) -> bool:
         """Whether the position ``(x, y)`` lies in the workspace (boundary included).
 

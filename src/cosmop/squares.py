@@ -10,7 +10,7 @@ from collections.abc import Iterable
 
 from shapely import LineString, Point, Polygon, box
 
-from cosmop.docking import DOCKING_HEADINGS, facing
+from cosmop.docking import DOCKING_HEADINGS, docking_pose
 
 __all__ = ["docking_places", "rectangle", "square", "swept_square"]
 
@@ -38,10 +38,9 @@ def docking_places(
     """
     (x0, x1), (y0, y1) = x, y
     out = []
-    for heading in headings:
-        ux, uy = facing(heading)
-        dx, dy = -gap * ux, -gap * uy
-        out.append(rectangle((x0 + dx, x1 + dx), (y0 + dy, y1 + dy)))
+    for heading in headings:  # the rectangle's corners, each moved to its docking pose
+        (ax, ay), (bx, by) = docking_pose((x0, y0), gap, heading), docking_pose((x1, y1), gap, heading)
+        out.append(rectangle((ax, bx), (ay, by)))
     return out
 
 

@@ -130,7 +130,7 @@ def _or(words: Iterable[str]) -> str:
 
 
 def _docking_heading(heading: float) -> int | None:
-    """The docking heading (:data:`~cosmop.squares.DOCKING_HEADINGS`) `heading` equals, or ``None``."""
+    """The docking heading (:data:`~cosmop.docking.DOCKING_HEADINGS`) `heading` equals, or ``None``."""
     return next((h for h in DOCKING_HEADINGS if _angle_eq(heading, h)), None)
 
 

@@ -84,8 +84,8 @@ def holds_at(
         return False
     if event.kind == "drop":
         obj = step.objects.get(event.obj)
-        where = scene.workspaces[event.workspace].centres(scene.objects[event.obj].size)
-        return obj is not None and where.contains(*obj.position, TOLERANCE)
+        size = scene.objects[event.obj].size
+        return obj is not None and scene.workspaces[event.workspace].holds(*obj.position, size, TOLERANCE)
     return True
 
 

@@ -376,8 +376,9 @@ class SimResult:
                 if event.kind == "drop":
                     (x, y), by = self.objects[event.obj]
                     size = scenario.scene.objects[event.obj].size
-                    ws = scenario.scene.workspaces[event.workspace].centres(size)
-                    out[event.obj] = by is None and ws.contains(x, y, 1e-6)
+                    out[event.obj] = by is None and scenario.scene.workspaces[event.workspace].holds(
+                        x, y, size, 1e-6
+                    )
         return out
 
 
@@ -618,7 +619,7 @@ class _World:
                 for e in agent.mission
                 if e.kind == "drop"
                 and e.obj == step.object
-                and scene.workspaces[e.workspace].centres(size).contains(x, y, 1e-6)
+                and scene.workspaces[e.workspace].holds(x, y, size, 1e-6)
             ]
         elif step.primitive == "Req":
             wanted = [e for e in agent.mission if e.name in self.inbox and e.receiver == agent.id]
