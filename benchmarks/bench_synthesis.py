@@ -23,7 +23,8 @@ from pathlib import Path
 
 from cosmop.planning.checker import check_robot_plan
 from cosmop.planning.synthesis import synthesize
-from cosmop.scenario import MovableObject, load_scenario
+from cosmop.scenario import load_scenario
+from cosmop.scene import MovableObject
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "benchmarks" / "results"

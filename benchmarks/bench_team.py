@@ -33,7 +33,7 @@ def _alone(scenario, robot):
     """The scenario with only `robot` (its tasks and objects unchanged)."""
     from dataclasses import replace
 
-    from cosmop.scenario import Mission
+    from cosmop.scene import Mission
 
     scene = replace(scenario.scene, robots={robot: scenario.scene.robots[robot]})
     mission = Mission(tasks={robot: scenario.mission.tasks[robot]})

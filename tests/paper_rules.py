@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from cosmop.scenario import Scenario
+from cosmop.scene import Scenario
 
 
 def west_only(scenario: Scenario) -> Scenario:

@@ -7,7 +7,8 @@ from functools import lru_cache
 from pathlib import Path
 
 from cosmop.planning.plan import Coordination, PlanSet, plan_from_actions
-from cosmop.scenario import Scenario, load_scenario
+from cosmop.scenario import load_scenario
+from cosmop.scene import Scenario
 from handmade_plans import R1_ACTIONS, R1_MISSION, R2_RES_ACTIONS, R2_RES_MISSION
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "01_warehouse_2x2" / "scenario.yaml"

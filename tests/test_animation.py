@@ -227,7 +227,7 @@ def test_what_a_frame_shows():
         workspaces=SCENE.workspaces,
         humans={"H1": types.SimpleNamespace(size=600)},
     )
-    animator = animation_module._Animator(scene, trace, trace["frames"], make_plans(), "demo", DPI, shown=1.0)
+    animator = animation_module._Animator(scene, trace, make_plans(), "demo", DPI, shown=1.0)
     r1, r2 = animator.artists["R1"], animator.artists["R2"]
     animator.draw(0)
     assert r2["question"].get_visible() and not r1["question"].get_visible()

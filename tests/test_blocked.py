@@ -12,7 +12,7 @@ from __future__ import annotations
 import pytest
 from shapely import LineString
 
-from cosmop.missions.events import parse_event
+from cosmop.events import parse_event
 from cosmop.pipeline import _with_task, plan_team
 from cosmop.planning.aside import ROOM, place_aside
 from cosmop.planning.checker import check_plan

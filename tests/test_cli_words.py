@@ -9,7 +9,7 @@ from pathlib import Path
 from typer.testing import CliRunner
 
 from cosmop.cli import app
-from cosmop.cli_words import plan_verdict
+from cosmop.cli.words import plan_verdict
 from run_2x2 import run_2x2
 from test_cli_decompose import choice_scenario, ordered_scenario
 

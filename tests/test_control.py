@@ -11,7 +11,7 @@ from shapely.geometry import LineString
 from cosmop.control import admissible_speed, is_safe, plan_path, point_segment_linf, segment_array
 from cosmop.planning import overlaps, swept_square
 from cosmop.planning.checker import square
-from cosmop.scenario import Dynamics, Human
+from cosmop.scene import Dynamics, Human
 from cosmop.sim.humans import Walker
 
 DYN = Dynamics()

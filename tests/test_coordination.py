@@ -12,8 +12,8 @@ from pathlib import Path
 
 import pytest
 
+from cosmop.events import parse_event
 from cosmop.missions.coordination import Pair, blocking_word, coordinate, requests_by_phase
-from cosmop.missions.events import parse_event
 from cosmop.missions.mission import GlobalMission, sequence_automaton
 from cosmop.missions.verification import verify
 from cosmop.planning.checker import check_robot_plan
@@ -33,7 +33,7 @@ def plan_requests(sc):
     requests = {}
     for robot, events in sequences.items():
         res = synthesize(sc.scene, robot, events, max_horizon=12)
-        requests[robot] = requests_by_phase([(s.primitive, s.object) for s in res.plan.steps], events)
+        requests[robot] = requests_by_phase([(s.primitive, s.object) for s in res.plan.steps], events, robot)
     return sequences, requests
 
 
@@ -47,7 +47,7 @@ def test_requests_are_attached_to_the_event_they_prepare():
         ("GoTo", None),
         ("DropOff", "O1"),
     ]
-    assert requests_by_phase(steps, mission) == [("O2", 0), ("O3", 1)]
+    assert requests_by_phase(steps, mission, "R1") == [("O2", 0), ("O3", 1)]
 
 
 def test_two_by_two_gets_one_pair():

@@ -7,7 +7,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from cosmop.errors import EventSyntaxError
-from cosmop.missions.events import ACCEPTED_FORMS, ID_PATTERN, Event, parse_event
+from cosmop.events import ACCEPTED_FORMS, ID_PATTERN, Event, parse_event
 
 PICK = Event("pick", "R1", "O1")
 DROP = Event("drop", "R1", "O1", "W1")

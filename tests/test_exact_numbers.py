@@ -1,6 +1,6 @@
 """Exact numbers: lengths on a micrometre grid, odd sizes planned exactly (issue 12, point 4).
 
-A scenario's lengths must be multiples of :data:`cosmop.scenario.LENGTH_GRID`; finer ones are
+A scenario's lengths must be multiples of :data:`cosmop.scene.LENGTH_GRID`; finer ones are
 refused at validation with the precision named.  On that grid, positions are integers (whole
 mm) when every pose a primitive can force is whole, and exact rationals otherwise, so an object
 of side 101 mm is picked from x = 1749.5 instead of being called unreachable.

@@ -34,12 +34,11 @@ def read_bag(directory):
 def test_the_bag_holds_the_trace_in_si_units_on_standard_topics(tmp_path):
     scenario, plans, result = run_2x2()
     trace = result.trace()
-    assert trace["units"] == {"length": "mm", "angle": "deg", "time": "s"}
-    assert result.summary()["units"] == trace["units"]
+    assert dict(trace.units) == {"length": "mm", "angle": "deg", "time": "s"}
+    assert result.summary()["units"] == dict(trace.units)
     summary = write_bag(scenario.scene, trace, tmp_path / "run", plans=plans)
     topics = read_bag(tmp_path / "run")
-    frames = trace["frames"]
-    n = len(frames)
+    n = len(trace.t)
     assert set(topics) == {"/tf", "/R1/pose", "/R2/pose", "/R1/plan", "/R2/plan", "/scene", "/coordination"}
     assert {t: len(m) for t, m in topics.items()} == summary.counts
     assert len(topics["/tf"]) == len(topics["/R1/pose"]) == n
@@ -48,13 +47,13 @@ def test_the_bag_holds_the_trace_in_si_units_on_standard_topics(tmp_path):
     assert topics["/scene"][0][1] == "visualization_msgs/msg/MarkerArray"
     # time stamps: the frames' times, in log time and header alike
     stamps = [ns for ns, _, _ in topics["/R2/pose"]]
-    assert stamps == [round(f["t"] * 1e9) for f in frames]
+    assert stamps == [round(t * 1e9) for t in trace.t.tolist()]
     k = n // 2
     _, _, pose = topics["/R1/pose"][k]
     assert pose.header.stamp.sec * 10**9 + pose.header.stamp.nanosec == stamps[k]
     assert pose.header.frame_id == "map"
     # one pose against the trace: metres and a yaw quaternion (REP 103)
-    x, y, heading = frames[k]["robots"]["R1"]["pose"]
+    x, y, heading = trace.robots_at(k)["R1"].pose
     assert pose.pose.position.x == pytest.approx(x / 1000) and pose.pose.position.y == pytest.approx(y / 1000)
     q = pose.pose.orientation
     assert math.degrees(2 * math.atan2(q.z, q.w)) == pytest.approx(heading, abs=1e-6)
@@ -70,7 +69,7 @@ def test_the_bag_holds_the_trace_in_si_units_on_standard_topics(tmp_path):
     # the message, at its time, with the trace's keys
     ns, _, text = topics["/coordination"][0]
     message = json.loads(text.data)
-    assert message == trace["messages"][0] and ns == round(message["t"] * 1e9)
+    assert message == trace.messages[0] and ns == round(message["t"] * 1e9)
     assert message["from"] == "R2" and message["to"] == "R1"
 
 
@@ -79,9 +78,9 @@ def test_scene_markers_show_walls_goods_carriers_and_message_arrows(tmp_path):
     trace = result.trace()
     write_bag(scenario.scene, trace, tmp_path / "run", plans=plans, rate=2.0, scene_rate=1.0)
     topics = read_bag(tmp_path / "run")
-    assert len(topics["/R1/pose"]) == pytest.approx(trace["frames"][-1]["t"] * 2 + 1, abs=1)
+    assert len(topics["/R1/pose"]) == pytest.approx(trace.t[-1] * 2 + 1, abs=1)
     arrays = topics["/scene"]
-    assert len(arrays) == pytest.approx(trace["frames"][-1]["t"] + 1, abs=1)
+    assert len(arrays) == pytest.approx(trace.t[-1] + 1, abs=1)
     first = {(m.ns, m.id): m for m in arrays[0][2].markers}
     walls = first[("walls", 0)]
     assert len(walls.points) == 2 * len(scenario.scene.obstacles)
@@ -90,7 +89,7 @@ def test_scene_markers_show_walls_goods_carriers_and_message_arrows(tmp_path):
     labels = {m.text for _, _, a in arrays for m in a.markers if m.ns == "robot_labels"}
     assert "R1 carries O1" in labels and "R2 carries O2" in labels
     arrows = [(ns, m) for ns, _, a in arrays for m in a.markers if m.ns == "messages"]
-    t_message = trace["messages"][0]["t"]
+    t_message = trace.messages[0]["t"]
     assert arrows and all(0 <= ns / 1e9 - t_message < 2.0 for ns, _ in arrows)
 
 
@@ -98,7 +97,7 @@ def test_cli_export_and_its_bad_input(tmp_path):
     _scenario, plans, result = run_2x2()
     result.save_trace(tmp_path / "trace.json")
     plans.save(tmp_path / "plan.json")
-    assert load_trace(tmp_path / "trace.json")["frames"][0]["t"] == 0.0
+    assert load_trace(tmp_path / "trace.json").t[0] == 0.0
     args = [
         "export",
         str(EXAMPLE),

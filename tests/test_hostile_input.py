@@ -27,7 +27,8 @@ from cosmop.planning.checker import check_plan
 from cosmop.planning.plan import MAX_STEPS, PlanError, PlanSet, load_plan
 from cosmop.planning.synthesis import synthesize
 from cosmop.reading import MAX_DEPTH, MAX_DIGITS, MAX_NODES, MAX_TEXT, load_json, load_yaml
-from cosmop.scenario import MAX_DFA_STATES, MAX_TASK_EVENTS, load_scenario, parse_scenario
+from cosmop.scenario import MAX_DFA_STATES, load_scenario, parse_scenario
+from cosmop.scene import MAX_TASK_EVENTS
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "01_warehouse_2x2" / "scenario.yaml"

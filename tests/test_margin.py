@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from cosmop.missions.events import Event
+from cosmop.events import Event
 from cosmop.planning.checker import check_robot_plan
 from cosmop.planning.regions import wall_regions
 from cosmop.planning.specification import MOTION_MARGIN, STEEPNESS

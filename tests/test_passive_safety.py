@@ -21,17 +21,19 @@ import numpy as np
 from hypothesis import HealthCheck, assume, event, given, settings
 from hypothesis import strategies as st
 
-from cosmop.control.dwa import DwaSettings, dwa_commands
+from cosmop.control.dwa import Drivers, DwaSettings, Obstacles, dwa_commands
 from cosmop.control.geometry import box_gaps, point_segment_linf, segment_array
+from cosmop.control.safety import Limits
+from cosmop.scene import Dynamics
 
-LIMITS = np.array([[750.0, 300.0, 500.0, math.radians(100.0), 0.1]])  # top, A, b, turn, cycle
+LIMITS = Limits.of([Dynamics(max_speed=750.0, acceleration=300.0, braking=500.0, turn_rate=100.0, cycle=0.1)])
 HALF = 200.0
 W_PREVIOUS = 0.0123  # rad/s: a turn rate no sampled arc has, to recognise the fallback
 
 
 def _trajectory(pose, v0, v1, w, samples: int = 400) -> np.ndarray:
     """Centres along "reach `v1` linearly within one cycle, then brake to a stop, turn held"."""
-    _, _, brake, _, eps = LIMITS[0]
+    brake, eps = LIMITS.braking[0], LIMITS.cycle[0]
     total = eps + v1 / brake
     t = np.linspace(0.0, total, samples + 1)
     speed = np.where(t <= eps, v0 + (v1 - v0) * t / eps, np.maximum(v1 - brake * (t - eps), 0.0))
@@ -75,20 +77,16 @@ def test_an_arc_taken_when_safe_fails_brakes_to_a_stop_without_touching(scene):
     # a state the controller can be in: the last cycle's check covered braking from here along
     # the previous arc (from a state no command can save, the property says nothing)
     assume(_clear(_trajectory(pose[0], v[0], max(0.0, v[0] - 50.0), W_PREVIOUS), walls, boxes))
-    cmd = dwa_commands(
+    drivers = Drivers(
         pose,
         v,
         np.array([HALF]),
         LIMITS,
         np.array([scene["target"]]),
         np.array([math.inf]),
-        walls,
-        boxes,
-        np.zeros(len(boxes)),
-        None,
-        DwaSettings(),
-        w_now=np.array([W_PREVIOUS]),
+        w=np.array([W_PREVIOUS]),
     )
+    cmd = dwa_commands(drivers, Obstacles(walls, boxes, np.zeros(len(boxes))), DwaSettings())
     assume(not cmd.safe[0])  # the property is about the case where safe fails
     assume(cmd.w[0] != W_PREVIOUS)  # an escape arc was taken, not the fallback brake
     event("escape arc checked")

@@ -8,7 +8,7 @@ import pytest
 
 import cosmop.planning.synthesis as synthesis_module
 from cosmop.errors import ScenarioError
-from cosmop.missions.events import Event
+from cosmop.events import Event
 from cosmop.planning.checker import check_robot_plan
 from cosmop.planning.reach import unreachable
 from cosmop.planning.specification import MOTION_MARGIN

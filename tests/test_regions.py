@@ -16,7 +16,7 @@ from hypothesis import strategies as st
 from shapely.geometry import LineString, box
 from shapely.ops import unary_union
 
-from cosmop.planning.regions import HalfPlane, motion_is_clear, object_regions, wall_regions
+from cosmop.planning.regions import HalfPlane, object_regions, wall_regions
 
 coord = st.integers(min_value=-3000, max_value=3000)
 point = st.tuples(coord, coord)
@@ -31,6 +31,15 @@ def swept(start, end, s):
             box(end[0] - h, end[1] - h, end[0] + h, end[1] + h),
         ]
     ).convex_hull
+
+
+def motion_is_clear(regions, start, end):
+    """The first region holding both end centres of a straight motion (the specification's
+    rule for a motion clear of one obstacle), or None."""
+    for region in regions:
+        if region.contains(*start) and region.contains(*end):
+            return region
+    return None
 
 
 def overlaps_segment(poly, a, b) -> bool:

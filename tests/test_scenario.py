@@ -17,20 +17,10 @@ import pytest
 import yaml
 
 from cosmop.errors import CosmopInputError, ScenarioError
+from cosmop.events import Event, parse_event
 from cosmop.io import write_atomic
-from cosmop.missions.events import Event, parse_event
-from cosmop.scenario import (
-    DfaSpec,
-    Mission,
-    MovableObject,
-    Robot,
-    Scenario,
-    Scene,
-    Wall,
-    Workspace,
-    load_scenario,
-    parse_scenario,
-)
+from cosmop.scenario import load_scenario, parse_scenario
+from cosmop.scene import DfaSpec, Mission, MovableObject, Robot, Scenario, Scene, Wall, Workspace
 
 EXAMPLE_DIR = Path(__file__).resolve().parents[1] / "examples" / "01_warehouse_2x2"
 TASKS_FILE = EXAMPLE_DIR / "scenario.yaml"

@@ -21,7 +21,8 @@ from typer.testing import CliRunner
 from cosmop.cli import EXIT_INPUT_ERROR, app
 from cosmop.errors import ScenarioError
 from cosmop.io import write_atomic
-from cosmop.scenario import Dynamics, Human, Robot, Scene, Wall, load_scenario, parse_scenario
+from cosmop.scenario import load_scenario, parse_scenario
+from cosmop.scene import Dynamics, Human, Robot, Scene, Wall
 
 BASE: dict[str, Any] = {
     "name": "corridor",

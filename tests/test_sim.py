@@ -14,6 +14,7 @@ from cosmop.cli import app
 from cosmop.pipeline import plan_team
 from cosmop.scenario import load_scenario
 from cosmop.sim import SIM_FORMAT, TRACE_FORMAT, SimSettings, simulate
+from cosmop.traces import Trace, TraceError, as_trace, load_trace
 from team_checks import assert_complete_word, assert_no_overlap
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -147,6 +148,57 @@ def test_summary_and_trace_files(tmp_path, people_2x2):
     assert set(frame) == {"t", "robots", "humans", "objects"}
     assert set(frame["robots"]["R1"]) >= {"pose", "v", "w", "carrying"}
     assert set(frame["humans"]) == {"H1", "H2"}
+    # the run's Trace is the one its file reads back, array for array
+    run, back = result.trace(), load_trace(tmp_path / "t.json")
+    assert back.to_json() == run.to_json() == trace
+    for name in ("t", "poses", "v", "w", "carrying", "waiting", "humans", "objects"):
+        assert np.array_equal(getattr(back, name), getattr(run, name)), name
+    names = np.array(run.primitive_names, dtype=object)[run.primitive]
+    assert (names == np.array(back.primitive_names, dtype=object)[back.primitive]).all()
+    assert not run.poses.flags.writeable and result.frames["pose"].flags.writeable
+
+
+def _frame(t, robots, humans=None, objects=None):
+    return {"t": t, "robots": robots, "humans": humans or {}, "objects": objects or {}}
+
+
+def test_a_trace_of_another_tool_may_name_other_things_in_other_frames(tmp_path):
+    data = {
+        "format": TRACE_FORMAT,
+        "frames": [
+            _frame(0, {"R2": {"pose": [0, 0, 90]}}, objects={"O1": [5, 5]}),
+            _frame(
+                1, {"R1": {"pose": [1, 2, 3], "carrying": "O9"}, "R2": {"pose": [1, 0, 90]}}, {"H1": [7, 8]}
+            ),
+        ],
+    }
+    trace = as_trace(data)
+    assert trace.robot_ids == ("R2", "R1") and trace.human_ids == ("H1",)
+    assert trace.object_ids == ("O1", "O9")  # O9 is only ever carried
+    assert np.isnan(trace.poses[0, 1]).all() and trace.poses[1, 1].tolist() == [1, 2, 3]
+    assert np.isnan(trace.humans[0, 0]).all() and np.isnan(trace.objects[1]).all()
+    assert trace.carrying.tolist() == [[-1, -1], [-1, 1]] and trace.v is None and trace.waiting is None
+    assert list(trace.robots_at(0)) == ["R2"] and trace.carried_at(1) == {"O9": "R1"}
+    assert trace.dt is None and trace.scenario is None and as_trace(trace) is trace
+    # written back: what each frame showed (an unsaid cargo is none), and no more
+    expected = _frame(0.0, {"R2": {"pose": [0.0, 0.0, 90.0], "carrying": None}}, {}, {"O1": [5.0, 5.0]})
+    assert trace.to_json()["frames"][0] == expected
+    assert trace.to_json()["frames"][1]["robots"]["R1"] == {"pose": [1.0, 2.0, 3.0], "carrying": "O9"}
+    trace.save(tmp_path / "t.json")
+    assert load_trace(tmp_path / "t.json").to_json() == trace.to_json()
+    with pytest.raises(ValueError, match="read-only"):
+        trace.poses[0, 0, 0] = 1.0
+
+
+def test_a_bad_trace_names_the_file_and_the_field(tmp_path):
+    bad = {"format": TRACE_FORMAT, "frames": [_frame(0, {"R1": {"pose": [0, 0, 0], "v": "fast"}})]}
+    (tmp_path / "bad.json").write_text(json.dumps(bad))
+    with pytest.raises(TraceError, match=r"bad\.json: frames\[0\]\.robots\.R1\.v: expected a speed"):
+        load_trace(tmp_path / "bad.json")
+    with pytest.raises(ValueError, match="frames"):  # a TraceError is a ValueError too
+        as_trace({"format": TRACE_FORMAT, "frames": []})
+    with pytest.raises(ValueError, match=r"Trace\.poses must have the shape \(2, 1, 3\)"):
+        Trace(t=[0.0, 1.0], robot_ids=("R1",), poses=np.zeros((2, 2, 3)))
 
 
 def test_plans_are_executed_as_written(warehouse_2x2):

@@ -15,7 +15,7 @@ import yaml
 from typer.testing import CliRunner
 
 from cosmop.cli import app
-from cosmop.missions.events import message, parse_event
+from cosmop.events import message, parse_event
 from cosmop.missions.mission import GlobalMission
 from cosmop.missions.precedence import Precedence
 from cosmop.pipeline import plan_team

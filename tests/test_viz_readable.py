@@ -110,7 +110,7 @@ def test_animation_has_a_legend_message_arrows_and_separate_object_ids():
     from test_animation import SCENE, make_plans, make_trace
 
     trace = make_trace(20, dt=0.1)
-    animator = animation._Animator(SCENE, trace, trace["frames"], make_plans(), None, 40)
+    animator = animation._Animator(SCENE, trace, make_plans(), None, 40)
     legend = [t.get_text() for t in animator.ax.get_legend().get_texts()]
     assert "waits for an answer (Req)" in legend and "message → receiver, time" in legend
     (arrow, text, message) = animator.arrows[0]

@@ -15,6 +15,7 @@ from dataclasses import replace
 from types import MappingProxyType
 
 from cosmop.automata import DFA
+from cosmop.events import Event, parse_event
 from cosmop.missions.allocation import (
     Alternative,
     Alternatives,
@@ -25,12 +26,11 @@ from cosmop.missions.allocation import (
     others,
     own_choices,
 )
-from cosmop.missions.events import Event, parse_event
 from cosmop.missions.mission import GlobalMission
 from cosmop.missions.ordering import order_words, with_messages
 from cosmop.planning.synthesis import Synthesis
 from cosmop.planning.timing import step_durations
-from cosmop.scenario import Scenario
+from cosmop.scene import Scenario
 
 __all__ = ["allocate"]
 

@@ -4,12 +4,14 @@ from __future__ import annotations
 
 import contextlib
 import os
-import secrets
+import shutil
+import tempfile
+from collections.abc import Iterator
 from pathlib import Path
 
 from cosmop.errors import CosmopInputError, OutputPathError
 
-__all__ = ["check_writable", "uninterrupted", "write_atomic"]
+__all__ = ["atomic_path", "check_writable", "uninterrupted", "write_atomic"]
 
 
 @contextlib.contextmanager
@@ -72,11 +74,11 @@ def check_writable(path: str | os.PathLike[str] | None, option: str, *, folder: 
 def write_atomic(path: str | os.PathLike[str], data: str | bytes) -> None:
     """Replace the file at `path` with `data`, all at once.
 
-    The data are written to a temporary file in the same directory, flushed to disk with
-    ``fsync`` and moved over `path` with :func:`os.replace`, which is atomic on POSIX and
-    Windows. Readers therefore see either the old file or the complete new one, never a
-    half-written file; if anything fails the temporary file is removed and `path` is
-    untouched.
+    The data are written through :func:`atomic_path`: to a file of the same name in a hidden
+    staging folder beside `path`, flushed to disk with ``fsync`` and moved over `path` with
+    :func:`os.replace`, which is atomic on POSIX and Windows. Readers therefore see either the
+    old file or the complete new one, never a half-written file; if anything fails the staging
+    folder is removed and `path` is untouched.
 
     Parameters
     ----------
@@ -90,41 +92,80 @@ def write_atomic(path: str | os.PathLike[str], data: str | bytes) -> None:
     A new file gets the usual permissions (``0o666`` masked by the process umask); an
     existing file keeps its permission bits.
     """
-    target = Path(path)
     if isinstance(data, str):
         payload = data.encode("utf-8")
     elif isinstance(data, bytes | bytearray | memoryview):
         payload = bytes(data)
     else:
         raise TypeError(f"write_atomic needs str or bytes, got {type(data).__name__}")
-    directory = target.parent
-    fd, tmp_name = _create_temp(directory, target.name)
+    with atomic_path(path) as tmp, open(tmp, "wb") as handle:
+        handle.write(payload)
+
+
+@contextlib.contextmanager
+def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
+    """A temporary path to write `path` through, moved onto `path` when the block succeeds.
+
+    For writers that take a file name rather than data (matplotlib's animation writers, a ROS
+    bag writer): the block writes a file or creates a folder at the yielded path, which has
+    the same name as `path` (so writers that pick the format by the suffix, or name a folder's
+    files after it, behave the same) inside a new hidden staging folder beside `path`, on the
+    same file system. On success a file is flushed to disk (``fsync``), takes the permission
+    bits of the file it replaces, and is moved onto `path` with :func:`os.replace` (atomic on
+    POSIX and Windows); a folder is moved as it is, which needs `path` to be missing (or, on
+    POSIX, an empty folder). The staging folder is always removed, so a failure, inside the
+    block or in the move, leaves `path` untouched and nothing behind.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The destination file or folder. Its directory must exist.
+
+    Yields
+    ------
+    pathlib.Path
+        ``<staging folder>/<name of path>``; nothing exists there yet.
+
+    Raises
+    ------
+    FileNotFoundError
+        If the directory of `path` is missing, or the block created nothing at the yielded path.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> folder = Path(tempfile.mkdtemp())
+    >>> with atomic_path(folder / "plot.txt") as tmp:
+    ...     _ = tmp.write_text("drawn")
+    >>> (folder / "plot.txt").read_text(), sorted(p.name for p in folder.iterdir())
+    ('drawn', ['plot.txt'])
+    >>> shutil.rmtree(folder)
+    """
+    target = Path(path)
+    staging = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent))
     try:
-        with os.fdopen(fd, "wb") as handle:
-            handle.write(payload)
-            handle.flush()
-            os.fsync(handle.fileno())
-        with contextlib.suppress(OSError):
-            if target.exists():
-                os.chmod(tmp_name, target.stat().st_mode & 0o7777)
-        os.replace(tmp_name, target)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp_name)
-        raise
-    _fsync_directory(directory)
+        tmp = staging / target.name
+        yield tmp
+        if tmp.is_file():
+            _fsync_file(tmp)
+            with contextlib.suppress(OSError):
+                if target.is_file():
+                    os.chmod(tmp, target.stat().st_mode & 0o7777)
+        os.replace(tmp, target)
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+    _fsync_directory(target.parent)
 
 
-def _create_temp(directory: Path, name: str) -> tuple[int, str]:
-    """Create a new, empty temporary file beside the target (mode 0o666 & ~umask)."""
-    flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0)
-    for _ in range(100):
-        candidate = os.path.join(directory, f".{name}.{secrets.token_hex(6)}.tmp")
-        try:
-            return os.open(candidate, flags, 0o666), candidate
-        except FileExistsError:
-            continue
-    raise FileExistsError(f"could not create a temporary file in {directory}")
+def _fsync_file(path: Path) -> None:
+    """Flush a written file's data to disk (it may have been written by another process)."""
+    # Windows flushes only through a handle open for writing; POSIX through any.
+    access = os.O_RDWR | os.O_BINARY if os.name == "nt" else os.O_RDONLY
+    fd = os.open(path, access)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
 
 
 def _fsync_directory(directory: Path) -> None:

@@ -16,16 +16,13 @@ first as bad input.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 import shapely
 
+from cosmop.scene import Scene
 from cosmop.squares import square
 from cosmop.units import UnitSystem, show_length, shown
-
-if TYPE_CHECKING:  # the scenario module calls this one while it builds a scene
-    from cosmop.scenario import Scene
 
 __all__ = ["TOUCH", "Overlap", "overlaps"]
 
@@ -103,7 +100,7 @@ def overlaps(scene: Scene, *, units: UnitSystem = "mm") -> list[Overlap]:
 
     Examples
     --------
-    >>> from cosmop.scenario import MovableObject, Robot, Scene, Wall
+    >>> from cosmop.scene import MovableObject, Robot, Scene, Wall
     >>> scene = Scene((Wall((0, -1000), (0, 1000)),), {"R1": Robot("R1", 400, (150, 0, 0))},
     ...               {"O1": MovableObject("O1", 100, (400, 0))})  # O1 touches R1: allowed
     >>> [o.describe() for o in overlaps(scene)]  # doctest: +NORMALIZE_WHITESPACE

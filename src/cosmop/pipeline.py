@@ -35,10 +35,10 @@ import shapely
 
 from cosmop.allocate import allocate
 from cosmop.automata import DFA
+from cosmop.events import Event, Primitive, parse_event
 from cosmop.missions.allocation import Choice
 from cosmop.missions.coordination import Coordinated, coordinate
 from cosmop.missions.decomposition import decompose
-from cosmop.missions.events import Event, parse_event
 from cosmop.missions.mission import GlobalMission, sequence_of
 from cosmop.missions.team import TeamVerdict, blocking_word, check_words
 from cosmop.planning.aside import ROOM, place_aside
@@ -49,7 +49,7 @@ from cosmop.planning.realisation import event_instants
 from cosmop.planning.synthesis import DEFAULT_RLIMIT, Synthesis, synthesize
 from cosmop.planning.teamsafety import TeamSafety, make_team_safe
 from cosmop.planning.timing import itinerary
-from cosmop.scenario import Scenario, Scene, Wall
+from cosmop.scene import Scenario, Scene, Wall
 from cosmop.squares import square
 
 __all__ = ["TeamResult", "plan_team"]
@@ -404,7 +404,7 @@ def _requests(
     instants = event_instants(plan, robot, scene, sequence)
     out = []
     for k, step in enumerate(plan.steps, 1):
-        if step.primitive == "Req" and step.object is not None:
+        if step.primitive == Primitive.REQ and step.object is not None:
             index = next((n for n, t in enumerate(instants) if t is not None and t >= k), len(sequence))
             out.append((step.object, index))
     return out

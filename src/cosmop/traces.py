@@ -1,36 +1,77 @@
-"""Reading simulation traces (``cosmop.trace/1``, what ``cosmop simulate --trace`` writes).
+"""Simulation traces (``cosmop.trace/1``): the :class:`Trace` of a run, and its JSON file.
 
-A trace is JSON: ``format``, ``scenario``, ``units`` (absent in older files: mm, degrees, s),
-``dt`` (s), ``frames`` (each with ``t`` in s, ``robots`` ``{id: {"pose": [x, y, heading], ...}}``,
-``humans`` and ``objects`` ``{id: [x, y]}``) and ``messages`` (each a mapping with at least ``t``,
-``from`` and ``to``; other keys are kept as they are, so new kinds of message pass through).
-:func:`load_trace` checks that shape and names the first field that is wrong.
+A :class:`Trace` holds a run frame by frame as numpy arrays over the frames and the ids of the
+robots, people and objects.  The simulator makes it (:meth:`cosmop.sim.SimResult.trace`); the
+animations and the web viewer (:mod:`cosmop.viz`) and the ROS 2 bag export
+(:mod:`cosmop.export`) read it.  Units: mm, degrees and seconds
+(:data:`cosmop.units.INTERNAL_UNITS`).
+
+Its file (:meth:`Trace.to_json`, :meth:`Trace.save`, :func:`load_trace`) is JSON: ``format``
+(:data:`TRACE_FORMAT`), ``scenario``, ``units`` (absent in older files: mm, degrees, s), ``dt``
+(s), ``frames`` (each with ``t`` in s, ``robots`` ``{id: {"pose": [x, y, heading], "v", "w",
+"carrying", "primitive", "waiting"}}``, ``humans`` and ``objects`` ``{id: [x, y]}``) and
+``messages`` (each a mapping with at least ``t``, ``from`` and ``to``; other keys are kept as
+they are, so new kinds of message pass through).  :func:`check_trace` checks that shape and
+names the first field that is wrong.
 """
 
 from __future__ import annotations
 
+import json
 import math
 import os
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, replace
+from types import MappingProxyType
 from typing import Any
 
-from cosmop.errors import CosmopInputError
-from cosmop.io import read_text
-from cosmop.reading import load_json
-from cosmop.units import check_units_field
+import numpy as np
 
-__all__ = ["TRACE_FORMAT", "TraceError", "check_trace", "load_trace", "message_label"]
+from cosmop.errors import CosmopInputError
+from cosmop.io import read_text, write_atomic
+from cosmop.reading import load_json
+from cosmop.units import INTERNAL_UNITS, check_units_field
+
+__all__ = [
+    "TRACE_FORMAT",
+    "RobotState",
+    "Trace",
+    "TraceError",
+    "as_trace",
+    "check_trace",
+    "load_trace",
+    "message_label",
+]
 
 TRACE_FORMAT = "cosmop.trace/1"
-"""The ``format`` of the traces this module reads."""
+"""The ``format`` of a trace file: what :meth:`Trace.to_json` writes and :func:`load_trace` reads."""
+
+_LENGTH_DIGITS = 3  # a file's lengths (mm), angles (degrees) and speeds: to 0.001
+_TIME_DIGITS = 6  # a file's times (s): to 1 µs
 
 
-class TraceError(CosmopInputError):
-    """A trace file that cannot be read or does not have the ``cosmop.trace/1`` shape."""
+class TraceError(CosmopInputError, ValueError):
+    """A trace that cannot be read or does not have the ``cosmop.trace/1`` shape.
+
+    It is a :class:`ValueError` too: a malformed trace handed to a function is a bad value.
+    """
 
 
 def _is_number(value: Any) -> bool:
     return isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
+
+
+def _is_name(value: Any) -> bool:
+    return value is None or isinstance(value, str)
+
+
+_STATE_KEYS = {  # the optional keys of a robot's state in a frame: a test and what it expects
+    "v": (_is_number, "a speed (mm/s)"),
+    "w": (_is_number, "a turning rate (deg/s)"),
+    "carrying": (_is_name, "the id of the object carried, or null"),
+    "primitive": (_is_name, "the name of a primitive, or null"),
+    "waiting": (lambda value: isinstance(value, bool), "true or false"),
+}
 
 
 def _check_frame(frame: Any, k: int, fail) -> None:
@@ -43,6 +84,9 @@ def _check_frame(frame: Any, k: int, fail) -> None:
         pose = state.get("pose") if isinstance(state, Mapping) else None
         if not (isinstance(pose, list) and len(pose) == 3 and all(_is_number(v) for v in pose)):
             fail(f"frames[{k}].robots.{rid}.pose", "[x, y, heading] (mm, mm, degrees)")
+        for key, (test, expected) in _STATE_KEYS.items():
+            if key in state and not test(state[key]):
+                fail(f"frames[{k}].robots.{rid}.{key}", expected)
     for group in ("humans", "objects"):
         points = frame.get(group, {})
         if not isinstance(points, Mapping) or not all(
@@ -88,12 +132,359 @@ def check_trace(data: Any, file: str | os.PathLike[str] | None = None) -> dict[s
     return dict(data)
 
 
-def load_trace(path: str | os.PathLike[str]) -> dict[str, Any]:
-    """Read and check a ``cosmop.trace/1`` file (see :func:`check_trace`)."""
+@dataclass(frozen=True)
+class RobotState:
+    """One robot in one frame of a :class:`Trace` (:meth:`Trace.robots_at`).
+
+    Attributes
+    ----------
+    pose : tuple of float
+        ``(x, y, heading)``: mm, mm, degrees.
+    carrying : str or None
+        The id of the object the robot carries.
+    waiting : bool
+        Whether the robot waits for an answer (a ``Req``).
+    """
+
+    pose: tuple[float, float, float]
+    carrying: str | None = None
+    waiting: bool = False
+
+
+_ARRAYS = {  # every array of a Trace: its dtype, the ids along its second axis, its last axis
+    "t": (float, None, ()),
+    "poses": (float, "robot_ids", (3,)),
+    "v": (float, "robot_ids", ()),
+    "w": (float, "robot_ids", ()),
+    "carrying": (int, "robot_ids", ()),
+    "primitive": (int, "robot_ids", ()),
+    "waiting": (bool, "robot_ids", ()),
+    "humans": (float, "human_ids", (2,)),
+    "objects": (float, "object_ids", (2,)),
+}
+
+
+# Arrays have no single truth value, so a trace equals only itself (eq=False).
+@dataclass(frozen=True, eq=False)
+class Trace:
+    """A run frame by frame: numpy arrays over the frames, and the ids they follow.
+
+    The arrays are read-only.  A thing a frame does not show is NaN there: a trace written by
+    another tool may name different robots, people or objects in different frames.
+
+    Attributes
+    ----------
+    t : ndarray, shape (n,)
+        Time of each frame, s.
+    robot_ids : tuple of str
+        The robots, in the order of the robot arrays' second axis.
+    poses : ndarray, shape (n, R, 3)
+        Each robot's pose ``(x, y, heading)`` in mm, mm and degrees; NaN where a frame lacks it.
+    v, w : ndarray, shape (n, R), optional
+        Speed (mm/s) and turning rate (deg/s) of each robot; None when the trace has none.
+    carrying : ndarray of int, shape (n, R), optional
+        Index into `object_ids` of the object each robot carries, -1 for none.
+    primitive : ndarray of int, shape (n, R), optional
+        Index into `primitive_names` of what each robot executes.
+    primitive_names : tuple of (str or None)
+        What the `primitive` indices stand for (the simulator's 0 is None: finished).
+    waiting : ndarray of bool, shape (n, R), optional
+        Whether each robot waits for an answer (a ``Req``).
+    human_ids, object_ids : tuple of str
+        The people and objects, in the order of their arrays' second axis.
+    humans, objects : ndarray, shape (n, H, 2) and (n, O, 2)
+        Positions, mm; NaN where a frame lacks them.  None (the default): none.
+    messages : tuple of Mapping
+        The messages, as given: ``t`` (s), ``from``, ``to`` and any other keys.
+    scenario : str or None
+        The scenario's name.
+    dt : float or None
+        The control cycle, s.
+    units : Mapping[str, str]
+        The file's ``units`` (:data:`cosmop.units.INTERNAL_UNITS`: mm, degrees, seconds).
+
+    Examples
+    --------
+    >>> trace = Trace(t=np.array([0.0, 0.1]), robot_ids=("R1",), poses=[[[0, 0, 0]], [[10.0004, 0, 90]]])
+    >>> trace.to_json()["frames"][1]
+    {'t': 0.1, 'robots': {'R1': {'pose': [10.0, 0.0, 90.0]}}, 'humans': {}, 'objects': {}}
+    >>> Trace.from_json(trace.to_json()).poses[1].tolist()
+    [[10.0, 0.0, 90.0]]
+    """
+
+    t: np.ndarray
+    robot_ids: tuple[str, ...]
+    poses: np.ndarray
+    v: np.ndarray | None = None
+    w: np.ndarray | None = None
+    carrying: np.ndarray | None = None
+    primitive: np.ndarray | None = None
+    primitive_names: tuple[str | None, ...] = ()
+    waiting: np.ndarray | None = None
+    human_ids: tuple[str, ...] = ()
+    humans: np.ndarray | None = None
+    object_ids: tuple[str, ...] = ()
+    objects: np.ndarray | None = None
+    messages: tuple[Mapping[str, Any], ...] = ()
+    scenario: str | None = None
+    dt: float | None = None
+    units: Mapping[str, str] = field(default_factory=lambda: MappingProxyType(dict(INTERNAL_UNITS)))
+
+    def __post_init__(self) -> None:
+        for name in ("robot_ids", "primitive_names", "human_ids", "object_ids", "messages"):
+            object.__setattr__(self, name, tuple(getattr(self, name)))
+        object.__setattr__(self, "units", MappingProxyType(dict(self.units)))
+        t = np.asarray(self.t, dtype=float)
+        if t.ndim != 1:
+            raise ValueError(f"Trace.t must have the shape (n,), got {t.shape}")
+        for name, (dtype, ids, tail) in _ARRAYS.items():
+            value = getattr(self, name)
+            if value is None and name in ("humans", "objects"):
+                value = np.empty((len(t), 0, 2))
+            if value is None:
+                continue
+            # A read-only view: the trace cannot change its arrays, and the caller's stay as they are.
+            array = np.asarray(value, dtype=dtype).view()
+            shape = (len(t),) if ids is None else (len(t), len(getattr(self, ids)), *tail)
+            if array.shape != shape:
+                raise ValueError(f"Trace.{name} must have the shape {shape}, got {array.shape}")
+            array.flags.writeable = False
+            object.__setattr__(self, name, array)
+        if self.dt is not None and not (_is_number(self.dt) and self.dt > 0):
+            raise ValueError(f"Trace.dt must be a positive number of seconds, got {self.dt!r}")
+
+    # -- reading -----------------------------------------------------------------------------
+
+    def ids(self, group: str) -> tuple[str, ...]:
+        """The ids of ``"robots"``, ``"humans"`` or ``"objects"``, in the order of their arrays."""
+        return {"robots": self.robot_ids, "humans": self.human_ids, "objects": self.object_ids}[group]
+
+    def positions(self, group: str) -> np.ndarray:
+        """Positions ``(x, y)`` (mm) of ``"robots"``, ``"humans"`` or ``"objects"``: shape (n, N, 2)."""
+        return self.poses[:, :, :2] if group == "robots" else getattr(self, group)
+
+    def seen(self, group: str, every: int = 1) -> np.ndarray:
+        """Every position (mm) of `group` that a frame shows, every `every`-th frame: shape (m, 2)."""
+        points = self.positions(group)[::every].reshape(-1, 2)
+        return points[~np.isnan(points[:, 0])]
+
+    def robots_at(self, k: int) -> dict[str, RobotState]:
+        """The robots frame `k` shows, in the order of :attr:`robot_ids`."""
+        poses = self.poses[k].tolist()
+        carrying = self.carrying[k].tolist() if self.carrying is not None else [-1] * len(poses)
+        waiting = self.waiting[k].tolist() if self.waiting is not None else [False] * len(poses)
+        return {
+            rid: RobotState(tuple(pose), self.object_ids[c] if c >= 0 else None, w)
+            for rid, pose, c, w in zip(self.robot_ids, poses, carrying, waiting, strict=True)
+            if not math.isnan(pose[0])
+        }
+
+    def points_at(self, group: str, k: int) -> dict[str, tuple[float, float]]:
+        """Where frame `k` shows the ``"humans"`` or the ``"objects"`` (mm), by id."""
+        points = self.positions(group)[k].tolist()
+        return {pid: (x, y) for pid, (x, y) in zip(self.ids(group), points, strict=True) if not math.isnan(x)}
+
+    def carried_at(self, k: int) -> dict[str, str]:
+        """The objects carried in frame `k`: the carrier's id by object id."""
+        return {s.carrying: rid for rid, s in self.robots_at(k).items() if s.carrying is not None}
+
+    # -- the file -----------------------------------------------------------------------------
+
+    def rounded(self) -> Trace:
+        """This trace at the precision of its file: lengths, degrees and speeds to 0.001, times to 1 µs."""
+        return replace(
+            self,
+            t=_rounded(self.t, _TIME_DIGITS),
+            **{
+                name: _rounded(getattr(self, name), _LENGTH_DIGITS)
+                for name in ("poses", "v", "w", "humans", "objects")
+            },
+        )
+
+    def to_json(self) -> dict[str, Any]:
+        """The ``cosmop.trace/1`` file as a JSON-ready dict: one frame per entry of :attr:`t`.
+
+        Lengths, degrees and speeds are rounded to 0.001, times to 1 µs (:meth:`rounded`); what
+        a frame does not show (NaN) and the keys the trace has no array for are left out.
+        """
+        data: dict[str, Any] = {"format": TRACE_FORMAT}
+        if self.scenario is not None:
+            data["scenario"] = self.scenario
+        data["units"] = dict(self.units)
+        if self.dt is not None:
+            data["dt"] = self.dt
+        exact = self.rounded()
+        robots = exact._json_robots()
+        humans, objects = (_json_points(exact.ids(g), exact.positions(g)) for g in ("humans", "objects"))
+        data["frames"] = [
+            {"t": t, "robots": robots[k], "humans": humans[k], "objects": objects[k]}
+            for k, t in enumerate(exact.t.tolist())
+        ]
+        data["messages"] = [dict(m) for m in self.messages]
+        return data
+
+    def _json_robots(self) -> list[dict[str, dict[str, Any]]]:
+        """Each frame's robot states as the file writes them (this trace already :meth:`rounded`)."""
+        objects, names = [*self.object_ids, None], self.primitive_names  # carrying -1: objects[-1], None
+        columns = {"pose": self.poses.tolist()}
+        for key, array, to_json in (
+            ("v", self.v, None),
+            ("w", self.w, None),
+            ("carrying", self.carrying, objects.__getitem__),
+            ("primitive", self.primitive, names.__getitem__),
+            ("waiting", self.waiting, None),
+        ):
+            if array is not None:
+                rows = array.tolist()
+                columns[key] = rows if to_json is None else [list(map(to_json, row)) for row in rows]
+        frames = []
+        for k in range(len(self.t)):
+            robots = {}
+            for i, rid in enumerate(self.robot_ids):
+                if math.isnan(columns["pose"][k][i][0]):
+                    continue  # this frame does not show the robot
+                state = {key: rows[k][i] for key, rows in columns.items()}
+                robots[rid] = {key: v for key, v in state.items() if not (isinstance(v, float) and v != v)}
+            frames.append(robots)
+        return frames
+
+    @classmethod
+    def from_json(cls, data: Any, file: str | os.PathLike[str] | None = None) -> Trace:
+        """The trace of a parsed ``cosmop.trace/1`` file, once :func:`check_trace` has checked it.
+
+        The ids of each kind are taken in the order the frames first name them (objects that
+        are only ever carried come last); a frame that does not name one is NaN there.  Keys no
+        robot state has (``v``, ``w``, ``carrying``, ``primitive``, ``waiting``) give None.
+
+        Raises
+        ------
+        TraceError
+            Naming `file`, the first wrong field and what was expected there.
+        """
+        checked = check_trace(data, file)
+        frames = checked["frames"]
+        robot_ids = _first_seen(frames, "robots")
+        columns = _robot_columns(frames, robot_ids)
+        carried = [oid for row in columns.get("carrying", ()) for oid in row if oid is not None]
+        object_ids = tuple(dict.fromkeys([*_first_seen(frames, "objects"), *carried]))
+        names: tuple[str | None, ...] = ()
+        if "carrying" in columns:
+            index = {oid: j for j, oid in enumerate(object_ids)} | {None: -1}
+            columns["carrying"] = _indices(columns["carrying"], index, len(robot_ids))
+        if "primitive" in columns:
+            named = [p for row in columns["primitive"] for p in row if p is not None]
+            names = (None, *dict.fromkeys(named))  # 0: none, as the simulator numbers them
+            index = {name: k for k, name in enumerate(names)}
+            columns["primitive"] = _indices(columns["primitive"], index, len(robot_ids))
+        human_ids = _first_seen(frames, "humans")
+        return cls(
+            t=[float(frame["t"]) for frame in frames],
+            robot_ids=robot_ids,
+            primitive_names=names,
+            human_ids=human_ids,
+            humans=_point_columns(frames, "humans", human_ids),
+            object_ids=object_ids,
+            objects=_point_columns(frames, "objects", object_ids),
+            messages=tuple(checked.get("messages", [])),
+            scenario=checked.get("scenario"),
+            dt=checked.get("dt"),
+            units=checked.get("units") or INTERNAL_UNITS,
+            **columns,
+        )
+
+    def save(self, path: str | os.PathLike[str]) -> None:
+        """Write :meth:`to_json` to `path` as compact JSON, atomically (:func:`cosmop.io.write_atomic`)."""
+        write_atomic(path, json.dumps(self.to_json(), separators=(",", ":")) + "\n")
+
+
+def _rounded(values: np.ndarray | None, digits: int) -> np.ndarray | None:
+    """`values` rounded to `digits` decimals exactly as Python's :func:`round` rounds each float.
+
+    ``np.round`` scales by ``10**digits`` first, which can tip a value to the other side of a
+    tie; the files keep the bytes they always had, so every value goes through ``round``.
+    """
+    if values is None:
+        return None
+    flat = [round(x, digits) for x in values.ravel().tolist()]
+    return np.array(flat, dtype=float).reshape(values.shape)
+
+
+def _json_points(ids: Sequence[str], positions: np.ndarray) -> list[dict[str, list[float]]]:
+    """Each frame's ``{id: [x, y]}`` (mm), leaving out what the frame does not show (NaN)."""
+    return [
+        {pid: point for pid, point in zip(ids, row, strict=True) if not math.isnan(point[0])}
+        for row in positions.tolist()
+    ]
+
+
+def _first_seen(frames: Sequence[Mapping[str, Any]], group: str) -> tuple[str, ...]:
+    """The ids the frames name under `group`, in the order they first appear."""
+    return tuple(dict.fromkeys(pid for frame in frames for pid in frame.get(group, {})))
+
+
+def _robot_columns(frames: Sequence[Mapping[str, Any]], robot_ids: Sequence[str]) -> dict[str, Any]:
+    """``poses`` (n, R, 3) and every optional key some robot state has, frame by frame.
+
+    ``v`` and ``w`` are arrays (NaN where not given), ``waiting`` a boolean array, ``carrying``
+    and ``primitive`` lists of rows of names (None where not given), still to be numbered.
+    """
+    n, index = len(frames), {rid: i for i, rid in enumerate(robot_ids)}
+    columns: dict[str, Any] = {"poses": np.full((n, len(robot_ids), 3), np.nan)}
+    given: set[str] = set()
+    for key, empty in (("v", np.nan), ("w", np.nan), ("waiting", False)):
+        columns[key] = np.full((n, len(robot_ids)), empty)
+    for key in ("carrying", "primitive"):
+        columns[key] = [[None] * len(robot_ids) for _ in range(n)]
+    for k, frame in enumerate(frames):
+        for rid, state in frame.get("robots", {}).items():
+            i = index[rid]
+            columns["poses"][k, i] = state["pose"]
+            for key in _STATE_KEYS.keys() & state.keys():
+                columns[key][k][i] = state[key]
+                given.add(key)
+    return {key: value for key, value in columns.items() if key == "poses" or key in given}
+
+
+def _indices(rows: list[list[str | None]], index: Mapping[str | None, int], width: int) -> np.ndarray:
+    """Rows of names (None included) as their numbers in `index`: shape (n, width)."""
+    return np.array([[index[name] for name in row] for row in rows], dtype=int).reshape(-1, width)
+
+
+def _point_columns(frames: Sequence[Mapping[str, Any]], group: str, ids: Sequence[str]) -> np.ndarray:
+    """Positions (mm) of the `group` ids in every frame, shape (n, N, 2); NaN where not shown."""
+    index = {pid: j for j, pid in enumerate(ids)}
+    out = np.full((len(frames), len(ids), 2), np.nan)
+    for k, frame in enumerate(frames):
+        for pid, point in frame.get(group, {}).items():
+            out[k, index[pid]] = point
+    return out
+
+
+def as_trace(trace: Trace | Mapping[str, Any]) -> Trace:
+    """`trace` itself, or the :class:`Trace` of a parsed ``cosmop.trace/1`` mapping.
+
+    What the public functions that read traces call first, so that they take either.
+
+    Raises
+    ------
+    TraceError
+        If a mapping does not have the ``cosmop.trace/1`` shape (:func:`check_trace`).
+    """
+    return trace if isinstance(trace, Trace) else Trace.from_json(trace)
+
+
+def load_trace(path: str | os.PathLike[str]) -> Trace:
+    """Read a ``cosmop.trace/1`` file as a :class:`Trace` (checked by :func:`check_trace`).
+
+    Raises
+    ------
+    TraceError
+        If the file cannot be read or parsed, naming it, or does not have the trace's shape,
+        naming it and the first wrong field.
+    """
     file = os.fspath(path)
     text = read_text(path, TraceError, "a trace file")
-    data = load_json(text, file, TraceError)
-    return check_trace(data, file)
+    return Trace.from_json(load_json(text, file, TraceError), file)
 
 
 def message_label(message: Mapping[str, Any]) -> str:

@@ -19,10 +19,9 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import replace
-from typing import TYPE_CHECKING, Any, Literal
+from typing import Any, Literal
 
-if TYPE_CHECKING:
-    from cosmop.scenario import Dynamics, Scene
+from cosmop.scene import Dynamics, Scene
 
 __all__ = [
     "INTERNAL_UNITS",
@@ -93,13 +92,11 @@ def _dynamics(d: Dynamics) -> Dynamics:
 
 
 def default_dynamics(units: UnitSystem) -> Dynamics:
-    """:class:`~cosmop.scenario.Dynamics`' defaults expressed in `units` (m/s, rad/s, ... for ``"m"``).
+    """:class:`~cosmop.scene.Dynamics`' defaults expressed in `units` (m/s, rad/s, ... for ``"m"``).
 
     A scene read in metres starts from these, so that :func:`scene_to_internal` turns them
     back into exactly the millimetre defaults.
     """
-    from cosmop.scenario import Dynamics
-
     d = Dynamics()
     if units == "mm":
         return d

@@ -57,6 +57,7 @@ import io
 import numbers
 from collections import deque
 from collections.abc import Iterable, Iterator
+from dataclasses import dataclass
 from types import ModuleType
 from typing import TYPE_CHECKING, TypeAlias
 
@@ -293,46 +294,94 @@ def to_faudes(
         If ``faudes`` is not installed.
     """
     fd = _load()
+    plain = _checked(alphabet, n_states, initial, marked, transitions)
+    return _generator(fd, plain, name)
 
-    def index(q: object) -> object:
-        # numpy integers are state indices too; booleans and floats are not
-        return int(q) if isinstance(q, numbers.Integral) and not isinstance(q, bool) else q
 
+@dataclass(frozen=True)
+class _Checked:
+    """Plain DFA data checked for :func:`to_faudes`, states as ``int``.
+
+    Attributes
+    ----------
+    symbols : dict of str to str
+        Each event name's libFAUDES symbol (:func:`encode_event`), in alphabet order.
+    n_states : int
+    initial : int
+        Unchecked (and unused) when ``n_states`` is 0.
+    marked : list of int
+    delta : dict of (int, str) to int
+        The transitions ``(src, event) -> dst``, in the order given.
+    """
+
+    symbols: dict[str, str]
+    n_states: int
+    initial: int
+    marked: list[int]
+    delta: dict[tuple[int, str], int]
+
+
+def _state_index(q: object) -> object:
+    """`q` as an ``int`` if it is an integer, else unchanged (and rejected when checked)."""
+    # numpy integers are state indices too; booleans and floats are not
+    return int(q) if isinstance(q, numbers.Integral) and not isinstance(q, bool) else q
+
+
+def _check_state(q: object, n_states: int, what: str) -> None:
+    """Raise :class:`ValueError` unless `q` is a state index in ``0 .. n_states - 1``."""
+    if not isinstance(q, int) or not 0 <= q < n_states:
+        raise ValueError(f"{what} {q!r} is not a state index in 0..{n_states - 1}")
+
+
+def _checked(
+    alphabet: Iterable[str],
+    n_states: object,
+    initial: object,
+    marked: Iterable[object],
+    transitions: Iterable[tuple[object, str, object]],
+) -> _Checked:
+    """Check the arguments of :func:`to_faudes` and index the transitions by ``(src, event)``.
+
+    Raises
+    ------
+    ValueError
+        As :func:`to_faudes` documents: the state count, then the initial and the marked
+        states, the event names, and the transitions in order.
+    """
     alphabet = list(alphabet)
-    marked = [index(q) for q in marked]
-    transitions = [(index(src), ev, index(dst)) for src, ev, dst in transitions]
-    n_states, initial = index(n_states), index(initial)
+    marked = [_state_index(q) for q in marked]
+    transitions = [(_state_index(src), ev, _state_index(dst)) for src, ev, dst in transitions]
+    n_states, initial = _state_index(n_states), _state_index(initial)
     if not isinstance(n_states, int) or n_states < 0:
         raise ValueError(f"n_states must be a non-negative int, got {n_states!r}")
-
-    def check_state(q: int, what: str) -> None:
-        if not isinstance(q, int) or not 0 <= q < n_states:
-            raise ValueError(f"{what} {q!r} is not a state index in 0..{n_states - 1}")
-
     if n_states > 0:
-        check_state(initial, "initial state")
+        _check_state(initial, n_states, "initial state")
     for q in marked:
-        check_state(q, "marked state")
+        _check_state(q, n_states, "marked state")
     symbols = {ev: encode_event(ev) for ev in alphabet}
     delta: dict[tuple[int, str], int] = {}
     for src, ev, dst in transitions:
-        check_state(src, "transition source")
-        check_state(dst, "transition target")
+        _check_state(src, n_states, "transition source")
+        _check_state(dst, n_states, "transition target")
         if ev not in symbols:
             raise ValueError(f"transition event {ev!r} is not in the alphabet")
         if delta.setdefault((src, ev), dst) != dst:
             raise ValueError(f"non-deterministic transitions from state {src} on {ev!r}")
+    return _Checked(symbols, n_states, initial, marked, delta)
 
+
+def _generator(fd: ModuleType, plain: _Checked, name: str) -> faudes.Generator:
+    """A libFAUDES generator for checked data: state ``i`` is libFAUDES state ``i + 1``."""
     gen = _new_generator(fd, name)
     with _quiet(fd):
-        event_index = {ev: gen.InsEvent(sym) for ev, sym in symbols.items()}
-        for q in range(n_states):
+        event_index = {ev: gen.InsEvent(sym) for ev, sym in plain.symbols.items()}
+        for q in range(plain.n_states):
             gen.InsState(q + 1)
-        if n_states > 0:
-            gen.SetInitState(initial + 1)
-        for q in marked:
+        if plain.n_states > 0:
+            gen.SetInitState(plain.initial + 1)
+        for q in plain.marked:
             gen.SetMarkedState(q + 1)
-        for (src, ev), dst in delta.items():
+        for (src, ev), dst in plain.delta.items():
             gen.SetTransition(src + 1, event_index[ev], dst + 1)
     return gen
 

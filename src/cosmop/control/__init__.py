@@ -7,15 +7,25 @@ passive-safe ones and scores them against a global path from :mod:`cosmop.contro
 Units are millimetres, seconds and radians.
 """
 
-from cosmop.control.dwa import DwaCommand, DwaSettings, dwa_commands
+from cosmop.control.dwa import Drivers, DwaCommand, DwaSettings, Obstacles, dwa_commands
 from cosmop.control.geometry import box_gaps, point_segment_linf, segment_array
 from cosmop.control.paths import GlobalPath, plan_path
-from cosmop.control.safety import admissible_speed, is_safe, obstacle_speed, stopping_horizon, stopping_margin
+from cosmop.control.safety import (
+    Limits,
+    admissible_speed,
+    is_safe,
+    obstacle_speed,
+    stopping_horizon,
+    stopping_margin,
+)
 
 __all__ = [
+    "Drivers",
     "DwaCommand",
     "DwaSettings",
     "GlobalPath",
+    "Limits",
+    "Obstacles",
     "admissible_speed",
     "box_gaps",
     "dwa_commands",

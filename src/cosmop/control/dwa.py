@@ -22,14 +22,14 @@ Units: mm, mm/s, radians and rad/s inside; degrees at the interfaces of :mod:`co
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from cosmop.control.geometry import box_gaps, point_segment_linf
-from cosmop.control.safety import obstacle_speed
+from cosmop.control.safety import Limits, is_safe, obstacle_speed, stopping_horizon
 
-__all__ = ["DwaCommand", "DwaSettings", "dwa_commands", "robot_gaps"]
+__all__ = ["Drivers", "DwaCommand", "DwaSettings", "Obstacles", "dwa_commands", "robot_gaps"]
 
 
 @dataclass(frozen=True)
@@ -118,28 +118,50 @@ def robot_gaps(
     return wall_gap, box_gap
 
 
-def dwa_commands(
-    pose: np.ndarray,
-    v: np.ndarray,
-    half: np.ndarray,
-    limits: np.ndarray,
-    target: np.ndarray,
-    stop_distance: np.ndarray,
-    walls: np.ndarray,
-    boxes: np.ndarray,
-    box_speed: np.ndarray,
-    ignore: np.ndarray | None,
-    settings: DwaSettings = DwaSettings(),
-    grip: np.ndarray | None = None,
-    box_velocity: np.ndarray | None = None,
-    room_cap: np.ndarray | None = None,
-    box_accel: np.ndarray | None = None,
-    w_now: np.ndarray | None = None,
-    agents: np.ndarray | None = None,
-) -> DwaCommand:
-    """One cycle of the extended DWA for `R` robots at once.
+@dataclass(frozen=True)
+class Obstacles:
+    """Everything a robot senses in one cycle: the walls and the boxes (objects, robots, people).
 
-    Parameters
+    Attributes
+    ----------
+    walls : ndarray, shape (W, 4)
+        Wall segments ``x1, y1, x2, y2``, mm.
+    boxes : ndarray, shape (M, 3)
+        Axis-aligned squares ``x, y, half side``, mm.
+    speed : ndarray, shape (M,)
+        :math:`V_o`, the top speed of each box, mm/s (0 for resting objects and parked robots).
+    velocity : ndarray, shape (M, 2), optional
+        Current velocities, mm/s, to extrapolate the boxes along a predicted arc when scoring
+        (the safety rule assumes the worst, :math:`V_o`, instead).
+    acceleration : ndarray, shape (M,), optional
+        Acceleration limits, mm/s² (``inf`` for people, 0 for objects): with the current
+        speeds they tighten :math:`V_o` to :func:`~cosmop.control.safety.obstacle_speed` over
+        each robot's stopping horizon.
+    agents : ndarray of bool, shape (M,), optional
+        Which boxes are robots or people, kept at the standoff (default: those that move).
+    names : tuple of str
+        The id of each box (for the caller; the controller does not read it).
+    """
+
+    walls: np.ndarray
+    boxes: np.ndarray
+    speed: np.ndarray
+    velocity: np.ndarray | None = None
+    acceleration: np.ndarray | None = None
+    agents: np.ndarray | None = None
+    names: tuple[str, ...] = ()
+
+    @property
+    def movers(self) -> np.ndarray:
+        """Which boxes are kept at the standoff: :attr:`agents`, else those that move."""
+        return self.speed > 0 if self.agents is None else self.agents
+
+
+@dataclass(frozen=True)
+class Drivers:
+    """The robots that drive this cycle, and where each heads (arrays over robots, ``(R, ...)``).
+
+    Attributes
     ----------
     pose : ndarray, shape (R, 3)
         ``x, y`` (mm) and heading (rad).
@@ -147,89 +169,161 @@ def dwa_commands(
         Translational speeds now, mm/s.
     half : ndarray, shape (R,)
         Half sides of the robots, mm.
-    limits : ndarray, shape (R, 5)
-        Per robot: top speed (mm/s), :math:`A`, :math:`b` (mm/s²), :math:`\\Omega` (rad/s),
-        :math:`\\varepsilon` (s).
+    limits : Limits
+        Their unicycle limits.
     target : ndarray, shape (R, 2)
         The look-ahead point on each robot's global path, mm.
     stop_distance : ndarray, shape (R,)
         Distance left to the goal along the path (mm): the speed is capped so that the robot
-        can stop there with half its braking.
-    walls : ndarray, shape (W, 4)
-    boxes : ndarray, shape (M, 3)
-        Other obstacles (objects, robots, people) as ``x, y, half side``.
-    box_speed : ndarray, shape (M,)
-        :math:`V_o` of each box, mm/s.
+        can stop there.
+    w : ndarray, shape (R,), optional
+        Current turn rates (rad/s): a robot with no admissible arc brakes along its arc.
+    room_cap : ndarray, shape (R,), optional
+        The most clearance that scores (mm; default ``DwaSettings.clearance``).  Set it to the
+        gap at the goal so that a goal close to an obstacle (a docking pose) does not repel its
+        own robot.
+    """
+
+    pose: np.ndarray
+    v: np.ndarray
+    half: np.ndarray
+    limits: Limits
+    target: np.ndarray
+    stop_distance: np.ndarray
+    w: np.ndarray | None = None
+    room_cap: np.ndarray | None = None
+
+    def __getitem__(self, rows) -> Drivers:
+        """The drivers `rows` (an index array or a mask)."""
+        return Drivers(
+            self.pose[rows],
+            self.v[rows],
+            self.half[rows],
+            self.limits[rows],
+            self.target[rows],
+            self.stop_distance[rows],
+            None if self.w is None else self.w[rows],
+            None if self.room_cap is None else self.room_cap[rows],
+        )
+
+
+def dwa_commands(
+    drivers: Drivers,
+    obstacles: Obstacles,
+    settings: DwaSettings = DwaSettings(),
+    *,
+    ignore: np.ndarray | None = None,
+    grip: np.ndarray | None = None,
+) -> DwaCommand:
+    """One cycle of the extended DWA for `R` robots at once.
+
+    Parameters
+    ----------
+    drivers : Drivers
+        The robots, their limits and their targets.
+    obstacles : Obstacles
+        The walls and the boxes they sense.
+    settings : DwaSettings
     ignore : ndarray of bool, shape (R, M), optional
         Boxes each robot does not treat as obstacles (itself).
-    settings : DwaSettings
     grip : ndarray of bool, shape (R, M), optional
         The object each robot touches with its gripper (just docked or just dropped): it does
         not count for ``safe`` (the robot touches it by design) but arcs into it score as
         touching, so the robot leaves it.
-    box_velocity : ndarray, shape (M, 2), optional
-        Current velocities of the boxes (mm/s), to extrapolate them along a predicted arc
-        when scoring (the safety rule assumes the worst, :math:`V_o`, instead).
-    box_accel : ndarray, shape (M,), optional
-        Acceleration limits of the boxes (mm/s²; ``inf`` for people, 0 for objects): with
-        their current speeds (from `box_velocity`) they tighten :math:`V_o` to
-        :func:`~cosmop.control.safety.obstacle_speed` over each robot's stopping horizon.
-    w_now : ndarray, shape (R,), optional
-        Current turn rates (rad/s): a robot with no admissible arc brakes along its arc.
-    agents : ndarray of bool, shape (M,), optional
-        Which boxes are robots or people, kept at the standoff (default: those that move).
-    room_cap : ndarray, shape (R,), optional
-        Per robot, the most clearance that scores (mm; default ``settings.clearance``).  Set
-        it to the gap at the goal so that a goal close to an obstacle (a docking pose) does
-        not repel its own robot.
 
     Returns
     -------
     DwaCommand
     """
-    R = len(pose)
-    top, acc, brk, eps = limits[:, 0], limits[:, 1], limits[:, 2], limits[:, 4]
-    xy, theta = pose[:, :2], pose[:, 2]
     skip = ignore if grip is None else (grip if ignore is None else ignore | grip)
-    wall_gap, box_gap = robot_gaps(xy, half, walls, boxes, skip)
-
-    # Passive safety: v < v_max for every obstacle (paper's safe, per-obstacle V).
-    movers = box_speed > 0 if agents is None else agents
-    gap_all = np.concatenate([wall_gap, box_gap - settings.standoff * movers[None, :]], axis=1)
-    speed_all = np.concatenate([np.zeros(wall_gap.shape[1]), box_speed])
-    margin = (acc / brk + 1)[:, None] * (acc[:, None] / 2 * eps[:, None] ** 2 + eps[:, None] * v[:, None])
-    margin = margin + (v * v / (2 * brk))[:, None]
-    horizon = eps + (v + acc * eps) / brk  # (R,): the stopping horizon T
-    if box_accel is not None and box_velocity is not None and len(boxes):
-        now = np.hypot(box_velocity[:, 0], box_velocity[:, 1])
-        bound = obstacle_speed(horizon[:, None], box_speed[None, :], now[None, :], box_accel[None, :])
-        speeds = np.concatenate([np.zeros((R, wall_gap.shape[1])), bound], axis=1)
-    else:
-        speeds = np.broadcast_to(speed_all[None, :], gap_all.shape)
-    margin = margin + speeds * horizon[:, None]
-    safe = np.all(gap_all > margin, axis=1)
-    min_gap = (
-        np.concatenate([wall_gap, box_gap], axis=1).min(axis=1) if gap_all.shape[1] else np.full(R, np.inf)
-    )
-
-    low, high, V, W = _window(pose, v, limits, target, stop_distance, settings)
-
-    if not safe.all() and len(boxes):
+    wall_gap, box_gap = robot_gaps(drivers.pose[:, :2], drivers.half, obstacles.walls, obstacles.boxes, skip)
+    safe = _passive_safety(drivers, obstacles, wall_gap, box_gap, settings)
+    everything = np.concatenate([wall_gap, box_gap], axis=1)
+    min_gap = everything.min(axis=1) if everything.shape[1] else np.full(len(drivers.v), np.inf)
+    if not safe.all() and len(obstacles.boxes):
         # Not safe: head away from the nearest box along the axis of its L-infinity gap first,
         # out of the standoff; the path is taken up again once safe holds.
+        drivers = _retreat(drivers, obstacles, box_gap, ~safe, settings)
+    low, high, V, W = _window(drivers, settings)
+    t, pts, th = _arcs(drivers, V, W, settings)
+    clear, mover_clear = _clearance(drivers, obstacles, ignore, t, pts, settings)
+    score = _score(drivers, settings, high, V, pts, th, clear, mover_clear)
+    w_out = np.zeros(len(drivers.v))
+    if not safe.all():
+        # Not safe: only arcs whose own braking path provably keeps clear (checked below), else
+        # brake along the previous arc -- the one the last cycle's check covered.
         rows = np.flatnonzero(~safe)
-        near = np.argmin(np.where(np.isinf(box_gap[rows]), np.inf, box_gap[rows]), axis=1)
-        close = box_gap[rows, near] < settings.standoff
-        delta = xy[rows] - boxes[near, :2]
-        along_x = np.abs(delta[:, 0]) >= np.abs(delta[:, 1])
-        away = np.where(along_x[:, None], [[1.0, 0.0]], [[0.0, 1.0]]) * np.sign(delta).clip(-1, 1)
-        away[np.all(away == 0, axis=1)] = [1.0, 0.0]
-        retreat = _open_retreat(xy[rows], half[rows], away, delta, walls, settings.standoff * 2)
-        target = target.copy()
-        target[rows[close]] = retreat[close]
-        low, high, V, W = _window(pose, v, limits, target, np.full(R, np.inf), settings)
+        ok = _escape_ok(
+            drivers[rows],
+            V[rows],
+            W[rows],
+            obstacles,
+            None if ignore is None else skip[rows],
+            _keep(box_gap[rows], obstacles.movers, settings),
+        )
+        score[rows] = np.where(ok, score[rows], -np.inf)
+        fallback = rows[~ok.any(axis=1)]
+        score[fallback] = -np.inf
+        w_out[fallback] = (np.zeros(len(drivers.v)) if drivers.w is None else drivers.w)[fallback]
+    best = np.argmax(score, axis=1)
+    rows_all = np.arange(len(drivers.v))
+    finite = np.isfinite(score[rows_all, best])
+    v_out = np.where(finite, V[rows_all, best], low)
+    w_out = np.where(finite, W[rows_all, best], w_out)
+    return DwaCommand(v=v_out, w=w_out, safe=safe, gap=min_gap)
 
-    # Predicted arcs: positions at t_k, k = 1..S, with (v, w) held.
+
+def _passive_safety(
+    drivers: Drivers, obstacles: Obstacles, wall_gap: np.ndarray, box_gap: np.ndarray, settings: DwaSettings
+) -> np.ndarray:
+    """The paper's ``safe`` for every robot against every obstacle at once, ``(R,)``.
+
+    Walls and resting objects have :math:`V_o = 0`; robots and people keep the standoff, and
+    their :math:`V_o` is :func:`~cosmop.control.safety.obstacle_speed` over the robot's
+    stopping horizon when their velocities and accelerations are known.
+    """
+    R, n_walls = len(drivers.v), wall_gap.shape[1]
+    gap = np.concatenate([wall_gap, box_gap - settings.standoff * obstacles.movers[None, :]], axis=1)
+    limits, v = drivers.limits.column(), drivers.v[:, None]
+    if obstacles.acceleration is not None and obstacles.velocity is not None and len(obstacles.boxes):
+        now = np.hypot(obstacles.velocity[:, 0], obstacles.velocity[:, 1])
+        bound = obstacle_speed(
+            stopping_horizon(v, limits),
+            obstacles.speed[None, :],
+            now[None, :],
+            obstacles.acceleration[None, :],
+        )
+        speeds = np.concatenate([np.zeros((R, n_walls)), bound], axis=1)
+    else:
+        speeds = np.broadcast_to(np.concatenate([np.zeros(n_walls), obstacles.speed])[None, :], gap.shape)
+    return np.all(is_safe(gap, v, speeds, limits), axis=1)
+
+
+def _retreat(
+    drivers: Drivers, obstacles: Obstacles, box_gap: np.ndarray, unsafe: np.ndarray, settings: DwaSettings
+) -> Drivers:
+    """`drivers` with the unsafe ones inside a box's standoff aimed at a point away from it,
+    and no stop distance (they leave at once)."""
+    rows = np.flatnonzero(unsafe)
+    xy, boxes = drivers.pose[:, :2], obstacles.boxes
+    near = np.argmin(np.where(np.isinf(box_gap[rows]), np.inf, box_gap[rows]), axis=1)
+    close = box_gap[rows, near] < settings.standoff
+    delta = xy[rows] - boxes[near, :2]
+    along_x = np.abs(delta[:, 0]) >= np.abs(delta[:, 1])
+    away = np.where(along_x[:, None], [[1.0, 0.0]], [[0.0, 1.0]]) * np.sign(delta).clip(-1, 1)
+    away[np.all(away == 0, axis=1)] = [1.0, 0.0]
+    retreat = _open_retreat(xy[rows], drivers.half[rows], away, delta, obstacles.walls, settings.standoff * 2)
+    target = drivers.target.copy()
+    target[rows[close]] = retreat[close]
+    return replace(drivers, target=target, stop_distance=np.full(len(drivers.v), np.inf))
+
+
+def _arcs(
+    drivers: Drivers, V: np.ndarray, W: np.ndarray, settings: DwaSettings
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Predicted arcs: the times ``t`` (S,), positions ``(R, K, S, 2)`` and headings
+    ``(R, K, S)`` at :math:`t_k = k\\,T/S`, k = 1..S, with ``(v, w)`` held."""
+    xy, theta = drivers.pose[:, :2], drivers.pose[:, 2]
     t = settings.horizon * np.arange(1, settings.samples + 1) / settings.samples  # (S,)
     th = theta[:, None, None] + W[:, :, None] * t[None, None, :]
     straight = np.abs(W) < 1e-6
@@ -244,19 +338,36 @@ def dwa_commands(
         V[:, :, None] * t * np.sin(theta)[:, None, None],
         -V[:, :, None] / w_safe * (np.cos(th) - np.cos(theta)[:, None, None]),
     )
-    pts = np.stack([xy[:, 0, None, None] + px, xy[:, 1, None, None] + py], axis=-1)  # (R, K, S, 2)
+    pts = np.stack([xy[:, 0, None, None] + px, xy[:, 1, None, None] + py], axis=-1)
+    return t, pts, th
 
-    # Clearance along each arc; moving obstacles grown by V t (pessimistic).
+
+def _clearance(
+    drivers: Drivers,
+    obstacles: Obstacles,
+    ignore: np.ndarray | None,
+    t: np.ndarray,
+    pts: np.ndarray,
+    settings: DwaSettings,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The least gap along each arc to anything, and to movers alone, ``(R, K)`` each, mm.
+
+    Moving boxes are extrapolated with their velocities when known (else grown by nothing:
+    the score only chooses among arcs the safety rule admits).
+    """
+    R, K, S = pts.shape[:3]
+    half, walls, boxes, movers = drivers.half, obstacles.walls, obstacles.boxes, obstacles.movers
     flat = pts.reshape(R, -1, 2)
     clear = np.full(flat.shape[:2], np.inf)
+    mover_clear = None
     if len(walls):
         clear = (point_segment_linf(flat, walls) - half[:, None, None]).min(axis=-1)
     if len(boxes):
-        tk = np.tile(t, V.shape[1])  # (K*S,): the time of each predicted point
-        if box_velocity is None:
+        if obstacles.velocity is None:
             bg = box_gaps(flat, half[:, None, None], boxes)  # (R, K*S, M)
         else:
-            moved = boxes[None, :, :2] + tk[:, None, None] * box_velocity[None, :, :]  # (K*S, M, 2)
+            tk = np.tile(t, K)  # (K*S,): the time of each predicted point
+            moved = boxes[None, :, :2] + tk[:, None, None] * obstacles.velocity[None, :, :]  # (K*S, M, 2)
             d = np.maximum(
                 np.abs(flat[:, :, None, 0] - moved[None, :, :, 0]),
                 np.abs(flat[:, :, None, 1] - moved[None, :, :, 1]),
@@ -265,16 +376,30 @@ def dwa_commands(
         if ignore is not None:
             bg = np.where(ignore[:, None, :], np.inf, bg)
         if movers.any():
-            mover_clear = bg[:, :, movers].min(axis=-1).reshape(R, V.shape[1], settings.samples).min(axis=-1)
+            mover_clear = bg[:, :, movers].min(axis=-1).reshape(R, K, S).min(axis=-1)
         if (~movers).any():
             clear = np.minimum(clear, bg[:, :, ~movers].min(axis=-1))
         clear = np.minimum(clear, bg.min(axis=-1))
-    clear = clear.reshape(R, V.shape[1], settings.samples).min(axis=-1)
-    if not len(boxes) or not movers.any():
+    clear = clear.reshape(R, K, S).min(axis=-1)
+    if mover_clear is None:
         mover_clear = np.full_like(clear, np.inf)
+    return clear, mover_clear
 
-    end = pts[:, :, -1, :]
-    end_heading = th[:, :, -1]
+
+def _score(
+    drivers: Drivers,
+    settings: DwaSettings,
+    high: np.ndarray,
+    V: np.ndarray,
+    pts: np.ndarray,
+    th: np.ndarray,
+    clear: np.ndarray,
+    mover_clear: np.ndarray,
+) -> np.ndarray:
+    """Each arc's score ``(R, K)``: progress towards the target, heading towards it at the
+    arc's end, room (up to the clearance cap and the personal space) and speed."""
+    xy, target = drivers.pose[:, :2], drivers.target
+    end, end_heading = pts[:, :, -1, :], th[:, :, -1]
     d_now = np.hypot(target[:, 0] - xy[:, 0], target[:, 1] - xy[:, 1])
     d_end = np.hypot(target[:, None, 0] - end[..., 0], target[:, None, 1] - end[..., 1])
     # Progress relative to the best the window allows, so that it also decides at low speed.
@@ -282,7 +407,12 @@ def dwa_commands(
     bearing = np.arctan2(target[:, None, 1] - end[..., 1], target[:, None, 0] - end[..., 0])
     heading = 1.0 - np.abs(np.angle(np.exp(1j * (bearing - end_heading)))) / np.pi
     heading = np.where(d_end < 1.0, 1.0, heading)
-    cap = np.full(R, settings.clearance) if room_cap is None else np.minimum(room_cap, settings.clearance)
+    R = len(drivers.v)
+    cap = (
+        np.full(R, settings.clearance)
+        if drivers.room_cap is None
+        else np.minimum(drivers.room_cap, settings.clearance)
+    )
     cap = np.maximum(cap, 0.0)[:, None]
     room = np.where(cap > 0, np.minimum(clear, cap) / np.maximum(cap, 1e-9), 1.0)
     room = np.minimum(room, np.clip(mover_clear / settings.personal_space, 0.0, 1.0))
@@ -290,47 +420,18 @@ def dwa_commands(
         settings.progress_weight * progress
         + settings.heading_weight * heading
         + settings.clearance_weight * room
-        + settings.speed_weight * V / np.maximum(top, 1.0)[:, None]
+        + settings.speed_weight * V / np.maximum(drivers.limits.max_speed, 1.0)[:, None]
     )
     # An arc that would touch something within the horizon is taken only if every arc would.
-    score = np.where(clear > 0, score, score - 1e3 + clear / 1e3)
-    w_out = np.zeros(R)
-    if not safe.all():
-        # Not safe: only arcs whose own braking path provably keeps clear (checked below), else
-        # brake along the previous arc -- the one the last cycle's check covered.
-        rows = np.flatnonzero(~safe)
-        # Inside the standoff of a mover, an escape arc may not end closer to it than now.
-        # (a few mm of slack per cycle, down to half the standoff, so that it can slide along)
-        near = box_gap[rows]
-        floor = np.minimum(near, np.maximum(near - 2.0, settings.standoff / 2))
-        keep = np.where(movers[None, :] & (near < settings.standoff), floor, -np.inf)
-        ok = _escape_ok(
-            pose[rows],
-            v[rows],
-            V[rows],
-            W[rows],
-            half[rows],
-            limits[rows],
-            walls,
-            boxes,
-            box_speed,
-            None if ignore is None else skip[rows],
-            box_velocity,
-            box_accel,
-            keep,
-        )
-        score[rows] = np.where(ok, score[rows], -np.inf)
-        none = ~ok.any(axis=1)
-        w_prev = np.zeros(R) if w_now is None else w_now
-        fallback = rows[none]
-        score[fallback] = -np.inf
-        w_out[fallback] = w_prev[fallback]
-    best = np.argmax(score, axis=1)
-    rows_all = np.arange(R)
-    v_out = V[rows_all, best]
-    w_out = np.where(np.isfinite(score[rows_all, best]), W[rows_all, best], w_out)
-    v_out = np.where(np.isfinite(score[rows_all, best]), v_out, low)
-    return DwaCommand(v=v_out, w=w_out, safe=safe, gap=min_gap)
+    return np.where(clear > 0, score, score - 1e3 + clear / 1e3)
+
+
+def _keep(near: np.ndarray, movers: np.ndarray, settings: DwaSettings) -> np.ndarray:
+    """Inside the standoff of a mover, an escape arc may not end closer to it than now (a few
+    mm of slack per cycle, down to half the standoff, so that it can slide along); ``-inf``
+    elsewhere."""
+    floor = np.minimum(near, np.maximum(near - 2.0, settings.standoff / 2))
+    return np.where(movers[None, :] & (near < settings.standoff), floor, -np.inf)
 
 
 def _open_retreat(xy, half, away, delta, walls, reach: float) -> np.ndarray:
@@ -355,14 +456,7 @@ def _open_retreat(xy, half, away, delta, walls, reach: float) -> np.ndarray:
     return out
 
 
-def _window(
-    pose: np.ndarray,
-    v: np.ndarray,
-    limits: np.ndarray,
-    target: np.ndarray,
-    stop_distance: np.ndarray,
-    settings: DwaSettings,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def _window(drivers: Drivers, settings: DwaSettings) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     r"""The sampled arcs of the dynamic window of each robot, towards its `target`.
 
     The speeds span :math:`[v - b\varepsilon, \min(v + A\varepsilon, v_{top},
@@ -377,9 +471,10 @@ def _window(
     V, W : ndarray, shape (R, K)
         Every sampled pair of speed (mm/s) and turn rate (rad/s).
     """
-    R = len(pose)
-    top, acc, brk, omega, eps = (limits[:, i] for i in range(5))
-    xy, theta = pose[:, :2], pose[:, 2]
+    R, v, target, stop_distance = len(drivers.v), drivers.v, drivers.target, drivers.stop_distance
+    lim = drivers.limits
+    top, acc, brk, omega, eps = lim.max_speed, lim.acceleration, lim.braking, lim.turn_rate, lim.cycle
+    xy, theta = drivers.pose[:, :2], drivers.pose[:, 2]
     low = np.maximum(0.0, v - brk * eps)
     high = np.minimum(v + acc * eps, top)
     high = np.minimum(high, np.sqrt(np.maximum(brk * stop_distance, 0.0)))
@@ -399,8 +494,14 @@ def _window(
 
 
 def _escape_ok(
-    pose, v, V, W, half, limits, walls, boxes, box_speed, skip, box_velocity, box_accel, keep, steps: int = 8
-):
+    drivers: Drivers,
+    V: np.ndarray,
+    W: np.ndarray,
+    obstacles: Obstacles,
+    skip: np.ndarray | None,
+    keep: np.ndarray,
+    steps: int = 8,
+) -> np.ndarray:
     """Whether each arc's worst case keeps clear: held for one cycle, then braking to a stop.
 
     The robot reaches speed ``V`` linearly within :math:`\\varepsilon`, then brakes with
@@ -413,7 +514,15 @@ def _escape_ok(
     on the spot from a standstill is always admitted (the square footprint does not move).
     """
     U, K = V.shape
-    _top, _acc, brk, _omega, eps = (limits[:, i] for i in range(5))
+    pose, v, half, brk, eps = (
+        drivers.pose,
+        drivers.v,
+        drivers.half,
+        drivers.limits.braking,
+        drivers.limits.cycle,
+    )
+    walls, boxes, box_speed = obstacles.walls, obstacles.boxes, obstacles.speed
+    box_velocity, box_accel = obstacles.velocity, obstacles.acceleration
     total = eps[:, None] + V / brk[:, None]  # (U, K): time until standing still
     dt = total / steps
     t = dt[:, :, None] * np.arange(1, steps + 1)[None, None, :]  # (U, K, n)

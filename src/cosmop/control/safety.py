@@ -35,14 +35,70 @@ for ever).  Units: mm, mm/s, mm/s², s.
 
 from __future__ import annotations
 
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
 import numpy as np
 
-from cosmop.scenario import Dynamics
+from cosmop.scene import Dynamics
 
-__all__ = ["admissible_speed", "is_safe", "obstacle_speed", "stopping_horizon", "stopping_margin"]
+__all__ = ["Limits", "admissible_speed", "is_safe", "obstacle_speed", "stopping_horizon", "stopping_margin"]
 
 
-def stopping_margin(v, speed_bound, dynamics: Dynamics):
+@dataclass(frozen=True)
+class Limits:
+    """The unicycle limits of a batch of robots, one array entry per robot.
+
+    The arrays of :class:`~cosmop.scene.Dynamics`, so that every function here that takes
+    `dynamics` takes a batch too (with :meth:`column`, against many obstacles at once).
+
+    Attributes
+    ----------
+    max_speed : ndarray
+        Top translational speed, mm/s.
+    acceleration, braking : ndarray
+        :math:`A` and :math:`b`, mm/s².
+    turn_rate : ndarray
+        :math:`\\Omega`, rad/s (a scenario gives degrees/s).
+    cycle : ndarray
+        :math:`\\varepsilon`, s.
+    """
+
+    max_speed: np.ndarray
+    acceleration: np.ndarray
+    braking: np.ndarray
+    turn_rate: np.ndarray
+    cycle: np.ndarray
+
+    @classmethod
+    def of(cls, dynamics: Sequence[Dynamics]) -> Limits:
+        """The limits of robots with these `dynamics`, in order.
+
+        >>> Limits.of([Dynamics(), Dynamics(max_speed=500)]).max_speed
+        array([750., 500.])
+        """
+        return cls(
+            max_speed=np.array([d.max_speed for d in dynamics], dtype=float),
+            acceleration=np.array([d.acceleration for d in dynamics], dtype=float),
+            braking=np.array([d.braking for d in dynamics], dtype=float),
+            turn_rate=np.array([math.radians(d.turn_rate) for d in dynamics], dtype=float),
+            cycle=np.array([d.cycle for d in dynamics], dtype=float),
+        )
+
+    def __getitem__(self, rows) -> Limits:
+        """The limits of the robots `rows` (an index array, a mask or a slice)."""
+        return Limits(*(getattr(self, name)[rows] for name in _LIMIT_FIELDS))
+
+    def column(self) -> Limits:
+        """The same limits as columns ``(R, 1)``, to broadcast against ``(R, M)`` obstacles."""
+        return Limits(*(getattr(self, name)[:, None] for name in _LIMIT_FIELDS))
+
+
+_LIMIT_FIELDS = ("max_speed", "acceleration", "braking", "turn_rate", "cycle")
+
+
+def stopping_margin(v, speed_bound, dynamics: Dynamics | Limits):
     """The right-hand side of ``safe``: the gap (mm) a robot at speed `v` needs.
 
     Parameters
@@ -51,8 +107,8 @@ def stopping_margin(v, speed_bound, dynamics: Dynamics):
         Translational speed now, mm/s (>= 0).
     speed_bound : float or ndarray
         :math:`V_o`, the most the obstacle moves, mm/s.
-    dynamics : Dynamics
-        :math:`A`, :math:`b`, :math:`\\varepsilon`.
+    dynamics : Dynamics or Limits
+        :math:`A`, :math:`b`, :math:`\\varepsilon` (arrays broadcast with `v` and `speed_bound`).
     """
     a, b, eps = dynamics.acceleration, dynamics.braking, dynamics.cycle
     return (
@@ -62,7 +118,7 @@ def stopping_margin(v, speed_bound, dynamics: Dynamics):
     )
 
 
-def stopping_horizon(v, dynamics: Dynamics):
+def stopping_horizon(v, dynamics: Dynamics | Limits):
     """:math:`T = \\varepsilon + (v + A\\varepsilon)/b`: the latest time a robot at `v` stands still, s."""
     a, b, eps = dynamics.acceleration, dynamics.braking, dynamics.cycle
     return eps + (v + a * eps) / b
@@ -92,12 +148,12 @@ def obstacle_speed(horizon, top, speed_now, acceleration):
     return np.minimum(top, np.where(np.isnan(reach), np.inf, reach))
 
 
-def is_safe(gap, v, speed_bound, dynamics: Dynamics):
+def is_safe(gap, v, speed_bound, dynamics: Dynamics | Limits):
     """The paper's ``safe``: ``gap > stopping_margin(v, V)`` (elementwise)."""
     return np.asarray(gap) > stopping_margin(v, speed_bound, dynamics)
 
 
-def admissible_speed(gap, speed_bound, dynamics: Dynamics):
+def admissible_speed(gap, speed_bound, dynamics: Dynamics | Limits):
     """The Corollary's :math:`v_{max}`: ``safe`` holds exactly for ``0 <= v < v_max``.
 
     Negative when not even a standing robot may start (the gap is below

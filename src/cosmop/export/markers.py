@@ -16,7 +16,8 @@ from cosmop.units import m_from_mm
 from cosmop.viz.palette import robot_colours
 
 if TYPE_CHECKING:
-    from cosmop.scenario import Scene
+    from cosmop.scene import Scene
+    from cosmop.traces import RobotState, Trace
 
 __all__ = ["MESSAGE_SHOWN_S", "SceneMarkers"]
 
@@ -42,17 +43,18 @@ class SceneMarkers:
         The message types (:class:`cosmop.export.rosbag._Ros`).
     scene : Scene
         Walls, workspaces and sizes (mm).
+    trace : Trace
+        The run: poses (mm, degrees), what the robots carry, people, objects and the messages
+        (``t`` s, ``from``, ``to``).
     robot_ids : sequence of str
         Every robot, in the order that fixes its colour (the scene's order first).
-    messages : sequence of Mapping
-        The trace's messages (``t`` s, ``from``, ``to``).
     """
 
-    def __init__(self, ros: Any, scene: Scene, robot_ids: Sequence[str], messages: Sequence[Mapping]) -> None:
-        self.ros, self.scene = ros, scene
+    def __init__(self, ros: Any, scene: Scene, trace: Trace, robot_ids: Sequence[str]) -> None:
+        self.ros, self.scene, self.trace = ros, scene, trace
         self.robot_ids = list(robot_ids)
         self.colours = dict(zip(self.robot_ids, robot_colours(len(self.robot_ids)), strict=True))
-        self.messages = sorted(messages, key=lambda m: float(m["t"]))
+        self.messages = sorted(trace.messages, key=lambda m: float(m["t"]))
 
     # -- builders ---------------------------------------------------------------------------
 
@@ -119,46 +121,49 @@ class SceneMarkers:
             out.append(self._text(ns, "workspace_labels", k, cx, cy, 0.1, wid, _BLACK))
         return out
 
-    def _objects(self, ns: int, frame: Mapping[str, Any], carried: Mapping[str, str]) -> list[Any]:
+    def _objects(self, ns: int, k: int, carried: Mapping[str, str]) -> list[Any]:
+        """The scene's objects where frame `k` shows them (else where the scene puts them)."""
         out = []
-        positions = frame.get("objects") or {}
-        for k, (oid, obj) in enumerate(self.scene.objects.items()):
+        positions = self.trace.points_at("objects", k)
+        for n, (oid, obj) in enumerate(self.scene.objects.items()):
             x, y = positions.get(oid, obj.position)
             side = m_from_mm(obj.size)
             z = _ROBOT_HEIGHT + side / 2 if oid in carried else side / 2  # a carried object rides on top
-            out.append(self._marker(ns, "objects", k, "CUBE", self._at(x, y, z), (side, side, side), _BROWN))
-            out.append(self._text(ns, "object_labels", k, x, y, z + side / 2 + 0.15, oid, _BROWN))
+            out.append(self._marker(ns, "objects", n, "CUBE", self._at(x, y, z), (side, side, side), _BROWN))
+            out.append(self._text(ns, "object_labels", n, x, y, z + side / 2 + 0.15, oid, _BROWN))
         return out
 
-    def _robots(self, ns: int, frame: Mapping[str, Any]) -> list[Any]:
+    def _robots(self, ns: int, k: int, robots: Mapping[str, RobotState]) -> list[Any]:
+        """The robots and people that frame `k` shows; `robots` are its robots' states."""
         out = []
-        for k, rid in enumerate(self.robot_ids):
-            state = (frame.get("robots") or {}).get(rid)
+        for n, rid in enumerate(self.robot_ids):
+            state = robots.get(rid)
             if state is None:
                 continue
-            x, y, heading = state["pose"]
+            x, y, heading = state.pose
             robot = self.scene.robots.get(rid)
             side = m_from_mm(robot.size) if robot is not None else 0.4
             colour = (*self.colours[rid], 0.7)
             body = self._at(x, y, _ROBOT_HEIGHT / 2, heading)
-            out.append(self._marker(ns, "robots", k, "CUBE", body, (side, side, _ROBOT_HEIGHT), colour))
-            label = rid if not state.get("carrying") else f"{rid} carries {state['carrying']}"
-            if state.get("waiting"):
+            out.append(self._marker(ns, "robots", n, "CUBE", body, (side, side, _ROBOT_HEIGHT), colour))
+            label = rid if not state.carrying else f"{rid} carries {state.carrying}"
+            if state.waiting:
                 label += " (waiting)"
             out.append(
-                self._text(ns, "robot_labels", k, x, y, _ROBOT_HEIGHT + 0.35, label, (*colour[:3], 1.0))
+                self._text(ns, "robot_labels", n, x, y, _ROBOT_HEIGHT + 0.35, label, (*colour[:3], 1.0))
             )
-        for k, hid in enumerate(getattr(self.scene, "humans", {}) or {}):
-            where = (frame.get("humans") or {}).get(hid)
+        humans = self.trace.points_at("humans", k)
+        for n, hid in enumerate(getattr(self.scene, "humans", {}) or {}):
+            where = humans.get(hid)
             if where is None:
                 continue
             d = m_from_mm(self.scene.humans[hid].size)
             pose = self._at(where[0], where[1], _HUMAN_HEIGHT / 2)
-            out.append(self._marker(ns, "people", k, "CYLINDER", pose, (d, d, _HUMAN_HEIGHT), _ORANGE))
+            out.append(self._marker(ns, "people", n, "CYLINDER", pose, (d, d, _HUMAN_HEIGHT), _ORANGE))
         return out
 
-    def _arrows(self, ns: int, t: float, frame: Mapping[str, Any]) -> list[Any]:
-        robots = frame.get("robots") or {}
+    def _arrows(self, ns: int, t: float, robots: Mapping[str, RobotState]) -> list[Any]:
+        """An arrow from sender to receiver for each message sent less than 2 s before `t` (s)."""
         out = []
         for k, message in enumerate(self.messages):
             age = t - float(message["t"])
@@ -166,7 +171,7 @@ class SceneMarkers:
             if not (0 <= age < MESSAGE_SHOWN_S) or sender is None or receiver is None:
                 continue
             z = _ROBOT_HEIGHT + 0.6
-            points = [self._point(*sender["pose"][:2], z), self._point(*receiver["pose"][:2], z)]
+            points = [self._point(*sender.pose[:2], z), self._point(*receiver.pose[:2], z)]
             left = MESSAGE_SHOWN_S - age
             lifetime = self.ros.t["builtin_interfaces/msg/Duration"](
                 sec=int(left), nanosec=round((left - math.floor(left)) * 1e9) % 1_000_000_000
@@ -187,11 +192,11 @@ class SceneMarkers:
             )
         return out
 
-    def array(self, ns: int, frame: Mapping[str, Any]) -> Any:
-        """The ``MarkerArray`` of `frame` (a trace frame), stamped `ns` nanoseconds."""
-        carried = {s["carrying"]: rid for rid, s in (frame.get("robots") or {}).items() if s.get("carrying")}
-        markers = self._fixed(ns) + self._objects(ns, frame, carried) + self._robots(ns, frame)
-        markers += self._arrows(ns, float(frame["t"]), frame)
+    def array(self, ns: int, k: int) -> Any:
+        """The ``MarkerArray`` of frame `k` of the trace, stamped `ns` nanoseconds."""
+        robots = self.trace.robots_at(k)
+        markers = self._fixed(ns) + self._objects(ns, k, self.trace.carried_at(k))
+        markers += self._robots(ns, k, robots) + self._arrows(ns, float(self.trace.t[k]), robots)
         return self.ros.t["visualization_msgs/msg/MarkerArray"](markers=markers)
 
 

@@ -27,23 +27,23 @@ same on every run. Chunks are compressed with zstd, as ``ros2 bag record
 
 from __future__ import annotations
 
-import contextlib
 import json
 import math
 import os
-import shutil
-import tempfile
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from cosmop.export.markers import SceneMarkers
+from cosmop.io import atomic_path
+from cosmop.traces import Trace, as_trace
 from cosmop.units import m_from_mm
+from cosmop.viz.scene import ids_with_trace
 
 if TYPE_CHECKING:
     from cosmop.planning.plan import PlanSet
-    from cosmop.scenario import Scene
+    from cosmop.scene import Scene
 
 __all__ = ["BagSummary", "ros_available", "write_bag"]
 
@@ -114,17 +114,17 @@ class _Ros:
         )
 
 
-def _frame_indices(frames: Sequence[Mapping[str, Any]], rate: float | None) -> list[int]:
-    """Indices of the frames to write: all, or about `rate` per second (the last always)."""
-    if rate is None or len(frames) < 2:
-        return list(range(len(frames)))
+def _frame_indices(times: Sequence[float], rate: float | None) -> list[int]:
+    """Indices of the frames (at `times`, s) to write: all, or about `rate` per second (the last always)."""
+    if rate is None or len(times) < 2:
+        return list(range(len(times)))
     chosen, next_t = [], -math.inf
-    for k, frame in enumerate(frames):
-        if float(frame["t"]) >= next_t - 1e-9:
+    for k, t in enumerate(times):
+        if t >= next_t - 1e-9:
             chosen.append(k)
-            next_t = float(frame["t"]) + 1.0 / rate
-    if chosen[-1] != len(frames) - 1:
-        chosen.append(len(frames) - 1)
+            next_t = t + 1.0 / rate
+    if chosen[-1] != len(times) - 1:
+        chosen.append(len(times) - 1)
     return chosen
 
 
@@ -156,58 +156,53 @@ def _write(writer: Any, ros: _Ros, connections: dict, counts: dict, topic: str, 
 
 
 def _write_all(
-    writer: Any, scene: Scene, trace: Mapping[str, Any], plans: PlanSet | None, options: dict
+    writer: Any, scene: Scene, trace: Trace, plans: PlanSet | None, options: dict
 ) -> dict[str, int]:
+    """Write every topic of the bag from `trace`; return the number of messages per topic."""
     ros = _Ros()
-    frames = trace["frames"]
+    times = trace.t.tolist()
     start_ns, connections, counts = options["start_ns"], {}, {}
-    robot_ids = list(dict.fromkeys([*scene.robots, *(r for f in frames for r in f.get("robots", {}))]))
-    first_ns = _ns(float(frames[0]["t"]), start_ns)
+
+    def write(topic: str, ns: int, msg: Any) -> None:
+        _write(writer, ros, connections, counts, topic, ns, msg)
+
+    def coordination(message: Mapping[str, Any]) -> None:
+        text = ros.t["std_msgs/msg/String"](data=json.dumps(dict(message), sort_keys=True))
+        write("/coordination", _ns(float(message["t"]), start_ns), text)
+
+    robot_ids = ids_with_trace(scene.robots, trace, "robots")
+    first_ns = _ns(times[0], start_ns)
     if plans is not None:
         for rid in robot_ids:
             path = _plan_path(ros, scene, plans, rid, first_ns, start_ns)
             if path is not None:
-                _write(writer, ros, connections, counts, f"/{rid}/plan", first_ns, path)
-    markers = SceneMarkers(ros, scene, robot_ids, trace.get("messages") or [])
-    messages = sorted(trace.get("messages") or [], key=lambda m: float(m["t"]))
+                write(f"/{rid}/plan", first_ns, path)
+    markers = SceneMarkers(ros, scene, trace, robot_ids)
+    messages = sorted(trace.messages, key=lambda m: float(m["t"]))
     pending = 0
     scene_next = -math.inf
-    for k in _frame_indices(frames, options["rate"]):
-        frame = frames[k]
-        t = float(frame["t"])
+    for k in _frame_indices(times, options["rate"]):
+        t = times[k]
         ns = _ns(t, start_ns)
         while pending < len(messages) and float(messages[pending]["t"]) <= t + 1e-9:
-            message = messages[pending]
-            text = ros.t["std_msgs/msg/String"](data=json.dumps(message, sort_keys=True))
-            _write(
-                writer, ros, connections, counts, "/coordination", _ns(float(message["t"]), start_ns), text
-            )
+            coordination(messages[pending])
             pending += 1
-        robots = frame.get("robots") or {}
-        transforms = [ros.transform(ns, f"{rid}/base_link", s["pose"]) for rid, s in robots.items()]
-        _write(
-            writer,
-            ros,
-            connections,
-            counts,
-            "/tf",
-            ns,
-            ros.t["tf2_msgs/msg/TFMessage"](transforms=transforms),
-        )
+        robots = trace.robots_at(k)
+        transforms = [ros.transform(ns, f"{rid}/base_link", s.pose) for rid, s in robots.items()]
+        write("/tf", ns, ros.t["tf2_msgs/msg/TFMessage"](transforms=transforms))
         for rid, state in robots.items():
-            _write(writer, ros, connections, counts, f"/{rid}/pose", ns, ros.pose_stamped(ns, state["pose"]))
-        if t >= scene_next - 1e-9 or k == len(frames) - 1:
-            _write(writer, ros, connections, counts, "/scene", ns, markers.array(ns, frame))
+            write(f"/{rid}/pose", ns, ros.pose_stamped(ns, state.pose))
+        if t >= scene_next - 1e-9 or k == len(times) - 1:
+            write("/scene", ns, markers.array(ns, k))
             scene_next = t + 1.0 / options["scene_rate"]
     for message in messages[pending:]:  # sent after the last frame drawn
-        text = ros.t["std_msgs/msg/String"](data=json.dumps(message, sort_keys=True))
-        _write(writer, ros, connections, counts, "/coordination", _ns(float(message["t"]), start_ns), text)
+        coordination(message)
     return counts
 
 
 def write_bag(
     scene: Scene,
-    trace: Mapping[str, Any],
+    trace: Trace | Mapping[str, Any],
     path: str | os.PathLike[str],
     *,
     plans: PlanSet | None = None,
@@ -215,14 +210,15 @@ def write_bag(
     scene_rate: float = 5.0,
     start: float = 0.0,
 ) -> BagSummary:
-    """Write a ``cosmop.trace/1`` trace as a ROS 2 bag directory (MCAP storage), atomically.
+    """Write a simulation trace as a ROS 2 bag directory (MCAP storage), atomically.
 
     Parameters
     ----------
     scene : Scene
         The scene simulated (walls, workspaces, sizes; mm).
-    trace : Mapping
-        The trace (:func:`cosmop.traces.load_trace` or :meth:`cosmop.sim.SimResult.trace`).
+    trace : Trace or Mapping
+        The run (:func:`cosmop.traces.load_trace` or :meth:`cosmop.sim.SimResult.trace`), or its
+        ``cosmop.trace/1`` JSON.  Poses in mm and degrees, times in s.
     path : str or os.PathLike
         The bag directory to create; it must not exist (``ros2 bag`` never overwrites either).
     plans : PlanSet, optional
@@ -242,6 +238,8 @@ def write_bag(
     ------
     FileExistsError
         If `path` exists.
+    cosmop.traces.TraceError
+        If `trace` is a mapping without the ``cosmop.trace/1`` shape.
     ImportError
         If ``rosbags`` is missing (``pip install 'cosmop[ros]'``).
     """
@@ -250,22 +248,17 @@ def write_bag(
     for name, value in (("rate", rate), ("scene_rate", scene_rate)):
         if value is not None and not (math.isfinite(value) and value > 0):
             raise ValueError(f"{name} must be a positive number of messages per second, got {value!r}")
+    trace = as_trace(trace)
     target = Path(path)
     if target.exists():
         raise FileExistsError(f"{target} exists; a bag is written into a new directory")
     options = {"rate": rate, "scene_rate": scene_rate, "start_ns": round(start * 1e9)}
-    staging = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent))
-    try:
-        bag = staging / target.name  # the MCAP file is named after its directory
+    with atomic_path(target) as bag:  # named as the target: the MCAP file is named after its folder
         writer = Writer(bag, version=8, storage_plugin=StoragePlugin.MCAP)
         writer.set_compression(CompressionMode.STORAGE, CompressionFormat.ZSTD)
         with writer:
             counts = _write_all(writer, scene, trace, plans, options)
-        os.replace(bag, target)
-    finally:
-        with contextlib.suppress(OSError):
-            shutil.rmtree(staging)
-    times = [float(f["t"]) for f in trace["frames"]] + [float(m["t"]) for m in trace.get("messages") or []]
+    times = trace.t.tolist() + [float(m["t"]) for m in trace.messages]
     return BagSummary(
         path=target,
         counts=dict(counts),

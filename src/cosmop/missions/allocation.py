@@ -394,18 +394,57 @@ def assign(
     ({'O1': ('R2', 'W'), 'O2': ('R1', 'W')}, 5, 9)
     """
     seconds = seconds or {}
-
-    def ranked(o: str, opts: Sequence[Option]) -> list[tuple[int, str, str]]:
-        keyed = [
-            (c, seconds.get((r, o, w), 0.0), r, w) for r, w in opts if (c := costs.get((r, o, w))) is not None
-        ]
-        return [(c, r, w) for c, _, r, w in sorted(keyed)]
-
-    usable = {o: ranked(o, opts) for o, opts in options.items()}
+    usable = {o: _ranked(o, opts, costs, seconds) for o, opts in options.items()}
     stuck = tuple(o for o, opts in usable.items() if not opts)
     if stuck:
         return Assignment(MappingProxyType({}), None, None, True, 0, stuck)
     order = sorted(usable, key=lambda o: (-usable[o][0][0], o))
+    found = _branch_and_bound(order, usable, max_nodes)
+    (span, total), picks = found.best
+    tasks = MappingProxyType(dict(sorted(zip(order, picks, strict=True))))
+    return Assignment(tasks, span, total, found.exhaustive, found.nodes)
+
+
+def _ranked(
+    obj: str,
+    opts: Sequence[Option],
+    costs: Mapping[tuple[str, str, str], int | None],
+    seconds: Mapping[tuple[str, str, str], float],
+) -> list[tuple[int, str, str]]:
+    """`obj`'s options that have a cost, as ``(cost, robot, workspace)``, cheapest then fastest first."""
+    keyed = [
+        (c, seconds.get((r, obj, w), 0.0), r, w) for r, w in opts if (c := costs.get((r, obj, w))) is not None
+    ]
+    return [(c, r, w) for c, _, r, w in sorted(keyed)]
+
+
+@dataclass(frozen=True)
+class _Search:
+    """Result of :func:`_branch_and_bound`.
+
+    Attributes
+    ----------
+    best : tuple
+        ``((makespan, total), picks)``: the best assignment found, one ``(robot, workspace)``
+        per object in search order.
+    nodes : int
+        Search nodes visited.
+    exhaustive : bool
+        Whether the search ended within its node bound (then ``best`` is optimal).
+    """
+
+    best: tuple[tuple[int, int], list[Option]]
+    nodes: int
+    exhaustive: bool
+
+
+def _branch_and_bound(order: Sequence[str], usable: Mapping[str, list], max_nodes: int) -> _Search:
+    """Depth-first branch and bound over the objects in `order`, from the greedy assignment.
+
+    Each object's options are tried in their rank order (`usable`); a branch is cut when its
+    bound (the loads so far, each object left at its cheapest, shared at best evenly) cannot
+    beat the best found.  Of equally good assignments the first found is kept.
+    """
     floor = [0] * (len(order) + 1)  # the least total the objects from i on still add
     for i in range(len(order) - 1, -1, -1):
         floor[i] = floor[i + 1] + usable[order[i]][0][0]
@@ -441,9 +480,7 @@ def assign(
             loads[r] = load - c
 
     visit(0, 0)
-    (span, total), picks = best
-    tasks = MappingProxyType(dict(sorted(zip(order, picks, strict=True))))
-    return Assignment(tasks, span, total, exhaustive, nodes)
+    return _Search(best, nodes, exhaustive)
 
 
 def _greedy(order: Sequence[str], usable: Mapping[str, list]) -> tuple[tuple[int, int], list[Option]]:

@@ -25,7 +25,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from types import MappingProxyType
 
-from cosmop.missions.events import Event
+from cosmop.events import Event, Primitive, realising_step
 from cosmop.missions.team import blocking_word as team_blocking_word
 
 
@@ -69,25 +69,21 @@ class Coordinated:
 
 
 def requests_by_phase(
-    steps: Sequence[tuple[str, str | None]], mission: Sequence[Event]
+    steps: Sequence[tuple[str, str | None]], mission: Sequence[Event], robot: str
 ) -> list[tuple[str, int]]:
-    """For each Req step of a plan, ``(object, index of the mission event it prepares)``.
+    """For each Req step of `robot`'s plan, ``(object, index of the mission event it prepares)``.
 
     ``steps`` are ``(primitive, object)`` in plan order.  A Req belongs to the phase of the
-    first mission event realised at or after it (pick: PickUp, drop: DropOff, away: Req/Res of
-    that object, return: the end of the plan).
+    first mission event realised at or after it (by the step of :func:`cosmop.events.realising_step`;
+    a return, by the end of the plan).
     """
-    realised = {"pick": "PickUp", "drop": "DropOff"}
     out, event_index = [], 0
     for primitive, obj in steps:
-        if primitive == "Req" and obj is not None:  # (a Req without object waits for a msg)
+        if primitive == Primitive.REQ and obj is not None:  # (a Req without object waits for a msg)
             out.append((obj, event_index))
         while event_index < len(mission):
-            event = mission[event_index]
-            done = (realised.get(event.kind) == primitive and event.obj == obj) or (
-                event.kind == "away" and primitive in ("Req", "Res") and event.obj == obj
-            )
-            if not done:
+            realised = realising_step(mission[event_index], robot)
+            if realised is None or realised[:2] != (primitive, obj):
                 break
             event_index += 1
     return out

@@ -27,8 +27,8 @@ from types import MappingProxyType
 import numpy as np
 
 from cosmop.automata import DFA, Composition, prefix_closure, trim
-from cosmop.missions.events import Event, parse_event
-from cosmop.scenario import Mission, Scenario
+from cosmop.events import Event, parse_event
+from cosmop.scene import Mission, Scenario
 
 
 def sequence_automaton(events: Sequence[str], *, closed: bool = True) -> DFA:
@@ -161,7 +161,7 @@ class GlobalMission:
 
     @classmethod
     def from_mission(cls, mission: Mission, robots: Iterable[str]) -> GlobalMission:
-        """Build from a validated scenario :class:`~cosmop.scenario.Mission`."""
+        """Build from a validated scenario :class:`~cosmop.scene.Mission`."""
         robots = tuple(robots)
         if mission.tasks is not None:
             events = {e.name: e for seq in mission.tasks.values() for e in seq}

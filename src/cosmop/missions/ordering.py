@@ -36,7 +36,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 from cosmop.automata import Composition
-from cosmop.missions.events import message, parse_event
+from cosmop.events import message, parse_event
 
 __all__ = [
     "Edge",

@@ -29,7 +29,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from cosmop.automata import DFA
-from cosmop.missions.events import parse_event
+from cosmop.events import parse_event
 from cosmop.missions.mission import GlobalMission
 from cosmop.missions.precedence import Link, Precedence
 from cosmop.missions.verification import Verification, verify

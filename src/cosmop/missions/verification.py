@@ -42,6 +42,7 @@ from __future__ import annotations
 import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -56,6 +57,9 @@ from cosmop.automata import (
 from cosmop.automata.composition import SizeLog, clusters, lift_word
 from cosmop.missions.decomposition import factor_counterexample
 from cosmop.missions.mission import GlobalMission
+
+if TYPE_CHECKING:  # pragma: no cover - typing only
+    from aalpy.base import SUL, Oracle
 
 Word = tuple[str, ...]
 
@@ -282,15 +286,37 @@ def _learn_assumption(
     ``violation`` is a word over :math:`\\Sigma_{M_1} \\cup \\Sigma_A` of :math:`M_1` composed
     with the environment's interface behaviour that violates ``spec``.
     """
-    from aalpy.base import SUL, Oracle
     from aalpy.learning_algs import run_Lstar
 
-    counts = {"membership": 0, "equivalence": 0}
     oracle = _Membership(m1, spec, interface)
+    sul = _membership_sul(oracle)
+    teacher = _teacher(sul, oracle, m1, environment, spec, interface, log)
+    try:
+        run_Lstar(
+            list(interface),
+            sul,
+            teacher,
+            automaton_type="dfa",
+            print_level=0,
+            max_learning_rounds=max_rounds,
+        )
+    except _RealViolation as violation:
+        pinned = DFA.from_word(violation.word, interface, closed=False)
+        holds, word = False, satisfaction_counterexample(parallel(m1, pinned), spec)
+    except SystemExit as exc:  # AALpy's reaction to inconsistent answers
+        raise RuntimeError(f"L*: inconsistent membership answers ({exc})") from None
+    else:  # L* also stops at the round cap without a proof: then the factor is undecided (None)
+        holds, word = (True if teacher.proved else None), None
+    return holds, teacher.last, word, sul.num_queries + teacher.membership, teacher.equivalence
 
-    def member(word: Word) -> bool:  # the teacher's own queries (AALpy counts its own)
-        counts["membership"] += 1
-        return oracle(word)
+
+def _membership_sul(oracle: _Membership) -> SUL:
+    """AALpy's view of `oracle` (a system under learning): one step per interface event.
+
+    Its output after a word is :math:`T` of that word; AALpy counts its queries
+    (``num_queries``) and caches repeats.
+    """
+    from aalpy.base import SUL
 
     class Membership(SUL):
         """AALpy's view of the membership oracle: one step per interface event."""
@@ -310,14 +336,38 @@ def _learn_assumption(
                 self.pairs = oracle.advance(self.pairs, letter)
             return oracle.holds(self.pairs)
 
+    return Membership()
+
+
+def _teacher(
+    sul: SUL,
+    oracle: _Membership,
+    m1: DFA,
+    environment: DFA,
+    spec: DFA,
+    interface: tuple[str, ...],
+    log: SizeLog,
+) -> Oracle:
+    """AALpy's equivalence oracle: checks a conjecture against both premises of the rule.
+
+    Its ``find_cex`` returns a counterexample to the conjecture, ``None`` when both premises
+    hold (then ``proved`` is set), or raises :class:`_RealViolation` for a word of the
+    environment that violates the mission.  ``last`` is the last conjecture (minimal, trim);
+    ``membership`` and ``equivalence`` count the teacher's own membership queries and the
+    conjectures checked.
+    """
+    from aalpy.base import Oracle
+
     class Teacher(Oracle):
         def __init__(self, alphabet: list[str], sul: SUL) -> None:
             super().__init__(alphabet, sul)
             self.last: DFA | None = None
             self.proved = False
+            self.membership = 0
+            self.equivalence = 0
 
         def find_cex(self, hypothesis):
-            counts["equivalence"] += 1
+            self.equivalence += 1
             a = log.observe(_to_dfa(hypothesis, interface))
             self.last = a
             w = satisfaction_counterexample(log.observe(parallel(m1, a)), spec)
@@ -327,30 +377,12 @@ def _learn_assumption(
             if c is None:  # both premises hold: the rule proves the factor
                 self.proved = True
                 return None
-            if member(c):  # the conjecture is too strong
+            self.membership += 1  # the teacher's own query (AALpy counts its own)
+            if oracle(c):  # the conjecture is too strong
                 return c
             raise _RealViolation(c)
 
-    sul = Membership()
-    teacher = Teacher(list(interface), sul)
-    try:
-        run_Lstar(
-            list(interface),
-            sul,
-            teacher,
-            automaton_type="dfa",
-            print_level=0,
-            max_learning_rounds=max_rounds,
-        )
-    except _RealViolation as violation:
-        pinned = DFA.from_word(violation.word, interface, closed=False)
-        word = satisfaction_counterexample(parallel(m1, pinned), spec)
-        return False, teacher.last, word, sul.num_queries + counts["membership"], counts["equivalence"]
-    except SystemExit as exc:  # AALpy's reaction to inconsistent answers
-        raise RuntimeError(f"L*: inconsistent membership answers ({exc})") from None
-    # L* also stops at the round cap without a proof: then the factor is undecided (None)
-    holds = True if teacher.proved else None
-    return holds, teacher.last, None, sul.num_queries + counts["membership"], counts["equivalence"]
+    return Teacher(list(interface), sul)
 
 
 def _cluster(start: set[str], local: Mapping[str, DFA]) -> list[str]:
@@ -396,61 +428,18 @@ def verify(
     if method not in {"auto", "assume-guarantee", "direct"}:
         raise ValueError(f"method must be auto, assume-guarantee or direct, not {method!r}")
     t0 = time.perf_counter()
-    log = SizeLog()
-    alphabets = {r: set(d.alphabet) for r, d in local.items()}
+    team = _Team(local, {r: set(d.alphabet) for r, d in local.items()}, SizeLog())
     checks: list[FactorCheck] = []
     reports: list[AssumptionReport] = []
     counterexample: Word | None = None
     for j, factor in enumerate(mission.automaton.components):
-        sigma = set(factor.alphabet)
-        # the guarantor is the robot owning most of the factor's events (team order breaks ties)
-        owners = sorted((r for r in local if alphabets[r] & sigma), key=lambda r: -len(alphabets[r] & sigma))
-        cluster = _cluster(set(owners), local)
-        modules = [local[r] for r in cluster]
-        environment_robots = [r for r in cluster if owners and r != owners[0]]
-        interface: tuple[str, ...] = ()
-        abstraction: DFA | None = None
-        use_ag = method != "direct" and len(cluster) > 1
-        if use_ag:
-            m1_sigma = alphabets[owners[0]]
-            env_sigma = set().union(*(alphabets[r] for r in environment_robots))
-            interface = tuple(sorted(env_sigma & (m1_sigma | sigma)))
-            abstraction = log.observe(
-                project_composition([local[r] for r in environment_robots], interface, log=log)
-            )
-            if method == "auto" and abstraction.n_states > max_environment_states:
-                use_ag = False
-        holds: bool | None = None
-        if use_ag:
-            assert abstraction is not None
-            holds, assumption, violation, mq, eq = _learn_assumption(
-                local[owners[0]], abstraction, factor, interface, log, max_rounds
-            )
-            reports.append(
-                AssumptionReport(
-                    factor=j,
-                    guarantor=owners[0],
-                    environment=tuple(environment_robots),
-                    interface=interface,
-                    assumption=assumption,
-                    environment_states=abstraction.n_states,
-                    membership_queries=mq,
-                    equivalence_queries=eq,
-                    holds=bool(holds),
-                )
-            )
-            if violation is not None:
-                counterexample = lift_word(modules, violation, alphabets[owners[0]] | set(interface))
-        if holds is None:  # direct check: by method, or because L* stopped at its round cap
-            word = factor_counterexample(modules, factor, log)
-            holds = word is None
-            if word is not None:
-                counterexample = word
-            method_used = "direct" if not use_ag else "direct (L* round cap)"
-        else:
-            method_used = "assume-guarantee"
-        checks.append(FactorCheck(j, method_used, tuple(cluster), holds))
-        if not holds:
+        found = _check_factor(j, factor, team, method, max_environment_states, max_rounds)
+        checks.append(found.check)
+        if found.report is not None:
+            reports.append(found.report)
+        if found.counterexample is not None:
+            counterexample = found.counterexample
+        if not found.check.holds:
             break
     return Verification(
         holds=all(c.holds for c in checks),
@@ -459,6 +448,165 @@ def verify(
         assumptions=tuple(reports),
         membership_queries=sum(r.membership_queries for r in reports),
         equivalence_queries=sum(r.equivalence_queries for r in reports),
-        largest_automaton=log.largest,
+        largest_automaton=team.log.largest,
         time_s=time.perf_counter() - t0,
     )
+
+
+@dataclass(frozen=True)
+class _Team:
+    """The modules verified and what the checks of all factors share.
+
+    Attributes
+    ----------
+    local : Mapping[str, DFA]
+        The modules :math:`M_i` by robot, in team order.
+    alphabets : Mapping[str, set of str]
+        Each module's events.
+    log : SizeLog
+        Every automaton built, for ``largest_automaton``.
+    """
+
+    local: Mapping[str, DFA]
+    alphabets: Mapping[str, set[str]]
+    log: SizeLog
+
+
+@dataclass(frozen=True)
+class _Roles:
+    """Who takes which part in the check of one factor.
+
+    Attributes
+    ----------
+    cluster : tuple of str
+        The robots that can influence the factor (its cone of influence), in team order.
+    guarantor : str or None
+        :math:`M_1`, the robot owning most of the factor's events; ``None`` when no robot
+        owns one.
+    environment : tuple of str
+        The rest of the cluster (:math:`M_2`).
+    """
+
+    cluster: tuple[str, ...]
+    guarantor: str | None
+    environment: tuple[str, ...]
+
+
+def _roles(sigma: set[str], team: _Team) -> _Roles:
+    """The cluster, guarantor and environment for a factor over the events `sigma`."""
+    local, alphabets = team.local, team.alphabets
+    # the guarantor is the robot owning most of the factor's events (team order breaks ties)
+    owners = sorted((r for r in local if alphabets[r] & sigma), key=lambda r: -len(alphabets[r] & sigma))
+    cluster = _cluster(set(owners), local)
+    environment = [r for r in cluster if owners and r != owners[0]]
+    return _Roles(tuple(cluster), owners[0] if owners else None, tuple(environment))
+
+
+@dataclass(frozen=True)
+class _FactorResult:
+    """The outcome of checking one factor.
+
+    Attributes
+    ----------
+    check : FactorCheck
+    report : AssumptionReport or None
+        When the asymmetric rule was applied.
+    counterexample : tuple of str or None
+        A word of the cluster violating the factor.
+    """
+
+    check: FactorCheck
+    report: AssumptionReport | None
+    counterexample: Word | None
+
+
+def _check_factor(
+    j: int,
+    factor: DFA,
+    team: _Team,
+    method: str,
+    max_environment_states: int,
+    max_rounds: int,
+) -> _FactorResult:
+    """Check factor `j` by the asymmetric rule or directly, as `method` asks (see :func:`verify`).
+
+    The rule applies to a cluster of more than one robot, unless ``method="auto"`` finds the
+    environment's abstraction larger than `max_environment_states`; a factor the rule leaves
+    undecided (L* at its round cap) is checked directly.
+    """
+    sigma = set(factor.alphabet)
+    roles = _roles(sigma, team)
+    interface: tuple[str, ...] = ()
+    abstraction: DFA | None = None
+    use_ag = method != "direct" and len(roles.cluster) > 1
+    if use_ag:
+        interface, abstraction = _environment(roles, sigma, team)
+        if method == "auto" and abstraction.n_states > max_environment_states:
+            use_ag = False
+    holds: bool | None = None
+    report, word = None, None
+    if use_ag:
+        assert abstraction is not None
+        holds, report, word = _assume_guarantee(j, factor, roles, interface, abstraction, team, max_rounds)
+    if holds is None:  # direct check: by method, or because L* stopped at its round cap
+        word = factor_counterexample([team.local[r] for r in roles.cluster], factor, team.log)
+        holds = word is None
+        method_used = "direct" if not use_ag else "direct (L* round cap)"
+    else:
+        method_used = "assume-guarantee"
+    return _FactorResult(FactorCheck(j, method_used, roles.cluster, holds), report, word)
+
+
+def _environment(roles: _Roles, sigma: set[str], team: _Team) -> tuple[tuple[str, ...], DFA]:
+    """The interface :math:`\\Sigma_A` and the environment's abstraction :math:`P_{\\Sigma_A}(M_2)`.
+
+    :math:`\\Sigma_A = \\Sigma_{M_2} \\cap (\\Sigma_{M_1} \\cup \\Sigma_K)`, sorted; the abstraction is
+    the compositional projection of the environment's modules (the product is never built).
+    """
+    m1_sigma = team.alphabets[roles.guarantor]
+    env_sigma = set().union(*(team.alphabets[r] for r in roles.environment))
+    interface = tuple(sorted(env_sigma & (m1_sigma | sigma)))
+    modules = [team.local[r] for r in roles.environment]
+    abstraction = team.log.observe(project_composition(modules, interface, log=team.log))
+    return interface, abstraction
+
+
+def _assume_guarantee(
+    j: int,
+    factor: DFA,
+    roles: _Roles,
+    interface: tuple[str, ...],
+    abstraction: DFA,
+    team: _Team,
+    max_rounds: int,
+) -> tuple[bool | None, AssumptionReport, Word | None]:
+    """Apply the asymmetric rule to factor `j`: learn an assumption for the guarantor.
+
+    Returns
+    -------
+    holds : bool or None
+        ``None`` when L* stopped at its round cap before a proof.
+    report : AssumptionReport
+    counterexample : tuple of str or None
+        A violation lifted to a word of the cluster.
+    """
+    guarantor = roles.guarantor
+    holds, assumption, violation, mq, eq = _learn_assumption(
+        team.local[guarantor], abstraction, factor, interface, team.log, max_rounds
+    )
+    report = AssumptionReport(
+        factor=j,
+        guarantor=guarantor,
+        environment=roles.environment,
+        interface=interface,
+        assumption=assumption,
+        environment_states=abstraction.n_states,
+        membership_queries=mq,
+        equivalence_queries=eq,
+        holds=bool(holds),
+    )
+    word = None
+    if violation is not None:
+        modules = [team.local[r] for r in roles.cluster]
+        word = lift_word(modules, violation, team.alphabets[guarantor] | set(interface))
+    return holds, report, word

@@ -29,7 +29,7 @@ import shapely
 from cosmop.docking import docking_pose
 from cosmop.planning.plan import RobotPlan
 from cosmop.planning.reach import free_component
-from cosmop.scenario import Scene
+from cosmop.scene import Scene
 from cosmop.squares import rectangle, square, swept_square
 
 __all__ = ["ROOM", "place_aside"]

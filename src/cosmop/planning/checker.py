@@ -62,12 +62,12 @@ from shapely.geometry.base import BaseGeometry
 
 from cosmop.docking import DOCKING_HEADINGS, docking_pose, in_front
 from cosmop.errors import EventSyntaxError
-from cosmop.missions.events import Event, parse_event
+from cosmop.events import Event, Primitive, parse_event, realising_step
 from cosmop.planning.joint import check_team
 from cosmop.planning.plan import PlanSet, RobotPlan, State, Step, _fmt, _point, initial_state
-from cosmop.planning.realisation import TOLERANCE, event_instants, holds_at, step_primitive
+from cosmop.planning.realisation import TOLERANCE, event_instants, holds_at
 from cosmop.planning.report import RULES, CheckReport, Violation
-from cosmop.scenario import Scenario, Scene, Wall
+from cosmop.scene import Scenario, Scene, Wall
 from cosmop.squares import square, swept_square
 
 __all__ = [
@@ -234,13 +234,13 @@ class _RobotChecker:
     def transition(self, k: int, step: Step, prev: State, cur: State) -> None:
         if step.message is not None:
             self.message(k, step, prev, cur)
-        elif step.primitive == "GoTo":
+        elif step.primitive == Primitive.GOTO:
             self.goto(k, step, prev, cur)
-        elif step.primitive == "PickUp":
+        elif step.primitive == Primitive.PICKUP:
             self.pickup(k, step, prev, cur)
-        elif step.primitive == "DropOff":
+        elif step.primitive == Primitive.DROPOFF:
             self.dropoff(k, step, prev, cur)
-        elif step.primitive == "Req":
+        elif step.primitive == Primitive.REQ:
             self.req(k, step, prev, cur)
         else:
             self.res(k, step, prev, cur)
@@ -495,7 +495,9 @@ class _RobotChecker:
         self.flags_static(k, prev, cur, "carried")
         self.flags_static(k, prev, cur, "away")
         event = parse_event(step.message)
-        role, robot = ("receiver", event.receiver) if step.primitive == "Req" else ("sender", event.sender)
+        role, robot = (
+            ("receiver", event.receiver) if step.primitive == Primitive.REQ else ("sender", event.sender)
+        )
         if robot != self.robot_id:
             self.add(
                 k,
@@ -546,7 +548,7 @@ class _RobotChecker:
             return f"PickUp({event.obj})"
         if event.kind == "drop":
             return f"DropOff({event.obj}) that leaves {event.obj} in {event.workspace}"
-        primitive, obj, name = step_primitive(event, self.robot_id)
+        primitive, obj, name = realising_step(event, self.robot_id)
         return f"{primitive}({obj or name})"
 
     def unmatched(self, event: Event, n: int, total: int, last: int | None, events: list[Event]) -> str:
@@ -567,7 +569,11 @@ class _RobotChecker:
         elif event.kind == "drop":
             for i in range(1 if last is None else last + 1, self.plan.horizon + 1):
                 step = self.plan.steps[i - 1]
-                if step.primitive == "DropOff" and step.object == event.obj and event.obj in step.objects:
+                if (
+                    step.primitive == Primitive.DROPOFF
+                    and step.object == event.obj
+                    and event.obj in step.objects
+                ):
                     text += (
                         f"; DropOff({event.obj}) at instant {i} leaves it at "
                         f"{_point(step.objects[event.obj].position)}, "
@@ -808,7 +814,7 @@ def _check_coordination(plan: PlanSet) -> list[Violation]:
                         )
                     )
             elif event.name not in robot_plan.mission:
-                primitive = "Req" if role == "requester" else "Res"
+                primitive = Primitive.REQ if role == "requester" else Primitive.RES
                 violations.append(
                     Violation(
                         robot_id,

@@ -40,10 +40,11 @@ import shapely
 from shapely import STRtree
 from shapely.geometry.base import BaseGeometry
 
+from cosmop.events import Primitive
 from cosmop.missions.precedence import Link, Node, Precedence
 from cosmop.planning.plan import RobotPlan, State, _fmt, _point, initial_state
 from cosmop.planning.realisation import at_pose
-from cosmop.scenario import Scene
+from cosmop.scene import Scene
 from cosmop.squares import square, swept_square
 
 __all__ = [
@@ -170,7 +171,7 @@ def _robot_occupancies(
     k = 0
     while k <= K:
         end = k
-        while end < K and plan.steps[end].primitive != "GoTo":
+        while end < K and plan.steps[end].primitive != Primitive.GOTO:
             end += 1  # steps end+1 keep the pose
         x, y, _ = poses[k]
         first = None if k == 0 else (robot, k)
@@ -178,7 +179,7 @@ def _robot_occupancies(
         where = "at its start" if k == 0 else f"from instant {k}"
         fixed = (
             k == 0
-            or any(plan.steps[i].primitive == "PickUp" for i in range(k, end))
+            or any(plan.steps[i].primitive == Primitive.PICKUP for i in range(k, end))
             or (end == K and at_pose(poses[k], home))
         )
         out.append(
@@ -195,7 +196,7 @@ def _robot_occupancies(
         )
         k = end + 1
     for k, step in enumerate(plan.steps, 1):
-        if step.primitive == "GoTo":
+        if step.primitive == Primitive.GOTO:
             p, q = poses[k - 1], poses[k]
             out.append(
                 Occupancy(
@@ -228,7 +229,7 @@ def _object_occupancies(
             (robot, k, step.primitive)
             for robot, plan in plans.items()
             for k, step in enumerate(plan.steps, 1)
-            if step.object == oid and step.primitive in ("PickUp", "DropOff")
+            if step.object == oid and step.primitive in (Primitive.PICKUP, Primitive.DROPOFF)
         ]
         if not handling:
             continue
@@ -242,7 +243,7 @@ def _object_occupancies(
         parties = frozenset(h[0] for h in handling)
         position, first = (positions or {}).get(oid, spec.position), None
         for robot, k, primitive in handling:
-            if primitive == "PickUp":
+            if primitive == Primitive.PICKUP:
                 if position is not None:
                     where = "at its start" if first is None else f"from {first[0]}'s instant {first[1]}"
                     out.append(

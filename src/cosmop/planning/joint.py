@@ -27,7 +27,7 @@ from cosmop.planning.conflicts import ConflictSettings, conflicts, is_ordered, o
 from cosmop.planning.plan import PlanSet, RobotPlan
 from cosmop.planning.realisation import message_links, unanswered_requests
 from cosmop.planning.report import Violation
-from cosmop.scenario import Scenario
+from cosmop.scene import Scenario
 
 __all__ = ["check_team"]
 

@@ -19,12 +19,12 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import replace
 
-from cosmop.missions.events import Event, message, parse_event
+from cosmop.events import Event, Primitive, message, parse_event
 from cosmop.missions.precedence import Node
 from cosmop.planning.checker import check_robot_plan
 from cosmop.planning.plan import RobotPlan, State, Step, initial_state, plan_from_actions
 from cosmop.planning.realisation import event_instants
-from cosmop.scenario import Scene
+from cosmop.scene import Scene
 
 __all__ = [
     "answer_early",
@@ -56,14 +56,14 @@ def answer_early(plan: RobotPlan) -> RobotPlan:
     """
     out: list[Step] = []
     for step in plan.steps:
-        if step.primitive == "Res" and step.message is None:
+        if step.primitive == Primitive.RES and step.message is None:
             pick = max(
-                (n for n, s in enumerate(out) if s.primitive == "PickUp" and s.object == step.object),
+                (n for n, s in enumerate(out) if s.primitive == Primitive.PICKUP and s.object == step.object),
                 default=None,
             )
             if pick is not None:
                 at = pick + 1
-                while at < len(out) and out[at].primitive == "Res" and out[at].message is None:
+                while at < len(out) and out[at].primitive == Primitive.RES and out[at].message is None:
                     at += 1
                 before = out[at - 1]
                 out.insert(at, replace(step, robot=before.robot, objects=before.objects))
@@ -82,16 +82,17 @@ def wait_early(scene: Scene, robot: str, plan: RobotPlan) -> RobotPlan:
     objects: the requested ones are away); otherwise the plan is kept.
     """
     actions: list[tuple] = [
-        ("GoTo", st.robot) if st.primitive == "GoTo" else (st.primitive, st.object) for st in plan.steps
+        (Primitive.GOTO, st.robot) if st.primitive == Primitive.GOTO else (st.primitive, st.object)
+        for st in plan.steps
     ]
     k, changed = 0, False
     while k < len(actions):
-        if actions[k][0] == "Req" and k > 0 and actions[k - 1][0] == "GoTo":
+        if actions[k][0] == Primitive.REQ and k > 0 and actions[k - 1][0] == Primitive.GOTO:
             b = k - 1
-            while b > 0 and actions[b - 1][0] == "GoTo":
+            while b > 0 and actions[b - 1][0] == Primitive.GOTO:
                 b -= 1
             e = k
-            while e + 1 < len(actions) and actions[e + 1][0] == "Req":
+            while e + 1 < len(actions) and actions[e + 1][0] == Primitive.REQ:
                 e += 1
             actions = actions[:b] + actions[k : e + 1] + actions[b:k] + actions[e + 1 :]
             changed = True
@@ -122,7 +123,7 @@ def split_drives(
     pose = tuple(start)
     for step in plan.steps:
         start, pose = pose, step.robot
-        if step.primitive != "GoTo":
+        if step.primitive != Primitive.GOTO:
             out.append(step)
             continue
         length = ((pose[0] - start[0]) ** 2 + (pose[1] - start[1]) ** 2) ** 0.5
@@ -149,9 +150,9 @@ def merge_drives(plan: RobotPlan, waypoints: set[tuple[float, float]]) -> RobotP
     out: list[Step] = []
     for step in plan.steps:
         if (
-            step.primitive == "GoTo"
+            step.primitive == Primitive.GOTO
             and out
-            and out[-1].primitive == "GoTo"
+            and out[-1].primitive == Primitive.GOTO
             and (out[-1].robot[0], out[-1].robot[1]) not in waypoints
         ):
             out[-1] = step
@@ -209,7 +210,7 @@ def insert_steps(
             state = step.state
             moved[k] = len(steps)
         for rank, name in sorted(at.get(k, ())):
-            primitive = "Res" if rank == 0 else "Req"
+            primitive = Primitive.RES if rank == 0 else Primitive.REQ
             steps.append(Step(primitive, None, state.robot, state.objects, name))
     return RobotPlan.from_steps(mission, steps), moved
 

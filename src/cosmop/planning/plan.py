@@ -60,18 +60,16 @@ import re
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, replace
 from types import MappingProxyType
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from cosmop._frozen import reduce_frozen
 from cosmop.docking import in_front
 from cosmop.errors import CosmopInputError, EventSyntaxError
+from cosmop.events import ID_PATTERN, Event, Primitive, parse_event
 from cosmop.io import read_text, write_atomic
-from cosmop.missions.events import ID_PATTERN, Event, parse_event
 from cosmop.reading import FieldPath, format_path, load_json
+from cosmop.scene import Scenario, Scene, Workspace
 from cosmop.units import INTERNAL_UNITS, check_units_field
-
-if TYPE_CHECKING:
-    from cosmop.scenario import Scenario, Scene
 
 __all__ = [
     "MAX_STEPS",
@@ -102,14 +100,14 @@ PLAN_FORMAT = "cosmop.plan/1"
 MAX_STEPS = 1000
 """Most steps one robot's plan may have (a plan file with more is refused; no horizon goes beyond)."""
 
-PRIMITIVES = ("GoTo", "PickUp", "DropOff", "Req", "Res")
+PRIMITIVES = tuple(Primitive)
 """The motion primitives, in the paper's order :math:`\\pi^1, \\dots, \\pi^5`."""
 
-OBJECT_PRIMITIVES = frozenset({"PickUp", "DropOff", "Req", "Res"})
+OBJECT_PRIMITIVES = frozenset({Primitive.PICKUP, Primitive.DROPOFF, Primitive.REQ, Primitive.RES})
 """The primitives that act on an object (every primitive but ``GoTo``; ``Req`` and ``Res`` of a
 ``msg`` name a message instead)."""
 
-MESSAGE_PRIMITIVES = frozenset({"Req", "Res"})
+MESSAGE_PRIMITIVES = frozenset({Primitive.REQ, Primitive.RES})
 """The primitives that can carry a ``msg`` message (wait for it, send it)."""
 
 MESSAGE_REASONS = ("order", "conflict", "mission")
@@ -271,18 +269,18 @@ def successor(
     """
     robot = state.robot
     objects = dict(state.objects)
-    if primitive == "GoTo":
+    if primitive == Primitive.GOTO:
         if to is None:
             raise ValueError("GoTo needs a target pose `to`")
         robot = to
     elif to is not None:
         raise ValueError(f"{primitive} does not move the robot; give no target pose")
-    elif primitive == "PickUp":
+    elif primitive == Primitive.PICKUP:
         objects[obj] = ObjectState(objects[obj].position, carried=True, away=objects[obj].away)
-    elif primitive == "DropOff":
+    elif primitive == Primitive.DROPOFF:
         gap = (scene.robots[robot_id].size + scene.objects[obj].size) / 2.0
         objects[obj] = ObjectState(_ahead(robot, gap), carried=False, away=objects[obj].away)
-    elif primitive == "Req":
+    elif primitive == Primitive.REQ:
         objects[obj] = ObjectState(objects[obj].position, carried=objects[obj].carried, away=True)
     return Step(primitive, obj, robot, objects)
 
@@ -327,7 +325,7 @@ def plan_from_actions(
     for action in actions:
         primitive, *rest = action
         arg = rest[0] if rest else None
-        if primitive == "GoTo":
+        if primitive == Primitive.GOTO:
             step = successor(scene, robot_id, state, primitive, to=arg)
         else:
             step = successor(scene, robot_id, state, primitive, obj=arg)
@@ -342,8 +340,8 @@ class Step:
 
     Parameters
     ----------
-    primitive : {"GoTo", "PickUp", "DropOff", "Req", "Res"}
-        The motion primitive.
+    primitive : Primitive or {"GoTo", "PickUp", "DropOff", "Req", "Res"}
+        The motion primitive (a name is turned into its :class:`~cosmop.events.Primitive`).
     object : str or None
         The object the primitive acts on; ``None`` for ``GoTo`` and for the ``Req``/``Res`` of
         a message.
@@ -363,7 +361,7 @@ class Step:
 
     __reduce__ = reduce_frozen  # picklable for worker processes
 
-    primitive: str
+    primitive: Primitive
     object: str | None
     robot: Pose
     objects: Mapping[str, ObjectState]
@@ -372,6 +370,7 @@ class Step:
     def __post_init__(self) -> None:
         if self.primitive not in PRIMITIVES:
             raise ValueError(f"unknown primitive {self.primitive!r}; expected one of {', '.join(PRIMITIVES)}")
+        object.__setattr__(self, "primitive", Primitive(self.primitive))
         if self.message is not None:
             if self.primitive not in MESSAGE_PRIMITIVES or self.object is not None:
                 raise ValueError(f"only Req and Res without an object carry a message, not {self.primitive}")
@@ -381,7 +380,7 @@ class Step:
             object.__setattr__(self, "message", event.name)
         elif self.primitive in OBJECT_PRIMITIVES and not self.object:
             raise ValueError(f"{self.primitive} needs the object it acts on")
-        if self.primitive == "GoTo" and self.object is not None:
+        if self.primitive == Primitive.GOTO and self.object is not None:
             raise ValueError(f"GoTo acts on no object, got {self.object!r}")
         object.__setattr__(self, "robot", _floats(self.robot, 3, "a robot pose"))
         object.__setattr__(self, "objects", _object_map(self.objects))
@@ -413,7 +412,7 @@ class Step:
         carried = [oid for oid, s in self.objects.items() if s.carried]
         if carried:
             notes.append("carrying " + ", ".join(carried))
-        if self.primitive == "DropOff" and self.object in self.objects:
+        if self.primitive == Primitive.DROPOFF and self.object in self.objects:
             notes.append(f"{self.object} at {_point(self.objects[self.object].position)}")
         away = [oid for oid, s in self.objects.items() if s.away]
         if away:
@@ -430,7 +429,7 @@ class RobotPlan:
     ----------
     mission : tuple of str
         The events the plan realises, in order, as canonical names (``pick(R1,O1)``,
-        ``drop(R1,O1,W1)``, ``return(R1)``, ``away(O2,R1,R2)``). :class:`~cosmop.missions.events.Event`
+        ``drop(R1,O1,W1)``, ``return(R1)``, ``away(O2,R1,R2)``). :class:`~cosmop.events.Event`
         values and the paper's compact names are accepted and stored canonically.
     horizon : int
         K, the number of steps.
@@ -472,7 +471,7 @@ class RobotPlan:
 
     @property
     def events(self) -> tuple[Event, ...]:
-        """The mission as :class:`~cosmop.missions.events.Event` values."""
+        """The mission as :class:`~cosmop.events.Event` values."""
         return tuple(parse_event(name) for name in self.mission)
 
     def state(self, k: int, initial: State | None = None) -> State:
@@ -811,8 +810,6 @@ class PlanSet:
 
         A place whose id the scenario already has is left out: the checker names that clash.
         """
-        from cosmop.scenario import Workspace  # a plan file never needs the loader otherwise
-
         scene = scenario.scene
         new = {t.workspace: Workspace(t.workspace, point=t.point) for t in self.added}
         new = {wid: ws for wid, ws in new.items() if wid not in scene.workspaces}
@@ -1156,7 +1153,7 @@ class _Reader:
             )
         obj = item.get("object")
         message = self.step_message(item, path, primitive)
-        if primitive == "GoTo" or message is not None:
+        if primitive == Primitive.GOTO or message is not None:
             if obj is not None:
                 what = (
                     "GoTo acts on no object"

@@ -25,8 +25,8 @@ from collections.abc import Sequence
 import shapely
 
 from cosmop.docking import docking_pose
-from cosmop.missions.events import Event
-from cosmop.scenario import Scene
+from cosmop.events import Event
+from cosmop.scene import Scene
 from cosmop.squares import docking_places
 
 __all__ = ["free_component", "unreachable"]

@@ -21,10 +21,10 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 
 from cosmop.errors import EventSyntaxError
-from cosmop.missions.events import Event, parse_event
+from cosmop.events import Event, Primitive, parse_event, realising_step
 from cosmop.missions.precedence import Link
 from cosmop.planning.plan import RobotPlan, State, Step, initial_state
-from cosmop.scenario import Scene
+from cosmop.scene import Scene
 
 __all__ = [
     "TOLERANCE",
@@ -32,7 +32,6 @@ __all__ = [
     "event_instants",
     "holds_at",
     "message_links",
-    "step_primitive",
     "unanswered_requests",
 ]
 
@@ -54,22 +53,6 @@ def at_pose(pose: Sequence[float], home: Sequence[float]) -> bool:
     )
 
 
-def step_primitive(event: Event, robot: str) -> tuple[str, str | None, str | None] | None:
-    """The step that realises `event` for `robot`: ``(primitive, object, message)``.
-
-    ``None`` for ``return`` (realised by a pose, not a step).
-    """
-    if event.kind == "pick":
-        return "PickUp", event.obj, None
-    if event.kind == "drop":
-        return "DropOff", event.obj, None
-    if event.kind == "away":
-        return ("Req" if robot == event.receiver else "Res"), event.obj, None
-    if event.kind == "msg":
-        return ("Req" if robot == event.receiver else "Res"), None, event.name
-    return None
-
-
 def holds_at(
     event: Event, robot: str, plan: RobotPlan, states: Sequence[State], scene: Scene, i: int
 ) -> bool:
@@ -79,7 +62,7 @@ def holds_at(
     if i == 0:
         return False
     step = plan.steps[i - 1]
-    wanted = step_primitive(event, robot)
+    wanted = realising_step(event, robot)
     if wanted is None or (step.primitive, step.object, step.message) != wanted:
         return False
     if event.kind == "drop":
@@ -147,12 +130,12 @@ def _message_steps(robot: str, plan: RobotPlan) -> list[tuple[int, Step, Event |
     pending = [e for e in _events(plan) if e.kind == "away"]
     out = []
     for k, step in enumerate(plan.steps, 1):
-        if step.primitive not in ("Req", "Res"):
+        if step.primitive not in (Primitive.REQ, Primitive.RES):
             continue
         if step.message is not None:
             out.append((k, step, parse_event(step.message)))
             continue
-        role = "receiver" if step.primitive == "Req" else "sender"
+        role = "receiver" if step.primitive == Primitive.REQ else "sender"
         event = next((e for e in pending if e.obj == step.object and getattr(e, role) == robot), None)
         if event is not None:
             pending.remove(event)
@@ -170,7 +153,7 @@ def unanswered_requests(plans: Mapping[str, RobotPlan]) -> list[tuple[str, int, 
         (robot, k, str(step.object))
         for robot, plan in plans.items()
         for k, step, event in _message_steps(robot, plan)
-        if event is None and step.primitive == "Req"
+        if event is None and step.primitive == Primitive.REQ
     ]
 
 
@@ -186,7 +169,7 @@ def message_links(plans: Mapping[str, RobotPlan]) -> list[Link]:
     for robot, plan in plans.items():
         for k, step, event in _message_steps(robot, plan):
             if event is not None:
-                table = waits if step.primitive == "Req" else sends
+                table = waits if step.primitive == Primitive.REQ else sends
                 table.setdefault(event.name, (robot, k))
     out = []
     for name in sorted(set(sends) | set(waits)):

@@ -98,30 +98,31 @@ def wall_regions(
     )
 
 
+def square_sides(ox, oy, d):
+    """The four sides of an axis-aligned square obstacle at centre distance `d`, as ``(a, b, c)``.
+
+    ``a x + b y >= c`` holds for centres ``(x, y)`` at least `d` left of, right of, below or
+    above the centre ``(ox, oy)``: ``(left, right, below, above)``.  The coefficients are
+    exact (``Fraction``); `ox`, `oy` and `d` may be numbers or solver terms, so the
+    specification (where an object's position is a variable) and :func:`object_regions` build
+    the same half-planes.
+    """
+    one, zero = Fraction(1), Fraction(0)
+    return ((-one, zero, d - ox), (one, zero, ox + d), (zero, -one, d - oy), (zero, one, oy + d))
+
+
 def object_regions(
     position: tuple[float, float], object_side: float, robot_side: float, name: str = "object"
 ) -> tuple[HalfPlane, HalfPlane, HalfPlane, HalfPlane]:
     """The four regions around a resting square object for a square robot.
 
     ``(left, right, below, above)`` of the object with clearance
-    :math:`d = (l_b + l_r)/2`: e.g. left is :math:`x \\le o_x - d`.
+    :math:`d = (l_b + l_r)/2`: e.g. left is :math:`x \\le o_x - d`.  A straight motion whose
+    two end centres lie in one of them never overlaps the object (touching allowed).
     """
     ox, oy = Fraction(position[0]), Fraction(position[1])
     d = (Fraction(object_side) + Fraction(robot_side)) / 2
-    one, zero = Fraction(1), Fraction(0)
-    return (
-        HalfPlane(-one, zero, -(ox - d), f"left of {name}"),
-        HalfPlane(one, zero, ox + d, f"right of {name}"),
-        HalfPlane(zero, -one, -(oy - d), f"below {name}"),
-        HalfPlane(zero, one, oy + d, f"above {name}"),
+    labels = (f"left of {name}", f"right of {name}", f"below {name}", f"above {name}")
+    return tuple(
+        HalfPlane(a, b, c, label) for (a, b, c), label in zip(square_sides(ox, oy, d), labels, strict=True)
     )
-
-
-def motion_is_clear(
-    regions: tuple[HalfPlane, ...], start: tuple[float, float], end: tuple[float, float]
-) -> HalfPlane | None:
-    """The first region containing both end centres of a straight motion, or ``None``."""
-    for region in regions:
-        if region.contains(*start) and region.contains(*end):
-            return region
-    return None

@@ -51,6 +51,7 @@ import shapely
 
 from cosmop.automata import DFA
 from cosmop.docking import facing
+from cosmop.events import Event, Primitive, realising_step
 from cosmop.logic import (
     FALSE,
     TRUE,
@@ -66,14 +67,12 @@ from cosmop.logic import (
     eq,
     to_fraction,
 )
-from cosmop.missions.events import Event
 from cosmop.planning.plan import State
-from cosmop.planning.regions import HalfPlane, wall_regions
-from cosmop.scenario import Scene
+from cosmop.planning.regions import HalfPlane, square_sides, wall_regions
+from cosmop.scene import Scene
 from cosmop.squares import docking_places
 
 NONE = 0
-PRIMITIVE_NAMES = ("GoTo", "PickUp", "DropOff", "Req", "Res")
 
 
 def _num(value: float) -> Fraction:
@@ -146,9 +145,9 @@ class RobotProblem:
         The local mission as a sequence of events (pick, drop, return, away).
     requests : bool
         Whether the robot may ask for objects to be moved away (Req).
-    primitives : Mapping[str, Primitive], optional
-        The primitive library (default :data:`PRIMITIVES`); each primitive says which objects
-        it applies to (:meth:`Primitive.targets`), and the actions are all such pairs.
+    primitives : Mapping[Primitive, Encoding], optional
+        The primitive library (default :data:`ENCODINGS`); each primitive says which objects
+        it applies to (:meth:`Encoding.targets`), and the actions are all such pairs.
     start : State, optional
         Instant 0 when it is not the scenario: a robot that replans mid-mission starts where it
         is (integer mm and degrees), with the objects as it knows them; ``return`` still means
@@ -173,7 +172,7 @@ class RobotProblem:
     robot: str
     mission: tuple[Event, ...]
     requests: bool = True
-    primitives: Mapping[str, Primitive] | None = None
+    primitives: Mapping[Primitive, Encoding] | None = None
     start: State | None = None
     unrequestable: frozenset[str] = frozenset()
     automaton: DFA | None = None
@@ -183,7 +182,7 @@ class RobotProblem:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "mission", tuple(self.mission))
-        primitives = PRIMITIVES if self.primitives is None else self.primitives
+        primitives = ENCODINGS if self.primitives is None else self.primitives
         object.__setattr__(self, "primitives", MappingProxyType(dict(primitives)))
         acts = [(prim.name, obj) for prim in self.primitives.values() for obj in prim.targets(self)]
         object.__setattr__(self, "actions", tuple(Action(name, o, i + 1) for i, (name, o) in enumerate(acts)))
@@ -258,7 +257,7 @@ class RobotProblem:
             [
                 self.pi.eq(a.code)
                 for a in self.actions
-                if a.primitive == "GoTo" or (a.primitive == "Req" and a.obj != obj)
+                if a.primitive == Primitive.GOTO or (a.primitive == Primitive.REQ and a.obj != obj)
             ]
         )
 
@@ -275,7 +274,7 @@ def _less(term, amount: Fraction):
 def _docking_poses(p: RobotProblem, obj: str, ox, oy, d: Fraction) -> list[tuple[int, Any, Any]]:
     """``(h, x, y)``: the robot centre that faces `obj` at ``(ox, oy)`` from heading ``h``, touching
     it, :math:`(o_x, o_y) - d\\,(\\cos h, \\sin h)`, for each of the object's docking headings
-    (:attr:`~cosmop.scenario.MovableObject.headings`); exact terms."""
+    (:attr:`~cosmop.scene.MovableObject.headings`); exact terms."""
     out = []
     for heading in p.scene.objects[obj].headings:
         ux, uy = facing(heading)
@@ -297,7 +296,7 @@ def _half_plane(h: HalfPlane, x, y) -> Formula:
     return h.a * x + h.b * y >= h.c
 
 
-class Primitive:
+class Encoding:
     """A safe motion primitive: its name and the constraint between :math:`q` and :math:`\\bigcirc q`.
 
     Subclasses set ``name`` and implement :meth:`targets` (the objects it applies to, ``None``
@@ -306,7 +305,7 @@ class Primitive:
     subclass added to the library passed to :class:`RobotProblem`; the solver does not change.
     """
 
-    name = ""
+    name: Primitive
 
     def targets(self, p: RobotProblem) -> tuple[str | None, ...]:
         raise NotImplementedError
@@ -481,21 +480,12 @@ def _wall_sides(p: RobotProblem, wall, name: str) -> list[tuple[_Face, _Face]]:
 
 def _object_sides(v: ObjectVars, d: Fraction, m: Fraction) -> list[tuple[_Face, _Face]]:
     """Left, right, below and above an object at centre distance `d` (touching) and `d + m`."""
-    one, zero = Fraction(1), Fraction(0)
-
-    def sides(e: Fraction) -> list[_Face]:
-        return [
-            _Face(-one, zero, e - v.x),
-            _Face(one, zero, v.x + e),
-            _Face(zero, -one, e - v.y),
-            _Face(zero, one, v.y + e),
-        ]
-
-    touching = sides(d)
-    return list(zip(touching, sides(d + m) if m else touching, strict=True))
+    touching = [_Face(*side) for side in square_sides(v.x, v.y, d)]
+    far = [_Face(*side) for side in square_sides(v.x, v.y, d + m)] if m else touching
+    return list(zip(touching, far, strict=True))
 
 
-class GoTo(Primitive):
+class GoTo(Encoding):
     """Move in a straight line; never overlap a wall or a resting object, never slide along one.
 
     Touching is allowed at either end of the motion; otherwise it keeps
@@ -503,7 +493,7 @@ class GoTo(Primitive):
     (:data:`MOTION_MARGIN`, :data:`STEEPNESS`, :func:`_apart`).
     """
 
-    name = "GoTo"
+    name = Primitive.GOTO
 
     def targets(self, p):
         return (None,)
@@ -521,10 +511,10 @@ class GoTo(Primitive):
         return out
 
 
-class PickUp(Primitive):
+class PickUp(Encoding):
     """Pick ``obj`` up carrying nothing, facing one of its sides and touching it (:func:`_docked`)."""
 
-    name = "PickUp"
+    name = Primitive.PICKUP
 
     def targets(self, p):
         return p.own_objects
@@ -540,11 +530,11 @@ class PickUp(Primitive):
         return out + _gripper_clear(p, obj, v.x, v.y) + _handling_room(p, obj, _pick_places(p, obj))
 
 
-class DropOff(Primitive):
+class DropOff(Encoding):
     """Leave the carried ``obj`` in front of the robot (any docking heading, :func:`_docked`), never
     onto a wall or another object."""
 
-    name = "DropOff"
+    name = Primitive.DROPOFF
 
     def targets(self, p):
         return p.own_objects
@@ -583,10 +573,10 @@ class DropOff(Primitive):
         return out
 
 
-class Req(Primitive):
+class Req(Encoding):
     """Ask for ``obj`` to be moved away and wait, clear of every pose that picks it (each side)."""
 
-    name = "Req"
+    name = Primitive.REQ
 
     def targets(self, p):
         if not p.requests:
@@ -608,10 +598,10 @@ class Req(Primitive):
         return [(f"Req {obj}", _robot_static(p) & flags & conj(room))]
 
 
-class Res(Primitive):
+class Res(Encoding):
     """Answer that ``obj`` (carried) has been moved away."""
 
-    name = "Res"
+    name = Primitive.RES
 
     def targets(self, p):
         return p.answered_objects
@@ -620,16 +610,23 @@ class Res(Primitive):
         return [(f"Res {obj}", _robot_static(p) & _objects_static(p) & p.obj(obj).carried)]
 
 
-PRIMITIVES: Mapping[str, Primitive] = MappingProxyType(
+ENCODINGS: Mapping[Primitive, Encoding] = MappingProxyType(
     {c.name: c() for c in (GoTo, PickUp, DropOff, Req, Res)}
 )
+"""The primitive library: each primitive's encoding, in the order of :class:`~cosmop.events.Primitive`."""
 
 
 def _goal(p: RobotProblem, event: Event) -> tuple[Formula, Formula]:
     """(allowed primitives before the event, the event's goal at its instant)."""
-    if event.kind == "pick":
-        return p.requests_except(event.obj), p.is_action("PickUp", event.obj)
-    if event.kind == "drop":
+    if event.kind == "return":
+        x0, y0, h0 = p.scene.robots[p.robot].pose
+        home = p.x.eq(_num(x0)) & p.y.eq(_num(y0)) & p.h.eq(_num(h0))
+        return p.requests_except(None), home & (p.requests_except(None) | p.pi.eq(NONE))
+    if event.kind not in ("pick", "drop", "away"):
+        raise ValueError(f"unknown event kind {event.kind!r}")
+    primitive, obj, _ = realising_step(event, p.robot)
+    goal = p.is_action(primitive, obj)
+    if event.kind == "drop":  # and the object inside the workspace
         v = p.obj(event.obj)
         ws = p.scene.workspaces[event.workspace].centres(p.scene.objects[event.obj].size)
         if ws.point is not None:
@@ -638,16 +635,8 @@ def _goal(p: RobotProblem, event: Event) -> tuple[Formula, Formula]:
             inside = conj(
                 [v.x >= _num(ws.x[0]), v.x <= _num(ws.x[1]), v.y >= _num(ws.y[0]), v.y <= _num(ws.y[1])]
             )
-        return p.requests_except(event.obj), p.is_action("DropOff", event.obj) & inside
-    if event.kind == "return":
-        x0, y0, h0 = p.scene.robots[p.robot].pose
-        home = p.x.eq(_num(x0)) & p.y.eq(_num(y0)) & p.h.eq(_num(h0))
-        return p.requests_except(None), home & (p.requests_except(None) | p.pi.eq(NONE))
-    if event.kind == "away":
-        if event.robot == p.robot:  # the requester
-            return p.requests_except(event.obj), p.is_action("Req", event.obj)
-        return p.requests_except(event.obj), p.is_action("Res", event.obj)
-    raise ValueError(f"unknown event kind {event.kind!r}")
+        goal = goal & inside
+    return p.requests_except(obj), goal
 
 
 def mission_formula(p: RobotProblem, events: Sequence[Event] | None = None) -> Formula:
@@ -749,7 +738,7 @@ def specification(p: RobotProblem, events: Sequence[Event] | None = None) -> lis
 
 def request_codes(p: RobotProblem) -> dict[int, str]:
     """Codes of the Req actions, with their objects."""
-    return {a.code: a.obj for a in p.actions if a.primitive == "Req" and a.obj is not None}
+    return {a.code: a.obj for a in p.actions if a.primitive == Primitive.REQ and a.obj is not None}
 
 
 def decode(p: RobotProblem, code: int) -> Action:
@@ -760,6 +749,6 @@ def decode(p: RobotProblem, code: int) -> Action:
 
 
 def events_of(mission: Iterable[Event | str]) -> tuple[Event, ...]:
-    from cosmop.missions.events import parse_event
+    from cosmop.events import parse_event
 
     return tuple(e if isinstance(e, Event) else parse_event(e) for e in mission)

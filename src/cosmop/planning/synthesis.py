@@ -24,7 +24,7 @@ nothing is claimed beyond).
 from __future__ import annotations
 
 import time
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -32,8 +32,8 @@ import z3
 
 from cosmop.automata import DFA
 from cosmop.automata.operations import project, trim
+from cosmop.events import Event, Primitive, parse_event
 from cosmop.logic import IncrementalUnrolling, Signature, Unrolling, conj, to_fraction
-from cosmop.missions.events import Event, parse_event
 from cosmop.planning.messages import answer_early, place_mission_messages, strip_messages, wait_early
 from cosmop.planning.plan import ObjectState, RobotPlan, State, Step
 from cosmop.planning.reach import unreachable
@@ -46,7 +46,7 @@ from cosmop.planning.specification import (
     request_codes,
     specification,
 )
-from cosmop.scenario import MAX_TASK_EVENTS, Scene
+from cosmop.scene import MAX_TASK_EVENTS, Scene
 
 DEFAULT_RLIMIT = 50_000_000
 
@@ -115,7 +115,7 @@ def _plan(
     steps, requested = [], []
     for state in trace[1:]:
         action = decode(p, int(state["pi"]))
-        if action.primitive == "Req":
+        if action.primitive == Primitive.REQ:
             requested.append(action.obj)
         objects = {
             o: ObjectState(
@@ -146,17 +146,8 @@ def _count_requests(p: RobotProblem, unrolling: Unrolling | IncrementalUnrolling
 def _feasible_within(p: RobotProblem, events: tuple[Event, ...], K: int, rlimit: int) -> bool:
     """Whether some plan of at most ``K`` steps realises `events` (one solver, the horizon grown)."""
     formula = conj(f for _, f in specification(p, events))
-    ctx = z3.Context()
-    grow, s = None, _solver(rlimit, ctx)
-    for k in range(max(1, sum(1 for e in events if e.kind != "return")), K + 1):
-        if grow is None:
-            grow = IncrementalUnrolling(Signature.of(formula), k, ctx=ctx)
-            s.add(grow.require(formula))
-        else:
-            s.add(grow.extend(k))
-        if s.check(grow.end) == z3.sat:
-            return True
-    return False
+    horizons = _horizons(formula, max(1, _least_steps(events)), K, rlimit, incremental=True)
+    return any(h.solver.check(*h.assumptions) == z3.sat for h in horizons)
 
 
 def synthesize(
@@ -213,6 +204,54 @@ def synthesize(
     put in afterwards (:func:`cosmop.planning.messages.place_mission_messages`).
     """
     t0 = time.perf_counter()
+    m = _local_mission(scene, robot, mission, start, max_horizon)
+    if m.walled_off is not None:  # no horizon can do it: say so without the solver
+        return Synthesis(robot, False, None, None, reason=m.walled_off, solve_s=time.perf_counter() - t0)
+    p = _problem(scene, robot, m, requests=requests, start=start, unrequestable=unrequestable, margin=margin)
+    found = _shortest_plan(p, m.lower, max_horizon, rlimit, incremental)
+    if found.plan is not None:
+        return found.synthesis(robot, t0, plan=_place_messages(p, found.plan, m.full))
+    if found.gave_up is not None:  # the solver could not decide a horizon: claim nothing beyond
+        return found.synthesis(robot, t0, reason=found.gave_up)
+    reason, blocking = _why_no_plan(p, max_horizon, rlimit, explain)
+    return found.synthesis(robot, t0, reason, blocking)
+
+
+@dataclass(frozen=True)
+class _Mission:
+    """A robot's local mission as the solver sees it, before any solver call.
+
+    Attributes
+    ----------
+    automaton : DFA or None
+        A branching mission without its messages and the events walls rule out; ``None`` for a
+        sequence.
+    full : tuple of Event
+        A sequence mission with its messages (placed after solving); the automaton's events.
+    events : tuple of Event
+        What the solver plans.
+    lower : int
+        Fewest steps of any plan: the first horizon searched.
+    walled_off : str or None
+        Why no horizon can work, found without the solver.
+    """
+
+    automaton: DFA | None
+    full: tuple[Event, ...]
+    events: tuple[Event, ...]
+    lower: int
+    walled_off: str | None
+
+
+def _local_mission(
+    scene: Scene, robot: str, mission: Iterable[Event | str] | DFA, start: State | None, max_horizon: int
+) -> _Mission:
+    """The events to plan, the least horizon, and what rules the mission out before solving.
+
+    Walls (:func:`~cosmop.planning.reach.unreachable`), the number of events planned at once
+    (:data:`~cosmop.scene.MAX_TASK_EVENTS`, sequences only) and a least horizon beyond
+    `max_horizon` each make ``walled_off`` say why no plan is searched.
+    """
     origin = start.robot[:2] if start is not None else None
     if isinstance(mission, DFA):
         automaton, walled_off = _plannable(scene, robot, mission, origin)
@@ -222,7 +261,7 @@ def synthesize(
         automaton, full = None, events_of(mission)
         events = strip_messages(full)
         walled_off = unreachable(scene, robot, events, origin)
-        lower = sum(1 for e in events if e.kind != "return")  # each such event takes a step
+        lower = _least_steps(events)
     if walled_off is None and automaton is None and len(events) > MAX_TASK_EVENTS:
         walled_off = (
             f"{robot}'s mission has {len(events)} events; at most {MAX_TASK_EVENTS} are planned at once"
@@ -232,25 +271,75 @@ def synthesize(
             f"{robot}'s mission needs at least {lower} steps, more than the longest plan searched "
             f"({max_horizon} steps)"
         )
-    if walled_off is not None:  # no horizon can do it: say so without the solver
-        return Synthesis(robot, False, None, None, reason=walled_off, solve_s=time.perf_counter() - t0)
-    forbid = frozenset(unrequestable)
-    p = RobotProblem(
+    return _Mission(automaton, full, events, lower, walled_off)
+
+
+def _least_steps(events: Iterable[Event]) -> int:
+    """Fewest steps of a plan that performs `events`: one per event but ``return``."""
+    return sum(1 for e in events if e.kind != "return")
+
+
+def _problem(
+    scene: Scene,
+    robot: str,
+    m: _Mission,
+    *,
+    requests: bool,
+    start: State | None,
+    unrequestable: frozenset[str],
+    margin: float,
+) -> RobotProblem:
+    """The solver's problem for the events of `m` (options as in :func:`synthesize`)."""
+    return RobotProblem(
         scene,
         robot,
-        events,
+        m.events,
         requests,
         start=start,
-        unrequestable=forbid,
-        automaton=automaton,
+        unrequestable=frozenset(unrequestable),
+        automaton=m.automaton,
         margin=to_fraction(margin),
     )
-    formula = conj(f for _, f in specification(p))
+
+
+@dataclass(frozen=True)
+class _Horizon:
+    """One horizon ``K`` ready to check: ``solver.check(*assumptions)`` decides it.
+
+    Attributes
+    ----------
+    K : int
+    solver : z3.Solver
+        Holds the specification unrolled over instants ``0..K``.
+    unrolling : Unrolling or IncrementalUnrolling
+        The unrolling, to read a model's trace and to count requests.
+    assumptions : tuple of z3.BoolRef
+        The literal choosing the horizon of a growing unrolling; empty for a fixed one.
+    """
+
+    K: int
+    solver: z3.Solver
+    unrolling: Unrolling | IncrementalUnrolling
+    assumptions: tuple[z3.BoolRef, ...]
+
+
+def _horizons(formula, first: int, last: int, rlimit: int, *, incremental: bool) -> Iterator[_Horizon]:
+    """`formula` unrolled for ``K = first .. last`` in turn, each in a solver ready to check.
+
+    Parameters
+    ----------
+    formula : Formula
+    first, last : int
+        The horizons, both included.
+    rlimit : int
+        Z3 resource limit per solver call.
+    incremental : bool
+        One solver whose unrolling grows (the horizon chosen by an assumption), else a fresh
+        context and solver per horizon.
+    """
     signature = Signature.of(formula)
-    checks = 0
     grow: IncrementalUnrolling | None = None
-    unsat: list[int] = []
-    for K in range(lower, max_horizon + 1):
+    for K in range(first, last + 1):
         if incremental:  # one solver; the horizon grows under the assumption ``end``
             if grow is None:
                 ctx = z3.Context()
@@ -259,78 +348,142 @@ def synthesize(
                 s.add(grow.require(formula))
             else:
                 s.add(grow.extend(K))
-            u, assumptions = grow, [grow.end]
+            yield _Horizon(K, s, grow, (grow.end,))
         else:  # a fresh context and solver per horizon: answers never depend on earlier calls
             ctx = z3.Context()
-            u, assumptions = Unrolling(signature, K, ctx=ctx), []
+            u = Unrolling(signature, K, ctx=ctx)
             s = _solver(rlimit, ctx)
             s.add(u.encode(formula))
-        checks += 1
-        verdict = s.check(*assumptions)
-        if verdict == z3.unknown:  # no answer within the resource limit: say so, claim nothing more
-            why = (
-                f"{robot}: the solver gave up at K={K} ({s.reason_unknown()}, resource limit {rlimit}); "
-                f"no plan of at most {K - 1} steps exists, longer ones were not searched"
-            )
-            return Synthesis(
-                robot,
-                False,
-                None,
-                None,
-                reason=why,
-                solve_s=time.perf_counter() - t0,
-                checks=checks,
-                unsat_horizons=tuple(unsat),
-            )
-        if verdict != z3.sat:
-            unsat.append(K)
-            continue
-        model = s.model()
-        if K > 0 and request_codes(p):  # at K = 0 there is no step to count
-            count = _count_requests(p, u)
-            best = model.eval(count, model_completion=True).as_long()
-            while best > 0:
-                s.push()
-                s.add(count <= best - 1)
-                checks += 1
-                if s.check(*assumptions) != z3.sat:
-                    s.pop()
-                    break
-                model = s.model()
-                best = model.eval(count, model_completion=True).as_long()
-                s.pop()
-        plan, asked = _plan(p, u, model)
-        plan = answer_early(plan)
-        if start is None:  # where a robot waits for answers: before it drives (no start state mid-run)
-            plan = wait_early(scene, robot, plan)
-        plan = place_mission_messages(scene, robot, plan, plan.events if automaton else full, start)
+            yield _Horizon(K, s, u, ())
+
+
+@dataclass(frozen=True)
+class _Search:
+    """What the search over horizons found, before messages are placed or failure explained.
+
+    Attributes
+    ----------
+    plan : RobotPlan or None
+        The shortest plan with the fewest requests, without the mission's messages.
+    horizon : int or None
+        Its length.
+    requests : tuple of str
+        Objects it requests.
+    gave_up : str or None
+        Why the search stopped undecided (the solver's resource limit).
+    checks : int
+        Solver calls made.
+    unsat : tuple of int
+        The horizons proved unsatisfiable.
+    """
+
+    plan: RobotPlan | None = None
+    horizon: int | None = None
+    requests: tuple[str, ...] = ()
+    gave_up: str | None = None
+    checks: int = 0
+    unsat: tuple[int, ...] = ()
+
+    def synthesis(
+        self,
+        robot: str,
+        t0: float,
+        reason: str | None = None,
+        blocking: tuple[str, ...] = (),
+        *,
+        plan: RobotPlan | None = None,
+    ) -> Synthesis:
+        """The result for `robot`: feasible when given `plan`, timed from `t0`."""
         return Synthesis(
             robot,
-            True,
+            plan is not None,
             plan,
-            K,
-            asked,
+            self.horizon,
+            self.requests,
+            reason=reason,
+            blocking=blocking,
             solve_s=time.perf_counter() - t0,
-            checks=checks,
-            unsat_horizons=tuple(unsat),
+            checks=self.checks,
+            unsat_horizons=self.unsat,
         )
-    if explain and automaton is not None:
-        reason, blocking = _explain_automaton(p, max_horizon, rlimit)
-    elif explain:
-        reason, blocking = _explain(p, events, max_horizon, rlimit)
-    else:
-        reason, blocking = f"no plan of at most {max_horizon} steps", ()
-    return Synthesis(
-        robot,
-        False,
-        None,
-        None,
-        reason=reason,
-        blocking=blocking,
-        solve_s=time.perf_counter() - t0,
-        checks=checks,
-        unsat_horizons=tuple(unsat),
-    )
+
+
+def _shortest_plan(p: RobotProblem, lower: int, max_horizon: int, rlimit: int, incremental: bool) -> _Search:
+    """The first satisfiable horizon from `lower` to `max_horizon`, and its plan.
+
+    Each horizon is checked in turn; at the first satisfiable one the number of requests is
+    minimised (:func:`_fewest_requests`).  A horizon the solver cannot decide within `rlimit`
+    ends the search with ``gave_up`` set.
+    """
+    formula = conj(f for _, f in specification(p))
+    checks = 0
+    unsat: list[int] = []
+    for h in _horizons(formula, lower, max_horizon, rlimit, incremental=incremental):
+        checks += 1
+        verdict = h.solver.check(*h.assumptions)
+        if verdict == z3.unknown:  # no answer within the resource limit: say so, claim nothing more
+            why = (
+                f"{p.robot}: the solver gave up at K={h.K} ({h.solver.reason_unknown()}, resource limit "
+                f"{rlimit}); no plan of at most {h.K - 1} steps exists, longer ones were not searched"
+            )
+            return _Search(gave_up=why, checks=checks, unsat=tuple(unsat))
+        if verdict != z3.sat:
+            unsat.append(h.K)
+            continue
+        model, more = _fewest_requests(p, h)
+        plan, asked = _plan(p, h.unrolling, model)
+        return _Search(plan, h.K, asked, checks=checks + more, unsat=tuple(unsat))
+    return _Search(checks=checks, unsat=tuple(unsat))
+
+
+def _fewest_requests(p: RobotProblem, h: _Horizon) -> tuple[z3.ModelRef, int]:
+    """A model of the satisfiable horizon `h` with the fewest Req steps, and the checks it took.
+
+    The bound on the number of requests is tightened until unsat, each bound in its own
+    ``push``/``pop`` so that `h`'s solver is left as it was.
+    """
+    s = h.solver
+    model, checks = s.model(), 0
+    if h.K > 0 and request_codes(p):  # at K = 0 there is no step to count
+        count = _count_requests(p, h.unrolling)
+        best = model.eval(count, model_completion=True).as_long()
+        while best > 0:
+            s.push()
+            s.add(count <= best - 1)
+            checks += 1
+            if s.check(*h.assumptions) != z3.sat:
+                s.pop()
+                break
+            model = s.model()
+            best = model.eval(count, model_completion=True).as_long()
+            s.pop()
+    return model, checks
+
+
+def _place_messages(p: RobotProblem, plan: RobotPlan, full: tuple[Event, ...]) -> RobotPlan:
+    """`plan` with answers early, requests before drives, and the mission's messages put in.
+
+    A branching mission's messages follow the word the plan performs; a sequence's are those
+    of `full`.
+    """
+    plan = answer_early(plan)
+    if p.start is None:  # where a robot waits for answers: before it drives (no start state mid-run)
+        plan = wait_early(p.scene, p.robot, plan)
+    return place_mission_messages(p.scene, p.robot, plan, plan.events if p.automaton else full, p.start)
+
+
+def _why_no_plan(
+    p: RobotProblem, max_horizon: int, rlimit: int, explain: bool
+) -> tuple[str, tuple[str, ...]]:
+    """The reason and the blocking parts when no plan of at most `max_horizon` steps exists.
+
+    Without `explain` only the bound is named (no further solver calls).
+    """
+    if explain and p.automaton is not None:
+        return _explain_automaton(p, max_horizon, rlimit)
+    if explain:
+        return _explain(p, p.mission, max_horizon, rlimit)
+    return f"no plan of at most {max_horizon} steps", ()
 
 
 def _plannable(
@@ -363,7 +516,7 @@ def _plannable(
 
 def _fewest_steps(dfa: DFA, events: tuple[Event, ...]) -> int:
     """Fewest steps of any plan: the fewest non-return events on a marked word (0-1 search)."""
-    weight = [0 if e.kind == "return" else 1 for e in events]
+    weight = [_least_steps((e,)) for e in events]
     best = np.full(dfa.n_states, np.iinfo(np.int64).max, dtype=np.int64)
     best[dfa.initial] = 0
     todo = [dfa.initial]

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 
 import shapely
 
-from cosmop.missions.events import parse_event
+from cosmop.events import parse_event
 from cosmop.missions.precedence import Link, Node, Precedence
 from cosmop.planning.conflicts import (
     Conflict,
@@ -37,7 +37,7 @@ from cosmop.planning.messages import merge_drives, place_edges, split_drives
 from cosmop.planning.plan import PlanMessage, RobotPlan, State
 from cosmop.planning.realisation import message_links
 from cosmop.planning.timing import durations, start_pose
-from cosmop.scenario import Scene
+from cosmop.scene import Scene
 
 __all__ = ["TeamSafety", "make_team_safe"]
 

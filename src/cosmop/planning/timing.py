@@ -1,6 +1,6 @@
 """How long each step of a plan takes: the execution model the coordination layer reasons with.
 
-The simulator drives unicycles with the limits of :class:`~cosmop.scenario.Dynamics`; this
+The simulator drives unicycles with the limits of :class:`~cosmop.scene.Dynamics`; this
 module estimates the same motions in closed form, so that plans can be ordered by when their
 steps are expected to happen (and shared as itineraries):
 
@@ -28,10 +28,11 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
+from cosmop.events import Primitive
 from cosmop.missions.precedence import Precedence
 from cosmop.planning.plan import Itinerary, RobotPlan, State
 from cosmop.planning.realisation import message_links
-from cosmop.scenario import Dynamics, Scene
+from cosmop.scene import Dynamics, Scene
 
 __all__ = [
     "ExecutionModel",
@@ -117,16 +118,16 @@ def step_durations(
     out, pose = [], tuple(start)
     run: list[tuple[int, tuple, tuple]] = []  # pieces of one straight drive: (index, from, to)
     for step in plan.steps:
-        if step.primitive == "GoTo" and run and not _collinear(run[-1][1], run[-1][2], step.robot):
+        if step.primitive == Primitive.GOTO and run and not _collinear(run[-1][1], run[-1][2], step.robot):
             _close(run, out, dynamics)
             run = []
         out.append(0.0)
-        if step.primitive == "GoTo":
+        if step.primitive == Primitive.GOTO:
             run.append((len(out) - 1, pose, step.robot))
         else:
             _close(run, out, dynamics)
             run = []
-            if step.primitive in ("PickUp", "DropOff"):
+            if step.primitive in (Primitive.PICKUP, Primitive.DROPOFF):
                 out[-1] = model.handling_time
         pose = step.robot
     _close(run, out, dynamics)

@@ -4,21 +4,15 @@
 (:mod:`cosmop.sim.simulation`); people walk their paths (:mod:`cosmop.sim.humans`); a stalled
 robot replans its remaining mission from where it is (:mod:`cosmop.sim.replan`).  The result
 carries the ``cosmop.sim/1`` summary, with every step's planned and realised times
-(:mod:`cosmop.sim.timing`), and the ``cosmop.trace/1`` trace.
+(:mod:`cosmop.sim.timing`), and the ``cosmop.trace/1`` trace (:mod:`cosmop.sim.result`).
 """
 
+from cosmop.sim.monitor import footprint_overlaps
 from cosmop.sim.replan import replan, sensed_scene
-from cosmop.sim.simulation import (
-    SIM_FORMAT,
-    TRACE_FORMAT,
-    Contact,
-    Message,
-    SimResult,
-    SimSettings,
-    footprint_overlaps,
-    simulate,
-)
+from cosmop.sim.result import SIM_FORMAT, Contact, Message, SimResult, SimSettings
+from cosmop.sim.simulation import simulate
 from cosmop.sim.timing import StepTimes
+from cosmop.traces import TRACE_FORMAT
 
 __all__ = [
     "SIM_FORMAT",

@@ -16,7 +16,7 @@ import math
 import numpy as np
 
 from cosmop.control.geometry import point_segment_linf
-from cosmop.scenario import Human
+from cosmop.scene import Human
 
 __all__ = ["Walker"]
 

@@ -13,20 +13,28 @@ the rest of every robot's plan, from where each robot is now, is ordered again b
 * the orders the mission itself requires (``away`` answers, order messages) are kept.
 
 If some conflict cannot be ordered, the new plan is refused and the robot keeps its old one.
+:func:`recoordinate_world` does this for a running simulation and installs the new rests in
+its robots' executors.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
-from cosmop.missions.events import parse_event
+from cosmop.events import Event, Primitive, parse_event
 from cosmop.planning.conflicts import ConflictSettings
-from cosmop.planning.plan import PlanMessage, RobotPlan, State, Step
+from cosmop.planning.plan import PlanMessage, RobotPlan, State, Step, initial_state
 from cosmop.planning.teamsafety import make_team_safe
-from cosmop.scenario import Scene
+from cosmop.scene import Scene
+from cosmop.sim.timing import carry_instants
 
-__all__ = ["Recoordination", "Remaining", "recoordinate"]
+if TYPE_CHECKING:
+    from cosmop.sim.world import Agent, World
+
+__all__ = ["Recoordination", "Remaining", "recoordinate", "recoordinate_world"]
 
 
 @dataclass(frozen=True)
@@ -74,9 +82,13 @@ class Recoordination:
 
 def _without(rest: Remaining, names: set[str]) -> RobotPlan:
     """The rest of a plan without the message steps and events in `names`."""
-    steps = [s for s in rest.steps if not (s.message in names and s.primitive in ("Req", "Res"))]
     steps = [
-        s for s in steps if not (s.primitive == "Req" and s.message is None and _away_of(rest, s) in names)
+        s for s in rest.steps if not (s.message in names and s.primitive in (Primitive.REQ, Primitive.RES))
+    ]
+    steps = [
+        s
+        for s in steps
+        if not (s.primitive == Primitive.REQ and s.message is None and _away_of(rest, s) in names)
     ]
     mission = [e for e in rest.mission if e not in names]
     return RobotPlan.from_steps(mission, steps)
@@ -138,3 +150,75 @@ def recoordinate(
             f"the new plans share a place no order resolves: {safety.unresolved[0].describe()}",
         )
     return Recoordination(True, safety.plans, safety.messages, tuple(sorted(pending)))
+
+
+# ----------------------------------------------------------------------------------------------
+# In a running simulation
+# ----------------------------------------------------------------------------------------------
+
+
+def recoordinate_world(
+    world: World, agent: Agent, new: RobotPlan, start: State
+) -> tuple[bool, str, list[str]]:
+    """Order the rest of every robot's plan again around `agent`'s `new` plan from `start`.
+
+    When accepted, every robot's executor takes its new rest (``world.conflict_messages``
+    gains the messages added).  Returns ``(accepted, why not, messages added)``.
+    """
+    splits = {a.id: a.split_mission(world.scenario) for a in world.agents}
+    rests = {}
+    for other in world.agents:
+        if other is agent:
+            rests[other.id] = Remaining(new.steps, new.mission, start)
+        else:
+            todo = splits[other.id][1]
+            rests[other.id] = Remaining(
+                tuple(other.steps[other.step_index :]), tuple(e.name for e in todo), _state_now(world, other)
+            )
+    positions = {
+        oid: None if world.carried_by[j] >= 0 else tuple(float(v) for v in world.object_xy[j])
+        for j, oid in enumerate(world.object_ids)
+    }
+    result = recoordinate(
+        world.scenario.scene,
+        rests,
+        agent.id,
+        sent=world.sent_messages,
+        conflict_messages=world.conflict_messages,
+        used=world.message_names,
+        positions=positions,
+    )
+    if not result.accepted:
+        return False, result.reason or "", []
+    for other in world.agents:
+        _install(other, result.plans[other.id], splits[other.id][0], new=other is agent)
+        if other is agent:  # its new plan starts where it stood, rounded to the millimetre
+            other.replan_start = (other.step_index, start.robot)
+    added = [m.event for m in result.messages]
+    world.conflict_messages |= set(added)
+    return True, "", added
+
+
+def _install(agent: Agent, plan: RobotPlan, done: list[Event], *, new: bool) -> None:
+    """Replace the rest of `agent`'s plan with `plan` (`done`: the mission events done so far).
+
+    The steps of a `new` plan were never planned (no instants); a re-ordered rest keeps the
+    instants of the steps it keeps (:func:`~cosmop.sim.timing.carry_instants`), and the robot
+    goes on with its current step unless that changed.
+    """
+    k = agent.step_index
+    current = agent.steps[k] if k < len(agent.steps) else None
+    kept = [] if new else agent.steps[k:]
+    agent.plan_instants = agent.plan_instants[:k] + carry_instants(kept, agent.plan_instants[k:], plan.steps)
+    agent.steps = agent.steps[:k] + list(plan.steps)
+    agent.mission = list(done) + [parse_event(e) for e in plan.mission]
+    if new or (k < len(agent.steps) and agent.steps[k] != current):
+        agent.restart_step()
+
+
+def _state_now(world: World, agent: Agent) -> State:
+    """Where `agent`'s robot is (mm, degrees) and the objects as its plan sees them now."""
+    k = agent.step_index
+    objects = agent.steps[k - 1].objects if k > 0 else initial_state(world.scenario.scene, agent.id).objects
+    x, y, h = world.pose[agent.index]
+    return State((float(x), float(y), math.degrees(float(h))), objects)

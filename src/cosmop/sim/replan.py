@@ -7,21 +7,31 @@ walls plus every sensed obstacle as a square of four walls -- and solves the rob
 mission events with :func:`cosmop.planning.synthesis.synthesize` from the robot's current state
 (integer mm and degrees), without new requests (a new request would need the top-down layer to
 re-verify the team).  The new plan must pass the exact plan checker, like every plan the tool
-returns.
+returns.  :func:`replan_stalled` does this for a robot of a running simulation that makes no
+progress, and hands its new plan to the team-safety layer (:mod:`cosmop.sim.recoordinate`).
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable, Sequence
 from dataclasses import replace
+from typing import TYPE_CHECKING
 
-from cosmop.missions.events import Event
+from cosmop.control.geometry import box_gaps
+from cosmop.events import Event, Primitive
 from cosmop.planning.checker import check_robot_plan
-from cosmop.planning.plan import RobotPlan, State
+from cosmop.planning.plan import ObjectState, RobotPlan, State
 from cosmop.planning.synthesis import synthesize
-from cosmop.scenario import Scene, Wall
+from cosmop.scene import Scene, Wall
+from cosmop.sim.recoordinate import recoordinate_world
 
-__all__ = ["replan", "sensed_scene"]
+if TYPE_CHECKING:
+    from cosmop.sim.world import Agent, World
+
+__all__ = ["replan", "replan_stalled", "sensed_scene"]
+
+_PERSON_ROOM = 10.0  # mm added around a sensed person (a robot gets the standoff)
 
 
 def sensed_scene(scene: Scene, boxes: Iterable[tuple[float, float, float]]) -> Scene:
@@ -81,3 +91,94 @@ def replan(
     if check_robot_plan(world, robot, result.plan, start=start):
         return None  # unsound plans are never executed
     return result.plan
+
+
+# ----------------------------------------------------------------------------------------------
+# In a running simulation
+# ----------------------------------------------------------------------------------------------
+
+
+def replan_stalled(world: World, agent: Agent) -> None:
+    """Receding horizon: replan `agent`'s remaining mission with the robots and people it senses.
+
+    Does nothing when the settings turn replanning off.  Every attempt goes to
+    ``world.replan_log``; a new plan is taken only if the team-safety layer orders it with
+    the others' rests (:func:`cosmop.sim.recoordinate.recoordinate_world`).
+    """
+    s = world.settings
+    if not s.replan:
+        return
+    world.replan_attempts += 1
+    _, todo = agent.split_mission(world.scenario)
+    # the mission's own events and messages; messages that kept plans apart are ordered afresh
+    remaining = [
+        e for e in todo if e.name not in world.conflict_messages and e.name not in world.sent_messages
+    ]
+    start = _start_state(world, agent)
+    # A replan should not be much longer than what is left of the plan: bound the search there
+    # (an infeasible replan -- a blocked doorway -- would otherwise search every horizon).
+    horizon = min(s.max_horizon, len(agent.steps) - agent.step_index + 4)
+    plan = replan(
+        world.scenario.scene,
+        agent.id,
+        remaining,
+        start,
+        _sensed(world, agent),
+        max_horizon=horizon,
+        rlimit=s.rlimit,
+    )
+    if plan is None:
+        world.replan_log.append(
+            {"t": round(world.t, 6), "robot": agent.id, "accepted": False, "why": "no plan"}
+        )
+        return
+    accepted, why, added = recoordinate_world(world, agent, plan, start)
+    world.replan_log.append(
+        {
+            "t": round(world.t, 6),
+            "robot": agent.id,
+            "accepted": accepted,
+            "why": why or None,
+            "messages": added,
+        }
+    )
+    if accepted:
+        world.replans += 1
+
+
+def _sensed(world: World, agent: Agent) -> list[tuple[float, float, float]]:
+    """The robots and people `agent` senses, as boxes ``x, y, half side`` (mm) grown by the
+    room to keep: robots the clearance the team-safety layer checks (the standoff), people a
+    little.  A robot that has finished stays where it is for good: sensed however far."""
+    s = world.settings
+    i = agent.index
+    sensed = world.obstacles()
+    boxes, names = sensed.boxes, list(sensed.names)
+    gaps = box_gaps(world.pose[i, :2], world.robot_half[i], boxes)
+    finished = {a.id for a in world.agents if a.done}
+    return [
+        (float(b[0]), float(b[1]), float(b[2]) + (s.dwa.standoff if n in world.robot_ids else _PERSON_ROOM))
+        for b, n, g in zip(boxes, names, gaps, strict=True)
+        if n != agent.id and n not in world.object_ids and (g < s.sense_range or n in finished)
+    ]
+
+
+def _start_state(world: World, agent: Agent) -> State:
+    """Where `agent` replans from: its pose and every object, rounded to integer mm and degrees.
+
+    An object another robot carries, or one it has asked to be moved away (a ``Req`` step done),
+    is away: not in its way.
+    """
+    i = agent.index
+    done_steps = agent.steps[: agent.step_index]
+    objects = {}
+    for j, oid in enumerate(world.object_ids):
+        carried = world.carried_by[j] == i
+        away = world.carried_by[j] >= 0 and not carried
+        away = away or any(st.primitive == Primitive.REQ and st.object == oid for st in done_steps)
+        pos = world.object_xy[j]
+        objects[oid] = ObjectState(
+            (round(float(pos[0])), round(float(pos[1]))), carried=bool(carried), away=away
+        )
+    x, y, h = world.pose[i]
+    return State((round(float(x)), round(float(y)), round(math.degrees(float(h)))), objects)

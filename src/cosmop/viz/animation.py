@@ -1,20 +1,13 @@
 """Animate a simulation trace like the paper's figures: a GIF or an MP4 of the robots at work.
 
-A trace (format ``cosmop.trace/1``) records every simulation cycle::
-
-    {"format": "cosmop.trace/1", "scenario": "warehouse-2x2", "dt": 0.1,
-     "frames": [{"t": 0.0,
-                 "robots": {"R1": {"pose": [-2000, -1000, 0], "v": 0, "w": 0, "carrying": null,
-                                   "primitive": "GoTo", "waiting": false}},
-                 "humans": {"H1": [0, 1000]},
-                 "objects": {"O1": [2000, -1000]}}, ...],
-     "messages": [{"t": 4.2, "from": "R2", "to": "R1", "object": "O2", "event": "away(O2,R1,R2)"}]}
-
-Coordinates are mm, headings degrees, times seconds. :func:`save_animation` draws the walls,
-workspaces, objects, robots (with their trails, planned paths, carried objects, a ``?`` while
-waiting for an answer and a ``!`` just after sending a message) and humans, frame by frame, and
-writes the file atomically. matplotlib is imported lazily (``pip install 'cosmop[viz]'``, Agg
-backend); MP4 also needs the ffmpeg binary of ``imageio-ffmpeg`` (``pip install 'cosmop[video]'``).
+A trace (:class:`cosmop.traces.Trace`, or its ``cosmop.trace/1`` JSON) records every simulation
+cycle: times, the robots' poses, what they carry and whether they wait, the people's and
+objects' positions, and the messages.  Coordinates are mm, headings degrees, times seconds.
+:func:`save_animation` draws the walls, workspaces, objects, robots (with their trails, planned
+paths, carried objects, a ``?`` while waiting for an answer and a ``!`` just after sending a
+message) and humans, frame by frame, and writes the file atomically. matplotlib is imported
+lazily (``pip install 'cosmop[viz]'``, Agg backend); MP4 also needs the ffmpeg binary of
+``imageio-ffmpeg`` (``pip install 'cosmop[video]'``).
 """
 
 from __future__ import annotations
@@ -25,30 +18,33 @@ import importlib.util
 import itertools
 import math
 import os
-import secrets
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
+from cosmop.io import atomic_path
 from cosmop.planning.plan import PlanSet
-from cosmop.scenario import Scene
-from cosmop.traces import message_label
-from cosmop.viz.palette import robot_colours
+from cosmop.scene import Scene
+from cosmop.traces import RobotState, Trace, as_trace, message_label
+from cosmop.viz.labels import text_marker
+from cosmop.viz.scene import (
+    ANIMATION_STYLE,
+    DEFAULT_OBJECT_SIZE,
+    DEFAULT_ROBOT_SIZE,
+    SceneArtists,
+    draw_scene,
+    ids_with_trace,
+    planned_path,
+    scene_legend,
+)
 
-__all__ = ["TRACE_FORMAT", "save_animation", "video_available"]
-
-TRACE_FORMAT = "cosmop.trace/1"
-"""The value of the ``format`` field of the simulation traces this module reads."""
+__all__ = ["save_animation", "video_available"]
 
 _SUFFIXES = (".gif", ".mp4")
 _MAX_FPS = 20.0
 _MESSAGE_SHOWN = 2.0  # seconds (simulated) a '!' and the message's arrow stay after it was sent
 _TARGET_LENGTH = 45.0  # seconds of animation by default: speed max(1, duration / 45)
-_DEFAULT_ROBOT_SIZE = 400.0  # mm, for robots in the trace but not in the scene
-_DEFAULT_OBJECT_SIZE = 100.0  # mm
-_DEFAULT_HUMAN_SIZE = 500.0  # mm
+_LEGEND_WIDTH = 1.9  # inches added on the right of the animation for the legend
 
 
 def video_available() -> bool:
@@ -97,22 +93,18 @@ def _frame_indices(n: int, max_frames: int) -> tuple[list[int], int]:
 
 
 def _timing(
-    trace: Mapping[str, Any],
-    frames: Sequence[Mapping[str, Any]],
-    max_frames: int,
-    fps: float | None,
-    speed: float | None,
+    trace: Trace, max_frames: int, fps: float | None, speed: float | None
 ) -> tuple[list[int], int, float]:
     """The frames to draw, their stride and the frame rate for a playback at `speed`.
 
     Without `fps`, the stride is grown until ``speed / (dt * stride) <= 20`` and the rate is
     exactly ``speed / (dt * stride)``; `speed` defaults to ``max(1, duration / 45)``.
     """
-    times = [float(frame["t"]) for frame in frames]
-    dt = _cycle(trace, times)
+    times = trace.t.tolist()
+    dt = _cycle(trace)
     if speed is None:
         speed = max(1.0, (times[-1] - times[0]) / _TARGET_LENGTH)
-    indices, stride = _frame_indices(len(frames), max_frames)
+    indices, stride = _frame_indices(len(times), max_frames)
     if fps is not None:
         return indices, stride, fps
     if dt is None:
@@ -120,65 +112,18 @@ def _timing(
     least = math.ceil(speed / (dt * _MAX_FPS) - 1e-9)
     if least > stride:  # fewer frames, so that the rate stays at most 20 per second
         stride = least
-        indices = list(range(0, len(frames), stride))
-        if indices[-1] != len(frames) - 1:
-            indices.append(len(frames) - 1)
+        indices = list(range(0, len(times), stride))
+        if indices[-1] != len(times) - 1:
+            indices.append(len(times) - 1)
     return indices, stride, speed / (dt * stride)
 
 
-def _cycle(trace: Mapping[str, Any], times: Sequence[float]) -> float | None:
-    """The simulation cycle in seconds: ``trace["dt"]``, else the median spacing of the frames."""
-    dt = trace.get("dt")
-    if isinstance(dt, int | float) and not isinstance(dt, bool) and math.isfinite(dt) and dt > 0:
-        return float(dt)
-    gaps = sorted(b - a for a, b in itertools.pairwise(times) if b > a)
+def _cycle(trace: Trace) -> float | None:
+    """The simulation cycle in seconds: the trace's ``dt``, else the median spacing of its frames."""
+    if trace.dt is not None:
+        return float(trace.dt)
+    gaps = sorted(b - a for a, b in itertools.pairwise(trace.t.tolist()) if b > a)
     return gaps[len(gaps) // 2] if gaps else None
-
-
-def _check_trace(trace: Any) -> list[Mapping[str, Any]]:
-    if not isinstance(trace, Mapping):
-        raise ValueError(f"a trace must be a mapping ({TRACE_FORMAT}), got {type(trace).__name__}")
-    fmt = trace.get("format", TRACE_FORMAT)
-    if fmt != TRACE_FORMAT:
-        raise ValueError(f"unsupported trace format {fmt!r}; expected {TRACE_FORMAT!r}")
-    frames = trace.get("frames")
-    if not isinstance(frames, Sequence) or isinstance(frames, str | bytes) or not frames:
-        raise ValueError("a trace needs a non-empty list of frames")
-    for k, frame in enumerate(frames):
-        if not isinstance(frame, Mapping) or "t" not in frame:
-            raise ValueError(f"trace frame {k} must be a mapping with a time 't' (s)")
-    return list(frames)
-
-
-# ----------------------------------------------------------------------------------------------
-# Atomic output through a file name
-# ----------------------------------------------------------------------------------------------
-
-
-def _temp_beside(target: Path) -> Path:
-    """Create a new, empty file beside `target` with the same suffix (the writers pick the format by it)."""
-    flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0)
-    for _ in range(100):
-        candidate = target.with_name(f".{target.stem}.{secrets.token_hex(6)}.tmp{target.suffix}")
-        try:
-            os.close(os.open(candidate, flags, 0o666))
-        except FileExistsError:
-            continue
-        return candidate
-    raise FileExistsError(f"could not create a temporary file in {target.parent}")
-
-
-def _publish(tmp: Path, target: Path) -> None:
-    """fsync `tmp` and move it onto `target` (keeping an existing target's permission bits)."""
-    fd = os.open(tmp, os.O_RDONLY | getattr(os, "O_BINARY", 0))
-    try:
-        os.fsync(fd)
-    finally:
-        os.close(fd)
-    with contextlib.suppress(OSError):
-        if target.exists():
-            os.chmod(tmp, target.stat().st_mode & 0o7777)
-    os.replace(tmp, target)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -186,7 +131,7 @@ def _publish(tmp: Path, target: Path) -> None:
 # ----------------------------------------------------------------------------------------------
 
 
-def _limits(scene: Scene, frames: Sequence[Mapping[str, Any]]) -> tuple[float, float, float, float]:
+def _limits(scene: Scene, trace: Trace) -> tuple[float, float, float, float]:
     """``(x0, x1, y0, y1)`` in mm: the walls' extent (or everything's, without walls) plus a margin."""
     xs: list[float] = []
     ys: list[float] = []
@@ -203,237 +148,157 @@ def _limits(scene: Scene, frames: Sequence[Mapping[str, Any]]) -> tuple[float, f
         for ws in scene.workspaces.values():
             xs += [ws.point[0]] if ws.point is not None else list(ws.x)
             ys += [ws.point[1]] if ws.point is not None else list(ws.y)
-        for frame in frames:
-            for state in (frame.get("robots") or {}).values():
-                xs.append(float(state["pose"][0]))
-                ys.append(float(state["pose"][1]))
-            for group in ("humans", "objects"):
-                for point in (frame.get(group) or {}).values():
-                    xs.append(float(point[0]))
-                    ys.append(float(point[1]))
+        for group in ("robots", "humans", "objects"):
+            points = trace.seen(group)
+            xs += points[:, 0].tolist()
+            ys += points[:, 1].tolist()
     if not xs:
         return -1000.0, 1000.0, -1000.0, 1000.0
-    sizes = [r.size for r in scene.robots.values()] or [_DEFAULT_ROBOT_SIZE]
+    sizes = [r.size for r in scene.robots.values()] or [DEFAULT_ROBOT_SIZE]
     span = max(max(xs) - min(xs), max(ys) - min(ys), 1.0)
     margin = max(0.03 * span, 0.5 * max(sizes))
     return min(xs) - margin, max(xs) + margin, min(ys) - margin, max(ys) + margin
 
 
-def _ids(declared: Mapping[str, Any], frames: Sequence[Mapping[str, Any]], group: str) -> list[str]:
-    """The scene's ids in order, then any others that appear in the trace."""
-    ids = dict.fromkeys(declared)
-    for frame in frames:
-        ids.update(dict.fromkeys(frame.get(group) or {}))
-    return list(ids)
+def _figure(limits: tuple[float, float, float, float], dpi: float) -> tuple[Any, Any]:
+    """A figure of the scene's shape with room for the legend, and its axes over `limits` (mm)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    x0, x1, y0, y1 = limits
+    width, height = x1 - x0, y1 - y0
+    base = 6.0
+    if width >= height:
+        figsize = (base + _LEGEND_WIDTH, max(2.5, base * height / width) + 0.5)
+    else:
+        figsize = (max(2.5, base * width / height) + 0.5 + _LEGEND_WIDTH, base)
+    # A figure outside pyplot (drawn with Agg): nothing to close, the user's backend untouched.
+    fig = Figure(figsize=figsize, dpi=dpi)
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot()
+    ax.set_xlim(x0, x1)
+    ax.set_ylim(y0, y1)
+    ax.set_aspect("equal")
+    ax.set_autoscale_on(False)
+    ax.set_xlabel("x [mm]", fontsize=8)
+    ax.set_ylabel("y [mm]", fontsize=8)
+    ax.tick_params(labelsize=7)
+    return fig, ax
 
 
-def _plan_polyline(scene: Scene, plans: PlanSet | None, rid: str) -> tuple[list[float], list[float]] | None:
-    plan = plans.robots.get(rid) if plans is not None else None
-    robot = scene.robots.get(rid)
-    if plan is None or robot is None:
-        return None
-    xs, ys = [robot.pose[0]], [robot.pose[1]]
-    for step in plan.steps:
-        if step.primitive == "GoTo":
-            xs.append(step.robot[0])
-            ys.append(step.robot[1])
-    return xs, ys
+def _trail(trace: Trace, rid: str) -> tuple[list[float], list[float]]:
+    """Robot `rid`'s position in every frame (mm); NaN where it is absent, which breaks the line."""
+    if rid not in trace.robot_ids:  # a robot of the scene that the trace does not follow
+        return [math.nan] * len(trace.t), [math.nan] * len(trace.t)
+    i = trace.robot_ids.index(rid)
+    return trace.poses[:, i, 0].tolist(), trace.poses[:, i, 1].tolist()
 
 
-def _text_marker(
-    ax: Any,
-    text: str,
-    colour: Any,
-    fontsize: float,
-    *,
-    weight: str = "normal",
-    va: str = "center",
-    zorder: float = 5,
-    visible: bool = True,
-) -> Any:
-    """A moving label: `text` as a marker (a glyph outline), horizontally centred on its point.
-
-    Markers are drawn much faster than :class:`~matplotlib.text.Text` (no layout per frame).
-    `va` is ``"top"``, ``"bottom"`` or ``"center"``: which edge of the text sits at the point.
-    Move it with ``set_data([x], [y])`` (mm).
-    """
-    from matplotlib.font_manager import FontProperties
-    from matplotlib.markers import MarkerStyle
-    from matplotlib.path import Path as MplPath
-    from matplotlib.textpath import TextPath
-
-    glyphs = TextPath((0, 0), text, size=fontsize, prop=FontProperties(weight=weight))
-    box = glyphs.get_extents()
-    dy = {"top": -box.y1, "bottom": -box.y0}.get(va, -(box.y0 + box.y1) / 2)
-    vertices = np.asarray(glyphs.vertices) + np.array([-(box.x0 + box.x1) / 2, dy])
-    extent = float(np.abs(vertices).max()) or 1.0  # the marker is scaled to this half-size, in points
-    marker = MarkerStyle(MplPath(vertices, glyphs.codes))
-    (line,) = ax.plot(
-        [],
-        [],
-        linestyle="none",
-        marker=marker,
-        markersize=2 * extent,
-        markerfacecolor=colour,
-        markeredgewidth=0,
-        zorder=zorder,
-        visible=visible,
-    )
-    return line
+def _sent_times(messages: Sequence[Any], robot_ids: Sequence[str]) -> dict[str, list[float]]:
+    """When each robot sent a message (s, in order): it shows a '!' for a while after each."""
+    sent: dict[str, list[float]] = {rid: [] for rid in robot_ids}
+    for message in messages:
+        sender = message.get("from") if isinstance(message, Mapping) else None
+        if sender in sent and isinstance(message.get("t"), int | float):
+            sent[sender].append(float(message["t"]))
+    for times in sent.values():
+        times.sort()
+    return sent
 
 
 class _Animator:
-    """The figure and its moving artists; :meth:`update` shows one trace frame."""
+    """The figure and its moving artists; :meth:`update` shows one frame of the trace.
+
+    `trace` is a :class:`~cosmop.traces.Trace` or its JSON; `_frames` is not read (callers of
+    the earlier signature pass the JSON's frames there).
+    """
 
     def __init__(
         self,
         scene: Scene,
-        trace: Mapping[str, Any],
-        frames: list[Mapping[str, Any]],
+        trace: Trace | Mapping[str, Any],
         plans: PlanSet | None,
         title: str | None,
         dpi: float,
         shown: float = _MESSAGE_SHOWN,
     ) -> None:
-        from matplotlib.backends.backend_agg import FigureCanvasAgg
-        from matplotlib.collections import LineCollection
-        from matplotlib.figure import Figure
-        from matplotlib.patches import Circle, Rectangle
-
-        self.frames = frames
+        self.trace = trace = as_trace(trace)
         self.shown = shown  # seconds a message stays drawn (at least about one frame's time step)
-        x0, x1, y0, y1 = _limits(scene, frames)
-        width, height = x1 - x0, y1 - y0
-        base = 6.0
-        if width >= height:
-            figsize = (base + _LEGEND_WIDTH, max(2.5, base * height / width) + 0.5)
-        else:
-            figsize = (max(2.5, base * width / height) + 0.5 + _LEGEND_WIDTH, base)
-        # A figure outside pyplot (drawn with Agg): nothing to close, the user's backend untouched.
-        fig = Figure(figsize=figsize, dpi=dpi)
-        FigureCanvasAgg(fig)
-        ax = fig.add_subplot()
-        self.fig, self.ax = fig, ax
-        ax.set_xlim(x0, x1)
-        ax.set_ylim(y0, y1)
-        ax.set_aspect("equal")
-        ax.set_autoscale_on(False)
-        ax.set_xlabel("x [mm]", fontsize=8)
-        ax.set_ylabel("y [mm]", fontsize=8)
-        ax.tick_params(labelsize=7)
-        self.prefix = title if title is not None else str(trace.get("scenario") or "")
-        self.title = ax.set_title(self.prefix, fontsize=9)
+        self.fig, self.ax = _figure(_limits(scene, trace), dpi)
+        self.prefix = title if title is not None else str(trace.scenario or "")
+        self.title = self.ax.set_title(self.prefix, fontsize=9)
+        drawn = draw_scene(
+            self.ax,
+            scene,
+            style=ANIMATION_STYLE,
+            robots=ids_with_trace(scene.robots, trace, "robots"),
+            objects=ids_with_trace(scene.objects, trace, "objects"),
+            humans=ids_with_trace(scene.humans, trace, "humans"),
+        )
+        self._take_pieces(scene, drawn)
+        self._draw_plans(scene, plans, drawn.colours)
+        self._add_robot_marks(drawn.colours)
+        messages = trace.messages
+        self.sent = _sent_times(messages, self.robot_ids)
+        self.arrows = self._message_arrows(messages, drawn.colours)
+        # GIF colours: few keep files small; each robot's colour needs its own shades
+        self.palette_size = min(256, 48 + 4 * len(self.robot_ids))
+        _legend(self.ax)
+        self.fig.tight_layout()
+        self.mm_per_pt = _mm_per_point(self.ax)
+        self.spots: dict[tuple, dict[str, tuple[float, float]]] = {}
+        self.moving = self._moving_artists()
+        self.background: Any = None
 
-        # The static background: walls, workspaces, planned paths.
-        if scene.obstacles:
-            segments = [[w.start, w.end] for w in scene.obstacles]
-            ax.add_collection(LineCollection(segments, colors="black", linewidths=2, zorder=2))
-        for wid, ws in scene.workspaces.items():
-            if ws.point is not None:
-                ax.plot(*ws.point, marker="x", color="grey", ms=7, zorder=1)
-                ax.annotate(
-                    wid, ws.point, textcoords="offset points", xytext=(4, 4), color="grey", fontsize=7
-                )
-            else:
-                ax.add_patch(
-                    Rectangle(
-                        (ws.x[0], ws.y[0]),
-                        ws.x[1] - ws.x[0],
-                        ws.y[1] - ws.y[0],
-                        color="lightgrey",
-                        alpha=0.7,
-                        zorder=0,
-                    )
-                )
-                ax.text(*ws.center, wid, ha="center", va="center", color="dimgrey", fontsize=7, zorder=1)
-
-        self.robot_ids = _ids(scene.robots, frames, "robots")
-        colours = robot_colours(len(self.robot_ids))
-        self.object_ids = _ids(scene.objects, frames, "objects")
-        self.human_ids = _ids(getattr(scene, "humans", None) or {}, frames, "humans")
-        humans = getattr(scene, "humans", None) or {}
-
-        # Objects on the ground (a carried one is hidden here and drawn on its carrier).
-        self.object_size = {
-            oid: float(scene.objects[oid].size) if oid in scene.objects else _DEFAULT_OBJECT_SIZE
-            for oid in self.object_ids
-        }
+    def _take_pieces(self, scene: Scene, drawn: SceneArtists) -> None:
+        """Keep the scene's moving pieces, and where each object was last seen (mm)."""
+        self.robots, self.objects, self.humans = drawn.robots, drawn.objects, drawn.humans
+        self.robot_ids, self.object_ids = list(self.robots), list(self.objects)
+        self.object_size = {oid: piece.size for oid, piece in self.objects.items()}
         self.object_at: dict[str, tuple[float, float] | None] = {
             oid: tuple(scene.objects[oid].position) if oid in scene.objects else None
             for oid in self.object_ids
         }
-        self.object_patch = {}
-        self.object_label = {}
-        for oid in self.object_ids:
-            s = self.object_size[oid]
-            self.object_patch[oid] = ax.add_patch(
-                Rectangle((0, 0), s, s, color="saddlebrown", zorder=3, visible=False)
-            )
-            self.object_label[oid] = _text_marker(ax, oid, "black", 6, zorder=3, visible=False)
+        self.object_patch = {oid: piece.patch for oid, piece in self.objects.items()}
+        self.object_label = {oid: piece.label for oid, piece in self.objects.items()}
+        self.human_artists = {hid: (piece.patch, piece.label) for hid, piece in self.humans.items()}
 
-        # Robots: trail, planned path, body, heading tick, id, cargo, '?' and '!'.
-        self.robot_size = {}
+    def _draw_plans(self, scene: Scene, plans: PlanSet | None, colours: Mapping[str, Any]) -> None:
+        """Each robot's planned path, dashed in its colour (part of the still background)."""
+        for rid in self.robot_ids:
+            plan = plans.robots.get(rid) if plans is not None else None
+            if plan is not None and rid in scene.robots:
+                path = planned_path(scene.robots[rid], plan)
+                self.ax.plot(
+                    *zip(*path, strict=True), color=colours[rid], lw=0.8, ls="--", alpha=0.8, zorder=1
+                )
+
+    def _add_robot_marks(self, colours: Mapping[str, Any]) -> None:
+        """Per robot, beside its square and id: trail, heading tick, cargo, '?' and '!'."""
+        from matplotlib.patches import Rectangle
+
+        ax = self.ax
         self.trail_x: dict[str, list[float]] = {}
         self.trail_y: dict[str, list[float]] = {}
         self.artists: dict[str, dict[str, Any]] = {}
-        messages = trace.get("messages") or []
-        self.sent: dict[str, list[float]] = {rid: [] for rid in self.robot_ids}
-        for message in messages:
-            sender = message.get("from") if isinstance(message, Mapping) else None
-            if sender in self.sent and isinstance(message.get("t"), int | float):
-                self.sent[sender].append(float(message["t"]))
-        for times in self.sent.values():
-            times.sort()
-        for i, rid in enumerate(self.robot_ids):
-            colour = colours[i]
-            size = float(scene.robots[rid].size) if rid in scene.robots else _DEFAULT_ROBOT_SIZE
-            self.robot_size[rid] = size
-            planned = _plan_polyline(scene, plans, rid)
-            if planned is not None:
-                ax.plot(*planned, color=colour, lw=0.8, ls="--", alpha=0.8, zorder=1)
-            xs, ys = [], []
-            for frame in frames:
-                state = (frame.get("robots") or {}).get(rid)
-                xs.append(float(state["pose"][0]) if state else math.nan)
-                ys.append(float(state["pose"][1]) if state else math.nan)
-            self.trail_x[rid], self.trail_y[rid] = xs, ys
+        for rid in self.robot_ids:
+            colour = colours[rid]
+            self.trail_x[rid], self.trail_y[rid] = _trail(self.trace, rid)
             (trail,) = ax.plot([], [], color=colour, lw=1.0, alpha=0.9, zorder=2)
-            body = ax.add_patch(
-                Rectangle((0, 0), size, size, fc=(*colour[:3], 0.3), ec=colour, lw=1.5, zorder=4)
-            )
             (tick,) = ax.plot([], [], color=colour, lw=2, solid_capstyle="butt", zorder=5)
-            label = _text_marker(ax, rid, colour, 7, weight="bold", va="top", zorder=6)
             cargo = ax.add_patch(Rectangle((0, 0), 1, 1, color="saddlebrown", zorder=6, visible=False))
-            question = _text_marker(ax, "?", colour, 14, weight="bold", va="bottom", zorder=7)
-            bang = _text_marker(ax, "!", colour, 14, weight="bold", va="bottom", zorder=7)
             self.artists[rid] = {
                 "trail": trail,
-                "body": body,
+                "body": self.robots[rid].patch,
                 "tick": tick,
-                "label": label,
+                "label": self.robots[rid].label,
                 "cargo": cargo,
-                "question": question,
-                "bang": bang,
+                "question": text_marker(ax, "?", colour, 14, weight="bold", va="bottom", zorder=7),
+                "bang": text_marker(ax, "!", colour, 14, weight="bold", va="bottom", zorder=7),
             }
 
-        # Humans: orange discs of their size.
-        self.human_artists = {}
-        for hid in self.human_ids:
-            size = float(getattr(humans.get(hid), "size", _DEFAULT_HUMAN_SIZE) or _DEFAULT_HUMAN_SIZE)
-            disc = ax.add_patch(
-                Circle((0, 0), size / 2, fc="orange", ec="darkorange", alpha=0.85, zorder=4, visible=False)
-            )
-            label = _text_marker(ax, hid, "black", 7, va="center", zorder=6, visible=False)
-            self.human_artists[hid] = (disc, label)
-        self.arrows = self._message_arrows(messages, colours)
-        # GIF colours: few keep files small; each robot's colour needs its own shades
-        self.palette_size = min(256, 48 + 4 * len(self.robot_ids))
-        _legend(ax)
-        fig.tight_layout()
-        self.mm_per_pt = _mm_per_point(ax)
-        self.spots: dict[tuple, dict[str, tuple[float, float]]] = {}
-
-        # Everything that moves is drawn over a background rendered once (blitting).
+    def _moving_artists(self) -> list[Any]:
+        """Everything that moves, in drawing order: drawn over a background rendered once (blitting)."""
         moving: list[Any] = [self.title]
         moving += list(self.object_patch.values()) + list(self.object_label.values())
         for a in self.artists.values():
@@ -442,10 +307,11 @@ class _Animator:
             moving += [disc, label]
         for arrow, text, _ in self.arrows:
             moving += [arrow, text]
-        self.moving = sorted(moving, key=lambda artist: artist.get_zorder())
-        self.background: Any = None
+        return sorted(moving, key=lambda artist: artist.get_zorder())
 
-    def _message_arrows(self, messages: Sequence[Any], colours: list) -> list[tuple[Any, Any, Mapping]]:
+    def _message_arrows(
+        self, messages: Sequence[Any], colours: Mapping[str, Any]
+    ) -> list[tuple[Any, Any, Mapping]]:
         """One hidden arrow and time label per message between two robots of the trace."""
         from matplotlib.patches import FancyArrowPatch
 
@@ -455,7 +321,7 @@ class _Animator:
                 continue
             if message.get("from") not in self.artists or message.get("to") not in self.artists:
                 continue
-            colour = colours[self.robot_ids.index(message["from"])]
+            colour = colours[message["from"]]
             arrow = self.ax.add_patch(
                 FancyArrowPatch(
                     (0, 0),
@@ -476,7 +342,7 @@ class _Animator:
             out.append((arrow, text, message))
         return out
 
-    def _show_messages(self, t: float, robots: Mapping[str, Any]) -> None:
+    def _show_messages(self, t: float, robots: Mapping[str, RobotState]) -> None:
         """Arrows from sender to receiver for the messages sent in the last ``shown`` seconds."""
         for arrow, text, message in self.arrows:
             age = t - float(message["t"])
@@ -485,8 +351,7 @@ class _Animator:
             arrow.set_visible(on)
             text.set_visible(on)
             if on:
-                a, b = (float(v) for v in sender["pose"][:2]), (float(v) for v in receiver["pose"][:2])
-                (x1, y1), (x2, y2) = tuple(a), tuple(b)
+                (x1, y1), (x2, y2) = sender.pose[:2], receiver.pose[:2]
                 arrow.set_positions((x1, y1), (x2, y2))
                 text.set_position(((x1 + x2) / 2, (y1 + y2) / 2))
 
@@ -551,86 +416,76 @@ class _Animator:
         return k > 0 and t - times[k - 1] < self.shown
 
     def update(self, index: int) -> None:
-        """Move the artists to frame `index` of the trace (an index into the full list of frames)."""
-        frame = self.frames[index]
-        t = float(frame["t"])
+        """Move the artists to frame `index` of the trace (an index into all its frames)."""
+        trace = self.trace
+        t = float(trace.t[index])
         text = f"t = {t:.1f} s"
         self.title.set_text(f"{self.prefix}    {text}" if self.prefix else text)
-        robots = frame.get("robots") or {}
-        carried: set[str] = set()
-
+        robots = trace.robots_at(index)
         for rid in self.robot_ids:
-            a = self.artists[rid]
-            state = robots.get(rid)
-            a["trail"].set_data(self.trail_x[rid][: index + 1], self.trail_y[rid][: index + 1])
-            visible = state is not None
-            for key in ("body", "tick", "label"):
-                a[key].set_visible(visible)
-            if not visible:
-                for key in ("cargo", "question", "bang"):
-                    a[key].set_visible(False)
-                continue
-            x, y, heading = (float(v) for v in state["pose"][:3])
-            size = self.robot_size[rid]
-            h = size / 2
-            a["body"].set_xy((x - h, y - h))
-            rad = math.radians(heading)
-            a["tick"].set_data([x, x + 0.8 * size * math.cos(rad)], [y, y + 0.8 * size * math.sin(rad)])
-            a["label"].set_data([x], [y - 1.1 * h])
-            oid = state.get("carrying")
-            if oid:
-                carried.add(oid)
-                s = self.object_size.get(oid, _DEFAULT_OBJECT_SIZE)
-                a["cargo"].set_bounds(x - s / 2, y - s / 2, s, s)
-            a["cargo"].set_visible(bool(oid))
-            waiting = bool(state.get("waiting"))
-            recent = self._message_recent(rid, t)
-            shift = 0.35 * h if waiting and recent else 0.0
-            a["question"].set_visible(waiting)
-            a["question"].set_data([x - shift], [y + 1.1 * h])
-            a["bang"].set_visible(recent)
-            a["bang"].set_data([x + shift], [y + 1.1 * h])
+            self._show_robot(rid, robots.get(rid), index, t)
+        self._show_objects(trace.points_at("objects", index), set(trace.carried_at(index)))
+        self._show_messages(t, robots)
+        humans = trace.points_at("humans", index)
+        for hid, piece in self.humans.items():
+            where = humans.get(hid)
+            piece.show(where is not None)
+            if where is not None:
+                piece.move(float(where[0]), float(where[1]))
 
-        objects = frame.get("objects") or {}
-        for oid in self.object_ids:
+    def _show_robot(self, rid: str, state: RobotState | None, index: int, t: float) -> None:
+        """Robot `rid` in `state` at time `t` (s) with its trail up to frame `index`."""
+        a = self.artists[rid]
+        a["trail"].set_data(self.trail_x[rid][: index + 1], self.trail_y[rid][: index + 1])
+        visible = state is not None
+        for key in ("body", "tick", "label"):
+            a[key].set_visible(visible)
+        if state is None:
+            for key in ("cargo", "question", "bang"):
+                a[key].set_visible(False)
+            return
+        x, y, heading = state.pose
+        self.robots[rid].move(x, y)
+        size = self.robots[rid].size
+        rad = math.radians(heading)
+        a["tick"].set_data([x, x + 0.8 * size * math.cos(rad)], [y, y + 0.8 * size * math.sin(rad)])
+        oid = state.carrying
+        if oid:
+            s = self.object_size.get(oid, DEFAULT_OBJECT_SIZE)
+            a["cargo"].set_bounds(x - s / 2, y - s / 2, s, s)
+        a["cargo"].set_visible(bool(oid))
+        waiting = state.waiting
+        recent = self._message_recent(rid, t)
+        h = size / 2
+        shift = 0.35 * h if waiting and recent else 0.0  # both marks: side by side
+        a["question"].set_visible(waiting)
+        a["question"].set_data([x - shift], [y + 1.1 * h])
+        a["bang"].set_visible(recent)
+        a["bang"].set_data([x + shift], [y + 1.1 * h])
+
+    def _show_objects(self, objects: Mapping[str, tuple[float, float]], carried: set[str]) -> None:
+        """The objects on the ground where the frame (or an earlier one) puts them, with their ids."""
+        for oid, piece in self.objects.items():
             if oid in objects:
-                self.object_at[oid] = (float(objects[oid][0]), float(objects[oid][1]))
+                self.object_at[oid] = objects[oid]
             where = self.object_at[oid]
             shown = where is not None and oid not in carried
-            self.object_patch[oid].set_visible(shown)
-            self.object_label[oid].set_visible(shown)
+            piece.show(shown)
             if shown:
-                s = self.object_size[oid]
-                self.object_patch[oid].set_xy((where[0] - s / 2, where[1] - s / 2))
-        spots = self._object_spots(carried)
-        for oid, (x, y) in spots.items():
+                piece.move(*where)
+        for oid, (x, y) in self._object_spots(carried).items():
             self.object_label[oid].set_data([x], [y])
-
-        self._show_messages(t, robots)
-        humans = frame.get("humans") or {}
-        for hid, (disc, label) in self.human_artists.items():
-            where = humans.get(hid)
-            disc.set_visible(where is not None)
-            label.set_visible(where is not None)
-            if where is not None:
-                disc.set_center((float(where[0]), float(where[1])))
-                label.set_data([float(where[0])], [float(where[1])])
-
-
-_LEGEND_WIDTH = 1.9  # inches added on the right of the animation for the legend
 
 
 def _legend(ax: Any) -> None:
     """What the markers of an animation mean, on the right of the axes."""
     from matplotlib.lines import Line2D
-    from matplotlib.patches import Patch
 
     def symbol(text: str, label: str) -> Line2D:
         return Line2D([], [], ls="none", marker=f"${text}$", color="black", ms=7, label=label)
 
     handles = [
-        Line2D([], [], color="black", lw=2, label="wall"),
-        Patch(color="lightgrey", label="workspace"),
+        *scene_legend(),
         Line2D(
             [], [], ls="none", marker="s", color="saddlebrown", ms=4, label="object (on a robot: carried)"
         ),
@@ -691,7 +546,7 @@ def _writer(animation: Any, suffix: str, fps: float, animator: _Animator) -> Any
 
 def save_animation(
     scene: Scene,
-    trace: Mapping[str, Any],
+    trace: Trace | Mapping[str, Any],
     path: str | os.PathLike[str],
     *,
     plans: PlanSet | None = None,
@@ -704,24 +559,21 @@ def save_animation(
 ) -> int:
     """Render `trace` to `path` (.gif with Pillow, .mp4 with ffmpeg); return the number of frames written.
 
-    Every drawn frame shows the walls (black), workspaces (grey rectangles, or crosses for
-    points), objects (brown squares; a carried one on its carrier), the robots as squares of
-    their size in their tab10 colour with a heading tick, their id and their trail so far, the
-    planned paths (dashed, if `plans` is given), humans (orange discs of their size), a ``?``
-    above a robot waiting for an answer and a ``!`` for 1 s (simulated) after it sent a message.
-    The title shows the simulated time. Axes are in mm with equal aspect and fixed limits (the
-    walls plus a margin). The file is replaced atomically: it is rendered to a temporary file
-    beside `path` and moved onto it, and nothing is left behind on failure.
+    Every frame is the scene as :func:`cosmop.viz.scene.draw_scene` draws it at that time
+    (a carried object on its carrier), each robot's trail so far, the planned paths (dashed),
+    a ``?`` above a robot waiting for a message and a ``!`` for 1 s after it sent one; the title
+    shows the simulated time. Axes in mm, equal aspect, fixed limits. The file is replaced
+    atomically (:func:`cosmop.io.atomic_path`): nothing is left behind on failure.
 
     Parameters
     ----------
     scene : Scene
         The scene simulated: walls, workspaces, robot and object sizes (mm), and optionally
         ``scene.humans`` (only their ``size``, mm, is used).
-    trace : Mapping
-        A ``cosmop.trace/1`` trace: ``dt`` (s), ``frames`` (``t`` in s, robot poses
-        ``[x, y, heading]`` in mm and degrees, ``carrying``, ``waiting``; human and object
-        positions in mm) and ``messages`` (``t`` in s, ``from``, ``to``, ...).
+    trace : Trace or Mapping
+        The run (:class:`cosmop.traces.Trace`, or its ``cosmop.trace/1`` JSON): ``dt`` (s),
+        times (s), robot poses (mm, mm, degrees), what they carry and whether they wait, human
+        and object positions (mm) and messages (``t`` in s, ``from``, ``to``, ...).
     path : str or os.PathLike
         The output file; its suffix picks the format: ``.gif`` or ``.mp4``. Its directory must
         exist.
@@ -751,11 +603,53 @@ def save_animation(
     Raises
     ------
     ValueError
-        If the suffix is neither ``.gif`` nor ``.mp4``, the trace is malformed, or `fps` or
-        `max_frames` are not positive.
+        If the suffix is neither ``.gif`` nor ``.mp4``, the trace is malformed (a
+        :class:`cosmop.traces.TraceError`, naming the field), or `fps` or `max_frames` are not
+        positive.
     ImportError
         If matplotlib (``pip install 'cosmop[viz]'``) or, for MP4, imageio-ffmpeg
         (``pip install 'cosmop[video]'``) is missing.
+    """
+    suffix = _check_options(path, max_frames=max_frames, fps=fps, dpi=dpi, speed=speed, size=size)
+    trace = as_trace(trace)
+    matplotlib = _matplotlib()
+    ffmpeg = _ffmpeg_exe() if suffix == ".mp4" else None
+
+    indices, stride, fps = _timing(trace, max_frames, fps, speed)
+    dt = _cycle(trace) or 0.0
+    animator = _Animator(scene, trace, plans, title, dpi, max(_MESSAGE_SHOWN, 1.5 * stride * dt))
+    if size is not None:
+        dpi = size / animator.fig.get_figwidth()
+        animator.fig.set_dpi(dpi)
+    _render(matplotlib, animator, path, suffix, fps, indices, dpi, ffmpeg)
+    return len(indices)
+
+
+def _render(matplotlib, animator, path, suffix: str, fps: float, indices, dpi: float, ffmpeg) -> None:
+    """Write the frames `indices` through the format's writer to `path`, atomically."""
+    rc: dict[str, Any] = {"savefig.bbox": None}  # the writers need frames of a fixed size
+    if ffmpeg is not None:
+        rc["animation.ffmpeg_path"] = ffmpeg
+    with matplotlib.rc_context(rc), atomic_path(path) as tmp:
+        writer = _writer(matplotlib.animation, suffix, fps, animator)
+        _write_frames(writer, animator, indices, tmp, dpi)
+
+
+def _check_options(
+    path: str | os.PathLike[str],
+    *,
+    max_frames: Any,
+    fps: Any,
+    dpi: Any,
+    speed: Any,
+    size: Any,
+) -> str:
+    """The output's suffix (``.gif`` or ``.mp4``), once the options of :func:`save_animation` are checked.
+
+    Raises
+    ------
+    ValueError
+        Naming the first option out of its range.
     """
     target = Path(path)
     suffix = target.suffix.lower()
@@ -774,38 +668,18 @@ def save_animation(
         raise ValueError(f"speed must be a positive number (simulated seconds per second), got {speed!r}")
     if size is not None and (isinstance(size, bool) or not isinstance(size, int) or size < 100):
         raise ValueError(f"size must be a width of at least 100 pixels, got {size!r}")
-    frames = _check_trace(trace)
-    matplotlib = _matplotlib()
-    ffmpeg = _ffmpeg_exe() if suffix == ".mp4" else None
+    return suffix
 
-    indices, stride, fps = _timing(trace, frames, max_frames, fps, speed)
-    dt = _cycle(trace, [float(frame["t"]) for frame in frames]) or 0.0
-    animator = _Animator(scene, trace, frames, plans, title, dpi, max(_MESSAGE_SHOWN, 1.5 * stride * dt))
-    if size is not None:
-        dpi = size / animator.fig.get_figwidth()
-        animator.fig.set_dpi(dpi)
-    rc: dict[str, Any] = {"savefig.bbox": None}  # the writers need frames of a fixed size
-    if ffmpeg is not None:
-        rc["animation.ffmpeg_path"] = ffmpeg
-    tmp: Path | None = None
+
+def _write_frames(writer: Any, animator: _Animator, indices: Sequence[int], path: Path, dpi: float) -> None:
+    """Draw the frames `indices` and have `writer` write them to `path`, finishing it even on failure."""
+    writer.setup(animator.fig, os.fspath(path), dpi)
     try:
-        with matplotlib.rc_context(rc):
-            writer = _writer(matplotlib.animation, suffix, fps, animator)
-            tmp = _temp_beside(target)
-            writer.setup(animator.fig, os.fspath(tmp), dpi)
-            try:
-                for index in indices:
-                    animator.draw(index)
-                    writer.grab_frame()
-            except BaseException:
-                with contextlib.suppress(Exception):
-                    writer.finish()  # reap ffmpeg; the partial file is removed below
-                raise
-            writer.finish()
-        _publish(tmp, target)
-        tmp = None
-    finally:
-        if tmp is not None:
-            with contextlib.suppress(OSError):
-                os.unlink(tmp)
-    return len(indices)
+        for index in indices:
+            animator.draw(index)
+            writer.grab_frame()
+    except BaseException:
+        with contextlib.suppress(Exception):
+            writer.finish()  # reap ffmpeg; the partial file is removed with the temporary folder
+        raise
+    writer.finish()

@@ -6,6 +6,9 @@ already placed nor any of the given obstacles (marker boxes), all in display pix
 that finds no free spot takes the farthest candidate with a thin leader line to its point. The
 boxes are estimated from the font size (0.7 em per character, 1.3 em high), which covers the
 DejaVu Sans glyphs of short ids, bold too, so placement needs no rendering pass.
+
+Labels that move (in animations) are made by :func:`text_marker` instead: the glyph outline
+of the text drawn as a marker, which matplotlib draws much faster than a text.
 """
 
 from __future__ import annotations
@@ -14,7 +17,9 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
-__all__ = ["Label", "place_labels"]
+import numpy as np
+
+__all__ = ["Label", "place_labels", "text_marker"]
 
 _DIRECTIONS = ((0, -1), (0, 1), (1, 0), (-1, 0), (1, -1), (-1, -1), (1, 1), (-1, 1))
 Box = tuple[float, float, float, float]  # x0, y0, x1, y1 in display pixels
@@ -116,3 +121,62 @@ def place_labels(
             )
         )
     return out
+
+
+def text_marker(
+    ax: Any,
+    text: str,
+    colour: Any,
+    fontsize: float,
+    *,
+    weight: str = "normal",
+    va: str = "center",
+    zorder: float = 5,
+    visible: bool = True,
+) -> Any:
+    """A moving label: `text` as a marker (a glyph outline), horizontally centred on its point.
+
+    Markers are drawn much faster than :class:`~matplotlib.text.Text` (no layout per frame).
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+    text : str
+    colour : matplotlib colour
+    fontsize : float
+        Points.
+    weight : str
+        Font weight, ``"normal"`` or ``"bold"``.
+    va : str
+        ``"top"``, ``"bottom"`` or ``"center"``: which edge of the text sits at the point.
+    zorder : float
+    visible : bool
+
+    Returns
+    -------
+    matplotlib.lines.Line2D
+        Without a point yet; move it with ``set_data([x], [y])`` (data units, mm).
+    """
+    from matplotlib.font_manager import FontProperties
+    from matplotlib.markers import MarkerStyle
+    from matplotlib.path import Path as MplPath
+    from matplotlib.textpath import TextPath
+
+    glyphs = TextPath((0, 0), text, size=fontsize, prop=FontProperties(weight=weight))
+    box = glyphs.get_extents()
+    dy = {"top": -box.y1, "bottom": -box.y0}.get(va, -(box.y0 + box.y1) / 2)
+    vertices = np.asarray(glyphs.vertices) + np.array([-(box.x0 + box.x1) / 2, dy])
+    extent = float(np.abs(vertices).max()) or 1.0  # the marker is scaled to this half-size, in points
+    marker = MarkerStyle(MplPath(vertices, glyphs.codes))
+    (line,) = ax.plot(
+        [],
+        [],
+        linestyle="none",
+        marker=marker,
+        markersize=2 * extent,
+        markerfacecolor=colour,
+        markeredgewidth=0,
+        zorder=zorder,
+        visible=visible,
+    )
+    return line

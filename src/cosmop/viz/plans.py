@@ -14,10 +14,10 @@ from pathlib import Path
 from typing import Any
 
 from cosmop.io import write_atomic
-from cosmop.planning.plan import PlanSet
-from cosmop.scenario import Scene
+from cosmop.planning.plan import PlanSet, RobotPlan
+from cosmop.scene import Scene
 from cosmop.viz.labels import Label, place_labels
-from cosmop.viz.palette import robot_colours
+from cosmop.viz.scene import PLAN_STYLE, draw_scene, planned_path, scene_legend
 
 _LABELS = {"PickUp": "P", "DropOff": "D", "Req": "?", "Res": "!"}
 _LISTED_ROBOTS = 12  # beyond this many robots the legend only says that robots are labelled
@@ -42,15 +42,14 @@ def _pyplot() -> Any:
 
 
 def _legend(ax: Any, plans: PlanSet | None, colours: dict[str, Any]) -> None:
+    """What the marks of the plan plot mean, on the right of the axes; with few robots, each one."""
     from matplotlib.lines import Line2D
-    from matplotlib.patches import Patch
 
     def marker(symbol: str, text: str) -> Line2D:
         return Line2D([], [], ls="none", marker=f"${symbol}$", color="black", ms=8, label=text)
 
     handles = [
-        Line2D([], [], color="black", lw=2, label="wall"),
-        Patch(color="lightgrey", label="workspace"),
+        *scene_legend(),
         Line2D([], [], ls="none", marker="s", color="saddlebrown", ms=5, label="object"),
         Line2D([], [], ls="none", marker="s", mfc="none", mec="black", ms=9, label="robot at its start"),
         Line2D([], [], color="black", lw=1.2, marker="o", ms=3, label="planned path (GoTo waypoints)"),
@@ -125,57 +124,23 @@ def draw_plan(scene: Scene, plans: PlanSet | None = None, *, title: str | None =
     numbered in the plan file's order. A legend on the right explains the markers. Units are mm.
     """
     plt = _pyplot()
-    from matplotlib.patches import Rectangle
-
     fig, ax = plt.subplots(figsize=(9, 7))
-    for wall in scene.obstacles:
-        ax.plot([wall.start[0], wall.end[0]], [wall.start[1], wall.end[1]], color="black", lw=2)
-    labels: list[Label] = []
-    for wid, ws in scene.workspaces.items():
-        if ws.point is not None:
-            ax.plot(*ws.point, marker="x", color="grey", ms=8)
-        else:
-            ax.add_patch(
-                Rectangle(
-                    (ws.x[0], ws.y[0]), ws.x[1] - ws.x[0], ws.y[1] - ws.y[0], color="lightgrey", alpha=0.7
-                )
-            )
-        labels.append(Label(*ws.center, wid, {"fontsize": 8, "color": "dimgrey"}, center=not ws.is_point))
-    for oid, obj in scene.objects.items():
-        h = obj.size / 2
-        ax.add_patch(
-            Rectangle((obj.position[0] - h, obj.position[1] - h), obj.size, obj.size, color="saddlebrown")
-        )
-        labels.append(Label(*obj.position, oid, {"fontsize": 7}))
-    colours = dict(zip(scene.robots, robot_colours(len(scene.robots)), strict=True))
+    drawn = draw_scene(ax, scene, style=PLAN_STYLE)
+    labels = list(drawn.labels)
     squares = [(*o.position, o.size) for o in scene.objects.values()]
     for rid, robot in scene.robots.items():
-        colour = colours[rid]
-        h = robot.size / 2
-        x0, y0, _ = robot.pose
-        ax.add_patch(Rectangle((x0 - h, y0 - h), robot.size, robot.size, fill=False, ec=colour, lw=1.5))
-        labels.insert(0, Label(x0, y0, rid, {"fontsize": 8, "color": colour, "weight": "bold"}, center=True))
         plan = plans.robots.get(rid) if plans is not None else None
-        if plan is None:
-            continue
-        xs, ys = [x0], [y0]
-        for step in plan.steps:
-            x, y, _ = step.robot
-            if step.primitive == "GoTo":
-                xs.append(x)
-                ys.append(y)
-            elif step.primitive in _LABELS:
-                what = step.object or (step.message.split(",")[-1].rstrip(")") if step.message else "")
-                text = _LABELS[step.primitive] + (what if step.primitive in ("Req", "Res") else "")
-                labels.append(Label(x, y, text, {"fontsize": 8, "color": colour, "weight": "bold"}))
-        ax.plot(xs, ys, color=colour, lw=1.2, marker="o", ms=3)
-        squares += [(x, y, 0) for x, y in zip(xs, ys, strict=True)]
+        if plan is not None:
+            path = planned_path(robot, plan)
+            ax.plot(*zip(*path, strict=True), color=drawn.colours[rid], lw=1.2, marker="o", ms=3)
+            labels += _primitive_labels(plan, drawn.colours[rid])
+            squares += [(x, y, 0) for x, y in path]
     if plans is not None:
-        labels += _coordination(ax, plans, colours)
+        labels += _coordination(ax, plans, drawn.colours)
     ax.set_aspect("equal")
     ax.set_xlabel("x [mm]")
     ax.set_ylabel("y [mm]")
-    _legend(ax, plans, colours)
+    _legend(ax, plans, drawn.colours)
     ax.set_title(title or (plans.scenario if plans is not None else ""))
     fig.tight_layout()
     ax.autoscale_view()
@@ -184,6 +149,18 @@ def draw_plan(scene: Scene, plans: PlanSet | None = None, *, title: str | None =
     obstacles = [(x0 - 3, y0 - 3, x1 + 3, y1 + 3) for x0, y0, x1, y1 in _boxes(ax, squares)]
     place_labels(ax, labels, obstacles=obstacles)
     return fig
+
+
+def _primitive_labels(plan: RobotPlan, colour: Any) -> list[Label]:
+    """A mark where each primitive but GoTo is done: P, D, ?O (request about O), !O (response)."""
+    labels = []
+    for step in plan.steps:
+        if step.primitive in _LABELS:
+            x, y, _ = step.robot
+            what = step.object or (step.message.split(",")[-1].rstrip(")") if step.message else "")
+            text = _LABELS[step.primitive] + (what if step.primitive in ("Req", "Res") else "")
+            labels.append(Label(x, y, text, {"fontsize": 8, "color": colour, "weight": "bold"}))
+    return labels
 
 
 def save_plan_png(scene: Scene, plans: PlanSet | None, path: str | Path, *, title: str | None = None) -> None:

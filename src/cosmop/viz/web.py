@@ -5,22 +5,26 @@ an SVG of the walls, workspaces, objects, robots and planned paths, a legend, an
 a time slider and a play button that move the robots (labelled, with what they carry, ``?``
 while waiting for an answer, ``!`` after sending one) and people, and draw each message as an
 arrow from sender to receiver with its time for :data:`MESSAGE_SHOWN_S` seconds, beside a log of
-all messages. The page shows lengths in metres; the data inside are the trace's mm and degrees.
+all messages. The page shows lengths in metres; the data inside are the trace's mm and degrees
+(:class:`cosmop.traces.Trace`).
 """
 
 from __future__ import annotations
 
 import json
 import os
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from importlib import resources
 from typing import Any
 
+import numpy as np
+
 from cosmop.io import write_atomic
 from cosmop.planning.plan import PlanSet
-from cosmop.scenario import Scene
-from cosmop.traces import message_label
+from cosmop.scene import Scene
+from cosmop.traces import Trace, as_trace, message_label
 from cosmop.viz.palette import robot_colours, to_hex
+from cosmop.viz.scene import DEFAULT_ROBOT_SIZE, ids_with_trace, planned_path
 
 __all__ = ["MESSAGE_SHOWN_S", "render_html", "save_html"]
 
@@ -43,75 +47,133 @@ _LEGEND = [
 ]
 
 
-def _bounds(scene: Scene, frames: Sequence[Mapping[str, Any]]) -> list[float]:
+def _bounds(scene: Scene, trace: Trace | None) -> list[float]:
+    """``[x0, x1, y0, y1]`` (mm): the scene and the robots' trace (every 200th of it), with margins."""
     xs = [p[0] for w in scene.obstacles for p in (w.start, w.end)]
     ys = [p[1] for w in scene.obstacles for p in (w.start, w.end)]
     xs += [r.pose[0] for r in scene.robots.values()] + [o.position[0] for o in scene.objects.values()]
     ys += [r.pose[1] for r in scene.robots.values()] + [o.position[1] for o in scene.objects.values()]
-    for frame in frames[:: max(1, len(frames) // 200)]:
-        for state in (frame.get("robots") or {}).values():
-            xs.append(state["pose"][0])
-            ys.append(state["pose"][1])
+    if trace is not None:
+        points = trace.seen("robots", max(1, len(trace.t) // 200))
+        xs += points[:, 0].tolist()
+        ys += points[:, 1].tolist()
     span = max(max(xs) - min(xs), max(ys) - min(ys), 1000.0)
     margin = 0.04 * span + 400
     return [min(xs) - margin, max(xs) + margin, min(ys) - margin - 0.04 * span, max(ys) + margin]
 
 
 def _plans(scene: Scene, plans: PlanSet | None) -> dict[str, Any]:
+    """Each robot's planned path and the marks of its other primitives (P, D, ?O, !O), mm."""
     out = {}
     for rid, plan in (plans.robots if plans is not None else {}).items():
         if rid not in scene.robots:
             continue
-        x0, y0, _ = scene.robots[rid].pose
-        path, marks = [[x0, y0]], []
-        for step in plan.steps:
-            x, y, _ = step.robot
-            if step.primitive == "GoTo":
-                path.append([x, y])
-            else:
-                marks.append([x, y, _MARKS[step.primitive] + (step.object or "")])
+        path = [list(point) for point in planned_path(scene.robots[rid], plan)]
+        marks = [
+            [*step.robot[:2], _MARKS[step.primitive] + (step.object or "")]
+            for step in plan.steps
+            if step.primitive != "GoTo"
+        ]
         out[rid] = {"path": path, "marks": marks}
     return out
 
 
-def _column(values: list[float], digits: int = 0) -> list[float]:
-    return [round(v, digits) if digits else round(v) for v in values]
+def _column(values: np.ndarray, digits: int = 0) -> list[float | None]:
+    """Values rounded for the page (to whole mm, or `digits` decimals); None where NaN (not shown)."""
+    return [None if v != v else round(v, digits) if digits else round(v) for v in values.tolist()]
 
 
-def _trace(trace: Mapping[str, Any], object_ids: list[str], max_frames: int) -> dict[str, Any]:
-    """The trace as columns (one list per robot and coordinate), at most `max_frames` frames."""
-    frames = trace["frames"]
-    stride = max(1, -(-len(frames) // max_frames))
-    picked = frames[::stride] if (len(frames) - 1) % stride == 0 else [*frames[::stride], frames[-1]]
-    index = {oid: k for k, oid in enumerate(object_ids)}
-    robots: dict[str, dict[str, list]] = {}
+def _trace(trace: Trace, object_ids: list[str], max_frames: int) -> dict[str, Any]:
+    """The trace as columns (one list per robot and coordinate), at most `max_frames` frames.
+
+    Each column has an entry per frame kept; None where the trace does not show the robot,
+    person or object then (a trace of another tool may leave it out of some frames).
+    """
+    n = len(trace.t)
+    stride = max(1, -(-n // max_frames))
+    picked = list(range(0, n, stride)) if (n - 1) % stride == 0 else [*range(0, n, stride), n - 1]
     points: dict[str, dict[str, dict[str, list]]] = {"humans": {}, "objects": {}}
-    for frame in picked:
-        for rid, state in (frame.get("robots") or {}).items():
-            r = robots.setdefault(rid, {"x": [], "y": [], "h": [], "carrying": [], "waiting": []})
-            r["x"].append(state["pose"][0])
-            r["y"].append(state["pose"][1])
-            r["h"].append(state["pose"][2])
-            r["carrying"].append(index.get(state.get("carrying")))
-            r["waiting"].append(bool(state.get("waiting")))
-        for group in points:
-            for ident, (x, y) in (frame.get(group) or {}).items():
-                p = points[group].setdefault(ident, {"x": [], "y": []})
-                p["x"].append(x)
-                p["y"].append(y)
-    for r in robots.values():
-        r["x"], r["y"], r["h"] = _column(r["x"]), _column(r["y"]), _column(r["h"], 1)
-    for group in points.values():
-        for p in group.values():
-            p["x"], p["y"] = _column(p["x"]), _column(p["y"])
-    return {"t": [round(float(f["t"]), 3) for f in picked], "robots": robots, **points}
+    for group, columns in points.items():
+        xy = trace.positions(group)[picked]
+        for j, pid in enumerate(trace.ids(group)):
+            if not np.isnan(xy[:, j, 0]).all():
+                columns[pid] = {"x": _column(xy[:, j, 0]), "y": _column(xy[:, j, 1])}
+    return {
+        "t": [round(t, 3) for t in trace.t[picked].tolist()],
+        "robots": _robot_columns(trace, picked, object_ids),
+        **points,
+    }
+
+
+def _robot_columns(trace: Trace, picked: list[int], object_ids: list[str]) -> dict[str, dict[str, list]]:
+    """Per robot the trace shows in the frames `picked`: x, y (mm), h (degrees), carrying, waiting.
+
+    ``carrying`` is an index into `object_ids` (the scene's objects; None: nothing, or an object
+    the scene does not declare).
+    """
+    index = {oid: k for k, oid in enumerate(object_ids)}
+    robots = {}
+    for i, rid in enumerate(trace.robot_ids):
+        x, y, h = trace.poses[picked, i].T
+        shown = (~np.isnan(x)).tolist()
+        if not any(shown):
+            continue
+        carrying = trace.carrying[picked, i].tolist() if trace.carrying is not None else [-1] * len(picked)
+        waiting = trace.waiting[picked, i].tolist() if trace.waiting is not None else [False] * len(picked)
+        robots[rid] = {
+            "x": _column(x),
+            "y": _column(y),
+            "h": _column(h, 1),
+            "carrying": [
+                index.get(trace.object_ids[c]) if on and c >= 0 else None
+                for c, on in zip(carrying, shown, strict=True)
+            ],
+            "waiting": [w if on else None for w, on in zip(waiting, shown, strict=True)],
+        }
+    return robots
+
+
+def _scene_data(scene: Scene, plans: PlanSet | None, robot_ids: list[str]) -> dict[str, Any]:
+    """Walls, workspaces, objects, people and robots (with colour and plan length) for the page."""
+    colours = dict(zip(robot_ids, map(to_hex, robot_colours(len(robot_ids))), strict=True))
+    steps = {rid: plan.horizon for rid, plan in (plans.robots if plans is not None else {}).items()}
+    return {
+        "walls": [[*w.start, *w.end] for w in scene.obstacles],
+        "workspaces": {
+            wid: {"point": list(w.point)} if w.is_point else {"x": list(w.x), "y": list(w.y)}
+            for wid, w in scene.workspaces.items()
+        },
+        "objects": {oid: {"size": o.size, "position": list(o.position)} for oid, o in scene.objects.items()},
+        "object_ids": list(scene.objects),
+        "humans": {hid: {"size": h.size} for hid, h in scene.humans.items()},
+        "robots": {
+            rid: {
+                "size": scene.robots[rid].size if rid in scene.robots else DEFAULT_ROBOT_SIZE,
+                "pose": list(scene.robots[rid].pose) if rid in scene.robots else [0.0, 0.0, 0.0],
+                "colour": colours[rid],
+                "steps": steps.get(rid),
+            }
+            for rid in robot_ids
+        },
+    }
+
+
+def _messages(trace: Trace | None) -> list[dict[str, Any]]:
+    """The trace's messages in time order: time (s), sender, receiver and a short label."""
+    return sorted(
+        (
+            {"t": float(m["t"]), "from": m["from"], "to": m["to"], "label": message_label(m)}
+            for m in (trace.messages if trace is not None else ())
+        ),
+        key=lambda m: m["t"],
+    )
 
 
 def render_html(
     scene: Scene,
     *,
     plans: PlanSet | None = None,
-    trace: Mapping[str, Any] | None = None,
+    trace: Trace | Mapping[str, Any] | None = None,
     title: str | None = None,
     max_frames: int = 3000,
 ) -> str:
@@ -123,8 +185,9 @@ def render_html(
         Walls, workspaces, objects, robots and people (mm).
     plans : PlanSet, optional
         Drawn as dashed paths with their primitives (P, D, ?O, !O).
-    trace : Mapping, optional
-        A ``cosmop.trace/1`` trace; without it the page shows the initial scene and the plans.
+    trace : Trace or Mapping, optional
+        The run (:class:`cosmop.traces.Trace`, or its ``cosmop.trace/1`` JSON); without it the
+        page shows the initial scene and the plans.
     title : str, optional
         Default: the plans' or trace's scenario name.
     max_frames : int, optional
@@ -134,44 +197,21 @@ def render_html(
     -------
     str
     """
-    frames = list(trace["frames"]) if trace is not None else []
-    robot_ids = list(dict.fromkeys([*scene.robots, *(r for f in frames for r in f.get("robots") or {})]))
-    colours = dict(zip(robot_ids, map(to_hex, robot_colours(len(robot_ids))), strict=True))
-    steps = {rid: plan.horizon for rid, plan in (plans.robots if plans is not None else {}).items()}
-    object_ids = list(scene.objects)
+    trace = as_trace(trace) if trace is not None else None
     name = (
-        title or (plans.scenario if plans is not None else None) or (trace or {}).get("scenario") or "cosmop"
+        title
+        or (plans.scenario if plans is not None else None)
+        or (trace.scenario if trace is not None else None)
+        or "cosmop"
     )
     data = {
         "title": name,
         "units_text": "lengths in m on the page (the files: mm and degrees); times in s",
-        "bounds": _bounds(scene, frames),
-        "walls": [[*w.start, *w.end] for w in scene.obstacles],
-        "workspaces": {
-            wid: {"point": list(w.point)} if w.is_point else {"x": list(w.x), "y": list(w.y)}
-            for wid, w in scene.workspaces.items()
-        },
-        "objects": {oid: {"size": o.size, "position": list(o.position)} for oid, o in scene.objects.items()},
-        "object_ids": object_ids,
-        "humans": {hid: {"size": h.size} for hid, h in scene.humans.items()},
-        "robots": {
-            rid: {
-                "size": scene.robots[rid].size if rid in scene.robots else 400.0,
-                "pose": list(scene.robots[rid].pose) if rid in scene.robots else [0.0, 0.0, 0.0],
-                "colour": colours[rid],
-                "steps": steps.get(rid),
-            }
-            for rid in robot_ids
-        },
+        "bounds": _bounds(scene, trace),
+        **_scene_data(scene, plans, ids_with_trace(scene.robots, trace, "robots")),
         "plans": _plans(scene, plans),
-        "trace": _trace(trace, object_ids, max_frames) if trace is not None else None,
-        "messages": sorted(
-            (
-                {"t": float(m["t"]), "from": m["from"], "to": m["to"], "label": message_label(m)}
-                for m in (trace or {}).get("messages") or []
-            ),
-            key=lambda m: m["t"],
-        ),
+        "trace": _trace(trace, list(scene.objects), max_frames) if trace is not None else None,
+        "messages": _messages(trace),
         "message_shown_s": MESSAGE_SHOWN_S,
         "legend": _LEGEND,
     }
@@ -187,7 +227,7 @@ def save_html(
     path: str | os.PathLike[str],
     *,
     plans: PlanSet | None = None,
-    trace: Mapping[str, Any] | None = None,
+    trace: Trace | Mapping[str, Any] | None = None,
     title: str | None = None,
 ) -> int:
     """Write :func:`render_html` to `path` atomically; return the number of bytes written."""

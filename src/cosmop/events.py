@@ -21,16 +21,31 @@ requester A whose meaning is fixed: object O has been moved away, so A's model m
 (:attr:`Event.sender`, :attr:`Event.receiver`); one exists per (tag or object, sender,
 receiver), so that several robots can wait on the same robot without deadlock.  Messages are
 asynchronous: sending never waits, receiving waits until the message has been sent.
+
+A plan realises events with the paper's safe motion primitives (:class:`Primitive`):
+:func:`realising_step` is the one map from an event to the step that realises it, used by the
+specification, the checker, the coordination and the simulator alike.
 """
 
 from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from enum import StrEnum
 
 from cosmop.errors import EventSyntaxError
 
-__all__ = ["ACCEPTED_FORMS", "EVENT_KINDS", "ID_PATTERN", "MESSAGE_KINDS", "Event", "message", "parse_event"]
+__all__ = [
+    "ACCEPTED_FORMS",
+    "EVENT_KINDS",
+    "ID_PATTERN",
+    "MESSAGE_KINDS",
+    "Event",
+    "Primitive",
+    "message",
+    "parse_event",
+    "realising_step",
+]
 
 ID_PATTERN = r"[A-Za-z_][A-Za-z0-9_-]*"
 """Regular expression that robot, object and workspace ids must match."""
@@ -265,6 +280,49 @@ def message(sender: str, receiver: str, tag: str) -> Event:
     'msg(R1,R2,after_drop_O1)'
     """
     return Event("msg", receiver, responder=sender, tag=tag)
+
+
+class Primitive(StrEnum):
+    """The paper's safe motion primitives: the steps a plan is made of.
+
+    Members are their names, so ``Primitive.GOTO == "GoTo"`` and a plan file holds the plain
+    strings.
+
+    >>> [str(p) for p in Primitive]
+    ['GoTo', 'PickUp', 'DropOff', 'Req', 'Res']
+    """
+
+    GOTO = "GoTo"
+    """Drive to a pose (x, y, heading)."""
+    PICKUP = "PickUp"
+    """Pick an object up from beside it."""
+    DROPOFF = "DropOff"
+    """Put the carried object down beside the robot."""
+    REQ = "Req"
+    """Wait for a message (``?``): an object moved away, or a tagged message."""
+    RES = "Res"
+    """Send a message (``!``) and go on at once."""
+
+
+def realising_step(event: Event, robot: str) -> tuple[Primitive, str | None, str | None] | None:
+    """The step that realises `event` in `robot`'s plan: ``(primitive, object, message tag)``.
+
+    ``pick(R,O)`` is ``PickUp`` of O and ``drop(R,O,W)`` is ``DropOff`` of O (inside W); a message
+    is a ``Req`` in its receiver's plan and a ``Res`` in its sender's, of the object for
+    ``away(O,A,B)`` and of the tag for ``msg(S,R,tag)``.  ``None`` for ``return(R)``, which a
+    pose realises, not a step.
+
+    >>> realising_step(parse_event("away(O2,R1,R2)"), "R2")
+    (<Primitive.RES: 'Res'>, 'O2', None)
+    """
+    if event.kind == "pick":
+        return Primitive.PICKUP, event.obj, None
+    if event.kind == "drop":
+        return Primitive.DROPOFF, event.obj, None
+    if event.kind in MESSAGE_KINDS:
+        primitive = Primitive.REQ if robot == event.receiver else Primitive.RES
+        return (primitive, event.obj, None) if event.kind == "away" else (primitive, None, event.name)
+    return None
 
 
 def _parse_compact(text: str) -> Event | None:

@@ -1,6 +1,6 @@
 """``cosmop`` commands that connect cosmop to the robotics ecosystem: grid maps, ROS 2 bags, a web viewer.
 
-They register on :data:`cosmop.cli.app` (imported at the end of :mod:`cosmop.cli`) and follow its
+They are registered by :mod:`cosmop.cli` on its one app and follow its
 rules: thin functions, input errors reported by the command group as one line with exit status 2.
 """
 
@@ -8,13 +8,16 @@ from __future__ import annotations
 
 from enum import StrEnum
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 from rich.text import Text
 
-from cosmop.cli import _stdout, app
+from cosmop.cli._app import load, stdout
 from cosmop.io import check_writable, write_atomic
+
+if TYPE_CHECKING:
+    from cosmop.traces import Trace
 
 __all__: list[str] = []
 
@@ -34,7 +37,6 @@ class _Units(StrEnum):
     m = "m"
 
 
-@app.command("import-map")
 def import_map(
     map_file: Annotated[
         Path,
@@ -103,7 +105,7 @@ def import_map(
     write_atomic(output, text)
     grid = imported.grid
     rows, cols = grid.shape
-    _stdout().print(
+    stdout().print(
         Text(
             f"wrote {output}: {cols} x {rows} cells of {grid.cell_size:g} mm, {int(grid.blocked.sum())} "
             f"blocked cells in {len(imported.rectangles)} rectangles, {len(imported.walls)} walls "
@@ -113,9 +115,12 @@ def import_map(
     )
 
 
-def _warn_if_other_scenario(loaded, trace: dict | None, plans) -> None:
+def _warn_if_other_scenario(loaded, trace: Trace | None, plans) -> None:
     """A trace or plan made for another scenario (by name) is drawn anyway, with a warning."""
-    for what, name in (("trace", (trace or {}).get("scenario")), ("plan", getattr(plans, "scenario", None))):
+    for what, name in (
+        ("trace", getattr(trace, "scenario", None)),
+        ("plan", getattr(plans, "scenario", None)),
+    ):
         if name is not None and name != loaded.name:
             typer.echo(f"warning: the {what} is of scenario {name!r}, not {loaded.name!r}", err=True)
 
@@ -140,7 +145,7 @@ def write_bag_and_report(scene, trace, bag: Path, plans, rate: float | None, sce
     from cosmop.export import write_bag
 
     summary = write_bag(scene, trace, bag, plans=plans, rate=rate, scene_rate=scene_rate)
-    _stdout().print(
+    stdout().print(
         Text(
             f"wrote ROS 2 bag {bag} (MCAP, metres and radians, frame 'map'): "
             f"{sum(summary.counts.values())} messages on {len(summary.counts)} topics, "
@@ -157,7 +162,6 @@ RateOption = Annotated[
 SceneRateOption = Annotated[float, typer.Option(help="/scene marker arrays per second (Hz).", min=1e-6)]
 
 
-@app.command()
 def export(
     scenario: Annotated[
         Path, typer.Argument(metavar="SCENARIO", help="Scenario file (YAML).", show_default=False)
@@ -186,11 +190,10 @@ def export(
     workspaces, objects, people, robots and what they carry, message arrows) and /coordination
     (String, one JSON object per message). Exit status 0 written, 2 bad input (nothing written).
     """
-    from cosmop.cli import _load
     from cosmop.planning.plan import load_plan
     from cosmop.traces import load_trace
 
-    loaded = _load(scenario)
+    loaded = load(scenario)
     data = load_trace(trace)
     plans = load_plan(plan_file) if plan_file is not None else None
     check_bag_target(bag)
@@ -198,7 +201,6 @@ def export(
     write_bag_and_report(loaded.scene, data, bag, plans, rate, scene_rate)
 
 
-@app.command()
 def view(
     scenario: Annotated[
         Path, typer.Argument(metavar="SCENARIO", help="Scenario file (YAML).", show_default=False)
@@ -218,18 +220,17 @@ def view(
     what they carry) and draw each message as an arrow with its time. Exit status 0 written,
     2 bad input (nothing written).
     """
-    from cosmop.cli import _load
     from cosmop.planning.plan import load_plan
     from cosmop.traces import load_trace
     from cosmop.viz.web import save_html
 
-    loaded = _load(scenario)
+    loaded = load(scenario)
     check_writable(output, "-o")
     plans = load_plan(plan_file) if plan_file is not None else None
     data = load_trace(trace) if trace is not None else None
     _warn_if_other_scenario(loaded, data, plans)
     size = save_html(loaded.scene, output, plans=plans, trace=data, title=loaded.name)
-    frames = len(data["frames"]) if data is not None else 0
-    _stdout().print(
+    frames = len(data.t) if data is not None else 0
+    stdout().print(
         Text(f"wrote {output} ({size / 1e6:.2f} MB, {frames} frames); open it in a browser", style="green")
     )

@@ -1,0 +1,38 @@
+"""The ``cosmop`` command line.
+
+The library is silent; this package is the friendly layer. Errors in the user's input
+(:class:`~cosmop.errors.CosmopInputError`) are printed as one line, ``error: <message>``, on
+standard error, and the command exits with status 2 -- the same status as a usage error. Other
+exit statuses: 0 for success, 1 for a well-formed problem without a solution (e.g. an infeasible
+scenario).
+
+One module per command (or family of commands), registered here, in order, on the one
+:data:`~cosmop.cli._app.app`: ``validate``, ``decompose``, ``plan`` and ``check``, ``simulate``, and the
+ecosystem's ``import-map``, ``export`` and ``view``; :mod:`cosmop.cli.words` says what a verdict
+means.  To add a command, write a thin function, list it here, and let it load its
+input with :func:`cosmop.cli._app.load` and leave the work to the library; input errors need no
+handling there.
+"""
+
+from cosmop.cli import decompose, ecosystem, plan, simulate, validate
+from cosmop.cli._app import EXIT_INPUT_ERROR, app
+
+__all__ = ["EXIT_INPUT_ERROR", "app", "main"]
+
+# The commands, in the order ``cosmop --help`` lists them.
+for _name, _command in (
+    ("validate", validate.validate),
+    ("decompose", decompose.decompose),
+    ("check", plan.check),
+    ("plan", plan.plan),
+    ("simulate", simulate.simulate),
+    ("import-map", ecosystem.import_map),
+    ("export", ecosystem.export),
+    ("view", ecosystem.view),
+):
+    app.command(_name)(_command)
+
+
+def main() -> None:
+    """Run the command line (``python -m cosmop``), with the program name ``cosmop``."""
+    app(prog_name="cosmop")

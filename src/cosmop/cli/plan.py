@@ -1,0 +1,199 @@
+"""``cosmop plan`` and ``cosmop check``: plan, coordinate and verify the team; check a plan file."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+from rich.console import Console
+from rich.table import Table
+from rich.text import Text
+
+from cosmop.cli._app import EXIT_INPUT_ERROR, ScenarioArgument, load, stderr, stdout
+from cosmop.cli.words import plan_verdict
+from cosmop.io import check_writable
+from cosmop.planning.checker import check_plan
+from cosmop.planning.plan import MAX_STEPS, load_plan
+from cosmop.scene import Scenario
+
+__all__ = ["check", "plan"]
+
+
+def check(
+    scenario: ScenarioArgument,
+    plan: Annotated[
+        Path, typer.Argument(metavar="PLAN", help="Plan file (cosmop.plan/1 JSON).", show_default=False)
+    ],
+    as_json: Annotated[bool, typer.Option("--json", help="Print the report as one JSON object.")] = False,
+) -> None:
+    """Check a plan file against its scenario with exact geometry (walls, poses, flags, mission).
+
+    Exit status 0 when the plan is valid, 1 when it breaks a rule (every violation is listed),
+    2 on bad input.
+    """
+    loaded = load(scenario)
+    plans = load_plan(plan)
+    report = check_plan(loaded, plans)
+    if as_json:
+        typer.echo(json.dumps(report.to_dict(), indent=2))
+        raise typer.Exit(0 if report.ok else 1)
+    console = stdout()
+    if not plans.feasible:
+        console.print(Text(f"the plan file marks the scenario infeasible: {plans.reason}", style="yellow"))
+    if report.ok:
+        console.print(Text(f"plan valid: {report.checked_steps} steps checked", style="green"))
+        raise typer.Exit(0)
+    table = Table(title=Text(f"violations of {plan.name}"), header_style="bold")
+    for column in ("robot", "instant", "rule", "problem"):
+        table.add_column(column)
+    for v in report.violations:
+        instant = "-" if v.instant is None else str(v.instant)
+        table.add_row(Text(v.robot or "-"), instant, Text(v.rule), Text(v.message))
+    console.print(table)
+    count = len(report.violations)
+    noun = "violation" if count == 1 else "violations"
+    console.print(Text(f"plan invalid: {count} {noun} in {report.checked_steps} steps checked", style="red"))
+    raise typer.Exit(1)
+
+
+def plan(
+    scenario: ScenarioArgument,
+    output: Annotated[
+        Path,
+        typer.Option("-o", "--output", help="Plan file to write (cosmop.plan/1 JSON).", show_default=False),
+    ],
+    png: Annotated[
+        Path | None, typer.Option(help="Also draw the scene and the plans into this PNG.", show_default=False)
+    ] = None,
+    max_horizon: Annotated[
+        int | None,
+        typer.Option(
+            help="Longest plan tried per robot (steps) [default: 16, or 3 per mission event + 6 if more]",
+            min=0,
+            max=MAX_STEPS,
+            show_default=False,
+        ),
+    ] = None,
+) -> None:
+    """Plan, coordinate and verify the team (paper, Fig. "Overall framework").
+
+    Each robot's shortest safe sequence of motion primitives is synthesised; every request
+    (Req) becomes an ``away(O, requester, responder)`` pair placed so that the team cannot
+    deadlock; the robots whose missions changed are re-planned; the coordinated missions are
+    verified against the global mission, and every plan passes the exact checker before it is
+    written.  The file is written even when infeasible (``"feasible": false`` and a reason).
+    Exit status 0 feasible, 1 infeasible, 2 bad input.
+    """
+    loaded = load(scenario)
+    check_writable(output, "-o")
+    check_writable(png, "--png")
+    if png is not None:
+        _need_viz()
+    result = _plan_with_progress(loaded, max_horizon)
+    result.plans.save(output)
+    if png is not None:
+        from cosmop.viz import save_plan_png
+
+        save_plan_png(loaded.scene, result.plans, png)
+    console = stdout()
+    console.print(_plan_table(loaded, result))
+    if result.plans.feasible:
+        console.print(Text(plan_verdict(result.plans, result.verification), style="green"))
+    if result.verification is not None:
+        _print_coordination(console, result)
+    if result.allocation is not None and result.allocation.alternative is not None:
+        _print_allocation(console, result)
+    if result.plans.feasible:
+        checked = result.report.checked_steps
+        console.print(Text(f"{checked} steps checked, all valid; written to {output}", style="green"))
+    else:
+        console.print(Text(f"infeasible: {result.plans.reason}; written to {output}", style="red"))
+    raise typer.Exit(0 if result.plans.feasible else 1)
+
+
+def _need_viz() -> None:
+    """Say that ``--png`` needs matplotlib before any work is done or anything is written."""
+    from cosmop.viz import available
+
+    if not available():
+        typer.echo("error: --png needs matplotlib: pip install 'cosmop[viz]'", err=True)
+        raise typer.Exit(EXIT_INPUT_ERROR)
+
+
+def _plan_with_progress(loaded: Scenario, max_horizon: int | None) -> Any:
+    """:func:`cosmop.pipeline.plan_team` under a spinner that names each robot as it is planned."""
+    from rich.progress import Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
+
+    from cosmop.pipeline import plan_team
+
+    columns = (SpinnerColumn(), TextColumn("{task.description}"), TimeElapsedColumn())
+    with Progress(*columns, console=stderr(), transient=True) as progress:
+        task = progress.add_task("planning", total=None)
+        return plan_team(
+            loaded,
+            max_horizon=max_horizon,
+            on_robot=lambda robot, res: progress.update(
+                task, description=f"planned {robot} ({res.horizon} steps)"
+            ),
+        )
+
+
+def _print_coordination(console: Console, result: Any) -> None:
+    """The formal verdict: coordination pairs, messages, conflicts ordered, and the expected finish."""
+    v, safety = result.verification, result.safety
+    ordered = f"{safety.conflicts} conflict(s) between plans, " if safety is not None else ""
+    console.print(
+        Text(
+            f"formally: coordination: {len(result.plans.coordination)} pair(s), "
+            f"{len(result.plans.messages)} message(s) ({ordered}deadlock-free); verification: "
+            f"{'holds' if v.holds else 'fails'} ({v.method})",
+            style="green" if v.holds else "red",
+        )
+    )
+    itinerary = result.plans.itinerary
+    if safety is not None and itinerary is not None and itinerary.makespan > 0:
+        console.print(
+            Text(
+                f"expected time to finish: {itinerary.makespan:.0f} s (each robot alone: at most "
+                f"{safety.makespan_alone:.0f} s); the plan file gives every step its expected "
+                "start and end"
+            )
+        )
+
+
+def _print_allocation(console: Console, result: Any) -> None:
+    """Which robot moves each good, and the cost of that choice."""
+    choice = result.allocation
+    moved = ", ".join(f"{o} by {r}" for o, r in result.plans.allocation.items()) or "nothing moved"
+    proof = "the best" if choice.exhaustive else "the best found within the search bound"
+    console.print(
+        Text(
+            f"allocation: {moved}; cost: longest {choice.makespan} steps, {choice.total} in all "
+            f"({proof}; {choice.method}, {choice.considered} compared)"
+        )
+    )
+
+
+def _plan_table(scenario: Scenario, result) -> Table:
+    """One row per robot: its plan's steps, K (the shortest plan), requests, answers, messages."""
+    table = Table(title=Text(f"plans for {scenario.name}"), header_style="bold")
+    for column in ("robot", "feasible", "steps", "K", "requests", "answers", "msgs out/in", "solve"):
+        table.add_column(column)
+    for robot, res in result.results.items():
+        plan = result.plans.robots.get(robot)
+        answers = [c.object + " to " + c.requester for c in result.plans.coordination if c.responder == robot]
+        sent = sum(1 for s in plan.steps if s.message is not None and s.primitive == "Res") if plan else 0
+        awaited = sum(1 for s in plan.steps if s.message is not None and s.primitive == "Req") if plan else 0
+        table.add_row(
+            robot,
+            "yes" if res.feasible else Text("no", style="red"),
+            str(plan.horizon) if plan is not None else "-",
+            str(res.horizon) if res.horizon is not None else "-",
+            Text(", ".join(res.requests) or "-"),
+            Text(", ".join(answers) or "-"),
+            f"{sent}/{awaited}" if sent or awaited else "-",
+            f"{res.solve_s:.2f} s",
+        )
+    return table

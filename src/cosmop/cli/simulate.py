@@ -1,0 +1,208 @@
+"""``cosmop simulate``: execute the plans in the scenario's world and say how the run went."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+from rich.table import Table
+from rich.text import Text
+
+from cosmop.cli._app import EXIT_INPUT_ERROR, ScenarioArgument, load, stderr, stdout
+from cosmop.cli.ecosystem import check_bag_target, write_bag_and_report
+from cosmop.io import check_writable, uninterrupted
+from cosmop.planning.checker import check_plan
+from cosmop.planning.plan import PlanSet, load_plan
+from cosmop.scene import Scenario
+from cosmop.traces import Trace
+
+__all__ = ["simulate"]
+
+
+def simulate(
+    scenario: ScenarioArgument,
+    plan_file: Annotated[
+        Path | None,
+        typer.Option(
+            "--plan",
+            help="Plan file to execute (cosmop.plan/1); planned first if absent.",
+            show_default=False,
+        ),
+    ] = None,
+    seed: Annotated[int, typer.Option(help="Seed of the people's random walks.")] = 0,
+    summary: Annotated[
+        Path | None, typer.Option(help="Write the summary (cosmop.sim/1 JSON) here.", show_default=False)
+    ] = None,
+    trace: Annotated[
+        Path | None,
+        typer.Option(help="Write the trace, every cycle (cosmop.trace/1 JSON).", show_default=False),
+    ] = None,
+    gif: Annotated[Path | None, typer.Option(help="Write an animation (GIF).", show_default=False)] = None,
+    mp4: Annotated[Path | None, typer.Option(help="Write an animation (MP4).", show_default=False)] = None,
+    speed: Annotated[
+        float | None,
+        typer.Option(
+            help="Animation: simulated seconds per second [default: the run lasts at most 45 s]", min=1e-3
+        ),
+    ] = None,
+    size: Annotated[
+        int | None, typer.Option(help="Animation width in pixels [default: about 790]", min=100)
+    ] = None,
+    bag: Annotated[
+        Path | None,
+        typer.Option(help="Write a ROS 2 bag DIRECTORY (MCAP; the ros extra).", show_default=False),
+    ] = None,
+    max_time: Annotated[float, typer.Option(help="Simulated seconds before giving up.", min=1.0)] = 900.0,
+    replan: Annotated[bool, typer.Option(help="Stalled robots replan their remaining mission.")] = True,
+) -> None:
+    """Execute the plans: passive-safe DWA, docking, messages, people walking through.
+
+    Every cycle each robot drives (GoTo), docks (PickUp, DropOff), waits for an answer (Req) or
+    sends one (Res); a monitor records every contact and whether the robot was moving then.
+    Exit status 0 when every robot finished with no contact while moving, 1 otherwise, 2 on bad
+    input.
+    """
+    loaded = load(scenario)
+    _check_outputs(summary=summary, trace=trace, gif=gif, mp4=mp4, bag=bag)
+    plans = _plans_to_run(loaded, plan_file)
+    result = _run_with_progress(loaded, plans, seed, max_time, replan)
+    run = result.trace()  # one Trace for the file, the bag and the animations
+    with uninterrupted():  # the trace and its summary: both or neither
+        if trace is not None:
+            run.save(trace)
+        if summary is not None:
+            result.save_summary(summary)
+    if bag is not None:
+        write_bag_and_report(loaded.scene, run, bag, plans, None, 5.0)
+    for path in (gif, mp4):
+        if path is not None:
+            _animate(loaded, run, plans, path, speed, size)
+    console = stdout()
+    console.print(_robots_table(loaded, result, seed))
+    ok = result.completed and result.contacts_while_moving == 0
+    console.print(Text(_verdict(loaded, result, plans), style="green" if ok else "red"))
+    raise typer.Exit(0 if ok else 1)
+
+
+def _check_outputs(
+    summary: Path | None, trace: Path | None, gif: Path | None, mp4: Path | None, bag: Path | None
+) -> None:
+    """Before any work: every output can be written and the extras it needs are installed."""
+    for option, path in (("--summary", summary), ("--trace", trace), ("--gif", gif), ("--mp4", mp4)):
+        check_writable(path, option)
+    for path, check_video in ((gif, False), (mp4, True)):
+        if path is None:
+            continue
+        from cosmop.viz import available, video_available
+
+        if not available() or (check_video and not video_available()):
+            extra = "video" if check_video else "viz"
+            typer.echo(f"error: --{path.suffix[1:]} needs pip install 'cosmop[{extra}]'", err=True)
+            raise typer.Exit(EXIT_INPUT_ERROR)
+    if bag is not None:
+        check_bag_target(bag)
+
+
+def _plans_to_run(loaded: Scenario, plan_file: Path | None) -> PlanSet:
+    """The plan file, checked exactly against the scenario (else exit 2), or a plan made now."""
+    from rich.progress import Progress, TextColumn, TimeElapsedColumn
+
+    if plan_file is not None:
+        plans = load_plan(plan_file)
+        report = check_plan(loaded, plans)
+        if not plans.feasible or not report.ok:
+            why = plans.reason if not plans.feasible else report.violations[0].message
+            typer.echo(
+                f"error: {plan_file}: expected a feasible plan valid for {loaded.name}: {why}", err=True
+            )
+            raise typer.Exit(EXIT_INPUT_ERROR)
+        return plans
+    from cosmop.pipeline import plan_team
+
+    with Progress(TextColumn("planning"), TimeElapsedColumn(), console=stderr(), transient=True) as progress:
+        progress.add_task("planning", total=None)
+        plans = plan_team(loaded).plans
+    if not plans.feasible:
+        stdout().print(Text(f"infeasible: {plans.reason}", style="red"))
+        raise typer.Exit(1)
+    return plans
+
+
+def _run_with_progress(loaded: Scenario, plans: PlanSet, seed: int, max_time: float, replan: bool) -> Any:
+    """:func:`cosmop.sim.simulate` under a bar of simulated time and robots done."""
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+    from cosmop.sim import SimSettings
+    from cosmop.sim import simulate as run_simulate
+
+    columns = (
+        TextColumn("simulating"),
+        BarColumn(),
+        TextColumn("{task.fields[done]}/{task.fields[robots]} robots done, t = {task.completed:.0f} s"),
+        TimeElapsedColumn(),
+    )
+    with Progress(*columns, console=stderr(), transient=True) as progress:
+        task = progress.add_task("simulating", total=max_time, done=0, robots=len(loaded.scene.robots))
+        return run_simulate(
+            loaded,
+            plans,
+            seed=seed,
+            settings=SimSettings(max_time=max_time, replan=replan),
+            on_cycle=lambda t, done, robots: progress.update(task, completed=t, done=done),
+        )
+
+
+def _animate(
+    loaded: Scenario, run: Trace, plans: PlanSet, path: Path, speed: float | None, size: int | None
+) -> None:
+    """Draw the run's trace into a GIF or MP4 under a spinner."""
+    from rich.progress import Progress, TextColumn, TimeElapsedColumn
+
+    from cosmop.viz import save_animation
+
+    with Progress(
+        TextColumn(f"drawing {path.name}"), TimeElapsedColumn(), console=stderr(), transient=True
+    ) as p:
+        p.add_task("drawing", total=None)
+        save_animation(loaded.scene, run, path, plans=plans, speed=speed, size=size)
+
+
+def _robots_table(loaded: Scenario, result: Any, seed: int) -> Table:
+    """One row per robot: where it ended, how far it drove, whether and when it finished."""
+    table = Table(title=Text(f"simulation of {loaded.name} (seed {seed})"), header_style="bold")
+    for column in ("robot", "pose [mm, deg]", "distance", "finished", "done at (planned)"):
+        table.add_column(column)
+    finished = result.finished
+    for rid, (pose, dist) in result.robots.items():
+        table.add_row(
+            rid,
+            f"{pose[0]:.0f}, {pose[1]:.0f}, {pose[2]:.0f}",
+            f"{dist / 1000:.1f} m",
+            "yes" if finished[rid] else Text("no", style="red"),
+            _done_at(result.steps.get(rid, ()), finished[rid]),
+        )
+    return table
+
+
+def _verdict(loaded: Scenario, result: Any, plans: PlanSet) -> str:
+    """The closing line: completed or not, times, goods in place, contacts, messages, replans."""
+    delivered = result.objects_in_workspaces(loaded, plans)
+    speed = result.sim_time_s / max(result.wall_time_s, 1e-9)
+    planned = result.makespan["planned"]
+    return (
+        f"{'completed' if result.completed else 'not completed'} in {result.sim_time_s:.1f} s simulated "
+        + (f"(planned {planned:.1f} s; " if planned is not None else "(")
+        + f"{result.wall_time_s:.1f} s, {speed:.0f}x real time); "
+        f"objects in place {sum(delivered.values())}/{len(delivered)}; contacts {len(result.contacts)}, "
+        f"while moving {result.contacts_while_moving}; messages {len(result.messages)}; "
+        f"replans {result.replans}"
+    )
+
+
+def _done_at(rows, finished: bool) -> str:
+    """When a robot ended its plan in the run, and when its itinerary expected it: ``64.7 s (46.1 s)``."""
+    realised = rows[-1].realised[1] if finished and rows and rows[-1].realised else None
+    planned = max((r.planned[1] for r in rows if r.planned is not None), default=None)
+    done = f"{realised:.1f} s" if realised is not None else "-"
+    return f"{done} ({planned:.1f} s)" if planned is not None else done

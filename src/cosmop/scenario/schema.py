@@ -1,0 +1,298 @@
+"""The scenario file's structure: pydantic models of format version 1, and what each field
+expects, in words, for the error messages of :mod:`cosmop.scenario.build`."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from types import NoneType, UnionType
+from typing import Annotated, Any, Literal, Union, get_args, get_origin
+
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, field_validator
+
+from cosmop.docking import SIDES
+from cosmop.reading import FieldPath
+from cosmop.units import SCENARIO_UNITS
+
+MAX_DFA_STATES = 2000
+"""Most states an explicit mission DFA may list (its minimisation is quadratic at worst)."""
+
+SCENARIO_VERSION = 1
+"""The scenario file format version this module reads (an optional top-level ``version`` key)."""
+
+
+Point = tuple[float, float]
+
+
+def _none_to(empty: Any) -> BeforeValidator:
+    """``objects:`` with nothing under it (null) means an empty collection."""
+    return BeforeValidator(lambda value: type(empty)() if value is None else value)
+
+
+def _int_state_to_str(value: Any) -> Any:
+    return str(value) if isinstance(value, int) and not isinstance(value, bool) else value
+
+
+_Number = Annotated[float, Field(strict=True, allow_inf_nan=False)]
+_Positive = Annotated[float, Field(strict=True, allow_inf_nan=False, gt=0)]
+_Text = Annotated[str, Field(strict=True)]
+_StateName = Annotated[str, BeforeValidator(_int_state_to_str), Field(strict=True, min_length=1)]
+_Pair = tuple[_Number, _Number]
+
+
+class _Model(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class _DynamicsModel(_Model):
+    """Any subset of the :class:`Dynamics` fields; an absent field is inherited."""
+
+    max_speed: _Positive | None = None
+    acceleration: _Positive | None = None
+    braking: _Positive | None = None
+    turn_rate: _Positive | None = None
+    cycle: _Positive | None = None
+
+    @field_validator("*", mode="before")
+    @classmethod
+    def _given_means_a_number(cls, value: Any) -> Any:
+        if value is None:  # "cycle: null" is a mistake, not "inherit"
+            raise ValueError("expected a number, got null")
+        return value
+
+    def overrides(self) -> dict[str, float]:
+        """The fields given, by name."""
+        return self.model_dump(exclude_none=True)
+
+
+class _RobotModel(_Model):
+    size: _Positive
+    pose: tuple[_Number, _Number, _Number]
+    dynamics: _DynamicsModel | None = None
+
+
+class _ObjectModel(_Model):
+    size: _Positive
+    position: _Pair
+    sides: Annotated[list[Literal["west", "south", "east", "north"]], Field(min_length=1, max_length=4)] = (
+        list(SIDES)
+    )
+
+
+class _WorkspaceModel(_Model):
+    x: _Pair | None = None
+    y: _Pair | None = None
+    point: _Pair | None = None
+
+
+class _AreaModel(_Model):
+    x: _Pair
+    y: _Pair
+
+
+class _HumanModel(_Model):
+    size: _Positive
+    speed: _Positive
+    path: Annotated[list[Annotated[list[_Number], Field(min_length=2, max_length=3)]], Field(min_length=1)]
+    loop: Annotated[bool, Field(strict=True)] = True
+    walk: _AreaModel | None = None
+
+
+class _SceneModel(_Model):
+    obstacles: Annotated[list[tuple[_Pair, _Pair]], _none_to([])] = []
+    robots: Annotated[dict[_Text, _RobotModel], Field(min_length=1)]
+    objects: Annotated[dict[_Text, _ObjectModel], _none_to({})] = {}
+    workspaces: Annotated[dict[_Text, _WorkspaceModel], _none_to({})] = {}
+    humans: Annotated[dict[_Text, _HumanModel], _none_to({})] = {}
+    dynamics: _DynamicsModel | None = None
+
+
+class _DfaModel(_Model):
+    initial: _StateName
+    transitions: list[tuple[_StateName, _Text, _StateName]]
+    states: list[_StateName] | None = None
+    marked: list[_StateName] | None = None
+
+
+def _one_to_list(value: Any) -> Any:
+    """``to: W1`` is ``to: [W1]``."""
+    return [value] if isinstance(value, str) else value
+
+
+class _DeliveryModel(_Model):
+    object: _Text
+    to: Annotated[list[_Text], BeforeValidator(_one_to_list), Field(min_length=1)]
+    by: Annotated[list[_Text], BeforeValidator(_one_to_list), Field(min_length=1)] | None = None
+
+
+class _MissionModel(_Model):
+    tasks: dict[_Text, Annotated[list[_Text], _none_to([])]] | None = None
+    dfa: _DfaModel | None = None
+    deliveries: Annotated[list[_DeliveryModel], Field(min_length=1)] | None = None
+    returns: Annotated[bool | None, Field(strict=True, alias="return")] = None
+
+
+class _ScenarioModel(_Model):
+    version: Annotated[int, Field(strict=True)] | None = None
+    name: Annotated[str, Field(strict=True, min_length=1)]
+    scene: _SceneModel
+    mission: _MissionModel
+    units: Literal[SCENARIO_UNITS] | None = None  # type: ignore[valid-type]
+
+
+_WALL = "a wall [[x1, y1], [x2, y2]]: two points of two numbers each (mm)"
+_RANGE = "a range [lo, hi] of two numbers with lo <= hi (mm)"
+_STATE = "a state name"
+_DYNAMICS = "a mapping with any of the keys max_speed, acceleration, braking, turn_rate, cycle"
+_DYNAMICS_FIELDS = {
+    "max_speed": "a positive number (top translational speed, mm/s)",
+    "acceleration": "a positive number (translational acceleration, mm/s^2)",
+    "braking": "a positive number (braking deceleration, mm/s^2)",
+    "turn_rate": "a positive number (top turning rate, degrees/s)",
+    "cycle": "a positive number (control cycle, s)",
+}
+_WAYPOINT = "a point [x, y] or [x, y, dwell]: two or three numbers (mm, mm, seconds)"
+# What is expected at a field; "*" stands for any id, "#" for any list index.
+_EXPECTED: dict[tuple[str, ...], str] = {
+    ("version",): f"{SCENARIO_VERSION}, the scenario format version",
+    ("name",): "a non-empty name (text)",
+    ("units",): "mm (millimetres and degrees, the default) or m (metres and radians, SI)",
+    ("scene", "obstacles"): "a list of walls [[x1, y1], [x2, y2]]",
+    ("scene", "obstacles", "#"): _WALL,
+    ("scene", "robots"): "a non-empty mapping from robot ids to {size, pose}",
+    ("scene", "robots", "*", "size"): "a positive number (side of the square robot, mm)",
+    ("scene", "robots", "*", "pose"): "a pose [x, y, heading]: three numbers (mm, mm, degrees)",
+    ("scene", "objects"): "a mapping from object ids to {size, position, sides (optional)}",
+    ("scene", "objects", "*", "size"): "a positive number (side of the square object, mm)",
+    ("scene", "objects", "*", "position"): "a position [x, y]: two numbers (mm)",
+    ("scene", "objects", "*", "sides"): (
+        "a non-empty list of the sides a robot may handle it from: west, south, east, north"
+    ),
+    ("scene", "objects", "*", "sides", "#"): "one of west, south, east, north",
+    ("scene", "workspaces"): "a mapping from workspace ids to {x: [lo, hi], y: [lo, hi]} or {point: [x, y]}",
+    ("scene", "workspaces", "*"): "{x: [lo, hi], y: [lo, hi]} or {point: [x, y]}",
+    ("scene", "workspaces", "*", "x"): _RANGE,
+    ("scene", "workspaces", "*", "y"): _RANGE,
+    ("scene", "workspaces", "*", "point"): "a point [x, y]: two numbers (mm)",
+    ("scene", "humans"): "a mapping from human ids to {size, speed, path}",
+    ("scene", "humans", "*", "size"): "a positive number (side of the square person, mm)",
+    ("scene", "humans", "*", "speed"): "a positive number (walking speed, mm/s)",
+    ("scene", "humans", "*", "path"): f"a non-empty list of waypoints, each {_WAYPOINT}",
+    ("scene", "humans", "*", "path", "#"): _WAYPOINT,
+    ("scene", "humans", "*", "loop"): "true or false (whether to repeat the path)",
+    ("scene", "humans", "*", "walk"): "an area {x: [lo, hi], y: [lo, hi]} (mm) to roam in",
+    ("scene", "humans", "*", "walk", "x"): _RANGE,
+    ("scene", "humans", "*", "walk", "y"): _RANGE,
+    ("scene", "dynamics"): _DYNAMICS,
+    ("scene", "robots", "*", "dynamics"): _DYNAMICS,
+    **{("scene", "dynamics", key): text for key, text in _DYNAMICS_FIELDS.items()},
+    **{("scene", "robots", "*", "dynamics", key): text for key, text in _DYNAMICS_FIELDS.items()},
+    ("mission",): (
+        "exactly one of tasks: {robot: [steps]}, dfa: {initial, transitions} or deliveries: [{object, to}]"
+    ),
+    ("mission", "deliveries"): "a non-empty list of deliveries {object, to, by}",
+    ("mission", "deliveries", "#"): "a delivery {object: O1, to: W1 or [W1, W2], by: [R1, R2] (optional)}",
+    ("mission", "deliveries", "#", "object"): "an object id",
+    ("mission", "deliveries", "#", "to"): "a workspace id or a non-empty list of them",
+    ("mission", "deliveries", "#", "to", "#"): "a workspace id",
+    ("mission", "deliveries", "#", "by"): "a robot id or a non-empty list of them",
+    ("mission", "deliveries", "#", "by", "#"): "a robot id",
+    ("mission", "return"): "true or false (deliveries: robots that moved something end at home)",
+    ("mission", "tasks"): "a mapping from robot ids to lists of task steps",
+    ("mission", "tasks", "*"): "a list of task steps such as [pick O1, drop O1 at W1, return]",
+    ("mission", "tasks", "*", "#"): "a task step (text) such as 'pick O1', 'drop O1 at W1' or 'return'",
+    ("mission", "dfa", "initial"): _STATE,
+    ("mission", "dfa", "states"): "a list of state names",
+    ("mission", "dfa", "states", "#"): _STATE,
+    ("mission", "dfa", "marked"): "a list of state names",
+    ("mission", "dfa", "marked", "#"): _STATE,
+    ("mission", "dfa", "transitions"): "a list of transitions [state, event, state]",
+    (
+        "mission",
+        "dfa",
+        "transitions",
+        "#",
+    ): 'a transition [state, event, state], e.g. [q0, "pick(R1,O1)", q1]',
+}
+
+
+def _unwrap(annotation: Any) -> Any:
+    while True:
+        origin = get_origin(annotation)
+        if origin is Annotated:
+            annotation = get_args(annotation)[0]
+        elif origin in (Union, UnionType):
+            members = [arg for arg in get_args(annotation) if arg is not NoneType]
+            if len(members) != 1:
+                return annotation
+            annotation = members[0]
+        else:
+            return annotation
+
+
+def _model_at(path: FieldPath) -> type[BaseModel] | None:
+    """The pydantic model describing the mapping at `path`, if that position is a model."""
+    annotation: Any = _ScenarioModel
+    for part in path:
+        annotation = _unwrap(annotation)
+        if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+            if part not in annotation.model_fields:
+                return None
+            annotation = annotation.model_fields[part].annotation
+        elif get_origin(annotation) is dict:
+            annotation = get_args(annotation)[1]
+        elif get_origin(annotation) is list:
+            annotation = get_args(annotation)[0]
+        else:
+            return None
+    annotation = _unwrap(annotation)
+    return annotation if isinstance(annotation, type) and issubclass(annotation, BaseModel) else None
+
+
+def _describe_keys(model: type[BaseModel]) -> str:
+    keys = [name if info.is_required() else f"{name} (optional)" for name, info in model.model_fields.items()]
+    return "a mapping with keys " + ", ".join(keys)
+
+
+def _expected_at(loc: FieldPath) -> tuple[FieldPath, str | None]:
+    """The field to report for an error at `loc`, and what is expected there."""
+    for length in range(len(loc), -1, -1):
+        prefix = loc[:length]
+        for pattern, text in _EXPECTED.items():
+            if len(pattern) == length and all(
+                _matches(p, part) for p, part in zip(pattern, prefix, strict=True)
+            ):
+                return prefix, text
+        model = _model_at(prefix)
+        if model is not None:
+            return prefix, _describe_keys(model)
+    return loc, None
+
+
+def _matches(pattern: str, part: str | int) -> bool:
+    if pattern == "#":
+        return isinstance(part, int)
+    return pattern == "*" or pattern == part
+
+
+def _lookup(data: Any, path: FieldPath) -> tuple[bool, Any]:
+    for part in path:
+        if isinstance(data, Mapping):
+            if part not in data:
+                return False, None
+        elif not (isinstance(data, list) and isinstance(part, int) and 0 <= part < len(data)):
+            return False, None
+        data = data[part]
+    return True, data
+
+
+def _show_points(*points: Point) -> str:
+    return "[" + ", ".join(f"[{x:g}, {y:g}]" for x, y in points) + "]"
+
+
+def _show(value: Any) -> str:
+    if value is None:
+        return "nothing (null)"
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    text = repr(value)
+    return text if len(text) <= 80 else text[:77] + "..."

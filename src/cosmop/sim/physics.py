@@ -1,0 +1,88 @@
+"""One control cycle of motion: every robot's unicycle and its docking creep.
+
+Robots are unicycles: each cycle a robot holds a turn rate in :math:`[-\\Omega, \\Omega]` and
+speeds up at most at :math:`A` or brakes at :math:`-b` until it has the speed it was given.
+The footprint is an axis-aligned square, so a turn on the spot moves no part of it.  Units:
+mm, mm/s, radians and rad/s, seconds.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from cosmop.sim.world import World, wrap_angle
+
+__all__ = ["integrate"]
+
+_SUBSTEPS = 4  # sub-steps of a cycle's arc (each at its midpoint heading)
+
+
+def integrate(world: World, v_cmd: np.ndarray, w_cmd: np.ndarray, docks: dict[int, tuple]) -> np.ndarray:
+    """Move every robot for one cycle towards the speed `v_cmd`, turning at `w_cmd`.
+
+    A robot slows down by braking at :math:`-b` until it reaches the commanded speed, then holds
+    it (the control passive safety assumes: a stop from :math:`v < b\\varepsilon` takes
+    :math:`v^2/2b`, not the :math:`v\\varepsilon/2` of a ramp spread over the cycle); it speeds
+    up at a constant acceleration over the cycle (at most :math:`A`).  The distance of each
+    sub-step is exact; its heading is the sub-step's midpoint heading.  The robots in `docks`
+    (robot index to docking pose ``x, y, heading deg``) creep instead (:func:`_creep`).
+
+    Returns each robot's translational speed at the end of the cycle, mm/s: what the monitor
+    calls moving.  A docking creep is a stop-and-go no faster than one cycle's braking, so the
+    robot is at rest at the start of every docking cycle and moving until it is on the pose.
+    """
+    dt = world.dt
+    acc, brk = world.limits.acceleration, world.limits.braking
+    v0 = world.v
+    v1 = np.clip(v_cmd, np.maximum(0.0, v0 - brk * dt), v0 + acc * dt)
+    v1 = np.minimum(v1, world.limits.max_speed)
+    slowing = v1 < v0
+    reached = np.where(slowing, (v0 - v1) / np.maximum(brk, 1e-9), dt)  # when v1 is reached, s
+
+    def covered(t: float) -> np.ndarray:
+        """Distance (mm) from the cycle's start to time `t` within it."""
+        ramp = v0 * t + (v1 - v0) * t * t / (2.0 * dt)
+        tb = np.minimum(t, reached)
+        braked = v0 * tb - brk * tb * tb / 2.0 + v1 * np.maximum(t - reached, 0.0)
+        return np.where(slowing, braked, ramp)
+
+    start = world.pose[:, :2].copy()
+    n = _SUBSTEPS
+    for k in range(n):
+        step = covered((k + 1) * dt / n) - covered(k * dt / n)
+        theta = world.pose[:, 2] + w_cmd * dt / (2 * n)
+        world.pose[:, 0] += step * np.cos(theta)
+        world.pose[:, 1] += step * np.sin(theta)
+        world.pose[:, 2] += w_cmd * dt / n
+    world.pose[:, 2] = wrap_angle(world.pose[:, 2])
+    world.v = v1
+    world.w = w_cmd.copy()
+    moving = v1.copy()
+    for i, dock in docks.items():
+        moving[i] = _creep(world, i, dock)
+    world.distance += np.hypot(*(world.pose[:, :2] - start).T)
+    return moving
+
+
+def _creep(world: World, i: int, dock: tuple) -> float:
+    """The docking controller: robot `i` creeps straight towards `dock` (``x, y`` mm, heading
+    deg), turning at most its turn rate, and halts exactly on it.  Returns its speed, mm/s."""
+    dt = world.dt
+    x, y = world.pose[i, :2]
+    dx, dy = dock[0] - x, dock[1] - y
+    dist = math.hypot(dx, dy)
+    step = world.creep_speed(i) * dt
+    if dist <= step:
+        world.pose[i, 0], world.pose[i, 1] = dock[0], dock[1]
+    else:
+        world.pose[i, 0] += dx * step / dist
+        world.pose[i, 1] += dy * step / dist
+    error = world.heading_error(i, math.radians(dock[2]))
+    turn = world.limits.turn_rate[i] * dt
+    h = world.pose[i, 2]
+    world.pose[i, 2] = math.radians(dock[2]) if abs(error) <= turn else h + math.copysign(turn, error)
+    world.v[i] = 0.0
+    world.w[i] = 0.0
+    return 0.0 if dist <= step else step / dt

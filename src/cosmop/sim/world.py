@@ -1,0 +1,375 @@
+"""The state of a running simulation: every robot's executor state and the shared world.
+
+:class:`World` holds what the robots, people and objects are doing (poses, speeds, who carries
+what), the message bus and the safety monitor's log; :class:`Agent` is one robot's place in its
+plan.  Both are mutable and owned by :func:`cosmop.sim.simulation.simulate`; the executors
+(:mod:`cosmop.sim.execute`), the physics (:mod:`cosmop.sim.physics`) and the monitor
+(:mod:`cosmop.sim.monitor`) read and change them.  Units: mm, mm/s and radians inside (poses
+keep their heading in radians), seconds; degrees where a plan's pose is read.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+
+from cosmop.control.dwa import Obstacles
+from cosmop.control.geometry import box_gaps, point_segment_linf, segment_array
+from cosmop.control.paths import GlobalPath
+from cosmop.control.safety import Limits
+from cosmop.events import MESSAGE_KINDS, Event, Primitive, parse_event, realising_step
+from cosmop.planning.plan import PlanSet, RobotPlan, Step
+from cosmop.planning.realisation import event_instants
+from cosmop.scene import Scenario
+from cosmop.sim.humans import Walker
+from cosmop.sim.result import Contact, Message, SimSettings, drop_holds
+
+__all__ = ["TOUCH", "Action", "Agent", "World", "wrap_angle"]
+
+TOUCH = 1e-6
+"""Gap (mm) under which two squares touch."""
+
+Action = tuple[str, Any]
+"""One cycle's command of a robot: ``("drive", (target, stop, room))`` for the dynamic window,
+``("move", (v, w))`` (mm/s, rad/s) or ``("dock", (x, y, heading deg))`` for the docking creep."""
+
+
+def wrap_angle(angle: np.ndarray | float) -> np.ndarray | float:
+    """`angle` (radians) wrapped into :math:`[-\\pi, \\pi)`."""
+    return (np.asarray(angle) + math.pi) % (2 * math.pi) - math.pi
+
+
+class Agent:
+    """One robot's executor state: where it is in its plan and what it is doing (mutable)."""
+
+    def __init__(self, rid: str, index: int, steps: tuple[Step, ...], mission: tuple[Event, ...]) -> None:
+        self.id = rid
+        self.index = index  # the robot's row in the world's arrays
+        self.steps = list(steps)  # the plan being executed (a replan replaces the rest)
+        self.mission = list(mission)  # the events those steps realise, messages included
+        self.step_index = 0  # the step being executed (== len(steps): finished)
+        # each step's instant in the plan the run started from (None: a replan added it)
+        self.plan_instants: list[int | None] = list(range(1, len(self.steps) + 1))
+        self.step_began = 0.0  # when the current step started, s
+        self.step_log: list[tuple[int | None, str, float, float]] = []  # done: instant, label, start, end
+        self.drive_phase = "start"  # of a drive: start (no path yet), drive, turn (onto the heading)
+        self.dock_stage: str | None = None  # of a pick or drop: approach, dock, handle (None: not begun)
+        self.path: GlobalPath | None = None  # the global path being followed
+        self.reseat_point: tuple[float, float] | None = None  # the plan's segment start to creep back to
+        self.replan_start: tuple[int, tuple] | None = None  # (step, pose): where a replan starts that step
+        self.handling_left = 0.0  # seconds of gripper work left
+        self.gripped: int | None = None  # the object (index) the gripper touches, not carried
+        self.best_path_left = math.inf  # path left (mm) at the last progress
+        self.goal_clearance = math.inf  # gap (mm) of the current goal to everything static
+        self.path_left = 0.0  # path left (mm) while driving, 0 otherwise: the right of way
+        self.detour_until = 0.0  # no new detour before this time, s
+        self.last_progress_t = 0.0  # time of the last progress, s
+        self.waiting = False  # standing for a message
+        self.answers_sent: dict[str, int] = {}  # Res steps done per object
+        # where it creeps out of touch before driving off: None not looked for yet, False none
+        self.way_out: tuple[float, float] | bool | None = None
+
+    @property
+    def done(self) -> bool:
+        """Whether the robot has executed its whole plan."""
+        return self.step_index >= len(self.steps)
+
+    @property
+    def step(self) -> Step:
+        """The step being executed."""
+        return self.steps[self.step_index]
+
+    def restart_step(self) -> None:
+        """Forget how the current step was being executed: it starts afresh next cycle."""
+        self.drive_phase = "start"
+        self.dock_stage = None
+        self.path = None
+        self.way_out = None
+
+    def split_mission(self, scenario: Scenario) -> tuple[list[Event], list[Event]]:
+        """The mission events done (by the completed steps) and those still to do."""
+        plan = RobotPlan.from_steps([e.name for e in self.mission], self.steps)
+        instants = event_instants(plan, self.id, scenario.scene)
+        done = [
+            e for e, t in zip(self.mission, instants, strict=True) if t is not None and t <= self.step_index
+        ]
+        return done, self.mission[len(done) :]
+
+
+class World:
+    """The state of a running simulation; :func:`~cosmop.sim.simulation.simulate` drives it.
+
+    Robots are rows of the arrays ``pose`` (x, y mm, heading rad), ``v`` (mm/s), ``w`` (rad/s),
+    ``robot_half`` and ``limits`` (:class:`~cosmop.control.safety.Limits`); objects rows of
+    ``object_xy`` and ``object_half``.  An object
+    carried by robot ``i`` has ``carried_by == i`` and rides at the robot's centre (its
+    ``object_xy`` is stale then); a resting one has ``carried_by == -1``.
+    """
+
+    def __init__(self, scenario: Scenario, plans: PlanSet, seed: int, settings: SimSettings) -> None:
+        scene = scenario.scene
+        self.scenario = scenario
+        self.settings = settings
+        self.robot_ids = tuple(scene.robots)
+        self.object_ids = tuple(scene.objects)
+        humans = scene.humans
+        self.human_ids = tuple(humans)
+        self.walls = segment_array([(w.start, w.end) for w in scene.obstacles])
+        self._init_robots(scenario)
+        objects = [scene.objects[o] for o in self.object_ids]
+        self.object_xy = np.array([o.position for o in objects], dtype=float).reshape(-1, 2)  # resting ones
+        self.object_half = np.array([o.size / 2.0 for o in objects])
+        self.carried_by = np.full(len(self.object_ids), -1)  # robot index, -1: resting
+        rng = np.random.default_rng(seed)  # the people's random walks: the only randomness
+        self.walkers = [Walker(humans[h], self.walls, rng) for h in self.human_ids]
+        self.human_half = np.array([w.half for w in self.walkers])
+        self.human_speed = np.array([humans[h].speed for h in self.human_ids])  # at most, mm/s
+        self.agents = []
+        for i, rid in enumerate(self.robot_ids):
+            plan = plans.robots.get(rid)
+            steps = plan.steps if plan is not None else ()
+            events = plan.events if plan is not None else ()
+            self.agents.append(Agent(rid, i, steps, events))
+        self.sent_messages: set[str] = set()  # the message events sent so far
+        self.events: list[tuple[float, str, str]] = [  # (t, robot, event) as the robots do them
+            (0.0, a.id, f"return({a.id})")
+            for a in self.agents
+            if a.done and any(e.kind == "return" for e in a.mission)
+        ]
+        self.messages: list[Message] = []  # the bus's log
+        self.contacts: list[Contact] = []  # the monitor's log
+        # (robot, what it touches) for the pairs touching now -> the episode's index in contacts
+        self.open_contacts: dict[tuple[int, str], int] = {}
+        self.replans = 0  # accepted replans
+        self.replan_attempts = 0
+        self.replan_log: list[dict[str, Any]] = []  # every replan: time, robot, accepted, messages
+        # the messages that keep plans apart (re-ordered on a replan) and every message name used
+        self.conflict_messages = {m.event for m in plans.messages if m.kind == "conflict"}
+        self.message_names = {
+            name for p in plans.robots.values() for name in p.mission if name.startswith("msg(")
+        }
+        self.t = 0.0  # simulated time, s
+
+    def _init_robots(self, scenario: Scenario) -> None:
+        """The robots' arrays: sizes, limits, poses at rest."""
+        robots = [scenario.scene.robots[r] for r in self.robot_ids]
+        R = len(robots)
+        self.robot_half = np.array([r.size / 2.0 for r in robots])
+        self.dynamics = [r.dynamics for r in robots]
+        cycles = {d.cycle for d in self.dynamics}
+        if len(cycles) != 1:
+            raise ValueError("every robot must share one control cycle")
+        self.dt = cycles.pop()  # the control cycle, s
+        self.limits = Limits.of(self.dynamics)  # the unicycle limits, arrays over robots
+        self.pose = np.array([[r.pose[0], r.pose[1], math.radians(r.pose[2])] for r in robots]).reshape(R, 3)
+        self.v = np.zeros(R)
+        self.w = np.zeros(R)
+        self.distance = np.zeros(R)  # driven so far, mm
+
+    # -- what the robots sense -----------------------------------------------------------------
+
+    def robot_boxes(self) -> np.ndarray:
+        """Every robot as a box ``x, y, half side`` (mm)."""
+        return np.column_stack([self.pose[:, :2], self.robot_half])
+
+    def resting_boxes(self) -> np.ndarray:
+        """Every resting (not carried) object as a box ``x, y, half side`` (mm)."""
+        keep = self.carried_by < 0
+        return np.column_stack([self.object_xy[keep], self.object_half[keep]])
+
+    def people_boxes(self) -> np.ndarray:
+        """Every person as a box ``x, y, half side`` (mm); call only with people."""
+        return np.column_stack([np.array([w.position for w in self.walkers]), self.human_half])
+
+    def obstacles(self) -> Obstacles:
+        """What the robots sense now: the walls, and the resting objects, robots and people (in
+        that order) as boxes with their speed bounds, ids and (:meth:`moving`) motion."""
+        resting = np.flatnonzero(self.carried_by < 0)
+        boxes = [self.resting_boxes(), self.robot_boxes()]
+        speed = [np.zeros(len(resting)), np.where(self.parked(), 0.0, self.limits.max_speed)]
+        names = [self.object_ids[j] for j in resting] + list(self.robot_ids)
+        if self.walkers:
+            boxes.append(self.people_boxes())
+            speed.append(self.human_speed)
+            names += list(self.human_ids)
+        agents = np.arange(len(names)) >= len(resting)  # robots and people, not objects
+        sensed = Obstacles(
+            self.walls,
+            np.vstack(boxes).reshape(-1, 3),
+            np.concatenate(speed),
+            agents=agents,
+            names=tuple(names),
+        )
+        return self.moving(sensed)
+
+    def moving(self, sensed: Obstacles) -> Obstacles:
+        """`sensed` with the velocities (mm/s; sensed, for prediction only) and acceleration
+        limits (mm/s^2) its boxes have now: resting objects and parked robots 0, people an
+        unknown acceleration (``inf``)."""
+        n_objects = len(sensed.names) - len(self.robot_ids) - len(self.walkers)
+        robots = slice(n_objects, n_objects + len(self.robot_ids))
+        velocity = np.zeros((len(sensed.names), 2))
+        heading = self.pose[:, 2]
+        velocity[robots] = np.column_stack([self.v * np.cos(heading), self.v * np.sin(heading)])
+        for k, walker in enumerate(self.walkers):
+            velocity[robots.stop + k] = walker.velocity
+        acceleration = np.zeros(len(sensed.names))
+        acceleration[robots] = np.where(self.parked(), 0.0, self.limits.acceleration)
+        acceleration[robots.stop :] = np.inf
+        return replace(sensed, velocity=velocity, acceleration=acceleration)
+
+    def own_boxes(self, names: Sequence[str]) -> np.ndarray:
+        """Which of the boxes `names` (of :meth:`obstacles`) is each robot itself, (R, n)."""
+        R = len(self.robot_ids)
+        return np.array([[n == rid for n in names] for rid in self.robot_ids]).reshape(R, len(names))
+
+    def static_gaps(self, points: np.ndarray, half: float) -> np.ndarray:
+        """L-infinity gaps (mm) of squares of half side `half` at `points` to walls and resting objects."""
+        points = np.asarray(points, dtype=float).reshape(-1, 2)
+        gap = np.full(len(points), np.inf)
+        if len(self.walls):
+            gap = np.minimum(gap, (point_segment_linf(points, self.walls) - half).min(axis=1))
+        if (self.carried_by < 0).any():
+            gap = np.minimum(gap, box_gaps(points, half, self.resting_boxes()).min(axis=1))
+        return gap
+
+    def static_boxes(self, robot: int, goal: tuple[float, ...] | None = None) -> np.ndarray:
+        """What the global path of robot `robot` avoids: resting objects and parked robots.
+
+        A robot that waits for a message, docks, handles an object or has finished stands
+        still for a while, so the others plan around it instead of queueing behind it.
+        """
+        boxes = [self.resting_boxes()]
+        parked = [
+            a.index
+            for a in self.agents
+            if a.index != robot and (a.done or a.waiting or a.dock_stage is not None) and self.v[a.index] == 0
+        ]
+        if parked:
+            half = self.robot_half[parked].copy()
+            if goal is not None:
+                # A parked robot stops up to the goal tolerance from its own goal, so a goal
+                # planned right beside it may lie a little inside: shrink that one, so that
+                # the goal stays reachable (the path is a guide; the dynamic window keeps the
+                # real distance).
+                reach = np.abs(self.pose[parked, :2] - np.asarray(goal[:2])).max(axis=1)
+                inside = reach < half + self.robot_half[robot]
+                half[inside] = np.minimum(
+                    half[inside], np.maximum(reach[inside] - self.robot_half[robot], 1.0)
+                )
+            boxes.append(np.column_stack([self.pose[parked, :2], half]))
+        return np.vstack(boxes).reshape(-1, 3)
+
+    def gaps_to_robots(self, i: int) -> np.ndarray:
+        """L-infinity gaps (mm) of robot `i`'s square to every robot's (itself included)."""
+        return box_gaps(self.pose[i, :2], self.robot_half[i], self.robot_boxes())
+
+    def object_positions(self) -> np.ndarray:
+        """Where every object is now (a carried one at its robot's centre), (O, 2) mm."""
+        positions = self.object_xy.copy()
+        for j, r in enumerate(self.carried_by):
+            if r >= 0:
+                positions[j] = self.pose[r, :2]
+        return positions
+
+    def creep_speed(self, i: int) -> float:
+        """Speed (mm/s) of robot `i`'s docking creep: at most ``dock_speed``, and no faster than
+        the robot stops within one cycle (so it halts exactly on its pose)."""
+        return min(self.settings.dock_speed, self.limits.braking[i] * self.dt)
+
+    def heading_error(self, i: int, heading: float) -> float:
+        """The turn (rad, wrapped) from robot `i`'s heading to `heading` (rad)."""
+        return float(wrap_angle(heading - self.pose[i, 2]))
+
+    # -- who may move ----------------------------------------------------------------------------
+
+    def parked(self) -> np.ndarray:
+        """Which robots are parked: standing and promising not to move (their V is 0).
+
+        A robot that has finished, waits for a message or lets its gripper work stands still,
+        and it leaves that state only when no other robot is within the standoff
+        (:meth:`crowded`).  The others may therefore treat it like a wall: come close, dock
+        beside it, and leave again -- two robots that touch could otherwise never part.
+        """
+        return np.array(
+            [(a.done or a.waiting or a.dock_stage == "handle") and self.v[a.index] == 0 for a in self.agents],
+            dtype=bool,
+        )
+
+    def crowded(self, i: int) -> bool:
+        """Whether robot `i` must stay parked: another robot that may still move is within its
+        standoff.  A robot that has finished never moves again and does not count; of two parked
+        robots close together the one listed first may leave (the other keeps its promise), so
+        that two waiting robots never hold each other for ever."""
+        gaps = self.gaps_to_robots(i)
+        gaps[i] = np.inf
+        parked = self.parked()
+        for agent in self.agents:
+            if agent.done or (parked[agent.index] and agent.index > i):
+                gaps[agent.index] = np.inf
+        return bool((gaps < self.settings.dwa.standoff).any())
+
+    # -- messages and mission events ---------------------------------------------------------------
+
+    def send(self, agent: Agent, step: Step) -> None:
+        """Send the message of a ``Res`` step: its ``msg``, or the next ``away`` answer about its
+        object (the k-th Res(O) answers the k-th away(O, *, sender) of the mission)."""
+        if step.message is not None:
+            event = parse_event(step.message)
+        else:
+            answers = [
+                e for e in agent.mission if e.kind == "away" and e.obj == step.object and e.sender == agent.id
+            ]
+            sent = agent.answers_sent.get(step.object, 0)
+            agent.answers_sent[step.object] = sent + 1
+            event = answers[min(sent, len(answers) - 1)]
+        self.messages.append(Message(round(self.t, 6), agent.id, event.receiver, event.obj, event.name))
+        self.sent_messages.add(event.name)
+        self.events.append((round(self.t, 6), agent.id, event.name))
+
+    def received(self, agent: Agent, step: Step) -> bool:
+        """Whether the message a ``Req`` step waits for has been sent."""
+        if step.message is not None:
+            return step.message in self.sent_messages
+        return any(
+            e.name in self.sent_messages
+            for e in agent.mission
+            if e.kind == "away" and e.obj == step.object and e.receiver == agent.id
+        )
+
+    def _happened(self, event: Event) -> bool:
+        """Whether the step that realises `event` made it happen: a drop left its object in the
+        workspace, an awaited message was sent."""
+        if event.kind == "drop":
+            xy = self.object_xy[self.object_ids.index(event.obj)]
+            return drop_holds(self.scenario.scene, event, xy)
+        if event.kind in MESSAGE_KINDS:
+            return event.name in self.sent_messages
+        return True
+
+    def log_events(self, agent: Agent, step: Step) -> None:
+        """Log the mission events a finished step realises (the executed word of the run)."""
+        done = {name for _, robot, name in self.events if robot == agent.id}
+        realised = (step.primitive, step.object, step.message)
+        wanted = [
+            e
+            for e in agent.mission
+            if step.primitive != Primitive.RES  # a message is logged when it is sent
+            and realising_step(e, agent.id) == realised
+            and self._happened(e)
+        ]
+        event = next((e for e in wanted if e.name not in done), None)
+        if event is not None:
+            self.events.append((round(self.t, 6), agent.id, event.name))
+            done.add(event.name)
+        # ``return`` holds as soon as the robot is home with the events before it done (as in
+        # the plan: messages it sends from home come after it)
+        pending = next((e for e in agent.mission if e.name not in done), None)
+        if pending is not None and pending.kind == "return":
+            home = self.scenario.scene.robots[agent.id].pose
+            if math.dist(self.pose[agent.index, :2], home[:2]) <= self.settings.goal_tolerance + 1e-6:
+                self.events.append((round(self.t, 6), agent.id, pending.name))
