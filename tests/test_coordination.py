@@ -13,10 +13,11 @@ from pathlib import Path
 import pytest
 
 from cosmop.events import parse_event
-from cosmop.missions.coordination import Pair, blocking_word, coordinate, requests_by_phase
+from cosmop.missions.coordination import Pair, blocking_word, coordinate
 from cosmop.missions.mission import GlobalMission, sequence_automaton
 from cosmop.missions.verification import verify
 from cosmop.planning.checker import check_robot_plan
+from cosmop.planning.realisation import request_phases
 from cosmop.planning.synthesis import synthesize
 from cosmop.scenario import load_scenario
 from paper_rules import west_only
@@ -33,21 +34,18 @@ def plan_requests(sc):
     requests = {}
     for robot, events in sequences.items():
         res = synthesize(sc.scene, robot, events, max_horizon=12)
-        requests[robot] = requests_by_phase([(s.primitive, s.object) for s in res.plan.steps], events, robot)
+        requests[robot] = request_phases(res.plan, robot, sc.scene, events)
     return sequences, requests
 
 
 def test_requests_are_attached_to_the_event_they_prepare():
-    mission = seq("pick(R1,O1)", "drop(R1,O1,W1)", "return(R1)")
-    steps = [
-        ("Req", "O2"),
-        ("GoTo", None),
-        ("PickUp", "O1"),
-        ("Req", "O3"),
-        ("GoTo", None),
-        ("DropOff", "O1"),
-    ]
-    assert requests_by_phase(steps, mission, "R1") == [("O2", 0), ("O3", 1)]
+    sc = load_scenario(ROOT / "examples" / "01_warehouse_2x2" / "scenario.yaml")
+    events = tuple(sc.mission.tasks["R1"])
+    plan = synthesize(sc.scene, "R1", events, max_horizon=12).plan
+    req = next(k for k, s in enumerate(plan.steps) if s.primitive == "Req")
+    pick = next(k for k, s in enumerate(plan.steps) if s.primitive == "PickUp")
+    assert req < pick  # R1 asks for O2 to be moved before it picks O1
+    assert request_phases(plan, "R1", sc.scene, events) == [("O2", 0)]
 
 
 def test_two_by_two_gets_one_pair():

@@ -71,9 +71,9 @@ def test_object_regions_are_sound(o, b, start, end, s):
 def test_touching_an_axis_aligned_wall_is_admitted():
     # the 2x2 example's inner wall x = 0 from y = 0 to 2500, robot side 400: centres at x = -200 touch it
     left, right, before, after = wall_regions((0, 0), (0, 2500), 400)
-    assert motion_is_clear((left, right), (200, 100), (200, 2400)) is not None
-    assert motion_is_clear((left, right), (-200, 100), (-200, 2400)) is not None
-    assert motion_is_clear((left, right), (-199, 100), (-200, 2400)) is None
+    assert left.contains(-200, 100) and left.contains(-200, 2400)  # touching on the west side
+    assert right.contains(200, 100) and right.contains(200, 2400)  # touching on the east side
+    assert not right.contains(-199, 100) and not left.contains(-199, 100)  # overlapping: no side holds it
     assert before.contains(1000, -200) and not before.contains(1000, -199)  # below the start, touching
     assert after.contains(0, 2700)
 

@@ -35,7 +35,7 @@ import shapely
 
 from cosmop.allocate import allocate
 from cosmop.automata import DFA
-from cosmop.events import Event, Primitive, parse_event
+from cosmop.events import Event, parse_event
 from cosmop.missions.allocation import Choice
 from cosmop.missions.coordination import Coordinated, coordinate
 from cosmop.missions.decomposition import decompose
@@ -45,7 +45,7 @@ from cosmop.planning.aside import ROOM, place_aside
 from cosmop.planning.checker import CheckReport, check_plan
 from cosmop.planning.conflicts import ConflictSettings
 from cosmop.planning.plan import MAX_STEPS, AddedTask, Coordination, PlanMessage, PlanSet, RobotPlan
-from cosmop.planning.realisation import event_instants
+from cosmop.planning.realisation import request_phases
 from cosmop.planning.synthesis import DEFAULT_RLIMIT, Synthesis, synthesize
 from cosmop.planning.teamsafety import TeamSafety, make_team_safe
 from cosmop.planning.timing import itinerary
@@ -397,19 +397,6 @@ def _plan_messages(plans: Mapping[str, RobotPlan], notes: Mapping[str, tuple[str
     return out
 
 
-def _requests(
-    plan: RobotPlan, robot: str, scene: Scene, sequence: tuple[Event, ...]
-) -> list[tuple[str, int]]:
-    """Each Req(O) of `plan` with the index (in `sequence`) of the first event realised after it."""
-    instants = event_instants(plan, robot, scene, sequence)
-    out = []
-    for k, step in enumerate(plan.steps, 1):
-        if step.primitive == Primitive.REQ and step.object is not None:
-            index = next((n for n, t in enumerate(instants) if t is not None and t >= k), len(sequence))
-            out.append((step.object, index))
-    return out
-
-
 def _base_index(sequence: tuple[Event, ...], index: int) -> int:
     """Index in the sequence without away events of the event at ``index`` of `sequence`."""
     return sum(1 for e in sequence[:index] if e.kind != "away")
@@ -433,7 +420,7 @@ def _coordinate_requests(
         t0 = time.perf_counter()
         scene = planner.scenario.scene  # with the places of goods moved aside so far
         requests = {
-            r: [(o, _base_index(current[r], i)) for o, i in _requests(res.plan, r, scene, current[r])]
+            r: [(o, _base_index(current[r], i)) for o, i in request_phases(res.plan, r, scene, current[r])]
             for r, res in results.items()
         }
         if requests == asked:

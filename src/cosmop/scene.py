@@ -1,7 +1,7 @@
 """The value types of a scenario: the scene (walls, robots, movable objects, workspaces,
 people) and the mission, as small immutable values.
 
-This module is the bottom of the house: every layer (missions, planning, control, simulation,
+This module sits near the bottom of the house: every layer (missions, planning, control, simulation,
 viz) speaks of a scenario in these types, and none of them need the file format.  The
 scenario file is read and checked by :mod:`cosmop.scenario`, which builds these values.
 
@@ -550,7 +550,7 @@ class Scenario:
     mission : Mission
         The global mission.
     source : pathlib.Path, optional
-        The file it was loaded from, as given to :func:`load_scenario`.
+        The file it was loaded from, as given to :func:`cosmop.scenario.load_scenario`.
     """
 
     name: str

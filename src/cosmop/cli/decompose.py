@@ -60,7 +60,7 @@ def decompose(
     if loaded.mission.deliveries is not None:
         _refuse_deliveries(scenario)
     result, verification, team = _decompose_and_verify(GlobalMission.from_scenario(loaded), method)
-    names = _write_dot(dot, result, quiet=not as_json) if dot is not None else ""
+    names = _write_dot(dot, result, tell_stderr=as_json) if dot is not None else ""
     holds = team.holds if team is not None else verification.holds
     ok = (result.separable or result.messaging is not None) and holds
     if as_json:
@@ -104,13 +104,13 @@ def _decompose_and_verify(mission: GlobalMission, method: Method) -> tuple[Any, 
     return result, verification, team
 
 
-def _write_dot(dot: Path, result: Any, quiet: bool) -> str:
+def _write_dot(dot: Path, result: Any, tell_stderr: bool) -> str:
     """Write each local mission as ``<robot>.dot``; the file names, for the closing line."""
     dot.mkdir(parents=True, exist_ok=True)
     for robot, dfa in result.local_missions.items():
         write_atomic(dot / f"{robot}.dot", dfa.to_dot(f"K_{robot}"))
     names = ", ".join(f"{robot}.dot" for robot in result.local_missions)
-    if not quiet:  # with --json, stdout is the JSON alone
+    if tell_stderr:  # with --json, stdout is the JSON alone
         typer.echo(f"wrote the local missions as Graphviz DOT to {dot}/: {names}", err=True)
     return names
 

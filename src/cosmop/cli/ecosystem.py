@@ -19,7 +19,7 @@ from cosmop.io import check_writable, write_atomic
 if TYPE_CHECKING:
     from cosmop.traces import Trace
 
-__all__: list[str] = []
+__all__ = ["check_bag_target", "export", "import_map", "view", "write_bag_and_report"]
 
 
 class _Unknown(StrEnum):

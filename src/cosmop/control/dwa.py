@@ -156,6 +156,18 @@ class Obstacles:
         """Which boxes are kept at the standoff: :attr:`agents`, else those that move."""
         return self.speed > 0 if self.agents is None else self.agents
 
+    def speed_bound(self, horizon) -> np.ndarray:
+        """:math:`V_o` of every box over a stopping `horizon` (s), mm/s.
+
+        :func:`~cosmop.control.safety.obstacle_speed` of the boxes' current speeds and
+        accelerations, or their top speed when those are unknown.  `horizon` broadcasts against
+        the boxes: a scalar gives ``(M,)``, a column ``(R, 1)`` gives ``(R, M)``.
+        """
+        if self.acceleration is None or self.velocity is None or not len(self.boxes):
+            return np.broadcast_to(self.speed, np.broadcast_shapes(np.shape(horizon), self.speed.shape))
+        now = np.hypot(self.velocity[:, 0], self.velocity[:, 1])
+        return obstacle_speed(horizon, self.speed, now, self.acceleration)
+
 
 @dataclass(frozen=True)
 class Drivers:
@@ -285,17 +297,8 @@ def _passive_safety(
     R, n_walls = len(drivers.v), wall_gap.shape[1]
     gap = np.concatenate([wall_gap, box_gap - settings.standoff * obstacles.movers[None, :]], axis=1)
     limits, v = drivers.limits.column(), drivers.v[:, None]
-    if obstacles.acceleration is not None and obstacles.velocity is not None and len(obstacles.boxes):
-        now = np.hypot(obstacles.velocity[:, 0], obstacles.velocity[:, 1])
-        bound = obstacle_speed(
-            stopping_horizon(v, limits),
-            obstacles.speed[None, :],
-            now[None, :],
-            obstacles.acceleration[None, :],
-        )
-        speeds = np.concatenate([np.zeros((R, n_walls)), bound], axis=1)
-    else:
-        speeds = np.broadcast_to(np.concatenate([np.zeros(n_walls), obstacles.speed])[None, :], gap.shape)
+    bound = np.broadcast_to(obstacles.speed_bound(stopping_horizon(v, limits)), (R, len(obstacles.boxes)))
+    speeds = np.concatenate([np.zeros((R, n_walls)), bound], axis=1)
     return np.all(is_safe(gap, v, speeds, limits), axis=1)
 
 
@@ -521,8 +524,7 @@ def _escape_ok(
         drivers.limits.braking,
         drivers.limits.cycle,
     )
-    walls, boxes, box_speed = obstacles.walls, obstacles.boxes, obstacles.speed
-    box_velocity, box_accel = obstacles.velocity, obstacles.acceleration
+    walls, boxes = obstacles.walls, obstacles.boxes
     total = eps[:, None] + V / brk[:, None]  # (U, K): time until standing still
     dt = total / steps
     t = dt[:, :, None] * np.arange(1, steps + 1)[None, None, :]  # (U, K, n)
@@ -548,13 +550,7 @@ def _escape_ok(
         ok &= fine.all(axis=(2, 3))
     if len(boxes):
         gap = box_gaps(pts, half[:, None, None], boxes).reshape(U, K, steps, -1)
-        if box_accel is not None and box_velocity is not None:
-            now = np.hypot(box_velocity[:, 0], box_velocity[:, 1])
-            bound = obstacle_speed(
-                total.max(axis=1)[:, None], box_speed[None, :], now[None, :], box_accel[None, :]
-            )
-        else:
-            bound = np.broadcast_to(box_speed[None, :], (U, len(boxes)))
+        bound = obstacles.speed_bound(total.max(axis=1)[:, None])  # (U, M)
         reach = t[..., None] * bound[:, None, None, :]
         fine = gap > reach + slack[..., None]
         # From a box that stands still (V = 0), moving away never closes the gap: an arc whose

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 from cosmop.units import m_from_mm
 from cosmop.viz.palette import robot_colours
+from cosmop.viz.scene import DEFAULT_ROBOT_SIZE
 
 if TYPE_CHECKING:
     from cosmop.scene import Scene
@@ -142,7 +143,7 @@ class SceneMarkers:
                 continue
             x, y, heading = state.pose
             robot = self.scene.robots.get(rid)
-            side = m_from_mm(robot.size) if robot is not None else 0.4
+            side = m_from_mm(robot.size if robot is not None else DEFAULT_ROBOT_SIZE)
             colour = (*self.colours[rid], 0.7)
             body = self._at(x, y, _ROBOT_HEIGHT / 2, heading)
             out.append(self._marker(ns, "robots", n, "CUBE", body, (side, side, _ROBOT_HEIGHT), colour))

@@ -25,7 +25,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from types import MappingProxyType
 
-from cosmop.events import Event, Primitive, realising_step
+from cosmop.events import Event
 from cosmop.missions.team import blocking_word as team_blocking_word
 
 
@@ -68,27 +68,6 @@ class Coordinated:
     blocking: tuple[str, ...] | None = None
 
 
-def requests_by_phase(
-    steps: Sequence[tuple[str, str | None]], mission: Sequence[Event], robot: str
-) -> list[tuple[str, int]]:
-    """For each Req step of `robot`'s plan, ``(object, index of the mission event it prepares)``.
-
-    ``steps`` are ``(primitive, object)`` in plan order.  A Req belongs to the phase of the
-    first mission event realised at or after it (by the step of :func:`cosmop.events.realising_step`;
-    a return, by the end of the plan).
-    """
-    out, event_index = [], 0
-    for primitive, obj in steps:
-        if primitive == Primitive.REQ and obj is not None:  # (a Req without object waits for a msg)
-            out.append((obj, event_index))
-        while event_index < len(mission):
-            realised = realising_step(mission[event_index], robot)
-            if realised is None or realised[:2] != (primitive, obj):
-                break
-            event_index += 1
-    return out
-
-
 def blocking_word(sequences: Mapping[str, Sequence[Event]]) -> tuple[str, ...] | None:
     """A shortest word into a deadlock, or ``None`` when the robots can always all complete.
 
@@ -110,7 +89,7 @@ def coordinate(
         Every robot's local mission (without coordination events for these requests).
     requests : Mapping[str, sequence of (str, int)]
         Per requester, ``(object, index of the mission event the request prepares)``, as from
-        :func:`requests_by_phase`.
+        :func:`cosmop.planning.realisation.request_phases`.
 
     Returns
     -------

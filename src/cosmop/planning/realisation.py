@@ -185,3 +185,21 @@ def message_links(plans: Mapping[str, RobotPlan]) -> list[Link]:
             )
         )
     return out
+
+
+def request_phases(
+    plan: RobotPlan, robot: str, scene: Scene, events: Sequence[Event]
+) -> list[tuple[str, int]]:
+    """Each ``Req(O)`` step of `plan` with the index in `events` of the first event realised at
+    or after it (``len(events)`` if none is): the event the request prepares.
+
+    These are the requests :func:`cosmop.missions.coordination.coordinate` turns into
+    request/response pairs.
+    """
+    instants = event_instants(plan, robot, scene, events)
+    out = []
+    for k, step in enumerate(plan.steps, 1):
+        if step.primitive == Primitive.REQ and step.object is not None:
+            index = next((n for n, t in enumerate(instants) if t is not None and t >= k), len(events))
+            out.append((step.object, index))
+    return out

@@ -302,7 +302,9 @@ class Encoding:
     Subclasses set ``name`` and implement :meth:`targets` (the objects it applies to, ``None``
     for a primitive without object) and :meth:`parts` (named formulas that hold whenever
     :math:`\\bigcirc \\pi` is this primitive applied to ``obj``).  A new primitive is a new
-    subclass added to the library passed to :class:`RobotProblem`; the solver does not change.
+    subclass added to the library passed to :class:`RobotProblem`; the solver does not change
+    (the plan format and the simulator need a :class:`~cosmop.events.Primitive` member and an
+    executor too).
     """
 
     name: Primitive

@@ -27,7 +27,7 @@ may stand on to pick it up or drop it off (``west``, ``south``, ``east``, ``nort
 by default).
 
 :func:`load_scenario` reads such a file and :func:`parse_scenario` validates an already-parsed
-mapping; both return an immutable :class:`Scenario` or raise
+mapping; both return an immutable :class:`~cosmop.scene.Scenario` or raise
 :class:`~cosmop.errors.ScenarioError` naming the file, the field and what was expected.
 
 The file is read by :func:`cosmop.reading.load_yaml`: a YAML dialect close to YAML 1.2's core

@@ -44,7 +44,7 @@ class _Model(BaseModel):
 
 
 class _DynamicsModel(_Model):
-    """Any subset of the :class:`Dynamics` fields; an absent field is inherited."""
+    """Any subset of the :class:`~cosmop.scene.Dynamics` fields; an absent field is inherited."""
 
     max_speed: _Positive | None = None
     acceleration: _Positive | None = None

@@ -22,7 +22,7 @@ import numpy as np
 
 from cosmop.control.geometry import box_gaps, point_segment_linf
 from cosmop.control.paths import GlobalPath, plan_path, straight_path
-from cosmop.control.safety import is_safe, obstacle_speed, stopping_horizon
+from cosmop.control.safety import is_safe, stopping_horizon
 from cosmop.sim.replan import replan_stalled
 from cosmop.sim.world import TOUCH, Action, Agent, World
 
@@ -235,8 +235,7 @@ def creep_is_safe(world: World, agent: Agent, target: tuple | None = None) -> bo
     xy, half = world.pose[i, :2], world.robot_half[i]
     if movers:
         gaps = box_gaps(xy, half, boxes[movers])
-        now = np.hypot(*sensed.velocity[movers].T)
-        bound = obstacle_speed(stopping_horizon(speed, dyn), speeds[movers], now, sensed.acceleration[movers])
+        bound = sensed.speed_bound(stopping_horizon(speed, dyn))[movers]
         if not np.all(is_safe(gaps, speed, bound, dyn)):
             return False
     if target is None:

@@ -150,7 +150,7 @@ def _cycle(world: World) -> None:
     # the dynamic window senses the world as it was when the cycle began: an object picked
     # up or dropped during the decisions is sensed next cycle
     sensed = world.obstacles()
-    commands = _decide(world)
+    commands = _gather_commands(world)
     _dynamic_window(world, sensed, commands)
     moving = integrate(world, commands.v, commands.w, commands.docks)
     for walker in world.walkers:
@@ -174,7 +174,7 @@ class _Commands:
     rooms: list[float] = field(default_factory=list)  # their goals' clearance, mm
 
 
-def _decide(world: World) -> _Commands:
+def _gather_commands(world: World) -> _Commands:
     """Every robot's decision for this cycle (:func:`cosmop.sim.execute.decide`), gathered."""
     commands = _Commands(v=world.v.copy(), w=np.zeros(len(world.robot_ids)))
     for agent in world.agents:
@@ -196,7 +196,7 @@ def _dynamic_window(world: World, sensed: Obstacles, commands: _Commands) -> Non
     """The speeds of the driving robots, from the passive-safe dynamic window, all at once.
 
     `sensed` is :meth:`~cosmop.sim.world.World.obstacles` at the start of the cycle; the
-    boxes' motion is read again now (:meth:`~cosmop.sim.world.World.moving`).
+    boxes' motion is read again now (:meth:`~cosmop.sim.world.World.with_motion`).
     """
     if not commands.driving:
         return
@@ -218,7 +218,7 @@ def _dynamic_window(world: World, sensed: Obstacles, commands: _Commands) -> Non
         room_cap=np.array(commands.rooms, dtype=float),
     )
     cmd = dwa_commands(
-        drivers, world.moving(sensed), world.settings.dwa, ignore=world.own_boxes(names)[idx], grip=grip
+        drivers, world.with_motion(sensed), world.settings.dwa, ignore=world.own_boxes(names)[idx], grip=grip
     )
     commands.v[idx] = cmd.v
     commands.w[idx] = cmd.w

@@ -22,6 +22,7 @@ from cosmop.control.geometry import box_gaps, point_segment_linf, segment_array
 from cosmop.control.paths import GlobalPath
 from cosmop.control.safety import Limits
 from cosmop.events import MESSAGE_KINDS, Event, Primitive, parse_event, realising_step
+from cosmop.physics import TOUCH  # the one tolerance under which two squares touch
 from cosmop.planning.plan import PlanSet, RobotPlan, Step
 from cosmop.planning.realisation import event_instants
 from cosmop.scene import Scenario
@@ -29,9 +30,6 @@ from cosmop.sim.humans import Walker
 from cosmop.sim.result import Contact, Message, SimSettings, drop_holds
 
 __all__ = ["TOUCH", "Action", "Agent", "World", "wrap_angle"]
-
-TOUCH = 1e-6
-"""Gap (mm) under which two squares touch."""
 
 Action = tuple[str, Any]
 """One cycle's command of a robot: ``("drive", (target, stop, room))`` for the dynamic window,
@@ -187,7 +185,7 @@ class World:
 
     def obstacles(self) -> Obstacles:
         """What the robots sense now: the walls, and the resting objects, robots and people (in
-        that order) as boxes with their speed bounds, ids and (:meth:`moving`) motion."""
+        that order) as boxes with their speed bounds, ids and (:meth:`with_motion`) motion."""
         resting = np.flatnonzero(self.carried_by < 0)
         boxes = [self.resting_boxes(), self.robot_boxes()]
         speed = [np.zeros(len(resting)), np.where(self.parked(), 0.0, self.limits.max_speed)]
@@ -204,9 +202,9 @@ class World:
             agents=agents,
             names=tuple(names),
         )
-        return self.moving(sensed)
+        return self.with_motion(sensed)
 
-    def moving(self, sensed: Obstacles) -> Obstacles:
+    def with_motion(self, sensed: Obstacles) -> Obstacles:
         """`sensed` with the velocities (mm/s; sensed, for prediction only) and acceleration
         limits (mm/s^2) its boxes have now: resting objects and parked robots 0, people an
         unknown acceleration (``inf``)."""

@@ -209,8 +209,7 @@ def _sent_times(messages: Sequence[Any], robot_ids: Sequence[str]) -> dict[str, 
 class _Animator:
     """The figure and its moving artists; :meth:`update` shows one frame of the trace.
 
-    `trace` is a :class:`~cosmop.traces.Trace` or its JSON; `_frames` is not read (callers of
-    the earlier signature pass the JSON's frames there).
+    `trace` is a :class:`~cosmop.traces.Trace` or its JSON.
     """
 
     def __init__(

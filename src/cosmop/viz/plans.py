@@ -14,12 +14,11 @@ from pathlib import Path
 from typing import Any
 
 from cosmop.io import write_atomic
-from cosmop.planning.plan import PlanSet, RobotPlan
+from cosmop.planning.plan import MESSAGE_PRIMITIVES, PlanSet, RobotPlan
 from cosmop.scene import Scene
 from cosmop.viz.labels import Label, place_labels
-from cosmop.viz.scene import PLAN_STYLE, draw_scene, planned_path, scene_legend
+from cosmop.viz.scene import PLAN_STYLE, STEP_MARKS, draw_scene, planned_path, scene_legend
 
-_LABELS = {"PickUp": "P", "DropOff": "D", "Req": "?", "Res": "!"}
 _LISTED_ROBOTS = 12  # beyond this many robots the legend only says that robots are labelled
 
 
@@ -155,10 +154,10 @@ def _primitive_labels(plan: RobotPlan, colour: Any) -> list[Label]:
     """A mark where each primitive but GoTo is done: P, D, ?O (request about O), !O (response)."""
     labels = []
     for step in plan.steps:
-        if step.primitive in _LABELS:
+        if step.primitive in STEP_MARKS:
             x, y, _ = step.robot
             what = step.object or (step.message.split(",")[-1].rstrip(")") if step.message else "")
-            text = _LABELS[step.primitive] + (what if step.primitive in ("Req", "Res") else "")
+            text = STEP_MARKS[step.primitive] + (what if step.primitive in MESSAGE_PRIMITIVES else "")
             labels.append(Label(x, y, text, {"fontsize": 8, "color": colour, "weight": "bold"}))
     return labels
 

@@ -14,6 +14,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+from cosmop.events import Primitive
 from cosmop.planning.plan import RobotPlan
 from cosmop.scene import Robot, Scene, Workspace
 from cosmop.traces import Trace
@@ -26,6 +27,7 @@ __all__ = [
     "DEFAULT_OBJECT_SIZE",
     "DEFAULT_ROBOT_SIZE",
     "PLAN_STYLE",
+    "STEP_MARKS",
     "Piece",
     "SceneArtists",
     "SceneStyle",
@@ -41,6 +43,9 @@ DEFAULT_OBJECT_SIZE = 100.0
 """Side (mm) of an object that a trace names but the scene does not declare."""
 DEFAULT_HUMAN_SIZE = 500.0
 """Diameter (mm) of a person that a trace names but the scene does not declare."""
+
+STEP_MARKS = {Primitive.PICKUP: "P", Primitive.DROPOFF: "D", Primitive.REQ: "?", Primitive.RES: "!"}
+"""The letter drawn at a plan step that is not a GoTo, in every picture (``?`` waits, ``!`` sends)."""
 
 _WALL_LAYER = 2  # matplotlib's layer of lines, in every style
 

@@ -24,14 +24,13 @@ from cosmop.planning.plan import PlanSet
 from cosmop.scene import Scene
 from cosmop.traces import Trace, as_trace, message_label
 from cosmop.viz.palette import robot_colours, to_hex
-from cosmop.viz.scene import DEFAULT_ROBOT_SIZE, ids_with_trace, planned_path
+from cosmop.viz.scene import DEFAULT_ROBOT_SIZE, STEP_MARKS, ids_with_trace, planned_path
 
 __all__ = ["MESSAGE_SHOWN_S", "render_html", "save_html"]
 
 MESSAGE_SHOWN_S = 2.0
 """Seconds (simulated) a message's arrow stays on the page after it was sent."""
 
-_MARKS = {"PickUp": "P", "DropOff": "D", "Req": "?", "Res": "!"}
 _LEGEND = [
     ('<span class="swatch" style="background:#111;height:3px"></span>', "wall"),
     ('<span class="swatch" style="background:#d9d9d9"></span>', "workspace"),
@@ -70,7 +69,7 @@ def _plans(scene: Scene, plans: PlanSet | None) -> dict[str, Any]:
             continue
         path = [list(point) for point in planned_path(scene.robots[rid], plan)]
         marks = [
-            [*step.robot[:2], _MARKS[step.primitive] + (step.object or "")]
+            [*step.robot[:2], STEP_MARKS[step.primitive] + (step.object or "")]
             for step in plan.steps
             if step.primitive != "GoTo"
         ]
