@@ -223,7 +223,7 @@ def creep_is_safe(world: World, agent: Agent, target: tuple | None = None) -> bo
     robot's square where it is must be safe at the creep speed from everything.
     """
     i = agent.index
-    sensed = world.obstacles()
+    sensed = world.with_motion(world.obstacles())
     boxes, speeds, names = sensed.boxes, sensed.speed, sensed.names
     skip = {agent.id}
     if agent.gripped is not None:

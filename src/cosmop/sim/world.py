@@ -185,7 +185,8 @@ class World:
 
     def obstacles(self) -> Obstacles:
         """What the robots sense now: the walls, and the resting objects, robots and people (in
-        that order) as boxes with their speed bounds, ids and (:meth:`with_motion`) motion."""
+        that order) as boxes with their speed bounds and ids; :meth:`with_motion` adds how they
+        move (only the controllers need it, so the monitor does not pay for it)."""
         resting = np.flatnonzero(self.carried_by < 0)
         boxes = [self.resting_boxes(), self.robot_boxes()]
         speed = [np.zeros(len(resting)), np.where(self.parked(), 0.0, self.limits.max_speed)]
@@ -195,14 +196,13 @@ class World:
             speed.append(self.human_speed)
             names += list(self.human_ids)
         agents = np.arange(len(names)) >= len(resting)  # robots and people, not objects
-        sensed = Obstacles(
+        return Obstacles(
             self.walls,
             np.vstack(boxes).reshape(-1, 3),
             np.concatenate(speed),
             agents=agents,
             names=tuple(names),
         )
-        return self.with_motion(sensed)
 
     def with_motion(self, sensed: Obstacles) -> Obstacles:
         """`sensed` with the velocities (mm/s; sensed, for prediction only) and acceleration
