@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 from rich.table import Table
@@ -15,7 +15,9 @@ from cosmop.io import check_writable, uninterrupted
 from cosmop.planning.checker import check_plan
 from cosmop.planning.plan import PlanSet, load_plan
 from cosmop.scene import Scenario
-from cosmop.traces import Trace
+
+if TYPE_CHECKING:
+    from cosmop.traces import Trace
 
 __all__ = ["simulate"]
 
