@@ -320,7 +320,7 @@ class World:
             event = parse_event(step.message)
         else:
             answers = [
-                e for e in agent.mission if e.kind == "away" and e.obj == step.object and e.sender == agent.id
+                e for e in agent.mission if realising_step(e, agent.id) == (Primitive.RES, step.object, None)
             ]
             sent = agent.answers_sent.get(step.object, 0)
             agent.answers_sent[step.object] = sent + 1
@@ -336,7 +336,7 @@ class World:
         return any(
             e.name in self.sent_messages
             for e in agent.mission
-            if e.kind == "away" and e.obj == step.object and e.receiver == agent.id
+            if realising_step(e, agent.id) == (Primitive.REQ, step.object, None)
         )
 
     def _happened(self, event: Event) -> bool:
