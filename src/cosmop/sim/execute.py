@@ -243,7 +243,7 @@ def _drop_clear(world: World, i: int, j: int, spot: np.ndarray) -> bool:
         need = [
             TOUCH
             if parked[k]
-            else stopping_margin(world.v[k], 0.0, world.dynamics[k]) + world.settings.dwa.standoff
+            else stopping_margin(world.v[k], 0.0, world.limits[k]) + world.settings.dwa.standoff
             for k in others
         ]
         if (gaps[:, 0] <= np.array(need)).any():

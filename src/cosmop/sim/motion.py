@@ -230,7 +230,7 @@ def creep_is_safe(world: World, agent: Agent, target: tuple | None = None) -> bo
         skip.add(world.object_ids[agent.gripped])
     movers = [b for b, n in enumerate(names) if n not in skip and (speeds[b] > 0 or sensed.agents[b])]
     still = [b for b, n in enumerate(names) if n not in skip and b not in movers]
-    dyn = world.dynamics[i]
+    dyn = world.limits[i]  # this robot's limits
     speed = world.creep_speed(i)
     xy, half = world.pose[i, :2], world.robot_half[i]
     if movers:

@@ -218,7 +218,7 @@ def _dynamic_window(world: World, sensed: Obstacles, commands: _Commands) -> Non
         room_cap=np.array(commands.rooms, dtype=float),
     )
     cmd = dwa_commands(
-        drivers, world.with_motion(sensed), world.settings.dwa, ignore=world.own_boxes(names)[idx], grip=grip
+        drivers, world.with_motion(sensed), world.settings.dwa, ignore=world.own_boxes(sensed)[idx], grip=grip
     )
     commands.v[idx] = cmd.v
     commands.w[idx] = cmd.w

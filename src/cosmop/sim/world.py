@@ -11,7 +11,6 @@ keep their heading in radians), seconds; degrees where a plan's pose is read.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 from dataclasses import replace
 from typing import Any
 
@@ -157,12 +156,11 @@ class World:
         robots = [scenario.scene.robots[r] for r in self.robot_ids]
         R = len(robots)
         self.robot_half = np.array([r.size / 2.0 for r in robots])
-        self.dynamics = [r.dynamics for r in robots]
-        cycles = {d.cycle for d in self.dynamics}
+        cycles = {r.dynamics.cycle for r in robots}
         if len(cycles) != 1:
             raise ValueError("every robot must share one control cycle")
         self.dt = cycles.pop()  # the control cycle, s
-        self.limits = Limits.of(self.dynamics)  # the unicycle limits, arrays over robots
+        self.limits = Limits.of([r.dynamics for r in robots])  # the unicycle limits, arrays over robots
         self.pose = np.array([[r.pose[0], r.pose[1], math.radians(r.pose[2])] for r in robots]).reshape(R, 3)
         self.v = np.zeros(R)
         self.w = np.zeros(R)
@@ -220,10 +218,14 @@ class World:
         acceleration[robots.stop :] = np.inf
         return replace(sensed, velocity=velocity, acceleration=acceleration)
 
-    def own_boxes(self, names: Sequence[str]) -> np.ndarray:
-        """Which of the boxes `names` (of :meth:`obstacles`) is each robot itself, (R, n)."""
+    def own_boxes(self, sensed: Obstacles) -> np.ndarray:
+        """Which box of `sensed` (of :meth:`obstacles`) is each robot itself, ``(R, n)``: the
+        robots' boxes follow the resting objects', in robot order."""
         R = len(self.robot_ids)
-        return np.array([[n == rid for n in names] for rid in self.robot_ids]).reshape(R, len(names))
+        first = len(sensed.names) - R - len(self.walkers)
+        own = np.zeros((R, len(sensed.names)), dtype=bool)
+        own[np.arange(R), first + np.arange(R)] = True
+        return own
 
     def static_gaps(self, points: np.ndarray, half: float) -> np.ndarray:
         """L-infinity gaps (mm) of squares of half side `half` at `points` to walls and resting objects."""
