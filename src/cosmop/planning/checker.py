@@ -65,7 +65,7 @@ from cosmop.errors import EventSyntaxError
 from cosmop.events import Event, Primitive, parse_event, realising_step
 from cosmop.planning.joint import check_team
 from cosmop.planning.plan import PlanSet, RobotPlan, State, Step, _fmt, _point, initial_state
-from cosmop.planning.realisation import TOLERANCE, event_instants, holds_at
+from cosmop.planning.realisation import TOLERANCE, angles_equal, at_pose, event_instants, holds_at
 from cosmop.planning.report import RULES, CheckReport, Violation
 from cosmop.scene import Scenario, Scene, Wall
 from cosmop.squares import square, swept_square
@@ -118,11 +118,6 @@ def _points_eq(p: Iterable[float], q: Iterable[float]) -> bool:
     return all(_eq(a, b) for a, b in zip(p, q, strict=True))
 
 
-def _angle_eq(a: float, b: float) -> bool:
-    diff = (a - b) % 360.0
-    return min(diff, 360.0 - diff) <= TOLERANCE
-
-
 def _or(words: Iterable[str]) -> str:
     """``a``, ``a or b``, ``a, b or c``."""
     words = list(words)
@@ -131,13 +126,7 @@ def _or(words: Iterable[str]) -> str:
 
 def _docking_heading(heading: float) -> int | None:
     """The docking heading (:data:`~cosmop.docking.DOCKING_HEADINGS`) `heading` equals, or ``None``."""
-    return next((h for h in DOCKING_HEADINGS if _angle_eq(heading, h)), None)
-
-
-def _pose_eq(p: Iterable[float], q: Iterable[float]) -> bool:
-    px, py, ph = p
-    qx, qy, qh = q
-    return _eq(px, qx) and _eq(py, qy) and _angle_eq(ph, qh)
+    return next((h for h in DOCKING_HEADINGS if angles_equal(heading, h)), None)
 
 
 def _pose(pose: Iterable[float]) -> str:
@@ -248,7 +237,7 @@ class _RobotChecker:
     # -- frame conditions --------------------------------------------------------------------
 
     def robot_static(self, k: int, prev: State, cur: State) -> None:
-        if not _pose_eq(prev.robot, cur.robot):
+        if not at_pose(prev.robot, cur.robot):
             self.add(
                 k,
                 "robot-static",

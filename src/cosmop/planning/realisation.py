@@ -28,6 +28,7 @@ from cosmop.scene import Scene
 
 __all__ = [
     "TOLERANCE",
+    "angles_equal",
     "at_pose",
     "event_instants",
     "holds_at",
@@ -39,7 +40,8 @@ TOLERANCE = 1e-6
 """Tolerance of numeric equality, mm or degrees."""
 
 
-def _angle_eq(a: float, b: float) -> bool:
+def angles_equal(a: float, b: float) -> bool:
+    """Whether two headings (degrees) agree within :data:`TOLERANCE`, modulo 360."""
     diff = (a - b) % 360.0
     return min(diff, 360.0 - diff) <= TOLERANCE
 
@@ -49,7 +51,7 @@ def at_pose(pose: Sequence[float], home: Sequence[float]) -> bool:
     return (
         abs(pose[0] - home[0]) <= TOLERANCE
         and abs(pose[1] - home[1]) <= TOLERANCE
-        and _angle_eq(pose[2], home[2])
+        and angles_equal(pose[2], home[2])
     )
 
 
