@@ -402,9 +402,14 @@ def _rounded(values: np.ndarray | None, digits: int) -> np.ndarray | None:
 
     ``np.round`` scales by ``10**digits`` first, which can tip a value to the other side of a
     tie; the files keep the bytes they always had, so every value goes through ``round``.
+    Values ``np.round`` leaves unchanged are already the doubles nearest to `digits`-decimal
+    numbers, far from any tie, and ``round`` leaves them unchanged too: a trace already
+    rounded (:meth:`cosmop.sim.SimResult.trace`) is not rounded again value by value.
     """
     if values is None:
         return None
+    if np.array_equal(np.round(values, digits), values, equal_nan=True):
+        return values
     flat = [round(x, digits) for x in values.ravel().tolist()]
     return np.array(flat, dtype=float).reshape(values.shape)
 

@@ -69,7 +69,8 @@ def simulate(
     _check_outputs(summary=summary, trace=trace, gif=gif, mp4=mp4, bag=bag)
     plans = _plans_to_run(loaded, plan_file)
     result = _run_with_progress(loaded, plans, seed, max_time, replan)
-    run = result.trace()  # one Trace for the file, the bag and the animations
+    # one Trace for the file, the bag and the animations, made only when one of them is asked for
+    run = result.trace() if any(p is not None for p in (trace, bag, gif, mp4)) else None
     with uninterrupted():  # the trace and its summary: both or neither
         if trace is not None:
             run.save(trace)
