@@ -715,15 +715,6 @@ def _replannable(conflict: Conflict, fixed: Mapping[str, Sequence[BaseGeometry]]
     return 0 if keep.last is None else 1
 
 
-def _count_ways(conflict: Conflict, precedence: Precedence) -> int:
-    """How many of the two ways of ordering `conflict` are still possible."""
-    n = 0
-    for x, y in ((conflict.a, conflict.b), (conflict.b, conflict.a)):
-        if x.last is not None and y.first is not None and not precedence.would_cycle(x.last, y.first):
-            n += 1
-    return n
-
-
 def _ways(conflict: Conflict, precedence: Precedence) -> list[tuple[Node, Node]]:
     """The start edges that can order `conflict`, the one expected to happen first first."""
     a, b = conflict.a, conflict.b
