@@ -22,7 +22,7 @@ LAYERS: tuple[frozenset[str], ...] = tuple(
         "units missions control",  # SI units; top-down decomposition; reactive control
         "physics traces maps planning",  # bodies overlapping; traces; grid maps; bottom-up synthesis
         "scenario sim viz allocate",  # the scenario loader; the simulator; pictures; choosing robots
-        "pipeline export",  # plan -> coordinate -> verify; ROS 2 bags
+        "pipeline export cluster",  # plan -> coordinate -> verify; ROS 2 bags; a Dask cluster
         "cli",  # the command line
         "_entry",  # the program, with Ctrl-C answered while it starts
         "__main__",  # python -m cosmop

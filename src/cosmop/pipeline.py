@@ -208,10 +208,15 @@ class _Planner:
                     self.on_robot(robot, out[robot])
         else:
             futures = {robot: self.executor.submit(_synthesize, job) for robot, job in work.items()}
-            for robot, future in futures.items():
-                out[robot] = future.result()
-                if self.on_robot is not None:
-                    self.on_robot(robot, out[robot])
+            try:
+                for robot, future in futures.items():
+                    out[robot] = future.result()
+                    if self.on_robot is not None:
+                        self.on_robot(robot, out[robot])
+            except BaseException:  # an interrupt or a failed synthesis: leave no work queued
+                for future in futures.values():
+                    future.cancel()
+                raise
         for robot, events in jobs.items():
             self.cache[self.key(robot, events, explain=explain or out[robot].feasible)] = out[robot]
         self.phases["synthesize"] += time.perf_counter() - t0
@@ -243,8 +248,9 @@ def plan_team(
         Worker processes for the robots' syntheses (default: one per core, at most one per
         robot; 1 plans in this process).  Ignored when `executor` is given.
     executor : concurrent.futures.Executor, optional
-        Where to run the syntheses (any ``submit``/``result`` executor, e.g. a Dask
-        ``Client.get_executor()``).  The result does not depend on it.
+        Where to run the syntheses: any ``submit``/``result`` executor, e.g. a Dask cluster's
+        (:func:`cosmop.cluster.dask_executor`).  The caller owns it (it is not shut down
+        here).  The result does not depend on it: each synthesis is deterministic.
     on_robot : callable, optional
         Called after every synthesis (progress display).
     conflicts : ConflictSettings, optional

@@ -18,7 +18,26 @@ from cosmop.planning.checker import check_plan
 from cosmop.planning.plan import MAX_STEPS, load_plan
 from cosmop.scene import Scenario
 
-__all__ = ["check", "plan"]
+__all__ = ["SchedulerOption", "WorkersOption", "check", "check_engine", "plan", "plan_with_progress"]
+
+WorkersOption = Annotated[
+    int | None,
+    typer.Option(
+        "--workers",
+        min=1,
+        help="Local processes for the robots' syntheses [default: one per core, at most one per robot]",
+        show_default=False,
+    ),
+]
+SchedulerOption = Annotated[
+    str | None,
+    typer.Option(
+        "--scheduler",
+        metavar="ADDRESS",
+        help="Run the syntheses on a Dask cluster, e.g. tcp://host:8786 (pip install 'cosmop[cluster]').",
+        show_default=False,
+    ),
+]
 
 
 def check(
@@ -76,6 +95,8 @@ def plan(
             show_default=False,
         ),
     ] = None,
+    workers: WorkersOption = None,
+    scheduler: SchedulerOption = None,
 ) -> None:
     """Plan, coordinate and verify the team (paper, Fig. "Overall framework").
 
@@ -84,14 +105,17 @@ def plan(
     deadlock; the robots whose missions changed are re-planned; the coordinated missions are
     verified against the global mission, and every plan passes the exact checker before it is
     written.  The file is written even when infeasible (``"feasible": false`` and a reason).
-    Exit status 0 feasible, 1 infeasible, 2 bad input.
+    The syntheses run in local processes, or on a Dask cluster with ``--scheduler``; the plans
+    are the same.  Exit status 0 feasible, 1 infeasible, 2 bad input (an unreachable scheduler
+    included).
     """
+    check_engine(workers, scheduler)
     loaded = load(scenario)
     check_writable(output, "-o")
     check_writable(png, "--png")
     if png is not None:
         _need_viz()
-    result = _plan_with_progress(loaded, max_horizon)
+    result = plan_with_progress(loaded, max_horizon, workers, scheduler)
     result.plans.save(output)
     if png is not None:
         from cosmop.viz import save_plan_png
@@ -122,8 +146,23 @@ def _need_viz() -> None:
         raise typer.Exit(EXIT_INPUT_ERROR)
 
 
-def _plan_with_progress(loaded: Scenario, max_horizon: int | None) -> Any:
-    """:func:`cosmop.pipeline.plan_team` under a spinner that names each robot as it is planned."""
+def check_engine(workers: int | None, scheduler: str | None) -> None:
+    """``--workers`` counts local processes; a cluster has its own workers (usage error, 2)."""
+    if workers is not None and scheduler is not None:
+        raise typer.BadParameter(
+            "local worker processes and a Dask scheduler exclude each other: "
+            "the cluster's workers run the syntheses (set them with dask worker --nworkers)",
+            param_hint="'--workers'",
+        )
+
+
+def plan_with_progress(
+    loaded: Scenario, max_horizon: int | None = None, workers: int | None = None, scheduler: str | None = None
+) -> Any:
+    """:func:`cosmop.pipeline.plan_team` under a spinner that names each robot as it is planned;
+    in local processes, or on the Dask cluster whose scheduler is at `scheduler`."""
+    from contextlib import nullcontext
+
     from rich.progress import Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
 
     from cosmop.pipeline import plan_team
@@ -131,13 +170,23 @@ def _plan_with_progress(loaded: Scenario, max_horizon: int | None) -> Any:
     columns = (SpinnerColumn(), TextColumn("{task.description}"), TimeElapsedColumn())
     with Progress(*columns, console=stderr(), transient=True) as progress:
         task = progress.add_task("planning", total=None)
-        return plan_team(
-            loaded,
-            max_horizon=max_horizon,
-            on_robot=lambda robot, res: progress.update(
-                task, description=f"planned {robot} ({res.horizon} steps)"
-            ),
-        )
+        engine = nullcontext(None)
+        if scheduler is not None:
+            from cosmop.cluster import dask_executor
+
+            progress.update(task, description=f"connecting to the Dask scheduler at {scheduler}")
+            engine = dask_executor(scheduler, field="--scheduler")
+        with engine as executor:
+            progress.update(task, description="planning")
+            return plan_team(
+                loaded,
+                max_horizon=max_horizon,
+                workers=workers,
+                executor=executor,
+                on_robot=lambda robot, res: progress.update(
+                    task, description=f"planned {robot} ({res.horizon} steps)"
+                ),
+            )
 
 
 def _print_coordination(console: Console, result: Any) -> None:

@@ -11,6 +11,7 @@ from rich.text import Text
 
 from cosmop.cli._app import EXIT_INPUT_ERROR, ScenarioArgument, load, stderr, stdout
 from cosmop.cli.ecosystem import check_bag_target, write_bag_and_report
+from cosmop.cli.plan import SchedulerOption, WorkersOption, check_engine, plan_with_progress
 from cosmop.io import check_writable, uninterrupted
 from cosmop.planning.checker import check_plan
 from cosmop.planning.plan import PlanSet, load_plan
@@ -57,17 +58,21 @@ def simulate(
     ] = None,
     max_time: Annotated[float, typer.Option(help="Simulated seconds before giving up.", min=1.0)] = 900.0,
     replan: Annotated[bool, typer.Option(help="Stalled robots replan their remaining mission.")] = True,
+    workers: WorkersOption = None,
+    scheduler: SchedulerOption = None,
 ) -> None:
     """Execute the plans: passive-safe DWA, docking, messages, people walking through.
 
     Every cycle each robot drives (GoTo), docks (PickUp, DropOff), waits for an answer (Req) or
     sends one (Res); a monitor records every contact and whether the robot was moving then.
-    Exit status 0 when every robot finished with no contact while moving, 1 otherwise, 2 on bad
-    input.
+    Without ``--plan`` the team is planned first, as ``cosmop plan`` does (``--workers``,
+    ``--scheduler``).  Exit status 0 when every robot finished with no contact while moving, 1
+    otherwise, 2 on bad input.
     """
+    check_engine(workers, scheduler)
     loaded = load(scenario)
     _check_outputs(summary=summary, trace=trace, gif=gif, mp4=mp4, bag=bag)
-    plans = _plans_to_run(loaded, plan_file)
+    plans = _plans_to_run(loaded, plan_file, workers, scheduler)
     result = _run_with_progress(loaded, plans, seed, max_time, replan)
     # one Trace for the file, the bag and the animations, made only when one of them is asked for
     run = result.trace() if any(p is not None for p in (trace, bag, gif, mp4)) else None
@@ -107,10 +112,10 @@ def _check_outputs(
         check_bag_target(bag)
 
 
-def _plans_to_run(loaded: Scenario, plan_file: Path | None) -> PlanSet:
+def _plans_to_run(
+    loaded: Scenario, plan_file: Path | None, workers: int | None, scheduler: str | None
+) -> PlanSet:
     """The plan file, checked exactly against the scenario (else exit 2), or a plan made now."""
-    from rich.progress import Progress, TextColumn, TimeElapsedColumn
-
     if plan_file is not None:
         plans = load_plan(plan_file)
         report = check_plan(loaded, plans)
@@ -121,11 +126,7 @@ def _plans_to_run(loaded: Scenario, plan_file: Path | None) -> PlanSet:
             )
             raise typer.Exit(EXIT_INPUT_ERROR)
         return plans
-    from cosmop.pipeline import plan_team
-
-    with Progress(TextColumn("planning"), TimeElapsedColumn(), console=stderr(), transient=True) as progress:
-        progress.add_task("planning", total=None)
-        plans = plan_team(loaded).plans
+    plans = plan_with_progress(loaded, workers=workers, scheduler=scheduler).plans
     if not plans.feasible:
         stdout().print(Text(f"infeasible: {plans.reason}", style="red"))
         raise typer.Exit(1)
