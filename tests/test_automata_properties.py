@@ -390,6 +390,19 @@ def test_dense_and_explored_products_are_identical(a: DFA, b: DFA) -> None:
         assert explored.initial == 0
 
 
+@FAST
+@given(a=dfas(("a", "b")), b=dfas(("c", "d", "e")))
+def test_interleaved_products_skip_the_search_only_when_every_pair_is_reached(a: DFA, b: DFA) -> None:
+    # no shared event: when both sides are accessible the whole table is the product (no
+    # search); otherwise the search runs.  Either way the table is the explorer's.
+    dense = operations._pair(a, b, synchronous=True)
+    with mock.patch.object(operations, "_DENSE_LIMIT", 0):
+        explored = operations._pair(a, b, synchronous=True)
+    assert tables(canonical(dense)) == tables(canonical(explored))
+    assert reachable_states(dense) == set(range(dense.n_states))
+    assert lang(dense, dense.alphabet, 4) == synchronous_words([a, b], 4)
+
+
 def test_explorer_with_table_growth_matches_dense() -> None:
     # 4**6 = 4096 accessible pairs: the explorer's CodeIndex (1024 slots at first) must grow
     chains = [DFA.from_word((f"p{i}", f"d{i}", f"r{i}")) for i in range(6)]
@@ -632,6 +645,14 @@ def test_inclusion_counterexample(a: DFA, b: DFA) -> None:
         assert not b.accepts(w)
     check_shortest(w, difference, length)
     assert is_included(a, b) == (w is None)
+
+
+@FAST
+@given(a=dfas(), b=dfas())
+def test_inclusion_finds_the_same_word_with_or_without_trimming(a: DFA, b: DFA) -> None:
+    # the search starts on ``a`` untrimmed and trims only when its fast path fails; the
+    # word it returns must be the one the trimmed automaton gives
+    assert inclusion_counterexample(a, b) == inclusion_counterexample(trim(a), b)
 
 
 @FAST

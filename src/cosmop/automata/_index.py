@@ -214,12 +214,13 @@ def _finish(codes, parents, vias, blocks, n_events, stopped_at) -> Exploration:
 def fresh_states(candidates: np.ndarray, seen: np.ndarray, scratch: np.ndarray) -> np.ndarray:
     """Sorted distinct ``candidates`` not yet ``seen``; marks them seen.
 
-    Small batches are deduplicated by sorting; a batch that is a sizeable fraction of all
-    states is deduplicated through the boolean ``scratch`` array (left all-False), which is
-    linear instead of ``n log n``.
+    A batch is deduplicated through the boolean ``scratch`` array (left all-False), a scan
+    of all states, unless it is tiny against them (under 1/512); then it is sorted.  The
+    scan costs about what sorting a batch of 1/500 of the states costs (measured on
+    16,384 and 2**20 states).
     """
     candidates = candidates[~seen[candidates]]
-    if 8 * candidates.size < seen.size:
+    if 512 * candidates.size < seen.size:
         out = np.unique(candidates)
     else:
         scratch[candidates] = True

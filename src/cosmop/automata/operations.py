@@ -153,36 +153,55 @@ def complement(dfa: DFA, alphabet: Iterable[str] | None = None) -> DFA:
 _DENSE_LIMIT = 1 << 26  # table entries (256 MB of int32) up to which products are built densely
 
 
-def _pair(a: DFA, b: DFA, *, synchronous: bool) -> DFA:
+def _pair(a: DFA, b: DFA, *, synchronous: bool, a_accessible: bool = False) -> DFA:
     """Product of two DFAs over :math:`\\Sigma_a \\cup \\Sigma_b`.
 
     ``synchronous=True``: the synchronous product (an event outside one alphabet leaves that
     component where it is).  ``False``: the intersection of the languages as subsets of
     :math:`(\\Sigma_a \\cup \\Sigma_b)^*` (an event outside one alphabet is blocked).
     Only accessible pairs are built; a pair is marked when both components are.
+    `a_accessible` says that every state of ``a`` is known to be accessible.
     """
     alphabet = tuple(sorted(set(a.alphabet) | set(b.alphabet)))
     missing = "loop" if synchronous else "block"
-    da = _columns(a, alphabet, missing).astype(np.int64)
-    db = _columns(b, alphabet, missing).astype(np.int64)
+    da, db = _columns(a, alphabet, missing), _columns(b, alphabet, missing)
     nb = b.n_states
+    if a.n_states * nb * max(len(alphabet), 1) <= _DENSE_LIMIT:
+        # Small pair space: fill the whole table at once, then keep the accessible part.
+        marked = (a.marked[:, None] & b.marked[None, :]).ravel()
+        whole = DFA(alphabet, _pair_table(da, db), a.initial * nb + b.initial, marked)
+        # No shared event: a pair (p, q) is reached by a word to p followed by a word to q,
+        # so when both sides are accessible every pair is, and the search can be skipped.
+        interleaved = synchronous and not set(a.alphabet) & set(b.alphabet)
+        if interleaved and (a_accessible or _all_accessible(a)) and _all_accessible(b):
+            return whole
+        return accessible(whole)
+    da, db = da.astype(np.int64), db.astype(np.int64)
 
     def successors(codes: np.ndarray) -> np.ndarray:
         ta = da[codes // nb]
         tb = db[codes % nb]
         return np.where((ta >= 0) & (tb >= 0), ta * nb + tb, -1)
 
-    if a.n_states * nb * max(len(alphabet), 1) <= _DENSE_LIMIT:
-        # Small pair space: fill the whole table at once, then keep the accessible part.
-        table = np.empty((a.n_states * nb, len(alphabet)), dtype=np.int32)
-        for j in range(len(alphabet)):
-            ta, tb = da[:, j][:, None], db[:, j][None, :]
-            table[:, j] = np.where((ta >= 0) & (tb >= 0), ta * nb + tb, -1).ravel()
-        marked = (a.marked[:, None] & b.marked[None, :]).ravel()
-        return accessible(DFA(alphabet, table, a.initial * nb + b.initial, marked))
     ex = explore(a.initial * nb + b.initial, successors, len(alphabet))
     marked = a.marked[ex.codes // nb] & b.marked[ex.codes % nb]
     return DFA(alphabet, ex.delta, 0, marked)
+
+
+def _pair_table(da: np.ndarray, db: np.ndarray) -> np.ndarray:
+    """Every pair's row: ``ta * nb + tb`` where both move, else ``-1`` (``int32``, pair
+    ``(p, q)`` at row ``p * nb + q``), built as one ``(na, nb, m)`` block (rows contiguous)."""
+    (na, m), nb = da.shape, db.shape[0]
+    ta, tb = da, db  # int32: a dense table has fewer than 2**26 entries, codes fit
+    table = np.empty((na, nb, m), dtype=np.int32)
+    np.multiply(ta[:, None, :], np.int32(nb), out=table)
+    table += tb[None, :, :]
+    np.putmask(table, (ta < 0)[:, None, :] | (tb < 0)[None, :, :], np.int32(-1))
+    return table.reshape(na * nb, m)
+
+
+def _all_accessible(dfa: DFA) -> bool:
+    return bool(reachable(dfa.delta, np.array([dfa.initial])).all())
 
 
 def parallel(*dfas: DFA) -> DFA:
@@ -209,8 +228,8 @@ def _fold(dfas: Sequence[DFA], *, synchronous: bool) -> DFA:
     if not dfas:
         raise ValueError("a product needs at least one DFA")
     result = dfas[0]
-    for other in dfas[1:]:
-        result = _pair(result, other, synchronous=synchronous)
+    for k, other in enumerate(dfas[1:]):  # every product after the first is accessible
+        result = _pair(result, other, synchronous=synchronous, a_accessible=k > 0)
     return result
 
 
@@ -245,20 +264,26 @@ def project(dfa: DFA, events: Iterable[str]) -> DFA:
     hidden = [k for k, e in enumerate(dfa.alphabet) if e not in set(target)]
     if not hidden:
         return DFA(target, _columns(dfa, target, "block"), dfa.initial, dfa.marked, dfa.state_names)
-    d_hidden = dfa.delta[:, hidden]
+    shown = [col for _, col in observable]
     seen = np.zeros(dfa.n_states, dtype=bool)
     scratch = np.zeros(dfa.n_states, dtype=bool)
 
     def closure(states: np.ndarray) -> np.ndarray:
+        """The sorted set of states reachable from `states` by hidden events."""
         parts = [fresh_states(states, seen, scratch)]
         frontier = parts[0]
         while frontier.size:
-            nxt = d_hidden[frontier].ravel()
+            # whole rows, observable columns blanked: cheaper than a hidden-column copy of delta
+            nxt = dfa.delta[frontier]
+            nxt[:, shown] = -1
+            nxt = nxt.ravel()
             frontier = fresh_states(nxt[nxt >= 0], seen, scratch)
             parts.append(frontier)
-        result = (np.sort(np.concatenate(parts)) if len(parts) > 2 else parts[0]).astype(np.int32)
+        size = sum(p.size for p in parts)
+        # a large set is read off the mask (linear in the states), a small one sorted
+        result = np.flatnonzero(seen) if 16 * size > seen.size else np.sort(np.concatenate(parts))
         seen[result] = False
-        return result
+        return result.astype(np.int32)
 
     start = closure(np.array([dfa.initial], dtype=np.int32))
     subsets: list[np.ndarray] = [start]
@@ -298,14 +323,20 @@ def inclusion_counterexample(a: DFA, b: DFA) -> tuple[str, ...] | None:
     ``trim(a)`` against the completion of ``b``; the first level holding a pair (marked in
     ``a``, not marked in ``b``) gives a shortest counterexample.
     """
-    a = trim(a)
     alphabet = tuple(sorted(set(a.alphabet) | set(b.alphabet)))
-    da = _columns(a, alphabet, "block")
     db = _columns(b, alphabet, "block")
     try:
-        found = _inclusion_by_partner(a, b, da, db)
+        # ``a`` as it is first: the search meets only accessible states, and a state from
+        # which no marked state is reachable is never marked, so it never ends the search;
+        # trimming (a pass over every transition) is paid only when the fast path fails
+        found = _inclusion_by_partner(a, b, _columns(a, alphabet, "block"), db)
     except _NotFunctional:
-        found = _inclusion_by_pairs(a, complete(b, alphabet), da)
+        a = trim(a)
+        da = _columns(a, alphabet, "block")
+        try:
+            found = _inclusion_by_partner(a, b, da, db)
+        except _NotFunctional:
+            found = _inclusion_by_pairs(a, complete(b, alphabet), da)
     return None if found is None else tuple(alphabet[j] for j in found)
 
 
