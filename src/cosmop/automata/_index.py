@@ -246,10 +246,9 @@ def coreachable(delta: np.ndarray, targets: np.ndarray) -> np.ndarray:
     n, m = delta.shape
     flat = delta.ravel()
     valid = flat >= 0
-    src = np.repeat(np.arange(n, dtype=np.int64), m)[valid]
-    dst = flat[valid].astype(np.int64)
-    order = np.argsort(dst, kind="stable")
-    rsrc = src[order]
+    edges = np.flatnonzero(valid)
+    dst = flat[edges]  # int32: sorts about twice as fast as int64
+    rsrc = edges[np.argsort(dst, kind="stable")] // m  # sources grouped by target
     ptr = np.zeros(n + 1, dtype=np.int64)
     np.cumsum(np.bincount(dst, minlength=n), out=ptr[1:])
     seen = np.zeros(n, dtype=bool)

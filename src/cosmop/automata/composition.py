@@ -121,7 +121,7 @@ def _order(components: Sequence[DFA], members: list[int], target: set[str]) -> l
 
 
 def project_composition(
-    components: Sequence[DFA], events: Iterable[str], *, log: SizeLog | None = None
+    components: Sequence[DFA], events: Iterable[str], *, log: SizeLog | None = None, minimal: bool = True
 ) -> DFA:
     """Natural projection of a synchronous product, computed compositionally.
 
@@ -133,11 +133,17 @@ def project_composition(
         The target alphabet :math:`\\Sigma'`.
     log : SizeLog, optional
         Records every intermediate automaton (to report the largest one built).
+    minimal : bool
+        Minimise every intermediate automaton (the default).  With ``False`` only the results
+        of a projection are minimised (a subset construction is rarely minimal): the language
+        is the same, and a caller that only searches the result, such as an inclusion check,
+        saves the minimisations of components taken as they are.
 
     Returns
     -------
     DFA
-        Minimal DFA of :math:`P_{\\Sigma'}(\\|_j L_m(G_j))` over :math:`\\Sigma'`.
+        A DFA of :math:`P_{\\Sigma'}(\\|_j L_m(G_j))` over :math:`\\Sigma'`, minimal unless
+        `minimal` is false.
 
     Notes
     -----
@@ -159,9 +165,11 @@ def project_composition(
             later = {e for j in order[k + 1 :] for e in components[j].alphabet}
             acc = components[i] if acc is None else observe(parallel(acc, components[i]))
             keep = (target | later) & set(acc.alphabet)
-            if keep != set(acc.alphabet):
+            projected = keep != set(acc.alphabet)
+            if projected:
                 acc = observe(project(acc, keep))
-            acc = observe(minimize(acc))
+            if minimal or projected:
+                acc = observe(minimize(acc))
         assert acc is not None
         if is_empty(acc):
             return DFA.empty(target)

@@ -264,9 +264,12 @@ def project(dfa: DFA, events: Iterable[str]) -> DFA:
     hidden = [k for k, e in enumerate(dfa.alphabet) if e not in set(target)]
     if not hidden:
         return DFA(target, _columns(dfa, target, "block"), dfa.initial, dfa.marked, dfa.state_names)
-    shown = [col for _, col in observable]
-    seen = np.zeros(dfa.n_states, dtype=bool)
-    scratch = np.zeros(dfa.n_states, dtype=bool)
+    shown = np.array([col for _, col in observable], dtype=np.intp)
+    n = dfa.n_states
+    # one more entry, always seen: ``seen[-1]`` is it, so "no move" (-1) is never fresh
+    seen = np.zeros(n + 1, dtype=bool)
+    seen[n] = True
+    scratch = np.zeros(n + 1, dtype=bool)
 
     def closure(states: np.ndarray) -> np.ndarray:
         """The sorted set of states reachable from `states` by hidden events."""
@@ -276,12 +279,11 @@ def project(dfa: DFA, events: Iterable[str]) -> DFA:
             # whole rows, observable columns blanked: cheaper than a hidden-column copy of delta
             nxt = dfa.delta[frontier]
             nxt[:, shown] = -1
-            nxt = nxt.ravel()
-            frontier = fresh_states(nxt[nxt >= 0], seen, scratch)
+            frontier = fresh_states(nxt.ravel(), seen, scratch)
             parts.append(frontier)
         size = sum(p.size for p in parts)
         # a large set is read off the mask (linear in the states), a small one sorted
-        result = np.flatnonzero(seen) if 16 * size > seen.size else np.sort(np.concatenate(parts))
+        result = np.flatnonzero(seen[:n]) if 16 * size > n else np.sort(np.concatenate(parts))
         seen[result] = False
         return result.astype(np.int32)
 
@@ -377,6 +379,7 @@ def _inclusion_by_partner(a: DFA, b: DFA, da: np.ndarray, db: np.ndarray) -> lis
     partner = np.full(n, -1, dtype=np.int64)
     parent = np.full(n, -1, dtype=np.int64)
     via = np.full(n, -1, dtype=np.int64)
+    stamp = np.empty(n, dtype=np.int64)
     partner[a.initial] = b.initial
 
     def word_to(q: int) -> list[int]:
@@ -403,12 +406,18 @@ def _inclusion_by_partner(a: DFA, b: DFA, da: np.ndarray, db: np.ndarray) -> lis
             raise _NotFunctional
         fresh = np.flatnonzero(known < 0)
         ta, tb, where = ta[fresh], tb[fresh], where[fresh]
-        new, first = np.unique(ta, return_index=True)
-        if np.any(tb != tb[first][np.searchsorted(new, ta)]):
+        # each entry's first occurrence of its state, without sorting: written backwards,
+        # the earliest position is the one left in `stamp`
+        positions = np.arange(ta.size)
+        stamp[ta[::-1]] = positions[::-1]
+        first = stamp[ta]
+        if np.any(tb != tb[first]):
             raise _NotFunctional
-        partner[new] = tb[first]
-        parent[new] = frontier[where[first] // m]
-        via[new] = where[first] % m
+        new = np.sort(ta[first == positions])
+        at = stamp[new]
+        partner[new] = tb[at]
+        parent[new] = frontier[where[at] // m]
+        via[new] = where[at] % m
         bad = np.flatnonzero(a.marked[new] & ~b_marked[partner[new]])
         if bad.size:
             return word_to(int(new[bad[0]]))

@@ -69,7 +69,7 @@ def factor_counterexample(modules: list[DFA], factor: DFA, log: SizeLog | None =
     (the projection is computed compositionally), lifted to a word of the product that
     projects onto it; ``None`` when the factor holds.
     """
-    view = project_composition(modules, factor.alphabet, log=log)
+    view = project_composition(modules, factor.alphabet, log=log, minimal=False)  # only searched
     u = inclusion_counterexample(view, factor)
     if u is None:
         return None
