@@ -29,6 +29,7 @@ from cosmop.automata.operations import (
     restrict,
     satisfaction_counterexample,
     trim,
+    with_marked,
     words,
 )
 
@@ -55,5 +56,6 @@ __all__ = [
     "restrict",
     "satisfaction_counterexample",
     "trim",
+    "with_marked",
     "words",
 ]

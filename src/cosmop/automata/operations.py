@@ -89,10 +89,33 @@ def restrict(dfa: DFA, keep: np.ndarray) -> DFA:
     return DFA(dfa.alphabet, delta, int(new_id[dfa.initial]), dfa.marked[keep], names)
 
 
+def _known_accessible(dfa: DFA) -> DFA:
+    """Note on `dfa` that every state is reachable (the construction guarantees it), so that
+    :func:`accessible` and :func:`is_empty` need no search; returns `dfa`."""
+    object.__setattr__(dfa, "_accessible", True)
+    return dfa
+
+
+def _is_known_accessible(dfa: DFA) -> bool:
+    return getattr(dfa, "_accessible", False)
+
+
+def with_marked(dfa: DFA, marked: np.ndarray) -> DFA:
+    """The same automaton with the states `marked` (boolean, one per state) marked.
+
+    >>> with_marked(DFA.from_word(("a", "b")), [False, True, False]).accepts(("a",))
+    True
+    """
+    out = DFA(dfa.alphabet, dfa.delta, dfa.initial, marked, dfa.state_names)
+    return _known_accessible(out) if _is_known_accessible(dfa) else out
+
+
 def accessible(dfa: DFA) -> DFA:
     """Restriction to the states reachable from :math:`q_0` (same generated language)."""
+    if _is_known_accessible(dfa):
+        return dfa
     keep = reachable(dfa.delta, np.array([dfa.initial]))
-    return dfa if keep.all() else restrict(dfa, keep)
+    return _known_accessible(dfa if keep.all() else restrict(dfa, keep))
 
 
 def coaccessible_mask(dfa: DFA) -> np.ndarray:
@@ -111,11 +134,14 @@ def trim(dfa: DFA) -> DFA:
     keep = coaccessible_mask(dfa)
     if not keep[dfa.initial]:
         return DFA.empty(dfa.alphabet)
-    return dfa if keep.all() else restrict(dfa, keep)
+    # a path to a state that can reach a marked one runs through such states only
+    return dfa if keep.all() else _known_accessible(restrict(dfa, keep))
 
 
 def is_empty(dfa: DFA) -> bool:
     """Whether :math:`L_m(G) = \\emptyset`."""
+    if _is_known_accessible(dfa):
+        return not dfa.marked.any()
     return not reachable(dfa.delta, np.array([dfa.initial]))[dfa.marked].any()
 
 
@@ -124,7 +150,7 @@ def prefix_closure(dfa: DFA) -> DFA:
     t = trim(dfa)
     if is_empty(t):
         return t
-    return DFA(t.alphabet, t.delta, t.initial, np.ones(t.n_states, dtype=bool), t.state_names)
+    return with_marked(t, np.ones(t.n_states, dtype=bool))
 
 
 def complete(dfa: DFA, alphabet: Iterable[str] | None = None) -> DFA:
@@ -142,7 +168,7 @@ def complete(dfa: DFA, alphabet: Iterable[str] | None = None) -> DFA:
 def complement(dfa: DFA, alphabet: Iterable[str] | None = None) -> DFA:
     """:math:`\\Sigma^* \\setminus L_m(G)` over :math:`\\Sigma \\cup` ``alphabet``."""
     c = complete(dfa, alphabet)
-    return DFA(c.alphabet, c.delta, c.initial, ~c.marked)
+    return with_marked(c, ~c.marked)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -174,7 +200,7 @@ def _pair(a: DFA, b: DFA, *, synchronous: bool, a_accessible: bool = False) -> D
         # so when both sides are accessible every pair is, and the search can be skipped.
         interleaved = synchronous and not set(a.alphabet) & set(b.alphabet)
         if interleaved and (a_accessible or _all_accessible(a)) and _all_accessible(b):
-            return whole
+            return _known_accessible(whole)
         return accessible(whole)
     da, db = da.astype(np.int64), db.astype(np.int64)
 
@@ -185,7 +211,7 @@ def _pair(a: DFA, b: DFA, *, synchronous: bool, a_accessible: bool = False) -> D
 
     ex = explore(a.initial * nb + b.initial, successors, len(alphabet))
     marked = a.marked[ex.codes // nb] & b.marked[ex.codes % nb]
-    return DFA(alphabet, ex.delta, 0, marked)
+    return _known_accessible(DFA(alphabet, ex.delta, 0, marked))  # explored from the start
 
 
 def _pair_table(da: np.ndarray, db: np.ndarray) -> np.ndarray:
@@ -201,7 +227,7 @@ def _pair_table(da: np.ndarray, db: np.ndarray) -> np.ndarray:
 
 
 def _all_accessible(dfa: DFA) -> bool:
-    return bool(reachable(dfa.delta, np.array([dfa.initial])).all())
+    return _is_known_accessible(dfa) or bool(reachable(dfa.delta, np.array([dfa.initial])).all())
 
 
 def parallel(*dfas: DFA) -> DFA:
@@ -310,7 +336,8 @@ def project(dfa: DFA, events: Iterable[str]) -> DFA:
         rows.append(row)
         k += 1
     marked = np.array([bool(dfa.marked[s].any()) for s in subsets])
-    return DFA(target, np.array(rows, dtype=np.int32).reshape(len(subsets), len(target)), 0, marked)
+    table = np.array(rows, dtype=np.int32).reshape(len(subsets), len(target))
+    return _known_accessible(DFA(target, table, 0, marked))  # every subset was reached
 
 
 # ---------------------------------------------------------------------------------------------
@@ -476,7 +503,7 @@ def canonical(dfa: DFA) -> DFA:
     perm = np.array(order)
     sub = dfa.delta[perm]
     delta = np.where(sub >= 0, new_id[np.maximum(sub, 0)], -1).astype(np.int32)
-    return DFA(dfa.alphabet, delta, 0, dfa.marked[perm])
+    return _known_accessible(DFA(dfa.alphabet, delta, 0, dfa.marked[perm]))
 
 
 def minimize(dfa: DFA) -> DFA:
@@ -490,7 +517,7 @@ def minimize(dfa: DFA) -> DFA:
     if is_empty(t):
         return DFA.empty(t.alphabet)
     classes = t.marked.astype(np.int64)
-    count = len(np.unique(classes))
+    count = int(classes.any()) + int(not classes.all())  # marked and unmarked: one or two classes
     while True:
         succ = np.where(t.delta >= 0, classes[np.maximum(t.delta, 0)], -1)
         signature = np.column_stack([classes, succ])

@@ -26,7 +26,7 @@ from types import MappingProxyType
 
 import numpy as np
 
-from cosmop.automata import DFA, Composition, prefix_closure, trim
+from cosmop.automata import DFA, Composition, prefix_closure, trim, with_marked
 from cosmop.events import Event, parse_event
 from cosmop.scene import Mission, Scenario
 
@@ -80,7 +80,7 @@ def completion(dfa: DFA, *, explicit: bool) -> DFA:
     if explicit:
         return trim(dfa)
     sinks = ~(dfa.delta >= 0).any(axis=1)
-    return trim(DFA(dfa.alphabet, dfa.delta, dfa.initial, sinks, dfa.state_names))
+    return trim(with_marked(dfa, sinks))
 
 
 def local_alphabets(events: Iterable[Event], robots: Iterable[str]) -> dict[str, tuple[str, ...]]:
