@@ -60,7 +60,7 @@ def cycle_cost(n: int, cycles: int) -> dict:
         actions = [("GoTo", (x + 6000 - 1000 * (x % 2000 > 0), y, 0)), ("GoTo", (x, y, 0))]
         robots[rid] = plan_from_actions(scenario.scene, rid, [f"return({rid})"], actions)
     plans = PlanSet(scenario.name, True, robots)
-    settings = SimSettings(max_time=cycles * 0.1, replan=False, wait_in_place=False)
+    settings = SimSettings(max_time=cycles * 0.1, replan=False)
     t0 = time.perf_counter()
     result = simulate(scenario, plans, settings=settings)
     wall = time.perf_counter() - t0

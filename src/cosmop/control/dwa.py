@@ -151,6 +151,22 @@ class Obstacles:
     agents: np.ndarray | None = None
     names: tuple[str, ...] = ()
 
+    def select(self, walls: np.ndarray, boxes: np.ndarray) -> Obstacles:
+        """The walls and boxes at the indices `walls` and `boxes` (kept in their order)."""
+
+        def pick(values):
+            return None if values is None else values[boxes]
+
+        return Obstacles(
+            self.walls[walls],
+            self.boxes[boxes],
+            self.speed[boxes],
+            pick(self.velocity),
+            pick(self.acceleration),
+            pick(self.agents),
+            tuple(self.names[j] for j in boxes) if self.names else (),
+        )
+
     @property
     def movers(self) -> np.ndarray:
         """Which boxes are kept at the standoff: :attr:`agents`, else those that move."""

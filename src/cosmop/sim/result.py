@@ -76,6 +76,10 @@ class SimSettings:
         Bounds of the solver when replanning.
     dwa : DwaSettings
         The dynamic window's search.
+    neighbourhood : bool
+        Give each robot's dynamic window only the walls and bodies within its reach
+        (:mod:`cosmop.control.neighbourhood`; the commands are the same, the cost linear in the
+        team).  ``False`` scores everything against everything, to compare.
     """
 
     max_time: float = 900.0
@@ -95,6 +99,7 @@ class SimSettings:
     max_horizon: int = 12
     rlimit: int = 10_000_000
     dwa: DwaSettings = field(default_factory=DwaSettings)
+    neighbourhood: bool = True
 
 
 @dataclass(frozen=True)

@@ -67,6 +67,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from cosmop.control.dwa import Drivers, Obstacles, dwa_commands
+from cosmop.control.neighbourhood import dwa_commands_near
 from cosmop.planning.plan import Itinerary, PlanSet
 from cosmop.planning.timing import itinerary
 from cosmop.scene import Scenario
@@ -217,7 +218,8 @@ def _dynamic_window(world: World, sensed: Obstacles, commands: _Commands) -> Non
         w=world.w[idx],
         room_cap=np.array(commands.rooms, dtype=float),
     )
-    cmd = dwa_commands(
+    window = dwa_commands_near if world.settings.neighbourhood else dwa_commands
+    cmd = window(
         drivers, world.with_motion(sensed), world.settings.dwa, ignore=world.own_boxes(sensed)[idx], grip=grip
     )
     commands.v[idx] = cmd.v

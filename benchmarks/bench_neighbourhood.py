@@ -1,0 +1,98 @@
+"""The simulator's cycle with and without the neighbourhood cut-off, side by side.
+
+For each team size N, a generated warehouse (``warehouse_gen.py``, seed 1) whose robots each
+drive a GoTo across their bay and back (plans built directly: only the local layer is timed)
+is simulated for ``--cycles`` cycles of 0.1 s, once with the cut-off
+(``SimSettings.neighbourhood``) and once without, in fresh processes, alternating, ``--repeats``
+times.  Recorded: wall time per cycle (median), real-time factor (simulated / wall time),
+contacts while moving, and a hash of the robots' poses in every frame, which must be the same
+with and without the cut-off.
+
+Usage: ``python benchmarks/bench_neighbourhood.py [--sizes 10,20,50,100] [--cycles 300] [--repeats 3]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import statistics
+import sys
+import time
+from pathlib import Path
+
+from _harness import child_row, save_results
+
+HERE = Path(__file__).resolve().parent
+
+
+def child(n: int, cycles: int, cut: bool) -> dict:
+    sys.path.insert(0, str(HERE))
+    from cosmop.planning import PlanSet, plan_from_actions
+    from cosmop.scenario import parse_scenario
+    from cosmop.sim import SimSettings, simulate
+    from warehouse_gen import warehouse
+
+    scenario = parse_scenario(warehouse(n, seed=1))
+    robots = {}
+    for rid, robot in scenario.scene.robots.items():
+        x, y, _ = robot.pose
+        actions = [("GoTo", (x + 6000 - 1000 * (x % 2000 > 0), y, 0)), ("GoTo", (x, y, 0))]
+        robots[rid] = plan_from_actions(scenario.scene, rid, [f"return({rid})"], actions)
+    plans = PlanSet(scenario.name, True, robots)
+    settings = SimSettings(max_time=cycles * 0.1, replan=False, neighbourhood=cut)
+    t = time.perf_counter()
+    result = simulate(scenario, plans, settings=settings)
+    wall = time.perf_counter() - t
+    return {
+        "n": n,
+        "cut_off": cut,
+        "walls": len(scenario.scene.obstacles),
+        "cycles": result.cycles,
+        "ms_per_cycle": 1000 * wall / result.cycles,
+        "real_time_factor": result.sim_time_s / wall,
+        "contacts_while_moving": result.contacts_while_moving,
+        "poses_sha256": hashlib.sha256(result.frames["pose"].tobytes()).hexdigest(),
+    }
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--sizes", default="10,20,50,100")
+    parser.add_argument("--cycles", type=int, default=300)
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--child", nargs=2, help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.child:
+        print(json.dumps(child(int(args.child[0]), args.cycles, args.child[1] == "on")))
+        return 0
+    rows, summary = [], []
+    for n in (int(s) for s in args.sizes.split(",")):
+        for _ in range(args.repeats):
+            for cut in ("on", "off"):
+                rows.append(child_row(__file__, "--child", str(n), cut, "--cycles", str(args.cycles)))
+        mine = [r for r in rows if r["n"] == n]
+        med = {
+            c: statistics.median(r["ms_per_cycle"] for r in mine if r["cut_off"] == c) for c in (True, False)
+        }
+        same = len({r["poses_sha256"] for r in mine}) == 1
+        row = {
+            "n": n,
+            "on_ms": med[True],
+            "off_ms": med[False],
+            "speed_up": med[False] / med[True],
+            "same": same,
+        }
+        summary.append(row)
+        print(
+            f"N={n:3d}  cut-off {med[True]:7.1f} ms/cycle ({100 / med[True]:5.1f}x real time)  "
+            f"without {med[False]:7.1f} ms/cycle ({100 / med[False]:5.1f}x)  speed-up {row['speed_up']:.2f}  "
+            f"same poses: {same}",
+            flush=True,
+        )
+    save_results("neighbourhood", [*rows, *({"summary": s} for s in summary)])
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

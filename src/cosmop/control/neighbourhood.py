@@ -1,0 +1,127 @@
+"""The neighbourhood cut-off: each robot's dynamic window scores only what can change its command.
+
+:func:`~cosmop.control.dwa.dwa_commands` measures every driver against every wall and box, a
+cost of :math:`R (W + M)` per cycle for :math:`R` drivers, :math:`W` walls and :math:`M` boxes.
+Almost all of them are too far to matter: :func:`reach` bounds, for each driver, the L-infinity
+gap beyond which an obstacle cannot change anything the window decides, and
+:func:`dwa_commands_near` gives each group of nearby drivers only the obstacles within reach.
+
+**Why the commands do not change (passive safety included).**  Let :math:`\\bar v` be the
+driver's top speed, :math:`(A, b, \\varepsilon)` its limits, :math:`T` its stopping horizon
+at :math:`\\bar v` (:func:`~cosmop.control.safety.stopping_horizon`), :math:`h` the window's
+prediction horizon and :math:`\\bar V` the largest speed of any box (its top speed, and its
+sensed speed).  Every decision of the window compares a gap with a bound, or takes a minimum of
+gaps capped from above:
+
+* ``safe`` asks, per obstacle, for a gap (less the standoff, for a robot or person) above
+  :func:`~cosmop.control.safety.stopping_margin` :math:`(v, V_o)`, which grows with
+  :math:`v \\le \\bar v` and :math:`V_o \\le \\bar V`; an obstacle farther than the standoff
+  plus that margin at :math:`(\\bar v, \\bar V)` passes it.  ``safe`` is the conjunction over
+  the obstacles, so it is the same without them.
+* The score takes the least gap along each arc: an arc stays within :math:`\\bar v h` of the
+  robot and a box moves at most :math:`\\bar V h` meanwhile, and gaps above the clearance cap
+  (walls, objects) or the personal space (robots, people) score as if infinite.  A farther
+  obstacle is never the minimum that counts, nor below zero.
+* An escape arc (checked only when ``safe`` fails) is held for a cycle and then brakes: its
+  points stay within :math:`\\bar v T` of the robot, a box moves :math:`\\bar V T`, and the
+  slack between samples is below :math:`\\bar v T`; a farther obstacle passes every sample.
+* The retreat steps away from the nearest box when it is within the standoff, checking the
+  walls twice the standoff away; both are within reach.
+
+:func:`reach` adds these terms (walls with :math:`\\bar V = 0`) with a margin of one standoff,
+so each driver's group sees a superset of its neighbourhood.  The obstacles a group keeps are
+in their original order and go through the same expressions, and the dropped ones never
+decide a test or attain a minimum, so the commands (speeds, turn rates, ``safe``) are those of
+the full computation, bit for bit; only :attr:`DwaCommand.gap` is ``inf`` instead of a gap
+beyond reach when nothing is near.  The cost per cycle is the drivers times the obstacles near
+them: linear in the team and independent of the size of the map (plus a pass over the
+obstacles' bounding boxes per group, which is cheap).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from cosmop.control.dwa import Drivers, DwaCommand, DwaSettings, Obstacles, dwa_commands
+from cosmop.control.safety import stopping_horizon, stopping_margin
+
+__all__ = ["dwa_commands_near", "reach"]
+
+
+def reach(drivers: Drivers, obstacles: Obstacles, settings: DwaSettings) -> tuple[np.ndarray, np.ndarray]:
+    """The gaps (mm) beyond which a wall, and a box, cannot change each driver's command.
+
+    Returns
+    -------
+    walls, boxes : ndarray, shape (R,)
+        See the module docstring for the bound; walls do not move.
+    """
+    limits = drivers.limits
+    top = np.maximum(limits.max_speed, drivers.v)
+    boxes_top = float(obstacles.speed.max(initial=0.0))
+    if obstacles.velocity is not None and len(obstacles.velocity):
+        boxes_top = max(boxes_top, float(np.hypot(*obstacles.velocity.T).max()))
+    time = np.maximum(settings.horizon, stopping_horizon(top, limits))
+    room = max(settings.clearance, settings.personal_space, 3 * settings.standoff)
+    walls = stopping_margin(top, 0.0, limits) + 2 * top * time + room + settings.standoff
+    boxes = stopping_margin(top, boxes_top, limits) + 2 * (top + boxes_top) * time + room + settings.standoff
+    return walls, boxes
+
+
+def dwa_commands_near(
+    drivers: Drivers,
+    obstacles: Obstacles,
+    settings: DwaSettings | None = None,
+    *,
+    ignore: np.ndarray | None = None,
+    grip: np.ndarray | None = None,
+    cell: float | None = None,
+) -> DwaCommand:
+    """:func:`~cosmop.control.dwa.dwa_commands`, each group of drivers against what is near it.
+
+    Drivers are grouped by square cells of side `cell` (mm; default: the largest reach); each
+    group is one call of the dynamic window with the walls and boxes within reach of any of
+    its drivers.  The commands are those of one call with everything (module docstring).
+    Parameters as :func:`~cosmop.control.dwa.dwa_commands`.
+    """
+    R, settings = len(drivers.v), settings or DwaSettings()
+    wall_reach, box_reach = reach(drivers, obstacles, settings)
+    xy, half = drivers.pose[:, :2], drivers.half
+    side = cell if cell is not None else float(max(wall_reach.max(), box_reach.max()))
+    _, group = np.unique(np.floor(xy / side).astype(np.int64), axis=0, return_inverse=True)
+    group = group.ravel()
+    w_lo, w_hi = _wall_bounds(obstacles.walls)
+    centres, halves = obstacles.boxes[:, :2], obstacles.boxes[:, 2:]
+    b_lo, b_hi = centres - halves, centres + halves
+    v, w, gap = np.zeros(R), np.zeros(R), np.full(R, np.inf)
+    safe = np.ones(R, dtype=bool)
+    for g in range(int(group.max(initial=-1)) + 1):
+        rows = np.flatnonzero(group == g)
+        lo, hi = xy[rows].min(axis=0), xy[rows].max(axis=0)
+        walls = np.flatnonzero(_rect_gap(lo, hi, w_lo, w_hi) <= (wall_reach[rows] + half[rows]).max())
+        boxes = np.flatnonzero(_rect_gap(lo, hi, b_lo, b_hi) <= (box_reach[rows] + half[rows]).max())
+        cmd = dwa_commands(
+            drivers[rows],
+            obstacles.select(walls, boxes),
+            settings,
+            ignore=None if ignore is None else ignore[np.ix_(rows, boxes)],
+            grip=None if grip is None else grip[np.ix_(rows, boxes)],
+        )
+        v[rows], w[rows], safe[rows], gap[rows] = cmd.v, cmd.w, cmd.safe, cmd.gap
+    return DwaCommand(v=v, w=w, safe=safe, gap=gap)
+
+
+def _wall_bounds(walls: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each wall segment's bounding box, as lower and upper corners ``(W, 2)``."""
+    ends = walls.reshape(-1, 2, 2)
+    return ends.min(axis=1), ends.max(axis=1)
+
+
+def _rect_gap(lo: np.ndarray, hi: np.ndarray, lows: np.ndarray, highs: np.ndarray) -> np.ndarray:
+    """L-infinity distance from the box ``[lo, hi]`` to each box ``[lows, highs]`` (0 when they meet).
+
+    It bounds from below the distance from any point of ``[lo, hi]`` to anything inside the
+    other box (a wall segment lies in its bounding box).
+    """
+    d = np.maximum(np.maximum(lows - hi, lo - highs), 0.0)
+    return d.max(axis=1) if len(d) else np.zeros(0)

@@ -1,0 +1,98 @@
+"""The neighbourhood cut-off gives the dynamic window's commands bit for bit, and cuts.
+
+Random crowded warehouses (seeded): drivers among walls, resting objects, moving robots and
+people, some of them inside another's standoff or against a wall so that ``safe`` fails and
+the escape arcs and the retreat run.  The commands of :func:`dwa_commands_near` (with its own
+cells, and with cells much smaller than the reach) must equal those of one call of
+:func:`dwa_commands` with everything.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from cosmop.control.dwa import Drivers, DwaSettings, Obstacles, dwa_commands
+from cosmop.control.neighbourhood import dwa_commands_near, reach
+from cosmop.control.safety import Limits
+from cosmop.scene import Dynamics
+
+
+def _crowd(seed: int, side: float = 40_000.0) -> tuple[Drivers, Obstacles, np.ndarray]:
+    rng = np.random.default_rng(seed)
+    R, n_walls, n_objects, n_people = 24, 60, 30, 8
+    start = rng.uniform(0, side, (n_walls, 2))
+    along = rng.integers(0, 2, n_walls)[:, None] == 0
+    length = rng.uniform(500, 6000, (n_walls, 1))
+    walls = np.hstack([start, start + np.where(along, [[1.0, 0.0]], [[0.0, 1.0]]) * length])
+    xy = rng.uniform(0, side, (R, 2))
+    # a third of the drivers stand close to another robot or a wall: inside the standoff
+    for i in range(0, R, 3):
+        xy[i] = xy[i + 1] + rng.choice([-1, 1], 2) * rng.uniform(350, 450, 2) * [1, 0]
+    xy[2] = walls[0, :2] + [0.0, 230.0]
+    pose = np.column_stack([xy, rng.uniform(-np.pi, np.pi, R)])
+    v = rng.uniform(0, 750, R)
+    v[::4] = 0.0
+    limits = Limits.of([Dynamics()] * R)
+    drivers = Drivers(
+        pose=pose,
+        v=v,
+        half=np.full(R, 200.0),
+        limits=limits,
+        target=xy + rng.uniform(-2000, 2000, (R, 2)),
+        stop_distance=rng.choice([np.inf, 800.0], R),
+        w=rng.uniform(-0.5, 0.5, R),
+        room_cap=rng.uniform(20, 200, R),
+    )
+    objects = np.column_stack([rng.uniform(0, side, (n_objects, 2)), np.full(n_objects, 150.0)])
+    people = np.column_stack([rng.uniform(0, side, (n_people, 2)), np.full(n_people, 250.0)])
+    robots = np.column_stack([xy, drivers.half])
+    boxes = np.vstack([objects, robots, people])
+    speed = np.concatenate([np.zeros(n_objects), np.full(R, 750.0), np.full(n_people, 1200.0)])
+    heading = rng.uniform(-np.pi, np.pi, len(boxes))
+    now = np.concatenate([np.zeros(n_objects), v, rng.uniform(0, 1200, n_people)])
+    velocity = np.column_stack([now * np.cos(heading), now * np.sin(heading)])
+    acceleration = np.concatenate([np.zeros(n_objects), np.full(R, 500.0), np.full(n_people, np.inf)])
+    agents = np.arange(len(boxes)) >= n_objects
+    obstacles = Obstacles(walls, boxes, speed, velocity, acceleration, agents)
+    own = np.zeros((R, len(boxes)), dtype=bool)
+    own[np.arange(R), n_objects + np.arange(R)] = True
+    return drivers, obstacles, own
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_the_cut_off_gives_the_same_commands(seed):
+    drivers, obstacles, own = _crowd(seed)
+    settings = DwaSettings()
+    full = dwa_commands(drivers, obstacles, settings, ignore=own)
+    assert not full.safe.all()  # the escape arcs and the retreat are exercised
+    for cell in (None, 1500.0):
+        near = dwa_commands_near(drivers, obstacles, settings, ignore=own, cell=cell)
+        np.testing.assert_array_equal(near.v, full.v)
+        np.testing.assert_array_equal(near.w, full.w)
+        np.testing.assert_array_equal(near.safe, full.safe)
+        close = np.isfinite(near.gap)
+        np.testing.assert_array_equal(near.gap[close], full.gap[close])
+        walls, boxes = reach(drivers, obstacles, settings)
+        assert (full.gap[~close] > np.minimum(walls, boxes)[~close]).all()
+
+
+def test_the_cut_off_drops_what_is_out_of_reach():
+    drivers, obstacles, _ = _crowd(0, side=400_000.0)  # ten times wider: most things are far
+    walls, boxes = reach(drivers, obstacles, DwaSettings())
+    assert 1_000 < walls.max() < 20_000 and 1_000 < boxes.max() < 20_000  # metres, not the map
+    seen = []
+
+    def counting(drivers, sub, settings, **kw):
+        seen.append(len(sub.walls) + len(sub.boxes))
+        return dwa_commands(drivers, sub, settings, **kw)
+
+    from cosmop.control import neighbourhood
+
+    original = neighbourhood.dwa_commands
+    neighbourhood.dwa_commands = counting
+    try:
+        dwa_commands_near(drivers, obstacles)
+    finally:
+        neighbourhood.dwa_commands = original
+    assert sum(seen) < (len(obstacles.walls) + len(obstacles.boxes)) / 2
