@@ -31,7 +31,7 @@ def _crowd(seed: int, side: float = 40_000.0) -> tuple[Drivers, Obstacles, np.nd
         xy[i] = xy[i + 1] + rng.choice([-1, 1], 2) * rng.uniform(350, 450, 2) * [1, 0]
     xy[2] = walls[0, :2] + [0.0, 230.0]
     pose = np.column_stack([xy, rng.uniform(-np.pi, np.pi, R)])
-    v = rng.uniform(0, 750, R)
+    v = rng.uniform(300, 750, R)
     v[::4] = 0.0
     limits = Limits.of([Dynamics()] * R)
     drivers = Drivers(
@@ -40,7 +40,7 @@ def _crowd(seed: int, side: float = 40_000.0) -> tuple[Drivers, Obstacles, np.nd
         half=np.full(R, 200.0),
         limits=limits,
         target=xy + rng.uniform(-2000, 2000, (R, 2)),
-        stop_distance=rng.choice([np.inf, 800.0], R),
+        stop_distance=rng.choice([np.inf, 300.0], R),  # 300 mm: the stop caps the window's speed
         w=rng.uniform(-0.5, 0.5, R),
         room_cap=rng.uniform(20, 200, R),
     )
@@ -96,3 +96,15 @@ def test_the_cut_off_drops_what_is_out_of_reach():
     finally:
         neighbourhood.dwa_commands = original
     assert sum(seen) < (len(obstacles.walls) + len(obstacles.boxes)) / 2
+
+
+def test_a_robot_in_danger_does_not_lift_another_robots_stop_at_its_goal():
+    # before the fix, one unsafe robot in the batch cleared every robot's stop distance, so a
+    # robot arriving at its goal elsewhere lost the cap that lets it stop there
+    drivers, obstacles, own = _crowd(2)
+    full = dwa_commands(drivers, obstacles, ignore=own)
+    calm = np.flatnonzero(full.safe & np.isfinite(drivers.stop_distance))
+    assert (~full.safe).any() and calm.size
+    for i in calm:
+        alone = dwa_commands(drivers[[i]], obstacles, ignore=own[[i]])
+        assert (alone.v[0], alone.w[0]) == (full.v[i], full.w[i])

@@ -334,7 +334,9 @@ def _retreat(
     retreat = _open_retreat(xy[rows], drivers.half[rows], away, delta, obstacles.walls, settings.standoff * 2)
     target = drivers.target.copy()
     target[rows[close]] = retreat[close]
-    return replace(drivers, target=target, stop_distance=np.full(len(drivers.v), np.inf))
+    stop = drivers.stop_distance.copy()
+    stop[rows] = np.inf  # the unsafe leave at once; the others keep their stop at the goal
+    return replace(drivers, target=target, stop_distance=stop)
 
 
 def _arcs(

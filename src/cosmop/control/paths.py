@@ -14,7 +14,6 @@ is allowed (a docking pose touches its object).  Units are millimetres.
 from __future__ import annotations
 
 import heapq
-import itertools
 import math
 from dataclasses import dataclass
 
@@ -93,15 +92,6 @@ def _grown(walls: np.ndarray, boxes: np.ndarray, half: float) -> list[Polygon]:
     return out
 
 
-def _free(lines_from: np.ndarray, lines_to: np.ndarray, blocked) -> np.ndarray:
-    """Which straight segments avoid the interior of `blocked` (a prepared geometry)."""
-    if len(lines_from) == 0:
-        return np.zeros(0, dtype=bool)
-    coords = np.stack([lines_from, lines_to], axis=1)
-    lines = shapely.linestrings(coords)
-    return ~shapely.intersects(blocked, lines)
-
-
 def plan_path(
     start: Point,
     goal: Point,
@@ -151,25 +141,11 @@ def plan_path(
     g = np.asarray(goal, dtype=float)
     corners = [_corners(grown, inner, offset) for offset in (1.0, margin)]
     nodes = np.vstack([s[None, :], g[None, :], *corners])
-    i, j = np.triu_indices(len(nodes), k=1)
-    ok = _free(nodes[i], nodes[j], inner)
-    i, j = i[ok], j[ok]
-    length = np.hypot(*(nodes[i] - nodes[j]).T)
-    if grown.is_empty or margin <= 0:
-        cost = length
-        clearance = np.full(len(i), np.inf)
-    else:
-        lines = shapely.linestrings(np.stack([nodes[i], nodes[j]], axis=1))
-        clearance = shapely.distance(grown.boundary, lines)
-        short = np.clip(1.0 - clearance / margin, 0.0, 1.0)
-        # A squeeze costs by its length and once: a short gap must not look cheap.
-        cost = length * (1.0 + penalty * short) + squeeze * short * margin
-    route = _dijkstra(nodes, i, j, cost)
-    if route is None:
+    costs = _EdgeCosts(nodes, inner, None if grown.is_empty else grown.boundary, margin, penalty, squeeze)
+    found = _a_star(nodes, costs)
+    if found is None:
         return None
-    used = {(min(a, b), max(a, b)) for a, b in itertools.pairwise(route)}
-    index = {(int(a), int(b)): k for k, (a, b) in enumerate(zip(i, j, strict=True))}
-    least = min((float(clearance[index[e]]) for e in used), default=float("inf"))
+    route, least = found
     return GlobalPath(tuple((float(x), float(y)) for x, y in nodes[route]), min(least, margin))
 
 
@@ -230,32 +206,67 @@ def _corners(grown, exact_inner, offset: float) -> np.ndarray:
     return cand[~inside_exact]
 
 
-def _dijkstra(nodes: np.ndarray, i: np.ndarray, j: np.ndarray, weights: np.ndarray) -> list[int] | None:
-    """Cheapest path from node 0 to node 1 over the undirected edges ``(i, j)``."""
+class _EdgeCosts:
+    """The edges from one node of the roadmap to many: which are free, their cost and clearance.
+
+    An edge is a straight segment that does not enter the interior of any grown obstacle; its
+    cost is its length, raised where its clearance to the grown obstacles is below the margin
+    (:func:`plan_path`).  Evaluated for one node's edges at a time, when the search reaches it.
+    """
+
+    def __init__(self, nodes, inner, boundary, margin: float, penalty: float, squeeze: float) -> None:
+        self.nodes, self.inner, self.boundary = nodes, inner, boundary
+        self.margin, self.penalty, self.squeeze = margin, penalty, squeeze
+
+    def __call__(self, u: int, others: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The free edges from `u` to `others`: their far ends, costs and clearances."""
+        ends = self.nodes[others]
+        lines = shapely.linestrings(np.stack([np.broadcast_to(self.nodes[u], ends.shape), ends], axis=1))
+        free = ~shapely.intersects(self.inner, lines)
+        others, lines, ends = others[free], lines[free], ends[free]
+        length = np.hypot(*(ends - self.nodes[u]).T)
+        if self.boundary is None or self.margin <= 0:
+            return others, length, np.full(len(others), np.inf)
+        clearance = shapely.distance(self.boundary, lines)
+        short = np.clip(1.0 - clearance / self.margin, 0.0, 1.0)
+        # A squeeze costs by its length and once: a short gap must not look cheap.
+        cost = length * (1.0 + self.penalty * short) + self.squeeze * short * self.margin
+        return others, cost, clearance
+
+
+def _a_star(nodes: np.ndarray, costs: _EdgeCosts) -> tuple[list[int], float] | None:
+    """Cheapest route from node 0 to node 1, and the least clearance along it.
+
+    A* with the straight-line distance to the goal, which never overestimates (an edge costs
+    at least its length) and is consistent, so a node taken off the queue is final and the
+    route is a cheapest one over the whole roadmap.  The edges are evaluated lazily, one
+    node's at a time and only to nodes not yet final: the work is the nodes the search
+    reaches times the nodes, instead of every pair of nodes.
+    """
     n = len(nodes)
-    adjacency: list[list[tuple[int, float]]] = [[] for _ in range(n)]
-    for a, b, w in zip(i.tolist(), j.tolist(), weights.tolist(), strict=True):
-        adjacency[a].append((b, w))
-        adjacency[b].append((a, w))
-    dist = [math.inf] * n
-    parent = [-1] * n
+    to_goal = np.hypot(*(nodes - nodes[1]).T)
+    dist, parent, clear = np.full(n, np.inf), np.full(n, -1), np.full(n, np.inf)
+    final = np.zeros(n, dtype=bool)
     dist[0] = 0.0
-    heap = [(0.0, 0)]
+    heap = [(float(to_goal[0]), 0.0, 0)]
     while heap:
-        d, u = heapq.heappop(heap)
-        if d > dist[u]:
+        _, d, u = heapq.heappop(heap)
+        if final[u]:
             continue
+        final[u] = True
         if u == 1:
             break
-        for v, w in adjacency[u]:
-            nd = d + w
-            if nd < dist[v]:
-                dist[v] = nd
-                parent[v] = u
-                heapq.heappush(heap, (nd, v))
-    if math.isinf(dist[1]):
+        ends, cost, clearance = costs(u, np.flatnonzero(~final))
+        via = d + cost
+        better = via < dist[ends]
+        ends, via, clearance = ends[better].tolist(), via[better].tolist(), clearance[better].tolist()
+        for v, dv, cv in zip(ends, via, clearance, strict=True):
+            dist[v], parent[v], clear[v] = dv, u, cv
+            heapq.heappush(heap, (dv + float(to_goal[v]), dv, v))
+    if not final[1]:
         return None
     route = [1]
     while route[-1] != 0:
-        route.append(parent[route[-1]])
-    return route[::-1]
+        route.append(int(parent[route[-1]]))
+    least = min((float(clear[v]) for v in route[:-1]), default=math.inf)
+    return route[::-1], least
