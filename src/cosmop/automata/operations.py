@@ -349,8 +349,10 @@ def inclusion_counterexample(a: DFA, b: DFA) -> tuple[str, ...] | None:
     """A shortest word of :math:`L_m(a) \\setminus L_m(b)`, or ``None`` if :math:`L_m(a) \\subseteq L_m(b)`.
 
     Languages are sets of words over the union of the alphabets.  Breadth-first search of
-    ``trim(a)`` against the completion of ``b``; the first level holding a pair (marked in
-    ``a``, not marked in ``b``) gives a shortest counterexample.
+    ``a`` against the completion of ``b``; the first level holding a pair (marked in ``a``,
+    not marked in ``b``) gives a shortest counterexample.  When a state of ``a`` meets a
+    single state of ``b`` (the usual case) the search runs over ``a``'s states alone, first
+    on ``a`` as given and, if that fails, on ``trim(a)``; else over the pairs.
     """
     alphabet = tuple(sorted(set(a.alphabet) | set(b.alphabet)))
     db = _columns(b, alphabet, "block")

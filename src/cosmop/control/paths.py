@@ -5,7 +5,8 @@ Minkowski sum of every obstacle with that square (its *configuration-space obsta
 segment grows into a hexagon (the convex hull of the squares at its ends) and an object of half
 side :math:`k` into the square of half side :math:`k + h`.  Shortest paths among polygons run
 through their corners, so the route is found in the *visibility graph* of those corners plus
-the start and the goal (Lozano-Pérez and Wesley) with Dijkstra's algorithm.  Corners are also
+the start and the goal (Lozano-Pérez and Wesley), searched with A* that tests a corner's edges
+only when it reaches that corner (:func:`_a_star`).  Corners are also
 offered pushed out by the wanted clearance, and edges that pass closer than it cost more, so
 the route keeps its distance where there is room and squeezes through where it must; touching
 is allowed (a docking pose touches its object).  Units are millimetres.
