@@ -1,8 +1,8 @@
 """The simulator's cycle with and without the neighbourhood cut-off, side by side.
 
-For each team size N, a generated warehouse (``warehouse_gen.py``, seed 1) whose robots each
-drive a GoTo across their bay and back (plans built directly: only the local layer is timed)
-is simulated for ``--cycles`` cycles of 0.1 s, once with the cut-off
+For each team size N, the generated warehouse of ``bench_sim.bay_drives`` (robots driving a
+GoTo across their bay and back; plans built directly: only the local layer is timed) is
+simulated for ``--cycles`` cycles of 0.1 s, once with the cut-off
 (``SimSettings.neighbourhood``) and once without, in fresh processes, alternating, ``--repeats``
 times.  Recorded: wall time per cycle (median), real-time factor (simulated / wall time),
 contacts while moving, and a hash of the robots' poses in every frame, which must be the same
@@ -28,18 +28,10 @@ HERE = Path(__file__).resolve().parent
 
 def child(n: int, cycles: int, cut: bool) -> dict:
     sys.path.insert(0, str(HERE))
-    from cosmop.planning import PlanSet, plan_from_actions
-    from cosmop.scenario import parse_scenario
+    from bench_sim import bay_drives
     from cosmop.sim import SimSettings, simulate
-    from warehouse_gen import warehouse
 
-    scenario = parse_scenario(warehouse(n, seed=1))
-    robots = {}
-    for rid, robot in scenario.scene.robots.items():
-        x, y, _ = robot.pose
-        actions = [("GoTo", (x + 6000 - 1000 * (x % 2000 > 0), y, 0)), ("GoTo", (x, y, 0))]
-        robots[rid] = plan_from_actions(scenario.scene, rid, [f"return({rid})"], actions)
-    plans = PlanSet(scenario.name, True, robots)
+    scenario, plans = bay_drives(n)
     settings = SimSettings(max_time=cycles * 0.1, replan=False, neighbourhood=cut)
     t = time.perf_counter()
     result = simulate(scenario, plans, settings=settings)

@@ -52,14 +52,20 @@ def real_time_ratio(repeats: int) -> dict:
     return {"runs": runs, "median_ratio": statistics.median(r["ratio"] for r in runs)}
 
 
-def cycle_cost(n: int, cycles: int) -> dict:
+def bay_drives(n: int):
+    """A generated warehouse of `n` robots (seed 1) whose robots each drive a GoTo across their
+    bay and back: plans built directly, without the solver, so that only the local layer runs."""
     scenario = parse_scenario(warehouse(n, seed=1))
     robots = {}
     for rid, robot in scenario.scene.robots.items():
         x, y, _ = robot.pose
         actions = [("GoTo", (x + 6000 - 1000 * (x % 2000 > 0), y, 0)), ("GoTo", (x, y, 0))]
         robots[rid] = plan_from_actions(scenario.scene, rid, [f"return({rid})"], actions)
-    plans = PlanSet(scenario.name, True, robots)
+    return scenario, PlanSet(scenario.name, True, robots)
+
+
+def cycle_cost(n: int, cycles: int) -> dict:
+    scenario, plans = bay_drives(n)
     settings = SimSettings(max_time=cycles * 0.1, replan=False)
     t0 = time.perf_counter()
     result = simulate(scenario, plans, settings=settings)
