@@ -49,11 +49,11 @@ def import_map(
     ],
     cell_size: Annotated[
         float | None,
-        typer.Option(help="Side of a cell in mm [default: 1000 for .map, the YAML's resolution]", min=1e-9),
+        typer.Option(help="Side of a cell in mm \\[default: 1000 for .map, the YAML's resolution]", min=1e-9),
     ] = None,
     origin: Annotated[
         tuple[float, float] | None,
-        typer.Option(help="The map's lower-left corner X Y in mm [default: 0 0, or the ROS origin]"),
+        typer.Option(help="The map's lower-left corner X Y in mm \\[default: 0 0, or the ROS origin]"),
     ] = None,
     unknown: Annotated[_Unknown, typer.Option(help="ROS maps: what unknown cells are.")] = _Unknown.blocked,
     walls: Annotated[
@@ -157,7 +157,7 @@ def write_bag_and_report(scene, trace, bag: Path, plans, rate: float | None, sce
 
 RateOption = Annotated[
     float | None,
-    typer.Option(help="Poses and /tf per second (Hz) [default: every frame of the trace]", min=1e-6),
+    typer.Option(help="Poses and /tf per second (Hz) \\[default: every frame of the trace]", min=1e-6),
 ]
 SceneRateOption = Annotated[float, typer.Option(help="/scene marker arrays per second (Hz).", min=1e-6)]
 

@@ -25,7 +25,7 @@ WorkersOption = Annotated[
     typer.Option(
         "--workers",
         min=1,
-        help="Local processes for the robots' syntheses [default: one per core, at most one per robot]",
+        help="Local processes for the robots' syntheses \\[default: one per core, at most one per robot]",
         show_default=False,
     ),
 ]
@@ -34,7 +34,7 @@ SchedulerOption = Annotated[
     typer.Option(
         "--scheduler",
         metavar="ADDRESS",
-        help="Run the syntheses on a Dask cluster, e.g. tcp://host:8786 (pip install 'cosmop[cluster]').",
+        help="Run the syntheses on a Dask cluster, e.g. tcp://host:8786 (pip install 'cosmop\\[cluster]').",
         show_default=False,
     ),
 ]
@@ -89,7 +89,7 @@ def plan(
     max_horizon: Annotated[
         int | None,
         typer.Option(
-            help="Longest plan tried per robot (steps) [default: 16, or 3 per mission event + 6 if more]",
+            help="Longest plan tried per robot (steps) \\[default: 16, or 3 per mission event + 6 if more]",
             min=0,
             max=MAX_STEPS,
             show_default=False,

@@ -46,11 +46,11 @@ def simulate(
     speed: Annotated[
         float | None,
         typer.Option(
-            help="Animation: simulated seconds per second [default: the run lasts at most 45 s]", min=1e-3
+            help="Animation: simulated seconds per second \\[default: the run lasts at most 45 s]", min=1e-3
         ),
     ] = None,
     size: Annotated[
-        int | None, typer.Option(help="Animation width in pixels [default: about 790]", min=100)
+        int | None, typer.Option(help="Animation width in pixels \\[default: about 790]", min=100)
     ] = None,
     bag: Annotated[
         Path | None,
