@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -23,6 +24,26 @@ def child_row(script: str, *args: str, timeout: float | None = None) -> dict:
         [sys.executable, script, *args], capture_output=True, text=True, check=True, timeout=timeout
     )
     return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
+def alternate(script: str, n: int, variants: tuple[str, ...], repeats: int, *args: str, timeout=None) -> dict:
+    """Side by side: `repeats` rounds of ``python SCRIPT --child N VARIANT ARGS``, one fresh
+    process per variant in turn (so that the machine's drift hits every variant alike).
+
+    Returns the rows in run order (each tagged with its ``variant``) and, per variant, the
+    runs' rows, for :func:`median_of`.
+    """
+    rows = []
+    for _ in range(repeats):
+        for variant in variants:
+            row = child_row(script, "--child", str(n), variant, *args, timeout=timeout)
+            rows.append({**row, "variant": variant})
+    return {"rows": rows, "by": {v: [r for r in rows if r["variant"] == v] for v in variants}}
+
+
+def median_of(runs: dict, key: str) -> dict[str, float]:
+    """The median of `key` per variant of :func:`alternate`'s `runs`."""
+    return {variant: statistics.median(r[key] for r in rows) for variant, rows in runs["by"].items()}
 
 
 def save_results(name: str, rows: list[dict]) -> Path:

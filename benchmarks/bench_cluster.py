@@ -18,12 +18,11 @@ import argparse
 import hashlib
 import json
 import resource
-import statistics
 import sys
 import time
 from pathlib import Path
 
-from _harness import child_row, save_results
+from _harness import alternate, median_of, save_results
 
 HERE = Path(__file__).resolve().parent
 
@@ -84,16 +83,12 @@ def main() -> int:
         print(json.dumps(child(int(args.child[0]), args.seed, args.child[1], args.workers)))
         return 0
     rows, summary = [], []
+    extra = ("--seed", str(args.seed), "--workers", str(args.workers))
     for n in (int(s) for s in args.sizes.split(",")):
-        for _ in range(args.repeats):
-            for engine in ("local", "dask"):
-                extra = ("--seed", str(args.seed), "--workers", str(args.workers))
-                rows.append(child_row(__file__, "--child", str(n), engine, *extra, timeout=7200))
-        mine = [r for r in rows if r["n"] == n]
-        median = {
-            e: statistics.median(r["total_s"] for r in mine if r["engine"] == e) for e in ("local", "dask")
-        }
-        same = len({r["plans_sha256"] for r in mine}) == 1
+        runs = alternate(__file__, n, ("local", "dask"), args.repeats, *extra, timeout=7200)
+        rows += runs["rows"]
+        median = median_of(runs, "total_s")
+        same = len({r["plans_sha256"] for r in runs["rows"]}) == 1
         summary.append({"n": n, **{f"{e}_median_s": t for e, t in median.items()}, "identical_plans": same})
         print(
             f"N={n:3d} local {median['local']:7.1f} s  dask {median['dask']:7.1f} s  "

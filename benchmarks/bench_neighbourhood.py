@@ -16,12 +16,11 @@ from __future__ import annotations
 import argparse
 import hashlib
 import json
-import statistics
 import sys
 import time
 from pathlib import Path
 
-from _harness import child_row, save_results
+from _harness import alternate, median_of, save_results
 
 HERE = Path(__file__).resolve().parent
 
@@ -60,25 +59,21 @@ def main() -> int:
         return 0
     rows, summary = [], []
     for n in (int(s) for s in args.sizes.split(",")):
-        for _ in range(args.repeats):
-            for cut in ("on", "off"):
-                rows.append(child_row(__file__, "--child", str(n), cut, "--cycles", str(args.cycles)))
-        mine = [r for r in rows if r["n"] == n]
-        med = {
-            c: statistics.median(r["ms_per_cycle"] for r in mine if r["cut_off"] == c) for c in (True, False)
-        }
-        same = len({r["poses_sha256"] for r in mine}) == 1
+        runs = alternate(__file__, n, ("on", "off"), args.repeats, "--cycles", str(args.cycles))
+        rows += runs["rows"]
+        med = median_of(runs, "ms_per_cycle")
+        same = len({r["poses_sha256"] for r in runs["rows"]}) == 1
         row = {
             "n": n,
-            "on_ms": med[True],
-            "off_ms": med[False],
-            "speed_up": med[False] / med[True],
+            "on_ms": med["on"],
+            "off_ms": med["off"],
+            "speed_up": med["off"] / med["on"],
             "same": same,
         }
         summary.append(row)
         print(
-            f"N={n:3d}  cut-off {med[True]:7.1f} ms/cycle ({100 / med[True]:5.1f}x real time)  "
-            f"without {med[False]:7.1f} ms/cycle ({100 / med[False]:5.1f}x)  speed-up {row['speed_up']:.2f}  "
+            f"N={n:3d}  cut-off {med['on']:7.1f} ms/cycle ({100 / med['on']:5.1f}x real time)  "
+            f"without {med['off']:7.1f} ms/cycle ({100 / med['off']:5.1f}x)  speed-up {row['speed_up']:.2f}  "
             f"same poses: {same}",
             flush=True,
         )
