@@ -18,17 +18,27 @@ import yaml
 RESULTS = Path(__file__).resolve().parent / "results"
 
 
-def child_row(script: str, *args: str, timeout: float | None = None) -> dict:
-    """Run ``python SCRIPT ARGS`` in a fresh process; its last line of output is a JSON row."""
+def child_row(script: str, *args: str, timeout: float | None = None, env: dict | None = None) -> dict:
+    """Run ``python SCRIPT ARGS`` in a fresh process; its last line of output is a JSON row.
+
+    `env` adds to the environment (e.g. ``PYTHONPATH`` to run an older checkout's code)."""
     proc = subprocess.run(
-        [sys.executable, script, *args], capture_output=True, text=True, check=True, timeout=timeout
+        [sys.executable, script, *args],
+        capture_output=True,
+        text=True,
+        check=True,
+        timeout=timeout,
+        env={**os.environ, **env} if env else None,
     )
     return json.loads(proc.stdout.strip().splitlines()[-1])
 
 
-def alternate(script: str, n: int, variants: tuple[str, ...], repeats: int, *args: str, timeout=None) -> dict:
+def alternate(
+    script: str, n: int | str, variants: tuple[str, ...], repeats: int, *args: str, timeout=None, env_of=None
+) -> dict:
     """Side by side: `repeats` rounds of ``python SCRIPT --child N VARIANT ARGS``, one fresh
     process per variant in turn (so that the machine's drift hits every variant alike).
+    ``env_of(variant)``, when given, is the environment a variant's process adds.
 
     Returns the rows in run order (each tagged with its ``variant``) and, per variant, the
     runs' rows, for :func:`median_of`.
@@ -36,7 +46,8 @@ def alternate(script: str, n: int, variants: tuple[str, ...], repeats: int, *arg
     rows = []
     for _ in range(repeats):
         for variant in variants:
-            row = child_row(script, "--child", str(n), variant, *args, timeout=timeout)
+            env = env_of(variant) if env_of else None
+            row = child_row(script, "--child", str(n), variant, *args, timeout=timeout, env=env)
             rows.append({**row, "variant": variant})
     return {"rows": rows, "by": {v: [r for r in rows if r["variant"] == v] for v in variants}}
 

@@ -71,12 +71,18 @@ def test_the_plan_file_carries_the_itinerary_and_old_files_still_load(corridor, 
     path = tmp_path / "plan.json"
     result.plans.save(path)
     data = json.loads(path.read_text())
-    step = data["robots"]["R2"]["steps"][3]
+    (robot, k) = next(  # the step that waits for a message
+        (r, k)
+        for r, plan in data["robots"].items()
+        for k, s in enumerate(plan["steps"])
+        if s["primitive"] == "Req"
+    )
+    step = data["robots"][robot]["steps"][k]
     assert list(step)[:4] == ["primitive", "object", "message", "start"] and "end" in step
     loaded = load_plan(path)
     assert loaded == result.plans and loaded.itinerary == result.plans.itinerary
     text = loaded.to_text()
-    start, end = loaded.itinerary.slot("R2", 4)
+    start, end = loaded.itinerary.slot(robot, k + 1)
     assert f"{start:7.1f}-{end:<7.1f}s" in text
     for plan in data["robots"].values():  # a plan file of before: no times at all
         for s in plan["steps"]:
@@ -132,7 +138,12 @@ def test_bad_times_name_the_field(corridor, edit, field, words):
 def test_the_checker_refuses_times_that_break_the_message_order(corridor):
     scenario, result = corridor
     plans = result.plans
-    link = next(x for x in message_links(plans.robots) if plans.itinerary.slot(x.receiver, x.wait)[1] > 1.0)
+
+    def waited(x) -> float:
+        start, end = plans.itinerary.slot(x.receiver, x.wait)
+        return end - start
+
+    link = next(x for x in message_links(plans.robots) if waited(x) > 1.0)  # a wait that lasts
     times = {r: list(slots) for r, slots in plans.itinerary.times.items()}
     # the receiver stops waiting at once, and the rest of its plan moves up accordingly
     start = times[link.receiver][link.wait - 1][0]
@@ -170,9 +181,12 @@ def test_the_itinerary_must_time_exactly_the_plans(corridor):
 def test_a_deadlocking_plan_set_has_no_itinerary(corridor):
     scenario, result = corridor
     plans = dict(result.plans.robots)
-    r2 = plans["R2"]
-    plans["R2"] = replace(
-        r2, steps=tuple(s for s in r2.steps if s.primitive != "Res"), horizon=r2.horizon - 1
+    sender = next(r for r, plan in plans.items() if any(s.primitive == "Res" for s in plan.steps))
+    plan = plans[sender]  # without its answers, a robot waits for ever
+    plans[sender] = replace(
+        plan,
+        steps=tuple(s for s in plan.steps if s.primitive != "Res"),
+        horizon=plan.horizon - sum(s.primitive == "Res" for s in plan.steps),
     )
     with pytest.raises(ValueError, match="deadlock"):
         itinerary(scenario.scene, plans)

@@ -12,8 +12,9 @@ finite traces :math:`\\rho(0), \\dots, \\rho(K)`.
   incremental variant for searching the smallest horizon (:class:`IncrementalUnrolling`).
 """
 
+from cosmop.logic._terms import assert_all
 from cosmop.logic.encode import IncrementalUnrolling, Unrolling
-from cosmop.logic.evaluate import evaluate, evaluate_all
+from cosmop.logic.evaluate import evaluate, evaluate_all, failing
 from cosmop.logic.formulas import (
     FALSE,
     OPS,
@@ -96,6 +97,7 @@ __all__ = [
     "Var",
     "as_expr",
     "as_formula",
+    "assert_all",
     "bools",
     "conj",
     "disj",
@@ -103,6 +105,7 @@ __all__ = [
     "evaluate",
     "evaluate_all",
     "exactly_one",
+    "failing",
     "ints",
     "maximum",
     "minimum",

@@ -67,6 +67,7 @@ from typing import Any
 
 import z3
 
+from cosmop.logic._terms import Terms
 from cosmop.logic.formulas import (
     Always,
     And,
@@ -124,6 +125,7 @@ class _Encoding:
             raise TypeError(f"prefix is a string, got {prefix!r}")
         self._ctx = ctx if ctx is not None else z3.main_ctx()
         self._prefix = prefix
+        self._terms = Terms(self._ctx)
         self._true = z3.BoolVal(True, self._ctx)
         self._false = z3.BoolVal(False, self._ctx)
         self._grid: dict[str, list[Any]] = {name: [] for name in self._signature}
@@ -131,6 +133,7 @@ class _Encoding:
         self._grow(K)
         self._memo: dict[tuple[Formula, int], z3.BoolRef] = {}
         self._integral: dict[LinExpr, bool] = {}
+        self._scales: dict[Compare, int] = {}
 
     # -- the variables ------------------------------------------------------------------------
     @property
@@ -283,29 +286,26 @@ class _Encoding:
         return known
 
     def _number(self, value: Fraction, real: bool) -> Any:
-        if real:
-            return z3.RealVal(value, self._ctx)
-        return z3.IntVal(int(value), self._ctx)
+        return self._terms.number(value, real=real)
 
     def _arith(self, expr: LinExpr, k: int, *, real: bool, scale: int = 1) -> Any:
         """:math:`\\mathit{scale} \\cdot e` at ``k`` (Int arithmetic needs integral scaled coefficients)."""
-        parts = []
+        parts, terms = [], self._terms
         for term, coefficient in expr.terms:
-            c = coefficient * scale
-            z = self._term(term, k, real)
-            parts.append(z if c == 1 else -z if c == -1 else self._number(c, real) * z)
+            c = coefficient if scale == 1 else coefficient * scale
+            parts.append(terms.scaled(c, self._term(term, k, real), real=real))
         if expr.const != 0 or not parts:
             parts.append(self._number(expr.const * scale, real))
-        return parts[0] if len(parts) == 1 else z3.Sum(parts)
+        return parts[0] if len(parts) == 1 else self._terms.add(parts)
 
     def _term(self, term: Shifted | Max | Min, k: int, real: bool) -> Any:
         if isinstance(term, Shifted):
             variable = self._var(term.var, k + term.offset)
-            return z3.ToReal(variable) if real and term.sort == "int" else variable
+            return self._terms.to_real(variable) if real and term.sort == "int" else variable
         inner_real = real or not self._is_int_term(term)
         a = self._arith(term.left, k, real=inner_real)
         b = self._arith(term.right, k, real=inner_real)
-        return z3.If(a > b, a, b) if isinstance(term, Max) else z3.If(a < b, a, b)
+        return self._terms.ite(self._terms.compare(">" if isinstance(term, Max) else "<", a, b), a, b)
 
     def _atom_expr(self, atom: Shifted | Compare, k: int) -> z3.BoolRef:
         """The atom at ``k``, all of whose instants are known to lie in [0, K]."""
@@ -314,15 +314,23 @@ class _Encoding:
         expr, op, const = atom.expr, atom.op, atom.const
         if not expr.terms:
             return self._true if _COMPARE[op](Fraction(0), const) else self._false
-        if all(self._is_int_term(t) for t, _ in expr.terms):
-            # Pure integer arithmetic: clear the denominators (a positive factor keeps `op`).
-            scale = math.lcm(const.denominator, *(c.denominator for _, c in expr.terms))
+        scale = self._scales.get(atom)
+        if scale is None:  # per atom, not per instant
+            scale = self._scales[atom] = self._int_scale(atom)
+        if scale:
             lhs = self._arith(expr, k, real=False, scale=scale)
-            rhs = z3.IntVal(int(const * scale), self._ctx)
+            rhs = self._number(const * scale, False)
         else:
             lhs = self._arith(expr, k, real=True)
-            rhs = z3.RealVal(const, self._ctx)
-        return _COMPARE[op](lhs, rhs)
+            rhs = self._number(const, True)
+        return self._terms.compare(op, lhs, rhs)
+
+    def _int_scale(self, atom: Compare) -> int:
+        """The factor that clears `atom`'s denominators when it is pure integer arithmetic (a
+        positive factor keeps its operator), else 0: it is compared over the reals."""
+        if not all(self._is_int_term(t) for t, _ in atom.expr.terms):
+            return 0
+        return math.lcm(atom.const.denominator, *(c.denominator for _, c in atom.expr.terms))
 
     # -- Boolean structure with constant folding ----------------------------------------------
     # Every constant this class produces is one of the two objects `self._true`, `self._false`
@@ -337,7 +345,7 @@ class _Encoding:
                 kept.append(a)
         if not kept:
             return true
-        return kept[0] if len(kept) == 1 else z3.And(kept)
+        return kept[0] if len(kept) == 1 else self._terms.and_(kept)
 
     def _or(self, args: Sequence[Any]) -> Any:
         true, false = self._true, self._false
@@ -349,14 +357,14 @@ class _Encoding:
                 kept.append(a)
         if not kept:
             return false
-        return kept[0] if len(kept) == 1 else z3.Or(kept)
+        return kept[0] if len(kept) == 1 else self._terms.or_(kept)
 
     def _not(self, a: Any) -> Any:
         if a is self._true:
             return self._false
         if a is self._false:
             return self._true
-        return z3.Not(a)
+        return self._terms.not_(a)
 
     def _iff(self, a: Any, b: Any) -> Any:
         for x, y in ((a, b), (b, a)):
@@ -364,7 +372,7 @@ class _Encoding:
                 return y
             if x is self._false:
                 return self._not(y)
-        return a == b
+        return self._terms.eq(a, b)
 
     # -- formulas -----------------------------------------------------------------------------
     def _lit(self, f: Formula, k: int) -> Any:
@@ -638,12 +646,16 @@ class IncrementalUnrolling(_Encoding):
     def _fresh(self) -> Any:
         return z3.FreshBool(f"{self._prefix}aux", self._ctx)
 
+    def _guarded(self, definition: Any) -> Any:
+        """`definition` at the current frontier only: :math:`e_K \\rightarrow` `definition`."""
+        return self._terms.implies(self._end, definition)
+
     def _new_end(self) -> Any:
         return z3.FreshBool(f"{self._prefix}end{self._K}_", self._ctx)
 
     def _advance(self) -> None:
         """Move the frontier from K to K + 1 and resolve the items that waited for it."""
-        self._out.append(z3.Not(self._end))
+        self._out.append(self._terms.not_(self._end))
         self._grow(self._K + 1)
         self._end = self._new_end()
         pending, self._pending = self._pending, []
@@ -652,19 +664,19 @@ class IncrementalUnrolling(_Encoding):
             if kind == _ATOM:
                 _, atom, k, d = item
                 if k + max(atom.offsets) <= self._K:
-                    self._out.append(d == self._atom_expr(atom, k))
+                    self._out.append(self._terms.eq(d, self._atom_expr(atom, k)))
                 else:
-                    self._out.append(z3.Implies(self._end, z3.Not(d)))
+                    self._out.append(self._guarded(self._terms.not_(d)))
                     self._pending.append(item)
             elif kind == _NEXT:
                 _, f, k, d = item
-                self._out.append(d == self._lit(f.arg, k + 1))
+                self._out.append(self._terms.eq(d, self._lit(f.arg, k + 1)))
             elif kind == _FUTURE:
                 _, f, k, d = item
-                self._out.append(d == self._step(f, k, self._lit(f, k + 1)))
+                self._out.append(self._terms.eq(d, self._step(f, k, self._lit(f, k + 1))))
             else:
                 _, f, d = item
-                self._out.append(z3.Implies(self._end, d == self._lit(f.arg, self._K)))
+                self._out.append(self._guarded(self._terms.eq(d, self._lit(f.arg, self._K))))
                 self._pending.append(item)
 
     def _atom(self, f: Shifted | Compare, k: int) -> Any:
@@ -674,7 +686,7 @@ class IncrementalUnrolling(_Encoding):
         if not offsets or k + max(offsets) <= self._K:
             return self._atom_expr(f, k)
         d = self._fresh()
-        self._out.append(z3.Implies(self._end, z3.Not(d)))
+        self._out.append(self._guarded(self._terms.not_(d)))
         self._pending.append((_ATOM, f, k, d))
         return d
 
@@ -682,7 +694,7 @@ class IncrementalUnrolling(_Encoding):
         if k < self._K:
             return self._lit(f.arg, k + 1)
         d = self._fresh()
-        self._out.append(z3.Implies(self._end, z3.Not(d)))
+        self._out.append(self._guarded(self._terms.not_(d)))
         self._pending.append((_NEXT, f, k, d))
         return d
 
@@ -691,7 +703,7 @@ class IncrementalUnrolling(_Encoding):
         if d is None:
             d = self._fresh()
             self._last_values[f] = d
-            self._out.append(z3.Implies(self._end, d == self._lit(f.arg, self._K)))
+            self._out.append(self._guarded(self._terms.eq(d, self._lit(f.arg, self._K))))
             self._pending.append((_LAST, f, d))
         return d
 
@@ -703,7 +715,7 @@ class IncrementalUnrolling(_Encoding):
         for j in range(i - 1, k - 1, -1):
             if j == K:
                 d = self._fresh()
-                self._out.append(z3.Implies(self._end, d == self._step(f, K, self._beyond(f))))
+                self._out.append(self._guarded(self._terms.eq(d, self._step(f, K, self._beyond(f)))))
                 self._pending.append((_FUTURE, f, K, d))
                 memo[(f, j)] = d
             else:

@@ -51,7 +51,7 @@ from cosmop.logic.formulas import (
     subformulas,
 )
 
-__all__ = ["evaluate", "evaluate_all"]
+__all__ = ["evaluate", "evaluate_all", "failing"]
 
 Trace = Sequence[Mapping[str, object]]
 
@@ -120,6 +120,23 @@ def evaluate_all(formula: object, trace: Trace) -> list[bool]:
     """
     root = as_formula(formula)
     return _Evaluator(trace).column(root)
+
+
+def failing(formulas: Sequence[object], trace: Trace) -> list[int]:
+    """The indices of the `formulas` that do not hold on `trace` (at instant 0).
+
+    One evaluation shares the work of the sub-formulas the formulas have in common, so
+    testing many constraints of one specification on a plan costs little more than one.
+
+    Examples
+    --------
+    >>> from cosmop.logic import ints
+    >>> (x,) = ints("x")
+    >>> failing([x >= 0, x >= 2, x.next() > x], [{"x": 1}, {"x": 3}])
+    [1]
+    """
+    evaluator = _Evaluator(trace)
+    return [i for i, f in enumerate(formulas) if not evaluator.column(as_formula(f))[0]]
 
 
 class _Evaluator:

@@ -177,6 +177,11 @@ def to_fraction(value: object) -> Fraction:
     ValueError
         For non-finite floats.
     """
+    kind = type(value)
+    if kind is Fraction:  # the common case in formulas, first: immutable, so itself
+        return value  # type: ignore[return-value]
+    if kind is int:
+        return Fraction(value)  # type: ignore[arg-type]
     if _is_bool(value):
         raise TypeError(f"expected a number, got the bool {value!r}")
     if isinstance(value, numbers.Integral):

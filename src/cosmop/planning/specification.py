@@ -44,6 +44,7 @@ from __future__ import annotations
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from fractions import Fraction
+from functools import lru_cache
 from types import MappingProxyType
 from typing import Any
 
@@ -110,18 +111,61 @@ the margin is not a plan."""
 
 @dataclass(frozen=True)
 class ObjectVars:
-    """CLTLB(D) variables of one object: position (mm, :func:`position_sort`), carried, away (bool)."""
+    """CLTLB(D) terms of one object: position (mm, :func:`position_sort`), carried, away (bool).
 
-    x: Var
-    y: Var
-    carried: Var
-    away: Var
+    A field no primitive of the robot can change is its value instead of a variable: a
+    number for a position, :data:`~cosmop.logic.TRUE` or :data:`~cosmop.logic.FALSE` for a
+    flag (:meth:`RobotProblem.obj`).  Substituting the value of a variable that the initial
+    state fixes and every step keeps changes no plan, and removes the variable at every instant.
+    """
+
+    x: Var | Fraction
+    y: Var | Fraction
+    carried: Var | Formula
+    away: Var | Formula
 
     @classmethod
     def named(cls, obj: str, sort: str = "int") -> ObjectVars:
         return cls(
             Var(f"{obj}.x", sort), Var(f"{obj}.y", sort), Var(f"{obj}.p", "bool"), Var(f"{obj}.a", "bool")
         )
+
+    @property
+    def resting(self) -> Formula:
+        """:math:`\\neg p \\wedge \\neg a`: the object lies where it is (an obstacle)."""
+        return _negated(self.carried) & _negated(self.away)
+
+    def read(self, state: Mapping[str, Any]) -> tuple[Any, Any, bool, bool]:
+        """``(x, y, carried, away)`` in a state of the trace (values for the fixed fields)."""
+        return tuple(
+            state[v.name] if isinstance(v, Var) else (v if isinstance(v, Fraction) else v == TRUE)
+            for v in (self.x, self.y, self.carried, self.away)
+        )
+
+
+def _negated(flag: Var | Formula) -> Formula:
+    """:math:`\\neg` `flag`, folded when it is a constant."""
+    return FALSE if flag == TRUE else TRUE if flag == FALSE else ~flag
+
+
+def _later(term: Any) -> Any:
+    """:math:`\\bigcirc` `term`; a fixed value is its own successor."""
+    return term.next() if isinstance(term, Var) else term
+
+
+def _released(carried: Var | Formula) -> Formula:
+    """:math:`\\neg\\bigcirc p`: not carried at the next instant."""
+    return _negated(_later(carried))
+
+
+def wall_key(i: int) -> str:
+    """The name of wall `i` (its index in the scene) as an obstacle: ``"wall 3"``."""
+    return f"wall {i}"
+
+
+def object_key(obj: str) -> str:
+    """The name of object `obj` as an obstacle: ``"object O2"``."""
+    return f"object {obj}"
 
 
 @dataclass(frozen=True)
@@ -160,6 +204,10 @@ class RobotProblem:
     margin : Fraction
         mm a GoTo keeps from walls and resting objects between its ends (default
         :data:`MOTION_MARGIN`; 0 lets a motion slide along what it touches).
+    obstacles : frozenset of str, optional
+        Write the parts of only these obstacles (:func:`wall_key`, :func:`object_key`); every
+        wall and object by default.  Lazy geometry (:mod:`cosmop.planning.obstacles`) builds
+        the parts of the obstacles it needs only.
 
     Notes
     -----
@@ -177,8 +225,10 @@ class RobotProblem:
     unrequestable: frozenset[str] = frozenset()
     automaton: DFA | None = None
     margin: Fraction = MOTION_MARGIN
+    obstacles: frozenset[str] | None = None
     actions: tuple[Action, ...] = field(init=False)
     sort: str = field(init=False)
+    objects: Mapping[str, ObjectVars] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "mission", tuple(self.mission))
@@ -187,6 +237,29 @@ class RobotProblem:
         acts = [(prim.name, obj) for prim in self.primitives.values() for obj in prim.targets(self)]
         object.__setattr__(self, "actions", tuple(Action(name, o, i + 1) for i, (name, o) in enumerate(acts)))
         object.__setattr__(self, "sort", position_sort(self.scene, self.start))
+        object.__setattr__(self, "objects", MappingProxyType(self._object_terms()))
+
+    def _object_terms(self) -> dict[str, ObjectVars]:
+        """Each object's terms: variables for what some action changes, values for the rest.
+
+        Only DropOff moves an object and only PickUp and DropOff change ``carried``, both for
+        the objects the mission handles (:attr:`own_objects`); only Req changes ``away``, for
+        its targets.  Every other field keeps its value at instant 0 (the scenario, or
+        `start`) at every step (each primitive's frame condition), so it is that value.
+        """
+        handled = set(self.own_objects)
+        asked = {a.obj for a in self.actions if a.primitive == Primitive.REQ}
+        out = {}
+        for o in self.scene.objects:
+            position, carried, away = self.at_start(o)
+            v = ObjectVars.named(o, self.sort)
+            out[o] = ObjectVars(
+                v.x if o in handled else _num(position[0]),
+                v.y if o in handled else _num(position[1]),
+                v.carried if o in handled else (TRUE if carried else FALSE),
+                v.away if o in asked else (TRUE if away else FALSE),
+            )
+        return out
 
     @property
     def own_objects(self) -> tuple[str, ...]:
@@ -233,8 +306,26 @@ class RobotProblem:
         """:math:`\\epsilon`, the mission event the step performs: 1 + its index in `mission`, 0 none."""
         return Var("event", "int")
 
+    def walls(self) -> list[tuple[int, Any]]:
+        """``(index, wall)`` of the walls whose parts are written (:attr:`obstacles`)."""
+        every = self.obstacles is None
+        return [(i, w) for i, w in enumerate(self.scene.obstacles) if every or wall_key(i) in self.obstacles]
+
+    def obstacle_objects(self) -> list[str]:
+        """The objects whose parts as obstacles are written (:attr:`obstacles`)."""
+        every = self.obstacles is None
+        return [o for o in self.scene.objects if every or object_key(o) in self.obstacles]
+
+    def at_start(self, obj: str) -> tuple[tuple[float, float], bool, bool]:
+        """``(position, carried, away)`` of `obj` at instant 0: in `start`, else the scenario's."""
+        known = self.start.objects.get(obj) if self.start is not None else None
+        if known is None:
+            return self.scene.objects[obj].position, False, False
+        return known.position, known.carried, known.away
+
     def obj(self, obj: str) -> ObjectVars:
-        return ObjectVars.named(obj, self.sort)
+        """The terms of `obj` (:class:`ObjectVars`; fixed fields are values)."""
+        return self.objects[obj]
 
     @property
     def side(self) -> Fraction:
@@ -288,8 +379,9 @@ def _docked(p: RobotProblem, obj: str, ox, oy, d: Fraction) -> Formula:
     return disj(p.h.eq(h) & p.x.eq(x) & p.y.eq(y) for h, x, y in _docking_poses(p, obj, ox, oy, d))
 
 
-def _static(*vars_: Var) -> Formula:
-    return conj(v.next().eq(v) if v.sort != "bool" else eq(v.next(), v) for v in vars_)
+def _static(*terms: Any) -> Formula:
+    """Every variable among `terms` keeps its value (fixed values always do)."""
+    return conj(v.next().eq(v) if v.sort != "bool" else eq(v.next(), v) for v in terms if isinstance(v, Var))
 
 
 def _half_plane(h: HalfPlane, x, y) -> Formula:
@@ -324,7 +416,7 @@ def _gripper_clear(p: RobotProblem, obj: str, ox, oy) -> list[tuple[str, Formula
     """
     side = _num(p.scene.objects[obj].size)
     out = []
-    for i, wall in enumerate(p.scene.obstacles):
+    for i, wall in p.walls():
         pairs = zip(
             wall_regions(wall.start, wall.end, p.side), wall_regions(wall.start, wall.end, side), strict=True
         )
@@ -353,7 +445,7 @@ def _handling_room(p: RobotProblem, obj: str, places: list | None) -> list[tuple
     far from every such place its constraint always holds, and is left out (a smaller formula).
     """
     out = []
-    for o in p.scene.objects:
+    for o in p.obstacle_objects():
         if o == obj:
             continue
         size = _num(p.scene.objects[o].size)
@@ -368,7 +460,7 @@ def _handling_room(p: RobotProblem, obj: str, places: list | None) -> list[tuple
                     continue
         w = p.obj(o)
         apart = disj([p.x <= w.x - gap, p.x >= w.x + gap, p.y <= w.y - gap, p.y >= w.y + gap])
-        out.append((f"room from {o} while handling {obj}", Implies(~w.carried & ~w.away, apart)))
+        out.append((f"room from {o} while handling {obj}", Implies(w.resting, apart)))
     return out
 
 
@@ -449,7 +541,8 @@ class _Face:
         return self.a * dy - self.b * dx
 
 
-def _apart(x, y, faces: Sequence[tuple[_Face, _Face]]) -> Formula:
+@lru_cache(maxsize=16384)  # robots of one size share their walls' formulas (pure, hashable)
+def _apart(x, y, faces: tuple[tuple[_Face, _Face], ...]) -> Formula:
     """A straight motion from :math:`(x, y)` to :math:`\\bigcirc(x, y)` clear of one obstacle.
 
     `faces` pairs each side on which a square touching the obstacle may lie with the same side
@@ -471,20 +564,20 @@ def _apart(x, y, faces: Sequence[tuple[_Face, _Face]]) -> Formula:
     return disj(out)
 
 
-def _wall_sides(p: RobotProblem, wall, name: str) -> list[tuple[_Face, _Face]]:
+def _wall_sides(p: RobotProblem, wall, name: str) -> tuple[tuple[_Face, _Face], ...]:
     """The four sides of a wall for the robot's square, touching and at the margin."""
     touching = [_Face(h.a, h.b, h.c) for h in wall_regions(wall.start, wall.end, p.side, name)]
     if not p.margin:
-        return list(zip(touching, touching, strict=True))
+        return tuple(zip(touching, touching, strict=True))
     grown = [_Face(h.a, h.b, h.c) for h in wall_regions(wall.start, wall.end, p.side + 2 * p.margin, name)]
-    return list(zip(touching, grown, strict=True))
+    return tuple(zip(touching, grown, strict=True))
 
 
-def _object_sides(v: ObjectVars, d: Fraction, m: Fraction) -> list[tuple[_Face, _Face]]:
+def _object_sides(v: ObjectVars, d: Fraction, m: Fraction) -> tuple[tuple[_Face, _Face], ...]:
     """Left, right, below and above an object at centre distance `d` (touching) and `d + m`."""
     touching = [_Face(*side) for side in square_sides(v.x, v.y, d)]
     far = [_Face(*side) for side in square_sides(v.x, v.y, d + m)] if m else touching
-    return list(zip(touching, far, strict=True))
+    return tuple(zip(touching, far, strict=True))
 
 
 class GoTo(Encoding):
@@ -503,13 +596,13 @@ class GoTo(Encoding):
     def parts(self, p, obj):
         x, y = p.x, p.y
         out = [("GoTo keeps the objects", _objects_static(p))]
-        for i, wall in enumerate(p.scene.obstacles):
+        for i, wall in p.walls():
             sides = _wall_sides(p, wall, f"wall {i}")
             out.append((f"wall {i} {[list(wall.start), list(wall.end)]}", _apart(x, y, sides)))
-        for o in p.scene.objects:
+        for o in p.obstacle_objects():
             v, d = p.obj(o), p.clearance(o)
             clear = _apart(x, y, _object_sides(v, d, p.margin))
-            out.append((f"object {o}", Implies(~v.carried & ~v.away, clear)))
+            out.append((f"object {o}", Implies(v.resting, clear)))
         return out
 
 
@@ -523,10 +616,9 @@ class PickUp(Encoding):
 
     def parts(self, p, obj):
         v, d = p.obj(obj), p.clearance(obj)
-        carry = conj(
-            [~p.obj(o).carried for o in p.scene.objects]
-            + [p.obj(o).carried.next() if o == obj else ~p.obj(o).carried.next() for o in p.scene.objects]
-        )
+        now = [_negated(p.obj(o).carried) for o in p.scene.objects]
+        later = [(_later if o == obj else _released)(p.obj(o).carried) for o in p.scene.objects]
+        carry = conj(now + later)
         pose = _docked(p, obj, v.x, v.y, d) & ~v.away
         out = [(f"PickUp {obj}", _robot_static(p) & carry & pose & _objects_static(p, carried=False))]
         return out + _gripper_clear(p, obj, v.x, v.y) + _handling_room(p, obj, _pick_places(p, obj))
@@ -543,14 +635,14 @@ class DropOff(Encoding):
 
     def parts(self, p, obj):
         v, d = p.obj(obj), p.clearance(obj)
-        held = conj(p.obj(o).carried if o == obj else ~p.obj(o).carried for o in p.scene.objects)
-        released = conj(~p.obj(o).carried.next() for o in p.scene.objects)
+        held = conj(p.obj(o).carried if o == obj else _negated(p.obj(o).carried) for o in p.scene.objects)
+        released = conj(_released(p.obj(o).carried) for o in p.scene.objects)
         place = _docked(p, obj, v.x.next(), v.y.next(), d)
         rest = _objects_static(p, carried=False, skip=obj) & _static(v.away)
         out = [(f"DropOff {obj}", _robot_static(p) & held & released & place & rest)]
         out += _gripper_clear(p, obj, v.x.next(), v.y.next()) + _handling_room(p, obj, _drop_places(p, obj))
         side = _num(p.scene.objects[obj].size)
-        for i, wall in enumerate(p.scene.obstacles):
+        for i, wall in p.walls():
             regions = wall_regions(wall.start, wall.end, side, f"wall {i}")
             out.append(
                 (
@@ -558,7 +650,7 @@ class DropOff(Encoding):
                     disj(_half_plane(h, v.x.next(), v.y.next()) for h in regions),
                 )
             )
-        for o in p.scene.objects:
+        for o in p.obstacle_objects():
             if o == obj:
                 continue
             w = p.obj(o)
@@ -571,7 +663,7 @@ class DropOff(Encoding):
                     v.y.next() >= w.y + gap,
                 ]
             )
-            out.append((f"{obj} dropped clear of {o}", Implies(~w.carried & ~w.away, apart)))
+            out.append((f"{obj} dropped clear of {o}", Implies(w.resting, apart)))
         return out
 
 
@@ -701,21 +793,20 @@ def automaton_parts(p: RobotProblem) -> list[tuple[str, Formula]]:
 def initial_state(p: RobotProblem) -> Formula:
     """Instant 0: the scenario's poses and positions, nothing carried or away, no primitive.
 
-    With ``p.start`` (a replan mid-mission) instant 0 is that state instead.
+    With ``p.start`` (a replan mid-mission) instant 0 is that state instead.  Fields that are
+    fixed values (:meth:`RobotProblem.obj`) already hold them and need no constraint.
     """
-    if p.start is not None:
-        x0, y0, h0 = p.start.robot
-        parts = [p.x.eq(_num(x0)), p.y.eq(_num(y0)), p.h.eq(_num(h0)), p.pi.eq(NONE)]
-        for o, state in p.start.objects.items():
-            v = p.obj(o)
-            parts += [v.x.eq(_num(state.position[0])), v.y.eq(_num(state.position[1]))]
-            parts += [v.carried if state.carried else ~v.carried, v.away if state.away else ~v.away]
-        return conj(parts)
-    x0, y0, h0 = p.scene.robots[p.robot].pose
+    x0, y0, h0 = p.start.robot if p.start is not None else p.scene.robots[p.robot].pose
     parts = [p.x.eq(_num(x0)), p.y.eq(_num(y0)), p.h.eq(_num(h0)), p.pi.eq(NONE)]
-    for o, spec in p.scene.objects.items():
+    for o in p.scene.objects:
+        position, carried, away = p.at_start(o)
         v = p.obj(o)
-        parts += [v.x.eq(_num(spec.position[0])), v.y.eq(_num(spec.position[1])), ~v.carried, ~v.away]
+        for term, value in ((v.x, position[0]), (v.y, position[1])):
+            if isinstance(term, Var):
+                parts.append(term.eq(_num(value)))
+        for flag, value in ((v.carried, carried), (v.away, away)):
+            if isinstance(flag, Var):
+                parts.append(flag if value else ~flag)
     return conj(parts)
 
 

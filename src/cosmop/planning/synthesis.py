@@ -26,6 +26,7 @@ from __future__ import annotations
 import time
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import z3
@@ -33,8 +34,9 @@ import z3
 from cosmop.automata import DFA
 from cosmop.automata.operations import project, trim
 from cosmop.events import Event, Primitive, parse_event
-from cosmop.logic import IncrementalUnrolling, Signature, Unrolling, conj, to_fraction
+from cosmop.logic import IncrementalUnrolling, Signature, Unrolling, assert_all, conj, to_fraction
 from cosmop.planning.messages import answer_early, place_mission_messages, strip_messages, wait_early
+from cosmop.planning.obstacles import Geometry, obstacle_of
 from cosmop.planning.plan import ObjectState, RobotPlan, State, Step
 from cosmop.planning.reach import unreachable
 from cosmop.planning.specification import (
@@ -76,6 +78,8 @@ class Synthesis:
         The horizons proved unsatisfiable before the plan was found (evidence that ``horizon``
         is minimal: every shorter length is among them or below the lower bound, one step per
         non-return event).
+    admitted : int
+        Obstacles the lazy geometry added to the solver after a plan broke them.
     """
 
     robot: str
@@ -88,6 +92,7 @@ class Synthesis:
     solve_s: float = 0.0
     checks: int = field(default=0, repr=False)
     unsat_horizons: tuple[int, ...] = ()
+    admitted: int = field(default=0, repr=False)
 
 
 def _solver(rlimit: int, ctx: z3.Context) -> z3.Solver:
@@ -117,14 +122,10 @@ def _plan(
         action = decode(p, int(state["pi"]))
         if action.primitive == Primitive.REQ:
             requested.append(action.obj)
-        objects = {
-            o: ObjectState(
-                (_value(state[f"{o}.x"]), _value(state[f"{o}.y"])),
-                bool(state[f"{o}.p"]),
-                bool(state[f"{o}.a"]),
-            )
-            for o in p.scene.objects
-        }
+        objects = {}
+        for o in p.scene.objects:
+            x, y, carried, away = p.obj(o).read(state)
+            objects[o] = ObjectState((_value(x), _value(y)), bool(carried), bool(away))
         steps.append(
             Step(
                 action.primitive,
@@ -145,9 +146,9 @@ def _count_requests(p: RobotProblem, unrolling: Unrolling | IncrementalUnrolling
 
 def _feasible_within(p: RobotProblem, events: tuple[Event, ...], K: int, rlimit: int) -> bool:
     """Whether some plan of at most ``K`` steps realises `events` (one solver, the horizon grown)."""
-    formula = conj(f for _, f in specification(p, events))
-    horizons = _horizons(formula, max(1, _least_steps(events)), K, rlimit, incremental=True)
-    return any(h.solver.check(*h.assumptions) == z3.sat for h in horizons)
+    geometry = Geometry(p, events, lazy=True)
+    horizons = _horizons(geometry, max(1, _least_steps(events)), K, rlimit, incremental=True)
+    return any(h.check(geometry)[1] is not None for h in horizons)
 
 
 def synthesize(
@@ -163,6 +164,7 @@ def synthesize(
     explain: bool = True,
     unrequestable: frozenset[str] = frozenset(),
     margin: float = MOTION_MARGIN,
+    lazy: bool = True,
 ) -> Synthesis:
     """The shortest safe plan of motion primitives for one robot's local mission.
 
@@ -193,6 +195,11 @@ def synthesize(
     margin : float
         mm a motion keeps from walls and resting objects between its ends
         (:data:`~cosmop.planning.specification.MOTION_MARGIN`; 0 allows sliding along them).
+    lazy : bool
+        Lazy geometry (the default): the solver starts with the walls and objects near the
+        robot's route and adds those a plan breaks, until none does
+        (:mod:`cosmop.planning.obstacles`); the same horizon and number of requests as the
+        eager encoding (``False``: every obstacle from the start), proved there.
 
     Returns
     -------
@@ -208,7 +215,7 @@ def synthesize(
     if m.walled_off is not None:  # no horizon can do it: say so without the solver
         return Synthesis(robot, False, None, None, reason=m.walled_off, solve_s=time.perf_counter() - t0)
     p = _problem(scene, robot, m, requests=requests, start=start, unrequestable=unrequestable, margin=margin)
-    found = _shortest_plan(p, m.lower, max_horizon, rlimit, incremental)
+    found = _shortest_plan(p, m.lower, max_horizon, rlimit, incremental, lazy)
     if found.plan is not None:
         return found.synthesis(robot, t0, plan=_place_messages(p, found.plan, m.full))
     if found.gave_up is not None:  # the solver could not decide a horizon: claim nothing beyond
@@ -322,13 +329,47 @@ class _Horizon:
     unrolling: Unrolling | IncrementalUnrolling
     assumptions: tuple[z3.BoolRef, ...]
 
+    def add(self, formula) -> None:
+        """Assert `formula` (at instant 0) from now on, at this horizon and every later one."""
+        if isinstance(self.unrolling, IncrementalUnrolling):
+            assert_all(self.solver, self.unrolling.require(formula))
+        else:
+            self.solver.add(self.unrolling.encode(formula))
 
-def _horizons(formula, first: int, last: int, rlimit: int, *, incremental: bool) -> Iterator[_Horizon]:
-    """`formula` unrolled for ``K = first .. last`` in turn, each in a solver ready to check.
+    def check(self, geometry: Geometry, *bound: z3.BoolRef) -> tuple[Any, z3.ModelRef | None, int]:
+        """Solve, with `bound` asserted for this call only, until the model breaks no obstacle.
+
+        A model that breaks obstacles the solver does not hold yet (:meth:`Geometry.broken`)
+        makes them held (asserted outside the bound's scope) and the check is repeated; see
+        :mod:`cosmop.planning.obstacles` for why the answer is the eager encoding's.
+
+        Returns
+        -------
+        verdict, model (when sat), checks made
+        """
+        checks = 0
+        while True:
+            checks += 1
+            self.solver.push()
+            self.solver.add(*bound)
+            verdict = self.solver.check(*self.assumptions)
+            model = self.solver.model() if verdict == z3.sat else None
+            broken = geometry.broken(self.unrolling.trace(model)) if model is not None else []
+            self.solver.pop()
+            if not broken:
+                return verdict, model, checks
+            self.add(geometry.admit(broken))
+
+
+def _horizons(
+    geometry: Geometry, first: int, last: int, rlimit: int, *, incremental: bool
+) -> Iterator[_Horizon]:
+    """The specification unrolled for ``K = first .. last`` in turn, each in a solver ready to check.
 
     Parameters
     ----------
-    formula : Formula
+    geometry : Geometry
+        The specification and which obstacle parts the solver holds.
     first, last : int
         The horizons, both included.
     rlimit : int
@@ -337,7 +378,7 @@ def _horizons(formula, first: int, last: int, rlimit: int, *, incremental: bool)
         One solver whose unrolling grows (the horizon chosen by an assumption), else a fresh
         context and solver per horizon.
     """
-    signature = Signature.of(formula)
+    signature = Signature.of(geometry.held)  # every variable is in the initial state
     grow: IncrementalUnrolling | None = None
     for K in range(first, last + 1):
         if incremental:  # one solver; the horizon grows under the assumption ``end``
@@ -345,15 +386,15 @@ def _horizons(formula, first: int, last: int, rlimit: int, *, incremental: bool)
                 ctx = z3.Context()
                 grow = IncrementalUnrolling(signature, K, ctx=ctx)
                 s = _solver(rlimit, ctx)
-                s.add(grow.require(formula))
+                assert_all(s, grow.require(geometry.held))
             else:
-                s.add(grow.extend(K))
+                assert_all(s, grow.extend(K))
             yield _Horizon(K, s, grow, (grow.end,))
         else:  # a fresh context and solver per horizon: answers never depend on earlier calls
             ctx = z3.Context()
             u = Unrolling(signature, K, ctx=ctx)
             s = _solver(rlimit, ctx)
-            s.add(u.encode(formula))
+            s.add(u.encode(geometry.held))
             yield _Horizon(K, s, u, ())
 
 
@@ -375,6 +416,8 @@ class _Search:
         Solver calls made.
     unsat : tuple of int
         The horizons proved unsatisfiable.
+    admitted : int
+        Obstacles the lazy geometry added after a plan broke them.
     """
 
     plan: RobotPlan | None = None
@@ -383,6 +426,7 @@ class _Search:
     gave_up: str | None = None
     checks: int = 0
     unsat: tuple[int, ...] = ()
+    admitted: int = 0
 
     def synthesis(
         self,
@@ -405,58 +449,59 @@ class _Search:
             solve_s=time.perf_counter() - t0,
             checks=self.checks,
             unsat_horizons=self.unsat,
+            admitted=self.admitted,
         )
 
 
-def _shortest_plan(p: RobotProblem, lower: int, max_horizon: int, rlimit: int, incremental: bool) -> _Search:
+def _shortest_plan(
+    p: RobotProblem, lower: int, max_horizon: int, rlimit: int, incremental: bool, lazy: bool
+) -> _Search:
     """The first satisfiable horizon from `lower` to `max_horizon`, and its plan.
 
     Each horizon is checked in turn; at the first satisfiable one the number of requests is
     minimised (:func:`_fewest_requests`).  A horizon the solver cannot decide within `rlimit`
-    ends the search with ``gave_up`` set.
+    ends the search with ``gave_up`` set.  With `lazy`, obstacles join the solver as plans
+    break them (:class:`~cosmop.planning.obstacles.Geometry`).
     """
-    formula = conj(f for _, f in specification(p))
+    geometry = Geometry(p, None, lazy)
     checks = 0
     unsat: list[int] = []
-    for h in _horizons(formula, lower, max_horizon, rlimit, incremental=incremental):
-        checks += 1
-        verdict = h.solver.check(*h.assumptions)
+    for h in _horizons(geometry, lower, max_horizon, rlimit, incremental=incremental):
+        verdict, model, made = h.check(geometry)
+        checks += made
         if verdict == z3.unknown:  # no answer within the resource limit: say so, claim nothing more
             why = (
                 f"{p.robot}: the solver gave up at K={h.K} ({h.solver.reason_unknown()}, resource limit "
                 f"{rlimit}); no plan of at most {h.K - 1} steps exists, longer ones were not searched"
             )
-            return _Search(gave_up=why, checks=checks, unsat=tuple(unsat))
-        if verdict != z3.sat:
+            return _Search(gave_up=why, checks=checks, unsat=tuple(unsat), admitted=geometry.admitted)
+        if model is None:
             unsat.append(h.K)
             continue
-        model, more = _fewest_requests(p, h)
+        model, more = _fewest_requests(p, h, geometry, model)
         plan, asked = _plan(p, h.unrolling, model)
-        return _Search(plan, h.K, asked, checks=checks + more, unsat=tuple(unsat))
-    return _Search(checks=checks, unsat=tuple(unsat))
+        return _Search(plan, h.K, asked, checks=checks + more, unsat=tuple(unsat), admitted=geometry.admitted)
+    return _Search(checks=checks, unsat=tuple(unsat), admitted=geometry.admitted)
 
 
-def _fewest_requests(p: RobotProblem, h: _Horizon) -> tuple[z3.ModelRef, int]:
+def _fewest_requests(
+    p: RobotProblem, h: _Horizon, geometry: Geometry, model: z3.ModelRef
+) -> tuple[z3.ModelRef, int]:
     """A model of the satisfiable horizon `h` with the fewest Req steps, and the checks it took.
 
-    The bound on the number of requests is tightened until unsat, each bound in its own
-    ``push``/``pop`` so that `h`'s solver is left as it was.
+    Starting from `model`, the bound on the number of requests is tightened until unsat, each
+    bound for one check only (:meth:`_Horizon.check`), so that `h`'s solver keeps no bound.
     """
-    s = h.solver
-    model, checks = s.model(), 0
+    checks = 0
     if h.K > 0 and request_codes(p):  # at K = 0 there is no step to count
         count = _count_requests(p, h.unrolling)
         best = model.eval(count, model_completion=True).as_long()
         while best > 0:
-            s.push()
-            s.add(count <= best - 1)
-            checks += 1
-            if s.check(*h.assumptions) != z3.sat:
-                s.pop()
+            _, better, made = h.check(geometry, count <= best - 1)
+            checks += made
+            if better is None:
                 break
-            model = s.model()
-            best = model.eval(count, model_completion=True).as_long()
-            s.pop()
+            model, best = better, better.eval(count, model_completion=True).as_long()
     return model, checks
 
 
@@ -565,11 +610,6 @@ def _because(head: str, blocking: tuple[str, ...] | None, K: int) -> str:
     return f"{head}; blocked by: {what}"
 
 
-def _is_obstacle(name: str) -> bool:
-    """Whether a specification part keeps the robot or a good off a wall or an object."""
-    return name.startswith(("wall", "object", "gripper", "room from")) or " dropped clear of " in name
-
-
 def _core(p: RobotProblem, parts: list[tuple[str, object]], K: int, rlimit: int) -> tuple[str, ...] | None:
     """A minimal set of obstacle parts of `parts` that leaves no plan of ``K`` steps.
 
@@ -586,7 +626,7 @@ def _core(p: RobotProblem, parts: list[tuple[str, object]], K: int, rlimit: int)
     names: dict[str, str] = {}
     guards = []
     for j, (name, f) in enumerate(parts):
-        if _is_obstacle(name):
+        if obstacle_of(name) is not None:
             label = z3.Bool(f"part{j}", ctx)
             names[str(label)] = name
             guards.append(label)

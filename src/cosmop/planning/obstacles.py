@@ -1,0 +1,242 @@
+"""Which obstacle constraints the solver holds: all of them (eager), or lazily, those a plan needs.
+
+A robot's specification (:func:`cosmop.planning.specification.specification`) is a list of
+named parts; some keep the robot or its goods off one wall or one resting object (the GoTo
+clearance, the gripper, the drop place, the room kept while handling).  On a large map almost
+all of them are about walls the robot never comes near, yet each is unrolled at every instant.
+
+Lazy geometry holds back the obstacles far from the robot's route and adds an obstacle's parts
+only when a plan breaks one of them.  Write :math:`\\Phi = C \\wedge \\bigwedge_{o \\in O} G_o`
+for the specification: :math:`C` the parts about no single obstacle, :math:`G_o` the
+conjunction of obstacle :math:`o`'s parts.  The solver holds :math:`\\Phi_S = C \\wedge
+\\bigwedge_{o \\in S} G_o` for a set :math:`S \\subseteq O` that only grows.
+
+**Claim.** The search of :mod:`cosmop.planning.synthesis` (horizons :math:`K` in increasing
+order; at each, models of :math:`\\Phi_S` are checked against every :math:`G_o`,
+:math:`o \\notin S`, exactly, by :func:`cosmop.logic.failing`, and the broken obstacles join
+:math:`S` before solving again; then the bound on requests is tightened the same way) returns
+the same shortest :math:`K` and the same least number of requests as the eager encoding
+:math:`S = O`.
+
+*Proof.* Every model of :math:`\\Phi` is a model of :math:`\\Phi_S` (fewer conjuncts).  (1) An
+unsatisfiable :math:`\\Phi_S` at horizon :math:`K`, or with at most :math:`r` requests, makes
+:math:`\\Phi` unsatisfiable there too.  (2) A model of :math:`\\Phi_S` that satisfies every
+:math:`G_o` with :math:`o \\notin S` is a model of :math:`\\Phi`, and it is the only kind of
+model the search accepts.  (3) Each rejected model adds at least one obstacle to the finite
+:math:`S`, so every check ends, at the latest with :math:`S = O`, either in an accepted model
+or in unsatisfiability.  By (1) every horizon below the one returned has no plan of
+:math:`\\Phi`; by (2) the one returned has one, so it is :math:`\\Phi`'s shortest.  At that
+horizon, by (2) the plan with :math:`r` requests is a plan of :math:`\\Phi`, and by (1) no plan
+of :math:`\\Phi` has fewer.  :math:`\\square`
+
+Which obstacles start in :math:`S` changes only the number of rounds, never the answer: those
+within reach of the box around the robot's start, home, its goods and its drop places.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping, Sequence
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+import shapely
+
+from cosmop.events import Event
+from cosmop.logic import Formula, conj, failing, to_fraction
+from cosmop.planning.regions import square_sides, wall_regions
+from cosmop.planning.specification import (
+    HANDLING_CLEARANCE,
+    RobotProblem,
+    object_key,
+    specification,
+    wall_key,
+)
+
+_OBSTACLE = (
+    re.compile(r"^(wall \d+)\b"),  # GoTo clear of wall i
+    re.compile(r"\bclear of (wall \d+)$"),  # the gripper and a drop, clear of wall i
+    re.compile(r"^object (\S+)$"),  # GoTo clear of object o
+    re.compile(r"^room from (\S+) while handling \S+$"),
+    re.compile(r"^\S+ dropped clear of (\S+)$"),
+)
+
+
+def obstacle_of(name: str) -> str | None:
+    """The obstacle a specification part keeps clear of: ``"wall 3"``, ``"object O2"``, or ``None``.
+
+    Examples
+    --------
+    >>> obstacle_of("gripper clear of wall 3"), obstacle_of("O1 dropped clear of O2")
+    ('wall 3', 'object O2')
+    >>> obstacle_of("PickUp O1") is None
+    True
+    """
+    for i, pattern in enumerate(_OBSTACLE):
+        found = pattern.search(name)
+        if found:
+            return found.group(1) if i < 2 else f"object {found.group(1)}"
+    return None
+
+
+class Geometry:
+    """The obstacle parts of one robot's specification, and which of them the solver holds.
+
+    Parameters
+    ----------
+    p : RobotProblem
+    events : sequence of Event, optional
+        The events planned (default the problem's mission), as for
+        :func:`~cosmop.planning.specification.specification`.
+    lazy : bool
+        Hold back the obstacles out of reach of the robot's route until a plan breaks them
+        (see the module docstring); else hold every part from the start.
+
+    Attributes
+    ----------
+    held : Formula
+        What the solver holds, :math:`\\Phi_S`.
+    admitted : int
+        Obstacles added after a plan broke them.
+
+    Notes
+    -----
+    The parts of an obstacle not held are written only when a plan comes near enough to it to
+    need testing: a plan that keeps, at every instant, the robot and its goods on one side of
+    an obstacle (the side's half-plane grown by the motion margin for the robot, as in
+    :func:`~cosmop.planning.specification.specification`) satisfies all its parts, so only the
+    others are written and evaluated exactly.  The one-side test is numeric with a safety gap
+    (:data:`_GAP`): it may send an obstacle to the exact test needlessly, never skip one.
+    """
+
+    def __init__(self, p: RobotProblem, events: Sequence[Event] | None, lazy: bool) -> None:
+        keys = [wall_key(i) for i in range(len(p.scene.obstacles))] + [object_key(o) for o in p.scene.objects]
+        held = set(keys) if not lazy else _near_route(p) | {object_key(o) for o in p.own_objects}
+        self._p, self._events = p, events
+        self.held = conj(f for _, f in specification(replace(p, obstacles=frozenset(held)), events))
+        self._waiting = [k for k in keys if k not in held]
+        self._written: dict[str, Formula] = {}
+        self._sides = _Sides(p) if self._waiting else None
+        self.admitted = 0
+
+    @property
+    def waiting(self) -> tuple[str, ...]:
+        """The obstacles the solver does not hold yet."""
+        return tuple(self._waiting)
+
+    def broken(self, trace: Sequence[Mapping[str, Any]]) -> list[str]:
+        """The obstacles not yet held whose parts the plan `trace` breaks (exact evaluation)."""
+        if self._sides is None:
+            return []
+        near = self._sides.unsure(self._waiting, trace)
+        self._write([k for k in near if k not in self._written])
+        return [near[i] for i in failing([self._written[k] for k in near], trace)]
+
+    def admit(self, keys: Sequence[str]) -> Formula:
+        """Move the obstacles `keys` into the solver's share: their parts, to assert."""
+        self._write([k for k in keys if k not in self._written])
+        added = conj(self._written.pop(k) for k in keys)
+        self._waiting = [k for k in self._waiting if k not in set(keys)]
+        self.admitted += len(keys)
+        self.held = conj([self.held, added])
+        return added
+
+    def _write(self, keys: Sequence[str]) -> None:
+        if not keys:
+            return
+        groups: dict[str, list[Formula]] = {k: [] for k in keys}
+        for name, formula in specification(replace(self._p, obstacles=frozenset(keys)), self._events):
+            key = obstacle_of(name)
+            if key in groups:
+                groups[key].append(formula)
+        self._written.update({k: conj(fs) for k, fs in groups.items()})
+
+
+_GAP = 1e-3
+"""mm by which the numeric one-side test must clear a half-plane (floating point is not exact)."""
+
+
+class _Sides:
+    """Each obstacle's half-planes that keep the robot, and its goods, clear of it (floats).
+
+    For a wall: its four regions (:func:`~cosmop.planning.regions.wall_regions`) for the
+    robot's square grown by the margin, and for each good's square; for a resting object: its
+    four sides (:func:`~cosmop.planning.regions.square_sides`) at the robot's centre distance
+    plus the larger of the margin and the handling clearance, and at each good's.  Each row is
+    :math:`(a, b, c)` scaled so that :math:`|a| + |b| = 1`.
+    """
+
+    def __init__(self, p: RobotProblem) -> None:
+        self._p = p
+        side, margin = p.side, p.margin
+        goods = {o: to_fraction(p.scene.objects[o].size) for o in p.own_objects}
+        planes: dict[str, list] = {}
+        for i, wall in enumerate(p.scene.obstacles):
+            regions = [wall_regions(wall.start, wall.end, g) for g in (side + 2 * margin, *goods.values())]
+            planes[wall_key(i)] = [[(h.a, h.b, h.c) for h in body] for body in regions]
+        robot_gap = max(margin, HANDLING_CLEARANCE)
+        for o, ob in p.scene.objects.items():
+            if o in goods:
+                continue  # own goods move: always held
+            at, size = p.at_start(o)[0], to_fraction(ob.size)
+            ox, oy = to_fraction(at[0]), to_fraction(at[1])
+            robot = list(square_sides(ox, oy, (size + side) / 2 + robot_gap))
+            carried = [list(square_sides(ox, oy, (size + g) / 2)) for g in goods.values()]
+            planes[object_key(o)] = [robot, *carried]
+        self._keys = list(planes)
+        self._row = {k: n for n, k in enumerate(self._keys)}
+        table = np.array([planes[k] for k in self._keys], dtype=float)  # (obstacles, bodies, 4 sides, abc)
+        table /= np.abs(table[..., :2]).sum(axis=-1, keepdims=True)
+        self._table = table
+        self._goods = list(goods)
+
+    def unsure(self, keys: Sequence[str], trace: Sequence[Mapping[str, Any]]) -> list[str]:
+        """The obstacles among `keys` that the plan does not keep to one side of, in order."""
+        if not keys:
+            return []
+        p = self._p
+        bodies = [[(float(s["x"]), float(s["y"])) for s in trace]]
+        bodies += [[tuple(float(v) for v in p.obj(o).read(s)[:2]) for s in trace] for o in self._goods]
+        rows = self._table[[self._row[k] for k in keys]]
+        clear = np.ones(rows.shape[:1] + rows.shape[2:3], dtype=bool)  # (obstacles, 4 sides)
+        for b, points in enumerate(bodies):
+            xy = np.asarray(points)  # (instants, 2)
+            plane = rows[:, b]  # (obstacles, 4, 3)
+            value = plane[..., 0, None] * xy[:, 0] + plane[..., 1, None] * xy[:, 1]
+            clear &= (value >= plane[..., 2, None] + _GAP).all(axis=-1)
+        return [k for k, ok in zip(keys, clear.any(axis=1), strict=True) if not ok]
+
+
+def _near_route(p: RobotProblem) -> set[str]:
+    """The obstacles within reach of the box around where the robot must be.
+
+    The box holds the robot's start and home, its goods where they start and the places it
+    may drop them; it is grown by the robot's side, the motion margin and the largest good,
+    so that every obstacle a straight drive inside it could touch is in.
+    """
+    scene = p.scene
+    points = [p.scene.robots[p.robot].pose[:2]]
+    if p.start is not None:
+        points.append(p.start.robot[:2])
+    for o in p.own_objects:
+        points.append(p.at_start(o)[0])
+        for e in p.mission:
+            if e.kind == "drop" and e.obj == o:
+                ws = scene.workspaces[e.workspace].centres(scene.objects[o].size)
+                (x0, x1), (y0, y1) = ws.ranges
+                points += [(x0, y0), (x1, y1)]
+    grow = float(p.side + p.margin) + max((ob.size for ob in scene.objects.values()), default=0.0)
+    xs, ys = [q[0] for q in points], [q[1] for q in points]
+    box = shapely.box(min(xs) - grow, min(ys) - grow, max(xs) + grow, max(ys) + grow)
+    near = set()
+    for i, wall in enumerate(scene.obstacles):
+        if box.intersects(shapely.LineString([wall.start, wall.end])):
+            near.add(wall_key(i))
+    for o, ob in scene.objects.items():
+        if box.intersects(shapely.Point(*p.at_start(o)[0]).buffer(ob.size, cap_style="square")):
+            near.add(object_key(o))
+    return near
+
+
+__all__ = ["Geometry", "obstacle_of"]
