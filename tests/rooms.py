@@ -1,4 +1,5 @@
-"""A seeded one-robot room with a branching delivery mission (tests and benchmarks share it)."""
+"""Seeded one-robot rooms (tests and benchmarks share them): a room with a branching delivery
+mission, and a room of shelves with a good to fetch."""
 
 from __future__ import annotations
 
@@ -58,3 +59,41 @@ def branching_words() -> list[tuple[str, ...]]:
                     )
                 )
     return out
+
+
+def shelves(seed: int) -> dict:
+    """A 12 m x 6 m room with shelf blocks in a 4 x 2 grid of bays; one robot fetches a good
+    lying against a shelf face (boxed in by other goods one time in three, so that it needs a
+    request) and brings it to a
+    dock across the room."""
+    rng = random.Random(seed)
+    walls = box_walls(0, 0, 12000, 6000)
+    bays = [(bx, by) for bx in range(4) for by in range(2)]
+    rng.shuffle(bays)
+    for bx, by in bays[:5]:  # a shelf block of 1 m x 1.6 m in five of the eight bays
+        x0, y0 = 3000 * bx + 1000, 3000 * by + 700
+        walls += box_walls(x0, y0, x0 + 1000, y0 + 1600)
+    shelf = bays[0]
+    x0, y0 = 3000 * shelf[0] + 1000, 3000 * shelf[1] + 700
+    gy = y0 + 350 + 100 * rng.randrange(0, 10)
+    objects = {"O1": {"size": 100, "position": [x0 + 1050, gy]}}  # against the block's east face
+    if seed % 3 == 0:  # goods above and below leave no room there; the one in front must go
+        objects |= {
+            "O2": {"size": 100, "position": [x0 + 1050, gy + 300]},
+            "O3": {"size": 100, "position": [x0 + 1050, gy - 300]},
+            "O4": {"size": 100, "position": [x0 + 1150, gy]},
+        }
+    free = bays[5:]
+    (rx, ry), (dx, dy) = free[0], free[-1]
+    robot = [3000 * rx + 1500, 3000 * ry + 1500, rng.choice([0, 90, 180, 270])]
+    dock = {"x": [3000 * dx + 1000, 3000 * dx + 2000], "y": [3000 * dy + 1000, 3000 * dy + 2000]}
+    return {
+        "name": f"shelves-{seed}",
+        "scene": {
+            "obstacles": walls,
+            "robots": {"R1": {"size": 400, "pose": robot}},
+            "objects": objects,
+            "workspaces": {"W1": dock},
+        },
+        "mission": {"tasks": {"R1": ["pick O1", "drop O1 at W1", "return"]}},
+    }

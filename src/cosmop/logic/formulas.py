@@ -421,15 +421,29 @@ class LinExpr(Expr):
     def __post_init__(self) -> None:
         merged: dict[Shifted | Max | Min, Fraction] = {}
         for term, coefficient in self.terms:
-            if isinstance(term, Shifted):
+            kind = type(term)
+            if kind is Shifted:
                 if term.sort == "bool":
                     raise TypeError(f"the bool variable {term.var.name!r} is not an arithmetic term")
             elif not isinstance(term, (Max, Min)):
                 raise TypeError(f"not an arithmetic term: {term!r}")
-            merged[term] = merged.get(term, Fraction(0)) + to_fraction(coefficient)
-        canonical = sorted(((t, c) for t, c in merged.items() if c != 0), key=lambda tc: _term_key(tc[0]))
+            c = to_fraction(coefficient)
+            known = merged.get(term)
+            merged[term] = c if known is None else known + c
+        canonical = [(t, c) for t, c in merged.items() if c]
+        if len(canonical) > 1:
+            canonical.sort(key=lambda tc: _term_key(tc[0]))
         object.__setattr__(self, "terms", tuple(canonical))
         object.__setattr__(self, "const", to_fraction(self.const))
+
+    @classmethod
+    def _canonical(cls, terms: tuple[tuple[Shifted | Max | Min, Fraction], ...], const: Fraction) -> LinExpr:
+        """An expression from terms already in canonical form (merged, non-zero, sorted):
+        no normalisation, for the operations that keep the form (scaling, dropping the constant)."""
+        out = object.__new__(cls)
+        object.__setattr__(out, "terms", terms)
+        object.__setattr__(out, "const", const)
+        return out
 
     def next(self, k: int = 1) -> LinExpr:
         k = _offset(k)
@@ -497,7 +511,11 @@ def _combine(left: object, right: object, sign: int) -> LinExpr:
 
 
 def _scale(expr: LinExpr, factor: Fraction) -> LinExpr:
-    return LinExpr(tuple((t, c * factor) for t, c in expr.terms), expr.const * factor)
+    if factor == 1:
+        return expr
+    if not factor:
+        return LinExpr((), Fraction(0))
+    return LinExpr._canonical(tuple((t, c * factor) for t, c in expr.terms), expr.const * factor)
 
 
 def sum_of(items: Iterable[object]) -> LinExpr:
@@ -783,8 +801,11 @@ class Compare(Formula):
         expr = as_expr(self.expr)
         if self.op not in OPS:
             raise ValueError(f"unknown comparison {self.op!r}; expected one of {OPS}")
-        const = to_fraction(self.const) - expr.const
-        object.__setattr__(self, "expr", LinExpr(expr.terms))
+        const = to_fraction(self.const)
+        if expr.const:  # move the constant to the right-hand side
+            const -= expr.const
+            expr = LinExpr._canonical(expr.terms, Fraction(0))
+        object.__setattr__(self, "expr", expr)
         object.__setattr__(self, "const", const)
 
     @property
@@ -801,7 +822,7 @@ def _compare(left: object, op: str, right: object) -> Compare:
     difference = _combine(left, right, -1)
     if difference is NotImplemented:
         raise TypeError(f"cannot compare {left!r} with {right!r}")
-    return Compare(LinExpr(difference.terms), op, -difference.const)
+    return Compare(difference, op, 0)
 
 
 def _is_boolean(value: object) -> bool:
