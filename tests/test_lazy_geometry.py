@@ -100,8 +100,8 @@ def test_a_horizon_too_short_is_infeasible_both_ways(start):
 
 def test_parts_are_named_after_their_obstacle():
     assert obstacle_of("wall 12 [[0, 0], [1, 0]]") == "wall 12"
-    assert obstacle_of("gripper clear of wall 4") == "wall 4"
-    assert obstacle_of("O1 dropped clear of wall 0") == "wall 0"
+    assert obstacle_of("gripper clear of wall 4") == "wall 4 while handling"
+    assert obstacle_of("O1 dropped clear of wall 0") == "wall 0 while handling"
     assert obstacle_of("object O7") == "object O7"
     assert obstacle_of("room from O2 while handling O1") == "object O2"
     assert obstacle_of("O1 dropped clear of O2") == "object O2"

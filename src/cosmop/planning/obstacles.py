@@ -64,19 +64,24 @@ _OBSTACLE = (
 
 
 def obstacle_of(name: str) -> str | None:
-    """The obstacle a specification part keeps clear of: ``"wall 3"``, ``"object O2"``, or ``None``.
+    """The obstacle a specification part keeps clear of, or ``None``.
+
+    A wall is two obstacles: ``"wall 3"`` to drives and ``"wall 3 while handling"`` to picks
+    and drops (they concern different instants and places); an object is one, ``"object O2"``.
 
     Examples
     --------
-    >>> obstacle_of("gripper clear of wall 3"), obstacle_of("O1 dropped clear of O2")
-    ('wall 3', 'object O2')
+    >>> obstacle_of("wall 3 [[0, 0], [1, 0]]"), obstacle_of("gripper clear of wall 3")
+    ('wall 3', 'wall 3 while handling')
+    >>> obstacle_of("O1 dropped clear of O2")
+    'object O2'
     >>> obstacle_of("PickUp O1") is None
     True
     """
     for i, pattern in enumerate(_OBSTACLE):
         found = pattern.search(name)
         if found:
-            return found.group(1) if i < 2 else f"object {found.group(1)}"
+            return (found.group(1), f"{found.group(1)} while handling", f"object {found.group(1)}")[min(i, 2)]
     return None
 
 
@@ -111,7 +116,9 @@ class Geometry:
     """
 
     def __init__(self, p: RobotProblem, events: Sequence[Event] | None, lazy: bool) -> None:
-        keys = [wall_key(i) for i in range(len(p.scene.obstacles))] + [object_key(o) for o in p.scene.objects]
+        walls = range(len(p.scene.obstacles))
+        keys = [wall_key(i, handling) for handling in (False, True) for i in walls]
+        keys += [object_key(o) for o in p.scene.objects]
         held = set(keys) if not lazy else _near_route(p) | {object_key(o) for o in p.own_objects}
         self._p, self._events = p, events
         self.held = conj(f for _, f in specification(replace(p, obstacles=frozenset(held)), events))
@@ -172,9 +179,11 @@ class _Sides:
         side, margin = p.side, p.margin
         goods = {o: to_fraction(p.scene.objects[o].size) for o in p.own_objects}
         planes: dict[str, list] = {}
+        self._drives: dict[str, bool] = {}
         for i, wall in enumerate(p.scene.obstacles):
             regions = [wall_regions(wall.start, wall.end, g) for g in (side + 2 * margin, *goods.values())]
             planes[wall_key(i)] = [[(h.a, h.b, h.c) for h in body] for body in regions]
+            self._drives[wall_key(i)] = True  # its drive parts concern the robot alone
         robot_gap = max(margin, HANDLING_CLEARANCE)
         for o, ob in p.scene.objects.items():
             if o in goods:
@@ -186,6 +195,8 @@ class _Sides:
             planes[object_key(o)] = [robot, *carried]
         self._keys = list(planes)
         self._row = {k: n for n, k in enumerate(self._keys)}
+        for i in range(len(p.scene.obstacles)):  # a wall's handling parts: robot and goods
+            self._row[wall_key(i, handling=True)] = self._row[wall_key(i)]
         table = np.array([planes[k] for k in self._keys], dtype=float)  # (obstacles, bodies, 4 sides, abc)
         table /= np.abs(table[..., :2]).sum(axis=-1, keepdims=True)
         self._table = table
@@ -199,42 +210,46 @@ class _Sides:
         bodies = [[(float(s["x"]), float(s["y"])) for s in trace]]
         bodies += [[tuple(float(v) for v in p.obj(o).read(s)[:2]) for s in trace] for o in self._goods]
         rows = self._table[[self._row[k] for k in keys]]
+        robot_only = np.array([self._drives.get(k, False) for k in keys])
         clear = np.ones(rows.shape[:1] + rows.shape[2:3], dtype=bool)  # (obstacles, 4 sides)
         for b, points in enumerate(bodies):
             xy = np.asarray(points)  # (instants, 2)
             plane = rows[:, b]  # (obstacles, 4, 3)
             value = plane[..., 0, None] * xy[:, 0] + plane[..., 1, None] * xy[:, 1]
-            clear &= (value >= plane[..., 2, None] + _GAP).all(axis=-1)
+            side_clear = (value >= plane[..., 2, None] + _GAP).all(axis=-1)
+            clear &= side_clear | (robot_only[:, None] & (b > 0))  # goods do not matter to drives
         return [k for k, ok in zip(keys, clear.any(axis=1), strict=True) if not ok]
 
 
 def _near_route(p: RobotProblem) -> set[str]:
-    """The obstacles within reach of the box around where the robot must be.
+    """The obstacles within reach of where the robot must be.
 
-    The box holds the robot's start and home, its goods where they start and the places it
-    may drop them; it is grown by the robot's side, the motion margin and the largest good,
-    so that every obstacle a straight drive inside it could touch is in.
+    To drives: the walls and objects in the box around the robot's start and home, its goods
+    where they start and the places it may drop them.  To picks and drops: the walls near
+    those goods and places.  Boxes are grown by the robot's side, the motion margin and the
+    largest good, so that every obstacle a straight drive inside them could touch is in.
     """
     scene = p.scene
-    points = [p.scene.robots[p.robot].pose[:2]]
-    if p.start is not None:
-        points.append(p.start.robot[:2])
+    grow = float(p.side + p.margin) + max((ob.size for ob in scene.objects.values()), default=0.0)
+    robot = [p.scene.robots[p.robot].pose[:2]] + ([p.start.robot[:2]] if p.start is not None else [])
+    places = []  # ((x0, y0), (x1, y1)) of each place the robot picks or drops a good at
     for o in p.own_objects:
-        points.append(p.at_start(o)[0])
+        places.append((p.at_start(o)[0],) * 2)
         for e in p.mission:
             if e.kind == "drop" and e.obj == o:
-                ws = scene.workspaces[e.workspace].centres(scene.objects[o].size)
-                (x0, x1), (y0, y1) = ws.ranges
-                points += [(x0, y0), (x1, y1)]
-    grow = float(p.side + p.margin) + max((ob.size for ob in scene.objects.values()), default=0.0)
-    xs, ys = [q[0] for q in points], [q[1] for q in points]
-    box = shapely.box(min(xs) - grow, min(ys) - grow, max(xs) + grow, max(ys) + grow)
-    near = set()
-    for i, wall in enumerate(scene.obstacles):
-        if box.intersects(shapely.LineString([wall.start, wall.end])):
-            near.add(wall_key(i))
+                (x0, x1), (y0, y1) = scene.workspaces[e.workspace].centres(scene.objects[o].size).ranges
+                places.append(((x0, y0), (x1, y1)))
+    corners = robot + [q for place in places for q in place]
+    xs, ys = [q[0] for q in corners], [q[1] for q in corners]
+    route = shapely.box(min(xs) - grow, min(ys) - grow, max(xs) + grow, max(ys) + grow)
+    boxes = [shapely.box(a[0] - grow, a[1] - grow, b[0] + grow, b[1] + grow) for a, b in places]
+    handling = shapely.union_all(boxes)
+    walls = shapely.linestrings([[w.start, w.end] for w in scene.obstacles]) if scene.obstacles else []
+    near = {wall_key(i) for i in np.flatnonzero(shapely.intersects(route, walls))} if len(walls) else set()
+    if len(walls) and not handling.is_empty:
+        near |= {wall_key(i, handling=True) for i in np.flatnonzero(shapely.intersects(handling, walls))}
     for o, ob in scene.objects.items():
-        if box.intersects(shapely.Point(*p.at_start(o)[0]).buffer(ob.size, cap_style="square")):
+        if route.intersects(shapely.Point(*p.at_start(o)[0]).buffer(ob.size, cap_style="square")):
             near.add(object_key(o))
     return near
 

@@ -158,9 +158,10 @@ def _released(carried: Var | Formula) -> Formula:
     return _negated(_later(carried))
 
 
-def wall_key(i: int) -> str:
-    """The name of wall `i` (its index in the scene) as an obstacle: ``"wall 3"``."""
-    return f"wall {i}"
+def wall_key(i: int, handling: bool = False) -> str:
+    """The name of wall `i` (its index in the scene) as an obstacle: ``"wall 3"`` to drives,
+    ``"wall 3 while handling"`` to picks and drops (the gripper, the good set down)."""
+    return f"wall {i} while handling" if handling else f"wall {i}"
 
 
 def object_key(obj: str) -> str:
@@ -205,9 +206,9 @@ class RobotProblem:
         mm a GoTo keeps from walls and resting objects between its ends (default
         :data:`MOTION_MARGIN`; 0 lets a motion slide along what it touches).
     obstacles : frozenset of str, optional
-        Write the parts of only these obstacles (:func:`wall_key`, :func:`object_key`); every
-        wall and object by default.  Lazy geometry (:mod:`cosmop.planning.obstacles`) builds
-        the parts of the obstacles it needs only.
+        Write the parts of only these obstacles (:func:`wall_key`, :func:`object_key`; a wall
+        is two, one to drives and one to picks and drops); every wall and object by default.
+        Lazy geometry (:mod:`cosmop.planning.obstacles`) writes the parts it needs only.
 
     Notes
     -----
@@ -306,10 +307,12 @@ class RobotProblem:
         """:math:`\\epsilon`, the mission event the step performs: 1 + its index in `mission`, 0 none."""
         return Var("event", "int")
 
-    def walls(self) -> list[tuple[int, Any]]:
-        """``(index, wall)`` of the walls whose parts are written (:attr:`obstacles`)."""
+    def walls(self, handling: bool = False) -> list[tuple[int, Any]]:
+        """``(index, wall)`` of the walls whose parts for drives (or for picks and drops, when
+        `handling`) are written (:attr:`obstacles`)."""
         every = self.obstacles is None
-        return [(i, w) for i, w in enumerate(self.scene.obstacles) if every or wall_key(i) in self.obstacles]
+        walls = enumerate(self.scene.obstacles)
+        return [(i, w) for i, w in walls if every or wall_key(i, handling) in self.obstacles]
 
     def obstacle_objects(self) -> list[str]:
         """The objects whose parts as obstacles are written (:attr:`obstacles`)."""
@@ -416,7 +419,7 @@ def _gripper_clear(p: RobotProblem, obj: str, ox, oy) -> list[tuple[str, Formula
     """
     side = _num(p.scene.objects[obj].size)
     out = []
-    for i, wall in p.walls():
+    for i, wall in p.walls(handling=True):
         pairs = zip(
             wall_regions(wall.start, wall.end, p.side), wall_regions(wall.start, wall.end, side), strict=True
         )
@@ -642,7 +645,7 @@ class DropOff(Encoding):
         out = [(f"DropOff {obj}", _robot_static(p) & held & released & place & rest)]
         out += _gripper_clear(p, obj, v.x.next(), v.y.next()) + _handling_room(p, obj, _drop_places(p, obj))
         side = _num(p.scene.objects[obj].size)
-        for i, wall in p.walls():
+        for i, wall in p.walls(handling=True):
             regions = wall_regions(wall.start, wall.end, side, f"wall {i}")
             out.append(
                 (
