@@ -72,13 +72,14 @@ def test_the_program_answers_ctrl_c_with_one_line_and_130(tmp_path):
     import sys
     import time
 
-    command = [
-        sys.executable,
-        "-m",
-        "cosmop",
-        "plan",
-        str(ROOT / "examples" / "02_warehouse_10x10" / "scenario.yaml"),
-    ]
+    import yaml
+
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    from warehouse_gen import warehouse
+
+    scenario = tmp_path / "warehouse.yaml"  # 30 robots: planning takes far longer than the wait
+    scenario.write_text(yaml.safe_dump(warehouse(30, seed=1), sort_keys=False))
+    command = [sys.executable, "-m", "cosmop", "plan", str(scenario)]
     proc = subprocess.Popen(
         [*command, "-o", str(tmp_path / "plan.json")],
         stdout=subprocess.PIPE,

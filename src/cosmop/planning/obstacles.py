@@ -43,7 +43,7 @@ from typing import Any
 import numpy as np
 import shapely
 
-from cosmop.events import Event
+from cosmop.events import Event, Primitive
 from cosmop.logic import Formula, conj, failing, to_fraction
 from cosmop.planning.regions import square_sides, wall_regions
 from cosmop.planning.specification import (
@@ -179,11 +179,12 @@ class _Sides:
         side, margin = p.side, p.margin
         goods = {o: to_fraction(p.scene.objects[o].size) for o in p.own_objects}
         planes: dict[str, list] = {}
-        self._drives: dict[str, bool] = {}
+        self._roles: dict[str, int] = {}  # 0: a wall to drives, 1: to picks and drops, 2: an object
+        self._handling = {a.code for a in p.actions if a.primitive in (Primitive.PICKUP, Primitive.DROPOFF)}
         for i, wall in enumerate(p.scene.obstacles):
             regions = [wall_regions(wall.start, wall.end, g) for g in (side + 2 * margin, *goods.values())]
             planes[wall_key(i)] = [[(h.a, h.b, h.c) for h in body] for body in regions]
-            self._drives[wall_key(i)] = True  # its drive parts concern the robot alone
+            self._roles[wall_key(i)], self._roles[wall_key(i, handling=True)] = 0, 1
         robot_gap = max(margin, HANDLING_CLEARANCE)
         for o, ob in p.scene.objects.items():
             if o in goods:
@@ -193,6 +194,7 @@ class _Sides:
             robot = list(square_sides(ox, oy, (size + side) / 2 + robot_gap))
             carried = [list(square_sides(ox, oy, (size + g) / 2)) for g in goods.values()]
             planes[object_key(o)] = [robot, *carried]
+            self._roles[object_key(o)] = 2
         self._keys = list(planes)
         self._row = {k: n for n, k in enumerate(self._keys)}
         for i in range(len(p.scene.obstacles)):  # a wall's handling parts: robot and goods
@@ -203,22 +205,35 @@ class _Sides:
         self._goods = list(goods)
 
     def unsure(self, keys: Sequence[str], trace: Sequence[Mapping[str, Any]]) -> list[str]:
-        """The obstacles among `keys` that the plan does not keep to one side of, in order."""
+        """The obstacles among `keys` that the plan does not keep to one side of, in order.
+
+        A wall's drive parts look at the robot at every instant; its parts for picks and drops
+        at the robot and the goods at the instants of a PickUp or DropOff and the next; an
+        object's parts at both.
+        """
         if not keys:
             return []
         p = self._p
-        bodies = [[(float(s["x"]), float(s["y"])) for s in trace]]
-        bodies += [[tuple(float(v) for v in p.obj(o).read(s)[:2]) for s in trace] for o in self._goods]
+        handled = [k for k in range(len(trace) - 1) if trace[k + 1]["pi"] in self._handling]
+        at = sorted({j for k in handled for j in (k, k + 1)})
+        robot = [(float(s["x"]), float(s["y"])) for s in trace]
         rows = self._table[[self._row[k] for k in keys]]
-        robot_only = np.array([self._drives.get(k, False) for k in keys])
-        clear = np.ones(rows.shape[:1] + rows.shape[2:3], dtype=bool)  # (obstacles, 4 sides)
-        for b, points in enumerate(bodies):
-            xy = np.asarray(points)  # (instants, 2)
-            plane = rows[:, b]  # (obstacles, 4, 3)
-            value = plane[..., 0, None] * xy[:, 0] + plane[..., 1, None] * xy[:, 1]
-            side_clear = (value >= plane[..., 2, None] + _GAP).all(axis=-1)
-            clear &= side_clear | (robot_only[:, None] & (b > 0))  # goods do not matter to drives
+        role = np.array([self._roles[k] for k in keys])[:, None]
+        robot_all, robot_handling = _clear(rows[:, 0], robot), _clear(rows[:, 0], [robot[j] for j in at])
+        goods = np.ones_like(robot_all)
+        for b, o in enumerate(self._goods, start=1):
+            goods &= _clear(rows[:, b], [tuple(float(v) for v in p.obj(o).read(trace[j])[:2]) for j in at])
+        clear = np.where(role == 0, robot_all, np.where(role == 1, robot_handling & goods, robot_all & goods))
         return [k for k, ok in zip(keys, clear.any(axis=1), strict=True) if not ok]
+
+
+def _clear(planes: np.ndarray, points: Sequence[tuple[float, float]]) -> np.ndarray:
+    """Per obstacle and side (`planes`: obstacles x 4 x abc), whether every point lies on it."""
+    if not points:
+        return np.ones(planes.shape[:2], dtype=bool)
+    xy = np.asarray(points)
+    value = planes[..., 0, None] * xy[:, 0] + planes[..., 1, None] * xy[:, 1]
+    return (value >= planes[..., 2, None] + _GAP).all(axis=-1)
 
 
 def _near_route(p: RobotProblem) -> set[str]:

@@ -337,26 +337,25 @@ class _Horizon:
             self.solver.add(self.unrolling.encode(formula))
 
     def check(self, geometry: Geometry, *bound: z3.BoolRef) -> tuple[Any, z3.ModelRef | None, int]:
-        """Solve, with `bound` holding for this call only, until the model breaks no obstacle.
+        """Solve, with `bound` asserted for this call only, until the model breaks no obstacle.
 
         A model that breaks obstacles the solver does not hold yet (:meth:`Geometry.broken`)
-        makes them held (asserted for good) and the check is repeated; see
+        makes them held (asserted outside the bound's scope) and the check is repeated; see
         :mod:`cosmop.planning.obstacles` for why the answer is the eager encoding's.
 
         Returns
         -------
         verdict, model (when sat), checks made
         """
-        checks, chosen = 0, self.assumptions
-        if bound:  # asserted under a fresh literal assumed for this call only: no push and pop
-            guard = z3.FreshBool("bound", self.solver.ctx)
-            self.solver.add(z3.Implies(guard, z3.And(*bound)))
-            chosen += (guard,)
+        checks = 0
         while True:
             checks += 1
-            verdict = self.solver.check(*chosen)
+            self.solver.push()
+            self.solver.add(*bound)
+            verdict = self.solver.check(*self.assumptions)
             model = self.solver.model() if verdict == z3.sat else None
             broken = geometry.broken(self.unrolling.trace(model)) if model is not None else []
+            self.solver.pop()
             if not broken:
                 return verdict, model, checks
             self.add(geometry.admit(broken))
@@ -491,7 +490,7 @@ def _fewest_requests(
     """A model of the satisfiable horizon `h` with the fewest Req steps, and the checks it took.
 
     Starting from `model`, the bound on the number of requests is tightened until unsat, each
-    bound under its own literal, assumed for its check only (:meth:`_Horizon.check`).
+    bound for one check only (:meth:`_Horizon.check`), so that `h`'s solver keeps no bound.
     """
     checks = 0
     if h.K > 0 and request_codes(p):  # at K = 0 there is no step to count
