@@ -210,6 +210,15 @@ class RobotProblem:
         is two, one to drives and one to picks and drops); every wall and object by default.
         Lazy geometry (:mod:`cosmop.planning.obstacles`) writes the parts it needs only.
 
+    Attributes
+    ----------
+    actions : tuple of Action
+        Every (primitive, object) the robot may take, with its code in :math:`\\pi`.
+    sort : str
+        The sort of positions (:func:`position_sort`).
+    objects : Mapping[str, ObjectVars]
+        Each object's terms: variables, or values for the fields no action changes.
+
     Notes
     -----
     With the default library PickUp and DropOff apply to the objects the mission picks, Req to
