@@ -509,18 +509,33 @@ def _robot_static(p: RobotProblem) -> Formula:
     return _static(p.x, p.y, p.h)
 
 
-def _objects_static(
-    p: RobotProblem, *, positions=True, carried=True, away=True, skip: str | None = None
-) -> Formula:
+def _objects_static(p: RobotProblem, *, carried=True, skip: str | None = None) -> Formula:
+    """Every object but `skip` keeps its position (and carried flag).  ``away`` flags have one
+    frame axiom each instead (:func:`away_frames`): only a request changes one."""
     out = []
     for o in p.scene.objects:
         if o == skip:
             continue
         v = p.obj(o)
-        out += [v.x, v.y] if positions else []
-        out += [v.carried] if carried else []
-        out += [v.away] if away else []
+        out += [v.x, v.y, *([v.carried] if carried else [])]
     return _static(*out)
+
+
+def away_frames(p: RobotProblem) -> list[tuple[str, Formula]]:
+    """:math:`\\Box(\\bigcirc\\top \\rightarrow (\\bigcirc a_o \\leftrightarrow a_o) \\vee
+    \\bigcirc(\\pi = \\mathrm{Req}_o))` for each good the robot may request: only its request
+    moves it away.
+
+    The same as every other primitive keeping :math:`a_o` in its effect, written once per good
+    instead of once per primitive and good (with N goods to request, N squared terms per
+    instant)."""
+    out = []
+    for a in p.actions:
+        if a.primitive == Primitive.REQ and isinstance(p.obj(a.obj).away, Var):
+            flag = p.obj(a.obj).away
+            kept = Always(Implies(Next(TRUE), eq(flag.next(), flag) | Next(p.pi.eq(a.code))))
+            out.append((f"{a.obj} goes away only on request", kept))
+    return out
 
 
 STEEPNESS = 4
@@ -650,7 +665,7 @@ class DropOff(Encoding):
         held = conj(p.obj(o).carried if o == obj else _negated(p.obj(o).carried) for o in p.scene.objects)
         released = conj(_released(p.obj(o).carried) for o in p.scene.objects)
         place = _docked(p, obj, v.x.next(), v.y.next(), d)
-        rest = _objects_static(p, carried=False, skip=obj) & _static(v.away)
+        rest = _objects_static(p, carried=False, skip=obj)
         out = [(f"DropOff {obj}", _robot_static(p) & held & released & place & rest)]
         out += _gripper_clear(p, obj, v.x.next(), v.y.next()) + _handling_room(p, obj, _drop_places(p, obj))
         side = _num(p.scene.objects[obj].size)
@@ -691,12 +706,7 @@ class Req(Encoding):
 
     def parts(self, p, obj):
         v, d, side = p.obj(obj), p.clearance(obj), p.side
-        flags = (
-            ~v.away
-            & v.away.next()
-            & _objects_static(p, away=False)
-            & _objects_static(p, positions=False, carried=False, skip=obj)
-        )
+        flags = ~v.away & v.away.next() & _objects_static(p)
         room = [  # clear of every pose that picks it: the helper picks from a side of its choosing
             disj([p.x <= px - side, p.x >= px + side, p.y <= py - side, p.y >= py + side])
             for _, px, py in _docking_poses(p, obj, v.x, v.y, d)
@@ -835,6 +845,7 @@ def specification(p: RobotProblem, events: Sequence[Event] | None = None) -> lis
     for action in p.actions:
         for name, effect in p.primitives[action.primitive].parts(p, action.obj):
             parts.append((name, Always(Implies(Next(p.pi.eq(action.code)), effect))))
+    parts += away_frames(p)
     if p.automaton is not None and events is None:
         return parts + automaton_parts(p)
     parts.append(("mission", mission_formula(p, events)))
