@@ -127,11 +127,6 @@ class Geometry:
         self._sides = _Sides(p) if self._waiting else None
         self.admitted = 0
 
-    @property
-    def waiting(self) -> tuple[str, ...]:
-        """The obstacles the solver does not hold yet."""
-        return tuple(self._waiting)
-
     def broken(self, trace: Sequence[Mapping[str, Any]]) -> list[str]:
         """The obstacles not yet held whose parts the plan `trace` breaks (exact evaluation)."""
         if self._sides is None:
@@ -144,7 +139,8 @@ class Geometry:
         """Move the obstacles `keys` into the solver's share: their parts, to assert."""
         self._write([k for k in keys if k not in self._written])
         added = conj(self._written.pop(k) for k in keys)
-        self._waiting = [k for k in self._waiting if k not in set(keys)]
+        admitted = set(keys)
+        self._waiting = [k for k in self._waiting if k not in admitted]
         self.admitted += len(keys)
         self.held = conj([self.held, added])
         return added

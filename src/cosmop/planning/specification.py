@@ -160,7 +160,10 @@ def _released(carried: Var | Formula) -> Formula:
 
 def wall_key(i: int, handling: bool = False) -> str:
     """The name of wall `i` (its index in the scene) as an obstacle: ``"wall 3"`` to drives,
-    ``"wall 3 while handling"`` to picks and drops (the gripper, the good set down)."""
+    ``"wall 3 while handling"`` to picks and drops (the gripper, the good set down).
+
+    The names of the specification's parts are built from these keys, and
+    :func:`cosmop.planning.obstacles.obstacle_of` reads them back."""
     return f"wall {i} while handling" if handling else f"wall {i}"
 
 
@@ -434,7 +437,7 @@ def _gripper_clear(p: RobotProblem, obj: str, ox, oy) -> list[tuple[str, Formula
         )
         out.append(
             (
-                f"gripper clear of wall {i}",
+                f"gripper clear of {wall_key(i)}",
                 disj(_half_plane(a, p.x, p.y) & _half_plane(b, ox, oy) for a, b in pairs),
             )
         )
@@ -624,12 +627,12 @@ class GoTo(Encoding):
         x, y = p.x, p.y
         out = [("GoTo keeps the objects", _objects_static(p))]
         for i, wall in p.walls():
-            sides = _wall_sides(p, wall, f"wall {i}")
-            out.append((f"wall {i} {[list(wall.start), list(wall.end)]}", _apart(x, y, sides)))
+            sides = _wall_sides(p, wall, wall_key(i))
+            out.append((f"{wall_key(i)} {[list(wall.start), list(wall.end)]}", _apart(x, y, sides)))
         for o in p.obstacle_objects():
             v, d = p.obj(o), p.clearance(o)
             clear = _apart(x, y, _object_sides(v, d, p.margin))
-            out.append((f"object {o}", Implies(v.resting, clear)))
+            out.append((object_key(o), Implies(v.resting, clear)))
         return out
 
 
@@ -670,10 +673,10 @@ class DropOff(Encoding):
         out += _gripper_clear(p, obj, v.x.next(), v.y.next()) + _handling_room(p, obj, _drop_places(p, obj))
         side = _num(p.scene.objects[obj].size)
         for i, wall in p.walls(handling=True):
-            regions = wall_regions(wall.start, wall.end, side, f"wall {i}")
+            regions = wall_regions(wall.start, wall.end, side, wall_key(i))
             out.append(
                 (
-                    f"{obj} dropped clear of wall {i}",
+                    f"{obj} dropped clear of {wall_key(i)}",
                     disj(_half_plane(h, v.x.next(), v.y.next()) for h in regions),
                 )
             )
