@@ -8,7 +8,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 from shapely.geometry import LineString
 
-from cosmop.control import admissible_speed, is_safe, plan_path, point_segment_linf, segment_array
+from cosmop.control import admissible_speed, box_gaps, is_safe, plan_path, point_segment_linf, segment_array
 from cosmop.planning import overlaps, swept_square
 from cosmop.planning.checker import square
 from cosmop.scene import Dynamics, Human
@@ -55,6 +55,30 @@ def test_linf_distance_to_segment_matches_sampling(px, py, seg):
     sampled = np.maximum(np.abs(x1 + t * (x2 - x1) - px), np.abs(y1 + t * (y2 - y1) - py)).min()
     assert exact <= sampled + 1e-6
     assert exact >= sampled - np.hypot(x2 - x1, y2 - y1) / 20000 - 1e-6
+
+
+def test_a_set_per_row_measures_each_row_against_its_own_set_and_padding_is_infinitely_far():
+    rng = np.random.default_rng(7)
+    walls = rng.uniform(-3000, 3000, (9, 4))
+    walls[:4, 2] = walls[:4, 0]  # axis-parallel ones beside diagonal ones
+    boxes = np.column_stack([rng.uniform(-3000, 3000, (9, 2)), rng.uniform(50, 300, 9)])
+    points = rng.uniform(-3000, 3000, (3, 5, 2))  # 3 rows of 5 points
+    chosen = [[0, 5, 8], [1, 2], [6]]
+    padded = np.full((3, 3, 4), np.inf)
+    padded_boxes = np.tile([np.inf, np.inf, 0.0], (3, 3, 1))
+    for row, keep in enumerate(chosen):
+        padded[row, : len(keep)] = walls[keep]
+        padded_boxes[row, : len(keep)] = boxes[keep]
+    together = point_segment_linf(points, padded)
+    gaps = box_gaps(points, 100.0, padded_boxes)
+    for row, keep in enumerate(chosen):
+        np.testing.assert_array_equal(
+            together[row, :, : len(keep)], point_segment_linf(points[row], walls[keep])
+        )
+        np.testing.assert_array_equal(gaps[row, :, : len(keep)], box_gaps(points[row], 100.0, boxes[keep]))
+        assert (
+            np.isposinf(together[row, :, len(keep) :]).all() and np.isposinf(gaps[row, :, len(keep) :]).all()
+        )
 
 
 WALLS_2X2 = [

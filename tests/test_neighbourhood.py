@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from cosmop.control import neighbourhood
 from cosmop.control.dwa import Drivers, DwaSettings, Obstacles, dwa_commands
 from cosmop.control.neighbourhood import dwa_commands_near, reach
 from cosmop.control.safety import Limits
@@ -84,12 +85,17 @@ def test_the_cut_off_drops_what_is_out_of_reach(monkeypatch):
     seen = []
 
     def counting(drivers, sub, settings, **kw):
-        seen.append(len(sub.walls) + len(sub.boxes))
+        # one call for every driver, each with its own set (padded at infinity to one width)
+        assert sub.walls.shape[0] == sub.boxes.shape[0] == len(drivers.v)
+        real = np.isfinite(sub.walls[..., 0]).sum(axis=1) + np.isfinite(sub.boxes[..., 0]).sum(axis=1)
+        seen.append((sub.walls.shape[1] + sub.boxes.shape[1], real))
         return dwa_commands(drivers, sub, settings, **kw)
 
     monkeypatch.setattr("cosmop.control.neighbourhood.dwa_commands", counting)
     dwa_commands_near(drivers, obstacles)
-    assert seen and sum(seen) < (len(obstacles.walls) + len(obstacles.boxes)) / 2
+    [(width, real)] = seen
+    everything = len(obstacles.walls) + len(obstacles.boxes)
+    assert width < everything / 4 and (real <= width).all() and real.min() >= 1  # at least itself
 
 
 def test_a_robot_in_danger_does_not_lift_another_robots_stop_at_its_goal():
@@ -102,3 +108,28 @@ def test_a_robot_in_danger_does_not_lift_another_robots_stop_at_its_goal():
     for i in calm:
         alone = dwa_commands(drivers[[i]], obstacles, ignore=own[[i]])
         assert (alone.v[0], alone.w[0]) == (full.v[i], full.w[i])
+
+
+def test_one_call_with_a_set_per_driver_equals_a_call_per_driver():
+    # dwa_commands_near pads each driver's set with obstacles at infinity; one call with those
+    # sets must give each driver exactly the commands of a call with its own set alone
+    drivers, obstacles, own = _crowd(4, side=12_000.0)
+    rng = np.random.default_rng(4)
+    R, W, M = len(drivers.v), len(obstacles.walls), len(obstacles.boxes)
+    walls = [np.sort(rng.choice(W, rng.integers(0, W // 2), replace=False)) for _ in range(R)]
+    boxes = [
+        np.union1d(rng.choice(M, rng.integers(1, M // 2), replace=False), np.flatnonzero(own[i]))
+        for i in range(R)
+    ]
+    sets = neighbourhood._near(obstacles, neighbourhood._padded(walls, W), neighbourhood._padded(boxes, M))
+    ignore = neighbourhood._take(own, neighbourhood._padded(boxes, M))
+    together = dwa_commands(drivers, sets, ignore=ignore)
+    assert not together.safe.all()
+    for i in range(R):
+        alone = dwa_commands(drivers[[i]], obstacles.select(walls[i], boxes[i]), ignore=own[[i]][:, boxes[i]])
+        assert (alone.v[0], alone.w[0], alone.safe[0], alone.gap[0]) == (
+            together.v[i],
+            together.w[i],
+            together.safe[i],
+            together.gap[i],
+        )

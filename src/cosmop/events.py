@@ -32,6 +32,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 from enum import StrEnum
+from functools import cached_property
 
 from cosmop.errors import EventSyntaxError
 
@@ -147,7 +148,7 @@ class Event:
             roles = "requester and the responder" if self.kind == "away" else "sender and the receiver"
             raise EventSyntaxError(f"the {roles} of {self.name} must be different robots")
 
-    @property
+    @cached_property  # (made once: the executors compare names every cycle)
     def name(self) -> str:
         """Canonical text, e.g. ``pick(R1,O1)``, ``drop(R1,O1,W1)``, ``return(R1)``,
         ``away(O2,R1,R2)``, ``msg(R1,R2,t)``."""

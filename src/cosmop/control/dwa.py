@@ -23,6 +23,7 @@ Units: mm, mm/s, radians and rad/s inside; degrees at the interfaces of :mod:`co
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from functools import lru_cache
 
 import numpy as np
 
@@ -107,12 +108,12 @@ def robot_gaps(
     """L-infinity gaps of robot squares to walls ``(R, W)`` and to boxes ``(R, M)``.
 
     `ignore` (shape ``(R, M)``) masks boxes a robot does not sense as obstacles (itself, the
-    object in its gripper); their gap is ``inf``.
+    object in its gripper); their gap is ``inf``.  `walls` and `boxes` are shared by every
+    robot, or one set per robot (:meth:`Obstacles.per_driver`).
     """
-    wall_gap = (
-        point_segment_linf(centres, walls) - half[:, None] if len(walls) else np.zeros((len(centres), 0))
-    )
-    box_gap = box_gaps(centres, half[:, None], boxes) if len(boxes) else np.zeros((len(centres), 0))
+    R = len(centres)
+    wall_gap = point_segment_linf(centres, walls) - half[:, None] if walls.shape[-2] else np.zeros((R, 0))
+    box_gap = box_gaps(centres, half[:, None], boxes) if boxes.shape[-2] else np.zeros((R, 0))
     if ignore is not None and box_gap.size:
         box_gap = np.where(ignore, np.inf, box_gap)
     return wall_gap, box_gap
@@ -167,6 +168,46 @@ class Obstacles:
             tuple(self.names[j] for j in boxes) if self.names else (),
         )
 
+    def per_driver(self, drivers: int) -> Obstacles:
+        """The same obstacles as one set per driver: every array gains a leading axis of length
+        `drivers` (views, no copies); obstacles already per driver are returned as they are.
+
+        Per-driver sets may differ (:func:`~cosmop.control.neighbourhood.dwa_commands_near`
+        gives each driver what is near it); a shorter set is padded with boxes and walls at
+        infinity (:func:`~cosmop.control.geometry.per_row`), which no test or minimum sees.
+        """
+        if self.walls.ndim == 3:
+            return self
+
+        def each(values):
+            return None if values is None else np.broadcast_to(values, (drivers, *values.shape))
+
+        return Obstacles(
+            each(self.walls),
+            each(self.boxes),
+            each(self.speed),
+            each(self.velocity),
+            each(self.acceleration),
+            each(self.agents),
+            self.names,
+        )
+
+    def rows(self, rows: np.ndarray) -> Obstacles:
+        """The per-driver sets of the drivers `rows` (obstacles made by :meth:`per_driver`)."""
+
+        def pick(values):
+            return None if values is None else values[rows]
+
+        return Obstacles(
+            self.walls[rows],
+            self.boxes[rows],
+            self.speed[rows],
+            pick(self.velocity),
+            pick(self.acceleration),
+            pick(self.agents),
+            self.names,
+        )
+
     @property
     def movers(self) -> np.ndarray:
         """Which boxes are kept at the standoff: :attr:`agents`, else those that move."""
@@ -179,9 +220,9 @@ class Obstacles:
         accelerations, or their top speed when those are unknown.  `horizon` broadcasts against
         the boxes: a scalar gives ``(M,)``, a column ``(R, 1)`` gives ``(R, M)``.
         """
-        if self.acceleration is None or self.velocity is None or not len(self.boxes):
+        if self.acceleration is None or self.velocity is None or not self.boxes.shape[-2]:
             return np.broadcast_to(self.speed, np.broadcast_shapes(np.shape(horizon), self.speed.shape))
-        now = np.hypot(self.velocity[:, 0], self.velocity[:, 1])
+        now = np.hypot(self.velocity[..., 0], self.velocity[..., 1])
         return obstacle_speed(horizon, self.speed, now, self.acceleration)
 
 
@@ -263,12 +304,12 @@ def dwa_commands(
     -------
     DwaCommand
     """
+    obstacles = obstacles.per_driver(len(drivers.v))  # one set per driver from here on
     skip = ignore if grip is None else (grip if ignore is None else ignore | grip)
     wall_gap, box_gap = robot_gaps(drivers.pose[:, :2], drivers.half, obstacles.walls, obstacles.boxes, skip)
     safe = _passive_safety(drivers, obstacles, wall_gap, box_gap, settings)
-    everything = np.concatenate([wall_gap, box_gap], axis=1)
-    min_gap = everything.min(axis=1) if everything.shape[1] else np.full(len(drivers.v), np.inf)
-    if not safe.all() and len(obstacles.boxes):
+    min_gap = np.minimum(wall_gap.min(axis=1, initial=np.inf), box_gap.min(axis=1, initial=np.inf))
+    if not safe.all() and obstacles.boxes.shape[-2]:
         # Not safe: head away from the nearest box along the axis of its L-infinity gap first,
         # out of the standoff; the path is taken up again once safe holds.
         drivers = _retreat(drivers, obstacles, box_gap, ~safe, settings)
@@ -285,9 +326,9 @@ def dwa_commands(
             drivers[rows],
             V[rows],
             W[rows],
-            obstacles,
+            obstacles.rows(rows),
             None if ignore is None else skip[rows],
-            _keep(box_gap[rows], obstacles.movers, settings),
+            _keep(box_gap[rows], obstacles.movers[rows], settings),
         )
         score[rows] = np.where(ok, score[rows], -np.inf)
         fallback = rows[~ok.any(axis=1)]
@@ -310,12 +351,12 @@ def _passive_safety(
     their :math:`V_o` is :func:`~cosmop.control.safety.obstacle_speed` over the robot's
     stopping horizon when their velocities and accelerations are known.
     """
-    R, n_walls = len(drivers.v), wall_gap.shape[1]
-    gap = np.concatenate([wall_gap, box_gap - settings.standoff * obstacles.movers[None, :]], axis=1)
     limits, v = drivers.limits.column(), drivers.v[:, None]
-    bound = np.broadcast_to(obstacles.speed_bound(stopping_horizon(v, limits)), (R, len(obstacles.boxes)))
-    speeds = np.concatenate([np.zeros((R, n_walls)), bound], axis=1)
-    return np.all(is_safe(gap, v, speeds, limits), axis=1)
+    safe = np.all(is_safe(wall_gap, v, 0.0, limits), axis=1)  # walls stand still
+    if obstacles.boxes.shape[-2]:
+        gap = box_gap - settings.standoff * obstacles.movers
+        safe &= np.all(is_safe(gap, v, obstacles.speed_bound(stopping_horizon(v, limits)), limits), axis=1)
+    return safe
 
 
 def _retreat(
@@ -327,11 +368,12 @@ def _retreat(
     xy, boxes = drivers.pose[:, :2], obstacles.boxes
     near = np.argmin(np.where(np.isinf(box_gap[rows]), np.inf, box_gap[rows]), axis=1)
     close = box_gap[rows, near] < settings.standoff
-    delta = xy[rows] - boxes[near, :2]
+    delta = xy[rows] - boxes[rows, near, :2]
     along_x = np.abs(delta[:, 0]) >= np.abs(delta[:, 1])
     away = np.where(along_x[:, None], [[1.0, 0.0]], [[0.0, 1.0]]) * np.sign(delta).clip(-1, 1)
     away[np.all(away == 0, axis=1)] = [1.0, 0.0]
-    retreat = _open_retreat(xy[rows], drivers.half[rows], away, delta, obstacles.walls, settings.standoff * 2)
+    walls = obstacles.walls[rows]
+    retreat = _open_retreat(xy[rows], drivers.half[rows], away, delta, walls, settings.standoff * 2)
     target = drivers.target.copy()
     target[rows[close]] = retreat[close]
     stop = drivers.stop_distance.copy()
@@ -345,7 +387,7 @@ def _arcs(
     """Predicted arcs: the times ``t`` (S,), positions ``(R, K, S, 2)`` and headings
     ``(R, K, S)`` at :math:`t_k = k\\,T/S`, k = 1..S, with ``(v, w)`` held."""
     xy, theta = drivers.pose[:, :2], drivers.pose[:, 2]
-    t = settings.horizon * np.arange(1, settings.samples + 1) / settings.samples  # (S,)
+    t = _instants(settings.horizon, settings.samples)  # (S,)
     th = theta[:, None, None] + W[:, :, None] * t[None, None, :]
     straight = np.abs(W) < 1e-6
     w_safe = np.where(straight, 1.0, W)[:, :, None]
@@ -359,7 +401,9 @@ def _arcs(
         V[:, :, None] * t * np.sin(theta)[:, None, None],
         -V[:, :, None] / w_safe * (np.cos(th) - np.cos(theta)[:, None, None]),
     )
-    pts = np.stack([xy[:, 0, None, None] + px, xy[:, 1, None, None] + py], axis=-1)
+    pts = np.empty((*px.shape, 2))
+    pts[..., 0] = xy[:, 0, None, None] + px
+    pts[..., 1] = xy[:, 1, None, None] + py
     return t, pts, th
 
 
@@ -380,31 +424,25 @@ def _clearance(
     half, walls, boxes, movers = drivers.half, obstacles.walls, obstacles.boxes, obstacles.movers
     flat = pts.reshape(R, -1, 2)
     clear = np.full(flat.shape[:2], np.inf)
-    mover_clear = None
-    if len(walls):
+    mover_clear = np.full((R, K), np.inf)
+    if walls.shape[-2]:
         clear = (point_segment_linf(flat, walls) - half[:, None, None]).min(axis=-1)
-    if len(boxes):
+    if boxes.shape[-2]:
         if obstacles.velocity is None:
             bg = box_gaps(flat, half[:, None, None], boxes)  # (R, K*S, M)
         else:
-            tk = np.tile(t, K)  # (K*S,): the time of each predicted point
-            moved = boxes[None, :, :2] + tk[:, None, None] * obstacles.velocity[None, :, :]  # (K*S, M, 2)
-            d = np.maximum(
-                np.abs(flat[:, :, None, 0] - moved[None, :, :, 0]),
-                np.abs(flat[:, :, None, 1] - moved[None, :, :, 1]),
-            )
-            bg = d - half[:, None, None] - boxes[None, None, :, 2]
+            tk = np.broadcast_to(t, (K, S)).reshape(-1, 1)  # (K*S, 1): the time of each predicted point
+            velocity = obstacles.velocity[:, None]
+            moved_x = boxes[:, None, :, 0] + tk * velocity[..., 0]  # (R, K*S, M)
+            moved_y = boxes[:, None, :, 1] + tk * velocity[..., 1]
+            d = np.maximum(np.abs(flat[:, :, None, 0] - moved_x), np.abs(flat[:, :, None, 1] - moved_y))
+            bg = d - half[:, None, None] - boxes[:, None, :, 2]
         if ignore is not None:
             bg = np.where(ignore[:, None, :], np.inf, bg)
         if movers.any():
-            mover_clear = bg[:, :, movers].min(axis=-1).reshape(R, K, S).min(axis=-1)
-        if (~movers).any():
-            clear = np.minimum(clear, bg[:, :, ~movers].min(axis=-1))
+            mover_clear = np.where(movers[:, None, :], bg, np.inf).min(axis=-1).reshape(R, K, S).min(axis=-1)
         clear = np.minimum(clear, bg.min(axis=-1))
-    clear = clear.reshape(R, K, S).min(axis=-1)
-    if mover_clear is None:
-        mover_clear = np.full_like(clear, np.inf)
-    return clear, mover_clear
+    return clear.reshape(R, K, S).min(axis=-1), mover_clear
 
 
 def _score(
@@ -452,7 +490,7 @@ def _keep(near: np.ndarray, movers: np.ndarray, settings: DwaSettings) -> np.nda
     mm of slack per cycle, down to half the standoff, so that it can slide along); ``-inf``
     elsewhere."""
     floor = np.minimum(near, np.maximum(near - 2.0, settings.standoff / 2))
-    return np.where(movers[None, :] & (near < settings.standoff), floor, -np.inf)
+    return np.where(movers & (near < settings.standoff), floor, -np.inf)
 
 
 def _open_retreat(xy, half, away, delta, walls, reach: float) -> np.ndarray:
@@ -468,7 +506,7 @@ def _open_retreat(xy, half, away, delta, walls, reach: float) -> np.ndarray:
         point = xy + direction * reach
         free = (
             np.ones(len(xy), dtype=bool)
-            if not len(walls)
+            if not walls.shape[-2]
             else (point_segment_linf(point, walls).min(axis=1) - half) >= 0.0
         )
         take = free & ~chosen
@@ -504,14 +542,30 @@ def _window(drivers: Drivers, settings: DwaSettings) -> tuple[np.ndarray, np.nda
     error = np.angle(np.exp(1j * (to_target - theta)))
     turning = np.abs(error) > np.radians(settings.turn_in_place)
     high = np.where(turning, low, high)
-    s = np.linspace(0.0, 1.0, settings.speeds)
+    s = _spread(0.0, settings.speeds)
     vs = low[:, None] + (high - low)[:, None] * s[None, :]  # (R, Nv)
-    ws = omega[:, None] * np.linspace(-1.0, 1.0, settings.turns)[None, :]
-    aim = np.clip(error / max(settings.horizon / 2, eps.max()), -omega, omega)
+    ws = omega[:, None] * _spread(-1.0, settings.turns)[None, :]
+    aim = np.minimum(np.maximum(error / max(settings.horizon / 2, eps.max()), -omega), omega)
     ws = np.concatenate([ws, aim[:, None]], axis=1)  # (R, Nw)
     V = np.repeat(vs[:, :, None], ws.shape[1], axis=2).reshape(R, -1)  # (R, K)
     W = np.repeat(ws[:, None, :], vs.shape[1], axis=1).reshape(R, -1)
     return low, high, V, W
+
+
+@lru_cache(maxsize=8)
+def _spread(start: float, count: int) -> np.ndarray:
+    """``count`` evenly spaced values from `start` to 1 (the window's samples, made once)."""
+    out = np.linspace(start, 1.0, count)
+    out.flags.writeable = False
+    return out
+
+
+@lru_cache(maxsize=8)
+def _instants(horizon: float, samples: int) -> np.ndarray:
+    """The predicted instants :math:`k\\,T/S`, k = 1..S, of an arc (made once)."""
+    out = horizon * np.arange(1, samples + 1) / samples
+    out.flags.writeable = False
+    return out
 
 
 def _escape_ok(
@@ -559,14 +613,14 @@ def _escape_ok(
     slack = step.max(axis=2, initial=0.0)[:, :, None]
     pts = np.stack([x, y], axis=-1).reshape(U, -1, 2)
     ok = np.ones((U, K), dtype=bool)
-    if len(walls):
+    if walls.shape[-2]:
         gap = (point_segment_linf(pts, walls) - half[:, None, None]).reshape(U, K, steps, -1)
         now_gap = point_segment_linf(pose[:, :2], walls) - half[:, None]  # (U, W)
         # moving away never closes a gap, even one already (numerically) shut: it must open
         opens = gap > np.minimum(now_gap, 0.0)[:, None, None, :]
         fine = (gap > slack[..., None]) | ((gap >= now_gap[:, None, None, :] - 1e-9) & opens)
         ok &= fine.all(axis=(2, 3))
-    if len(boxes):
+    if boxes.shape[-2]:
         gap = box_gaps(pts, half[:, None, None], boxes).reshape(U, K, steps, -1)
         bound = obstacles.speed_bound(total.max(axis=1)[:, None])  # (U, M)
         reach = t[..., None] * bound[:, None, None, :]

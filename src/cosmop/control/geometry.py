@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["box_gaps", "point_segment_linf", "segment_array"]
+__all__ = ["box_gaps", "per_row", "point_segment_linf", "segment_array"]
 
 
 def segment_array(segments) -> np.ndarray:
@@ -28,52 +28,69 @@ def point_segment_linf(points: np.ndarray, segments: np.ndarray) -> np.ndarray:
     p_y|)` with :math:`d = b - a`.  The function of `t` is convex and piecewise linear, so its
     minimum lies at an end point or a break point: where either term is zero or where the two
     terms are equal; all six candidates are evaluated.  An axis-parallel segment is a
-    degenerate box, for which the distance is the larger of the two interval distances.
+    degenerate box, for which the distance is the larger of the two interval distances; a
+    segment with infinite ends is infinitely far (padding, see :func:`per_row`).
 
     Parameters
     ----------
     points : ndarray, shape (..., 2)
         Points (mm).
-    segments : ndarray, shape (m, 4)
-        Segments ``x1, y1, x2, y2`` (mm).
+    segments : ndarray, shape (m, 4) or (R, m, 4)
+        Segments ``x1, y1, x2, y2`` (mm); with three axes, one set per row of `points`
+        (``points`` then has shape ``(R, ..., 2)``).
 
     Returns
     -------
     ndarray, shape (..., m)
         Distances (mm).
     """
-    segments = np.asarray(segments, dtype=float)
-    straight = (segments[:, 0] == segments[:, 2]) | (segments[:, 1] == segments[:, 3])
+    seg = per_row(np.asarray(segments, dtype=float), np.ndim(points))
+    straight = (seg[..., 0] == seg[..., 2]) | (seg[..., 1] == seg[..., 3])
     if straight.all():
-        return _axis_aligned(points, segments)
+        return _axis_aligned(points, seg)
+    if seg.ndim > 2:  # one set per row: both formulas, each kept where it holds
+        return np.where(straight, _axis_aligned(points, seg), _general(points, seg))
     if straight.any():
-        out = np.empty((*np.shape(points)[:-1], len(segments)))
-        out[..., straight] = _axis_aligned(points, segments[straight])
-        out[..., ~straight] = _general(points, segments[~straight])
+        out = np.empty((*np.shape(points)[:-1], len(seg)))
+        out[..., straight] = _axis_aligned(points, seg[straight])
+        out[..., ~straight] = _general(points, seg[~straight])
         return out
-    return _general(points, segments)
+    return _general(points, seg)
+
+
+def per_row(obstacles: np.ndarray, point_axes: int) -> np.ndarray:
+    """`obstacles` ``(R, m, k)`` (one set per row) shaped to broadcast against points of
+    `point_axes` axes ``(R, ..., 2)`` once those gain an obstacle axis; ``(m, k)`` as it is.
+
+    Sets of different sizes are padded with obstacles at infinity (every coordinate
+    ``inf``, sizes 0): their gaps are ``inf``, as if they were absent.
+    """
+    if obstacles.ndim == 2:
+        return obstacles
+    R, m, k = obstacles.shape
+    return obstacles.reshape(R, *(1,) * (point_axes - 2), m, k)
 
 
 def _axis_aligned(points: np.ndarray, segments: np.ndarray) -> np.ndarray:
     """An axis-parallel segment is a degenerate box: the larger of the two interval distances."""
     p = np.asarray(points, dtype=float)[..., None, :]
-    lo = np.minimum(segments[:, :2], segments[:, 2:])
-    hi = np.maximum(segments[:, :2], segments[:, 2:])
+    lo = np.minimum(segments[..., :2], segments[..., 2:])
+    hi = np.maximum(segments[..., :2], segments[..., 2:])
     d = np.maximum(np.maximum(lo - p, p - hi), 0.0)
     return np.maximum(d[..., 0], d[..., 1])
 
 
 def _general(points: np.ndarray, segments: np.ndarray) -> np.ndarray:
     p = np.asarray(points, dtype=float)[..., None, :]
-    ax = segments[:, 0] - p[..., 0]
-    ay = segments[:, 1] - p[..., 1]
-    dx = segments[:, 2] - segments[:, 0]
-    dy = segments[:, 3] - segments[:, 1]
-    ax, ay = np.broadcast_arrays(ax, ay)
-    best = np.maximum(np.abs(ax), np.abs(ay))
-    end = np.maximum(np.abs(ax + dx), np.abs(ay + dy))
-    np.minimum(best, end, out=best)
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # padding: inf - inf
+        ax = segments[..., 0] - p[..., 0]
+        ay = segments[..., 1] - p[..., 1]
+        dx = segments[..., 2] - segments[..., 0]
+        dy = segments[..., 3] - segments[..., 1]
+        ax, ay = np.broadcast_arrays(ax, ay)
+        best = np.maximum(np.abs(ax), np.abs(ay))
+        end = np.maximum(np.abs(ax + dx), np.abs(ay + dy))
+        np.minimum(best, end, out=best)
         for num, den in ((-ax, dx), (-ay, dy), (ay - ax, dx - dy), (-(ax + ay), dx + dy)):
             t = np.where(den != 0, num / np.where(den != 0, den, 1.0), 0.0)
             np.clip(t, 0.0, 1.0, out=t)
@@ -91,8 +108,9 @@ def box_gaps(centres: np.ndarray, half: float | np.ndarray, boxes: np.ndarray) -
         Centres of the squares (mm).
     half : float or ndarray broadcastable to ``centres.shape[:-1] + (1,)``
         Their half sides (mm).
-    boxes : ndarray, shape (m, 3)
-        Boxes as ``x, y, half side`` (mm).
+    boxes : ndarray, shape (m, 3) or (R, m, 3)
+        Boxes as ``x, y, half side`` (mm); with three axes, one set per row of `centres`
+        (padded with boxes at infinity, see :func:`per_row`).
 
     Returns
     -------
@@ -100,5 +118,6 @@ def box_gaps(centres: np.ndarray, half: float | np.ndarray, boxes: np.ndarray) -
         :math:`\\max(|\\Delta x|, |\\Delta y|) - h - k`, mm.
     """
     c = np.asarray(centres, dtype=float)[..., None, :]
-    d = np.maximum(np.abs(c[..., 0] - boxes[:, 0]), np.abs(c[..., 1] - boxes[:, 1]))
-    return d - half - boxes[:, 2]
+    b = per_row(boxes, np.ndim(centres))
+    d = np.maximum(np.abs(c[..., 0] - b[..., 0]), np.abs(c[..., 1] - b[..., 1]))
+    return d - half - b[..., 2]

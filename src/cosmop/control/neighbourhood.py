@@ -85,30 +85,69 @@ def dwa_commands_near(
     Parameters as :func:`~cosmop.control.dwa.dwa_commands`.
     """
     R, settings = len(drivers.v), settings or DwaSettings()
+    if R == 0:
+        return DwaCommand(v=np.zeros(0), w=np.zeros(0), safe=np.ones(0, dtype=bool), gap=np.zeros(0))
     wall_reach, box_reach = reach(drivers, obstacles, settings)
     xy, half = drivers.pose[:, :2], drivers.half
     side = cell if cell is not None else float(max(wall_reach.max(), box_reach.max()))
-    _, group = np.unique(np.floor(xy / side).astype(np.int64), axis=0, return_inverse=True)
-    group = group.ravel()
+    group = _cells(xy, side)
     w_lo, w_hi = _wall_bounds(obstacles.walls)
     centres, halves = obstacles.boxes[:, :2], obstacles.boxes[:, 2:]
     b_lo, b_hi = centres - halves, centres + halves
-    v, w, gap = np.zeros(R), np.zeros(R), np.full(R, np.inf)
-    safe = np.ones(R, dtype=bool)
-    for g in range(int(group.max(initial=-1)) + 1):
+    walls, boxes = [], []  # per group: the indices of the walls and boxes within reach
+    for g in range(int(group.max()) + 1):
         rows = np.flatnonzero(group == g)
         lo, hi = xy[rows].min(axis=0), xy[rows].max(axis=0)
-        walls = np.flatnonzero(_rect_gap(lo, hi, w_lo, w_hi) <= (wall_reach[rows] + half[rows]).max())
-        boxes = np.flatnonzero(_rect_gap(lo, hi, b_lo, b_hi) <= (box_reach[rows] + half[rows]).max())
-        cmd = dwa_commands(
-            drivers[rows],
-            obstacles.select(walls, boxes),
-            settings,
-            ignore=None if ignore is None else ignore[np.ix_(rows, boxes)],
-            grip=None if grip is None else grip[np.ix_(rows, boxes)],
-        )
-        v[rows], w[rows], safe[rows], gap[rows] = cmd.v, cmd.w, cmd.safe, cmd.gap
-    return DwaCommand(v=v, w=w, safe=safe, gap=gap)
+        walls.append(np.flatnonzero(_rect_gap(lo, hi, w_lo, w_hi) <= (wall_reach[rows] + half[rows]).max()))
+        boxes.append(np.flatnonzero(_rect_gap(lo, hi, b_lo, b_hi) <= (box_reach[rows] + half[rows]).max()))
+    walls, boxes = _padded(walls, len(obstacles.walls))[group], _padded(boxes, len(obstacles.boxes))[group]
+    return dwa_commands(
+        drivers,
+        _near(obstacles, walls, boxes),
+        settings,
+        ignore=None if ignore is None else _take(ignore, boxes),
+        grip=None if grip is None else _take(grip, boxes),
+    )
+
+
+def _padded(indices: list[np.ndarray], missing: int) -> np.ndarray:
+    """The index lists as the rows of one matrix, filled up with `missing` (the padding)."""
+    out = np.full((len(indices), max((len(i) for i in indices), default=0)), missing, dtype=np.int64)
+    for row, i in enumerate(indices):
+        out[row, : len(i)] = i
+    return out
+
+
+def _near(obstacles: Obstacles, walls: np.ndarray, boxes: np.ndarray) -> Obstacles:
+    """Each driver's own set: the walls and boxes at its row of `walls` ``(R, W)`` and `boxes`
+    ``(R, M)``; the index one past the end is a wall or box at infinity (no speed, no mover)."""
+
+    def pad(values, filler):
+        return None if values is None else np.concatenate([values, [filler]])[boxes]
+
+    return Obstacles(
+        np.concatenate([obstacles.walls, np.full((1, 4), np.inf)])[walls],
+        pad(obstacles.boxes, [np.inf, np.inf, 0.0]),
+        pad(obstacles.speed, 0.0),
+        pad(obstacles.velocity, [0.0, 0.0]),
+        pad(obstacles.acceleration, 0.0),
+        pad(obstacles.agents, False),
+    )
+
+
+def _take(mask: np.ndarray, boxes: np.ndarray) -> np.ndarray:
+    """Each driver's row of `mask` ``(R, M)`` at its boxes ``(R, m)`` (False for the padding)."""
+    padded = np.concatenate([mask, np.zeros((len(mask), 1), dtype=bool)], axis=1)
+    return np.take_along_axis(padded, boxes, axis=1)
+
+
+def _cells(xy: np.ndarray, side: float) -> np.ndarray:
+    """The group of each point ``(R, 2)``: the square cell of side `side` it lies in, numbered
+    in order of first appearance (a dictionary: the points are few, and sorting them is not
+    needed)."""
+    numbers: dict[tuple[int, int], int] = {}
+    keys = np.floor(xy / side).astype(np.int64).tolist()
+    return np.array([numbers.setdefault((x, y), len(numbers)) for x, y in keys], dtype=np.int64)
 
 
 def _wall_bounds(walls: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -17,6 +17,7 @@ from __future__ import annotations
 import heapq
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import shapely
@@ -51,6 +52,15 @@ class GlobalPath:
     def length(self) -> float:
         return sum(math.dist(a, b) for a, b in zip(self.points, self.points[1:], strict=False))
 
+    @cached_property
+    def _segments(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Each segment's start, direction and length, and the length with 1 for a zero one
+        (made once: a robot asks for its look-ahead point every cycle)."""
+        pts = np.asarray(self.points, dtype=float)
+        a, d = pts[:-1], pts[1:] - pts[:-1]
+        lengths = np.hypot(d[:, 0], d[:, 1])
+        return a, d, lengths, np.where(lengths > 0, lengths, 1.0)
+
     def lookahead(self, position: Point, distance: float, corner: float = 30.0) -> tuple[Point, float]:
         """The point up to `distance` mm further along the path than `position`'s projection.
 
@@ -59,13 +69,9 @@ class GlobalPath:
 
         Returns the point and the length of the path left after the projection (mm).
         """
-        pts = np.asarray(self.points, dtype=float)
-        if len(pts) == 1:
+        if len(self.points) == 1:
             return self.points[0], 0.0
-        a, b = pts[:-1], pts[1:]
-        d = b - a
-        lengths = np.hypot(d[:, 0], d[:, 1])
-        safe_len = np.where(lengths > 0, lengths, 1.0)
+        a, d, lengths, safe_len = self._segments
         t = ((position[0] - a[:, 0]) * d[:, 0] + (position[1] - a[:, 1]) * d[:, 1]) / safe_len**2
         t = np.clip(np.where(lengths > 0, t, 0.0), 0.0, 1.0)
         proj = a + t[:, None] * d

@@ -26,7 +26,7 @@ def monitor(world: World, moving_speed: np.ndarray) -> None:
     for pair in list(world.open_contacts):
         if pair not in now:
             del world.open_contacts[pair]
-    for pair in now:
+    for pair in sorted(now):  # in a fixed order: the log is deterministic
         moving = bool(moving_speed[pair[0]] > 0)
         if pair not in world.open_contacts:
             world.open_contacts[pair] = len(world.contacts)
@@ -40,20 +40,19 @@ def _touching(world: World) -> set[tuple[int, str]]:
     """The pairs (robot index, what it touches) now; ``wall k`` names a wall.  The gripper's
     contact with the object it grips is no contact, unless the two overlap."""
     sensed = world.obstacles()
-    boxes, names = sensed.boxes, list(sensed.names)
+    boxes, names = sensed.boxes, sensed.names
     wall_gap, box_gap = robot_gaps(world.pose[:, :2], world.robot_half, world.walls, boxes, None)
-    now: set[tuple[int, str]] = set()
-    for i, agent in enumerate(world.agents):
-        for w in np.flatnonzero(wall_gap[i] <= TOUCH):
-            now.add((i, f"wall {int(w)}"))
-        for b in np.flatnonzero(box_gap[i] <= TOUCH):
-            name = names[b]
-            if name == agent.id:
-                continue
-            gripped = agent.gripped is not None and name == world.object_ids[agent.gripped]
-            if gripped and box_gap[i, b] >= -TOUCH:
-                continue
-            now.add((i, name))
+    # one pass over the touching pairs (a few), not one per robot and kind of obstacle
+    walls = zip(*np.nonzero(wall_gap <= TOUCH), strict=True)
+    now: set[tuple[int, str]] = {(int(i), f"wall {int(w)}") for i, w in walls}
+    for i, b in zip(*np.nonzero(box_gap <= TOUCH), strict=True):
+        agent, name = world.agents[i], names[b]
+        if name == agent.id:
+            continue
+        gripped = agent.gripped is not None and name == world.object_ids[agent.gripped]
+        if gripped and box_gap[i, b] >= -TOUCH:
+            continue
+        now.add((int(i), name))
     return now
 
 

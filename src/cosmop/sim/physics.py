@@ -41,21 +41,22 @@ def integrate(world: World, v_cmd: np.ndarray, w_cmd: np.ndarray, docks: dict[in
     slowing = v1 < v0
     reached = np.where(slowing, (v0 - v1) / np.maximum(brk, 1e-9), dt)  # when v1 is reached, s
 
-    def covered(t: float) -> np.ndarray:
-        """Distance (mm) from the cycle's start to time `t` within it."""
-        ramp = v0 * t + (v1 - v0) * t * t / (2.0 * dt)
-        tb = np.minimum(t, reached)
-        braked = v0 * tb - brk * tb * tb / 2.0 + v1 * np.maximum(t - reached, 0.0)
-        return np.where(slowing, braked, ramp)
-
-    start = world.pose[:, :2].copy()
+    # distance from the cycle's start to each sub-step's end, (n + 1, R): a ramp, or braking
+    # at -b until v1 is reached and holding it after
     n = _SUBSTEPS
-    for k in range(n):
-        step = covered((k + 1) * dt / n) - covered(k * dt / n)
-        theta = world.pose[:, 2] + w_cmd * dt / (2 * n)
+    t = (np.arange(n + 1) * dt / n)[:, None]
+    ramp = v0 * t + (v1 - v0) * t * t / (2.0 * dt)
+    tb = np.minimum(t, reached)
+    braked = v0 * tb - brk * tb * tb / 2.0 + v1 * np.maximum(t - reached, 0.0)
+    covered = np.where(slowing, braked, ramp)
+    steps = covered[1:] - covered[:-1]
+    start = world.pose[:, :2].copy()
+    half_turn, turn = w_cmd * dt / (2 * n), w_cmd * dt / n
+    for step in steps:
+        theta = world.pose[:, 2] + half_turn
         world.pose[:, 0] += step * np.cos(theta)
         world.pose[:, 1] += step * np.sin(theta)
-        world.pose[:, 2] += w_cmd * dt / n
+        world.pose[:, 2] += turn
     world.pose[:, 2] = wrap_angle(world.pose[:, 2])
     world.v = v1
     world.w = w_cmd.copy()

@@ -47,7 +47,7 @@ class Agent:
         self.id = rid
         self.index = index  # the robot's row in the world's arrays
         self.steps = list(steps)  # the plan being executed (a replan replaces the rest)
-        self.mission = list(mission)  # the events those steps realise, messages included
+        self.mission = mission  # the events those steps realise, messages included
         self.step_index = 0  # the step being executed (== len(steps): finished)
         # each step's instant in the plan the run started from (None: a replan added it)
         self.plan_instants: list[int | None] = list(range(1, len(self.steps) + 1))
@@ -69,6 +69,26 @@ class Agent:
         self.answers_sent: dict[str, int] = {}  # Res steps done per object
         # where it creeps out of touch before driving off: None not looked for yet, False none
         self.way_out: tuple[float, float] | bool | None = None
+
+    @property
+    def mission(self) -> list[Event]:
+        """The events the plan's steps realise, messages included (a replan replaces them)."""
+        return self._mission
+
+    @mission.setter
+    def mission(self, events) -> None:
+        self._mission = list(events)
+        self._realising: dict[tuple[Primitive, str | None], list[Event]] = {}
+
+    def realising(self, primitive: Primitive, obj: str | None) -> list[Event]:
+        """The mission's events that a step `primitive` about `obj` (no message) realises, in
+        order (kept: a waiting robot asks every cycle)."""
+        key = (primitive, obj)
+        if key not in self._realising:
+            self._realising[key] = [
+                e for e in self._mission if realising_step(e, self.id) == (primitive, obj, None)
+            ]
+        return self._realising[key]
 
     @property
     def done(self) -> bool:
@@ -150,6 +170,7 @@ class World:
             name for p in plans.robots.values() for name in p.mission if name.startswith("msg(")
         }
         self.t = 0.0  # simulated time, s
+        self._layout_key: tuple[bytes, bytes] | None = None  # what the sensed layout was made for
 
     def _init_robots(self, scenario: Scenario) -> None:
         """The robots' arrays: sizes, limits, poses at rest."""
@@ -185,22 +206,27 @@ class World:
         """What the robots sense now: the walls, and the resting objects, robots and people (in
         that order) as boxes with their speed bounds and ids; :meth:`with_motion` adds how they
         move (only the controllers need it, so the monitor does not pay for it)."""
-        resting = np.flatnonzero(self.carried_by < 0)
-        boxes = [self.resting_boxes(), self.robot_boxes()]
+        resting, names, agents = self._sensed_layout()
+        boxes = [resting, self.robot_boxes()]
         speed = [np.zeros(len(resting)), np.where(self.parked(), 0.0, self.limits.max_speed)]
-        names = [self.object_ids[j] for j in resting] + list(self.robot_ids)
         if self.walkers:
             boxes.append(self.people_boxes())
             speed.append(self.human_speed)
-            names += list(self.human_ids)
-        agents = np.arange(len(names)) >= len(resting)  # robots and people, not objects
         return Obstacles(
-            self.walls,
-            np.vstack(boxes).reshape(-1, 3),
-            np.concatenate(speed),
-            agents=agents,
-            names=tuple(names),
+            self.walls, np.vstack(boxes).reshape(-1, 3), np.concatenate(speed), agents=agents, names=names
         )
+
+    def _sensed_layout(self) -> tuple[np.ndarray, tuple[str, ...], np.ndarray]:
+        """The resting objects' boxes, every box's name and which boxes are robots or people, as
+        :meth:`obstacles` lists them; they change only when an object is picked or dropped, so
+        they are kept until then."""
+        key = (self.carried_by.tobytes(), self.object_xy.tobytes())
+        if self._layout_key != key:
+            resting = np.flatnonzero(self.carried_by < 0)
+            names = tuple(self.object_ids[j] for j in resting) + self.robot_ids + self.human_ids
+            self._layout_key = key
+            self._layout = (self.resting_boxes(), names, np.arange(len(names)) >= len(resting))
+        return self._layout
 
     def with_motion(self, sensed: Obstacles) -> Obstacles:
         """`sensed` with the velocities (mm/s; sensed, for prediction only) and acceleration
@@ -321,9 +347,7 @@ class World:
         if step.message is not None:
             event = parse_event(step.message)
         else:
-            answers = [
-                e for e in agent.mission if realising_step(e, agent.id) == (Primitive.RES, step.object, None)
-            ]
+            answers = agent.realising(Primitive.RES, step.object)
             sent = agent.answers_sent.get(step.object, 0)
             agent.answers_sent[step.object] = sent + 1
             event = answers[min(sent, len(answers) - 1)]
@@ -335,11 +359,7 @@ class World:
         """Whether the message a ``Req`` step waits for has been sent."""
         if step.message is not None:
             return step.message in self.sent_messages
-        return any(
-            e.name in self.sent_messages
-            for e in agent.mission
-            if realising_step(e, agent.id) == (Primitive.REQ, step.object, None)
-        )
+        return any(e.name in self.sent_messages for e in agent.realising(Primitive.REQ, step.object))
 
     def _happened(self, event: Event) -> bool:
         """Whether the step that realises `event` made it happen: a drop left its object in the
