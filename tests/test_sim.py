@@ -4,17 +4,20 @@ from __future__ import annotations
 
 import json
 import multiprocessing
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from typer.testing import CliRunner
 
 from cosmop.cli import app
 from cosmop.pipeline import plan_team
 from cosmop.scenario import load_scenario
-from cosmop.sim import SIM_FORMAT, TRACE_FORMAT, SimSettings, simulate
-from cosmop.traces import Trace, TraceError, as_trace, load_trace
+from cosmop.sim import SIM_FORMAT, TRACE_FORMAT, SimSettings, simulate, time_limit
+from cosmop.traces import Trace, TraceError, _rounded, as_trace, load_trace
 from team_checks import assert_complete_word, assert_no_overlap
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -79,6 +82,27 @@ def test_10x10_completes():
     full = simulate(scenario, plans, settings=SimSettings(max_time=40.0, neighbourhood=False))
     n = len(full.frames["t"])
     np.testing.assert_array_equal(result.frames["pose"][:n], full.frames["pose"])
+
+
+def test_the_time_limit_grows_with_the_planned_makespan(warehouse_2x2):
+    scenario, plans = warehouse_2x2
+    makespan = plans.itinerary.makespan
+    assert 0 < makespan < 300  # the 2x2: the least limit holds
+    assert time_limit(scenario, plans) == 900.0
+    assert time_limit(scenario, plans, SimSettings(max_time=12.5)) == 12.5
+    # the same plans expected to take ten times as long: three times that
+    slow = replace(
+        plans,
+        itinerary=replace(
+            plans.itinerary,
+            times={
+                r: tuple((a * 10, b * 10) for a, b in slots) for r, slots in plans.itinerary.times.items()
+            },
+        ),
+    )
+    assert time_limit(scenario, slow) == pytest.approx(30 * makespan)
+    short = simulate(scenario, slow, settings=SimSettings(max_time=5.0))
+    assert not short.completed and short.sim_time_s == pytest.approx(5.0)
 
 
 def _run_seed(job):
@@ -161,6 +185,27 @@ def test_summary_and_trace_files(tmp_path, people_2x2):
     names = np.array(run.primitive_names, dtype=object)[run.primitive]
     assert (names == np.array(back.primitive_names, dtype=object)[back.primitive]).all()
     assert not run.poses.flags.writeable and result.frames["pose"].flags.writeable
+
+
+@settings(max_examples=300)
+@given(
+    values=st.lists(
+        st.one_of(
+            st.floats(allow_nan=True, allow_infinity=True),
+            st.integers(-(10**9), 10**9).map(lambda k: k / 2000),  # ties at the third decimal
+            st.integers(-(10**9), 10**9).map(lambda k: k / 2_000_000),  # and at the sixth
+        ),
+        min_size=1,
+        max_size=40,
+    ),
+    digits=st.sampled_from([3, 6]),
+)
+def test_trace_values_are_rounded_exactly_as_round_rounds_them(values, digits):
+    # the files keep their bytes: the vectorised rounding must be Python's round, ties included
+    out = _rounded(np.array(values, dtype=float), digits)
+    for x, y in zip(values, out.tolist(), strict=True):
+        expected = round(x, digits) if np.isfinite(x) else x
+        assert (y == expected and np.signbit(y) == np.signbit(expected)) or (np.isnan(x) and np.isnan(y))
 
 
 def _frame(t, robots, humans=None, objects=None):

@@ -337,14 +337,19 @@ class Trace:
             if array is not None:
                 rows = array.tolist()
                 columns[key] = rows if to_json is None else [list(map(to_json, row)) for row in rows]
+        # NaN (not shown) is looked for value by value only in the arrays that have one
+        holes = any(
+            np.isnan(a).any() for a in (self.poses, self.v, self.w) if a is not None and a.dtype.kind == "f"
+        )
         frames = []
         for k in range(len(self.t)):
             robots = {}
             for i, rid in enumerate(self.robot_ids):
-                if math.isnan(columns["pose"][k][i][0]):
-                    continue  # this frame does not show the robot
-                state = {key: rows[k][i] for key, rows in columns.items()}
-                robots[rid] = {key: v for key, v in state.items() if not (isinstance(v, float) and v != v)}
+                if not holes:
+                    robots[rid] = {key: rows[k][i] for key, rows in columns.items()}
+                elif not math.isnan(columns["pose"][k][i][0]):  # else: this frame does not show it
+                    state = {key: rows[k][i] for key, rows in columns.items()}
+                    robots[rid] = {k: v for k, v in state.items() if not (isinstance(v, float) and v != v)}
             frames.append(robots)
         return frames
 
@@ -410,8 +415,16 @@ def _rounded(values: np.ndarray | None, digits: int) -> np.ndarray | None:
         return None
     if np.array_equal(np.round(values, digits), values, equal_nan=True):
         return values
-    flat = [round(x, digits) for x in values.ravel().tolist()]
-    return np.array(flat, dtype=float).reshape(values.shape)
+    # k / 10**d with k the integer nearest to x 10**d is the double ``round`` returns, unless
+    # the product was rounded across a tie: only the values within a hair of one go through
+    # ``round`` (the hair: the product's rounding error, with a wide margin)
+    scaled = values * 10.0**digits
+    out = np.rint(scaled) / 10.0**digits
+    hair = 1e-6 + 1e-14 * np.abs(scaled)
+    with np.errstate(invalid="ignore"):
+        close = np.abs(np.abs(scaled - np.floor(scaled)) - 0.5) <= hair
+    out[close] = [round(x, digits) for x in values[close].tolist()]
+    return out
 
 
 def _json_points(ids: Sequence[str], positions: np.ndarray) -> list[dict[str, list[float]]]:

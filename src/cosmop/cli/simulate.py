@@ -56,7 +56,14 @@ def simulate(
         Path | None,
         typer.Option(help="Write a ROS 2 bag DIRECTORY (MCAP; the ros extra).", show_default=False),
     ] = None,
-    max_time: Annotated[float, typer.Option(help="Simulated seconds before giving up.", min=1.0)] = 900.0,
+    max_time: Annotated[
+        float | None,
+        typer.Option(
+            help="Simulated seconds before giving up \\[default: three times the planned makespan, "
+            "at least 900 s]",
+            min=1.0,
+        ),
+    ] = None,
     replan: Annotated[bool, typer.Option(help="Stalled robots replan their remaining mission.")] = True,
     workers: WorkersOption = None,
     scheduler: SchedulerOption = None,
@@ -133,12 +140,16 @@ def _plans_to_run(
     return plans
 
 
-def _run_with_progress(loaded: Scenario, plans: PlanSet, seed: int, max_time: float, replan: bool) -> Any:
+def _run_with_progress(
+    loaded: Scenario, plans: PlanSet, seed: int, max_time: float | None, replan: bool
+) -> Any:
     """:func:`cosmop.sim.simulate` under a bar of simulated time and robots done."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
-    from cosmop.sim import SimSettings
+    from cosmop.sim import SimSettings, time_limit
     from cosmop.sim import simulate as run_simulate
+
+    settings = SimSettings(max_time=max_time, replan=replan)
 
     columns = (
         TextColumn("simulating"),
@@ -147,12 +158,13 @@ def _run_with_progress(loaded: Scenario, plans: PlanSet, seed: int, max_time: fl
         TimeElapsedColumn(),
     )
     with Progress(*columns, console=stderr(), transient=True) as progress:
-        task = progress.add_task("simulating", total=max_time, done=0, robots=len(loaded.scene.robots))
+        limit = time_limit(loaded, plans, settings)
+        task = progress.add_task("simulating", total=limit, done=0, robots=len(loaded.scene.robots))
         return run_simulate(
             loaded,
             plans,
             seed=seed,
-            settings=SimSettings(max_time=max_time, replan=replan),
+            settings=settings,
             on_cycle=lambda t, done, robots: progress.update(task, completed=t, done=done),
         )
 

@@ -123,6 +123,10 @@ def robot_gaps(
 class Obstacles:
     """Everything a robot senses in one cycle: the walls and the boxes (objects, robots, people).
 
+    The shapes below are those of one set shared by every driver.  One set per driver has a
+    leading axis of the drivers on every array (``(R, W, 4)``, ``(R, M, 3)``, ``(R, M)``, ...;
+    :meth:`per_driver`); the dynamic window works on that form.
+
     Attributes
     ----------
     walls : ndarray, shape (W, 4)

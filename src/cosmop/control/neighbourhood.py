@@ -36,6 +36,15 @@ the full computation, bit for bit; only :attr:`DwaCommand.gap` is ``inf`` instea
 beyond reach when nothing is near.  The cost per cycle is the drivers times the obstacles near
 them: linear in the team and independent of the size of the map (plus a pass over the
 obstacles' bounding boxes per group, which is cheap).
+
+**One call for every group.**  The groups' sets differ, but the window runs once for all
+drivers: each driver gets its group's set as its own row
+(:meth:`~cosmop.control.dwa.Obstacles.per_driver`), shorter sets padded with walls and boxes at
+infinity.  Their gaps are ``inf``, so they too never decide a test or attain a minimum, and
+every driver's commands are those of a call with its set alone
+(``tests/test_neighbourhood.py``).  A call costs a few hundred NumPy operations whatever
+its size, so one call instead of one per group is what makes a cycle of many scattered
+drivers cheap.
 """
 
 from __future__ import annotations
@@ -80,8 +89,9 @@ def dwa_commands_near(
     """:func:`~cosmop.control.dwa.dwa_commands`, each group of drivers against what is near it.
 
     Drivers are grouped by square cells of side `cell` (mm; default: the largest reach); each
-    group is one call of the dynamic window with the walls and boxes within reach of any of
-    its drivers.  The commands are those of one call with everything (module docstring).
+    group's drivers get the walls and boxes within reach of any of them, and one call of the
+    dynamic window serves every group (module docstring).  The commands are those of one call
+    with everything.
     Parameters as :func:`~cosmop.control.dwa.dwa_commands`.
     """
     R, settings = len(drivers.v), settings or DwaSettings()
@@ -100,6 +110,15 @@ def dwa_commands_near(
         lo, hi = xy[rows].min(axis=0), xy[rows].max(axis=0)
         walls.append(np.flatnonzero(_rect_gap(lo, hi, w_lo, w_hi) <= (wall_reach[rows] + half[rows]).max()))
         boxes.append(np.flatnonzero(_rect_gap(lo, hi, b_lo, b_hi) <= (box_reach[rows] + half[rows]).max()))
+    if len(walls) == 1:  # one group: one set, shared (no padding needed)
+        near = boxes[0]
+        return dwa_commands(
+            drivers,
+            obstacles.select(walls[0], near),
+            settings,
+            ignore=None if ignore is None else ignore[:, near],
+            grip=None if grip is None else grip[:, near],
+        )
     walls, boxes = _padded(walls, len(obstacles.walls))[group], _padded(boxes, len(obstacles.boxes))[group]
     return dwa_commands(
         drivers,
@@ -138,7 +157,7 @@ def _near(obstacles: Obstacles, walls: np.ndarray, boxes: np.ndarray) -> Obstacl
 def _take(mask: np.ndarray, boxes: np.ndarray) -> np.ndarray:
     """Each driver's row of `mask` ``(R, M)`` at its boxes ``(R, m)`` (False for the padding)."""
     padded = np.concatenate([mask, np.zeros((len(mask), 1), dtype=bool)], axis=1)
-    return np.take_along_axis(padded, boxes, axis=1)
+    return padded[np.arange(len(mask))[:, None], boxes]
 
 
 def _cells(xy: np.ndarray, side: float) -> np.ndarray:

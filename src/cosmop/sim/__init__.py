@@ -10,7 +10,7 @@ carries the ``cosmop.sim/1`` summary, with every step's planned and realised tim
 from cosmop.sim.monitor import footprint_overlaps
 from cosmop.sim.replan import replan, sensed_scene
 from cosmop.sim.result import SIM_FORMAT, Contact, Message, SimResult, SimSettings
-from cosmop.sim.simulation import simulate
+from cosmop.sim.simulation import simulate, time_limit
 from cosmop.sim.timing import StepTimes
 from cosmop.traces import TRACE_FORMAT
 
@@ -26,4 +26,5 @@ __all__ = [
     "replan",
     "sensed_scene",
     "simulate",
+    "time_limit",
 ]

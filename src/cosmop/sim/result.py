@@ -25,7 +25,16 @@ from cosmop.sim.timing import StepTimes
 from cosmop.traces import Trace
 from cosmop.units import INTERNAL_UNITS
 
-__all__ = ["FRAME_PRIMITIVES", "SIM_FORMAT", "Contact", "Message", "SimResult", "SimSettings", "drop_holds"]
+__all__ = [
+    "DEFAULT_TIME_LIMIT",
+    "FRAME_PRIMITIVES",
+    "SIM_FORMAT",
+    "Contact",
+    "Message",
+    "SimResult",
+    "SimSettings",
+    "drop_holds",
+]
 
 SIM_FORMAT = "cosmop.sim/1"
 """The ``format`` of a simulation summary (``summary.json``)."""
@@ -34,14 +43,21 @@ FRAME_PRIMITIVES = (None, *(str(p) for p in PRIMITIVES))
 """What the ``primitive`` frame array's indices stand for (0: none, the robot has finished)."""
 
 
+DEFAULT_TIME_LIMIT = 900.0
+"""The least time limit of a run when none is set, simulated s (:class:`SimSettings`)."""
+
+
 @dataclass(frozen=True)
 class SimSettings:
     """How the simulation runs (the robots' limits come from the scenario's ``dynamics``).
 
     Attributes
     ----------
-    max_time : float
-        Simulated seconds after which an unfinished run stops (``completed`` false).
+    max_time : float or None
+        Simulated seconds after which an unfinished run stops (``completed`` false).  ``None``
+        (the default): three times the makespan the plans expect, and at least 900 s -- a
+        team that waits for each other's messages often runs half as long again as planned,
+        and a long mission must not be cut off for being long.
     goal_tolerance, pass_tolerance : float
         Distance (mm) within which a final / intermediate GoTo waypoint counts as reached.
     heading_tolerance : float
@@ -82,7 +98,7 @@ class SimSettings:
         team).  ``False`` scores everything against everything, to compare.
     """
 
-    max_time: float = 900.0
+    max_time: float | None = None
     goal_tolerance: float = 15.0
     pass_tolerance: float = 150.0
     heading_tolerance: float = 2.0

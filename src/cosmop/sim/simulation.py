@@ -75,7 +75,7 @@ from cosmop.sim.execute import decide, let_go
 from cosmop.sim.monitor import footprint_overlaps, monitor
 from cosmop.sim.physics import integrate
 from cosmop.sim.recording import Recorder
-from cosmop.sim.result import SIM_FORMAT, Contact, Message, SimResult, SimSettings
+from cosmop.sim.result import DEFAULT_TIME_LIMIT, SIM_FORMAT, Contact, Message, SimResult, SimSettings
 from cosmop.sim.timing import step_times
 from cosmop.sim.world import World
 from cosmop.traces import TRACE_FORMAT
@@ -89,6 +89,7 @@ __all__ = [
     "SimSettings",
     "footprint_overlaps",
     "simulate",
+    "time_limit",
 ]
 
 
@@ -133,7 +134,7 @@ def simulate(
     recorder.record(world)
     completed = False
     cycles = 0
-    for _ in range(math.ceil(settings.max_time / world.dt)):
+    for _ in range(math.ceil(time_limit(scenario, plans, settings) / world.dt)):
         _cycle(world)
         cycles += 1
         recorder.record(world)
@@ -144,6 +145,17 @@ def simulate(
             completed = True
             break
     return _result(world, scenario, plans, recorder.frames(world), completed, cycles, wall0)
+
+
+def time_limit(scenario: Scenario, plans: PlanSet, settings: SimSettings | None = None) -> float:
+    """When a run of `plans` stops unfinished, simulated s: ``settings.max_time``, or by
+    default three times the plans' expected makespan and at least 900 s (:class:`SimSettings`)."""
+    settings = settings or SimSettings()
+    if settings.max_time is not None:
+        return settings.max_time
+    planned = _planned_times(plans.extend(scenario), plans)
+    makespan = planned.makespan if planned is not None else 0.0
+    return max(DEFAULT_TIME_LIMIT, 3.0 * makespan)
 
 
 def _cycle(world: World) -> None:
@@ -272,17 +284,18 @@ def _result(
         replan_log=tuple(world.replan_log),
         steps=step_times(
             {rid: [s.label for s in p.steps] for rid, p in plans.robots.items()},
-            _planned_times(world, plans),
+            _planned_times(world.scenario, plans),
             {a.id: a.step_log for a in world.agents},
         ),
     )
 
 
-def _planned_times(world: World, plans: PlanSet) -> Itinerary | None:
-    """The plan set's itinerary, or the expected one for a plan file without times."""
+def _planned_times(scenario: Scenario, plans: PlanSet) -> Itinerary | None:
+    """The plan set's itinerary, or the expected one for a plan file without times (`scenario`
+    with the places of the plans' added tasks)."""
     if plans.itinerary is not None:
         return plans.itinerary
     try:
-        return itinerary(world.scenario.scene, plans.robots)
+        return itinerary(scenario.scene, plans.robots)
     except ValueError:  # messages that deadlock: no schedule to compare with
         return None
