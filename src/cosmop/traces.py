@@ -349,7 +349,7 @@ class Trace:
                     robots[rid] = {key: rows[k][i] for key, rows in columns.items()}
                 elif not math.isnan(columns["pose"][k][i][0]):  # else: this frame does not show it
                     state = {key: rows[k][i] for key, rows in columns.items()}
-                    robots[rid] = {k: v for k, v in state.items() if not (isinstance(v, float) and v != v)}
+                    robots[rid] = {n: v for n, v in state.items() if not (isinstance(v, float) and v != v)}
             frames.append(robots)
         return frames
 

@@ -174,7 +174,8 @@ class Obstacles:
 
     def per_driver(self, drivers: int) -> Obstacles:
         """The same obstacles as one set per driver: every array gains a leading axis of length
-        `drivers` (views, no copies); obstacles already per driver are returned as they are.
+        `drivers` (copies: small next to the window's own arrays, and cheaper to make than
+        broadcast views); obstacles already per driver are returned as they are.
 
         Per-driver sets may differ (:func:`~cosmop.control.neighbourhood.dwa_commands_near`
         gives each driver what is near it); a shorter set is padded with boxes and walls at
@@ -184,7 +185,7 @@ class Obstacles:
             return self
 
         def each(values):
-            return None if values is None else np.broadcast_to(values, (drivers, *values.shape))
+            return None if values is None else values[None].repeat(drivers, axis=0)
 
         return Obstacles(
             each(self.walls),

@@ -39,8 +39,7 @@ def monitor(world: World, moving_speed: np.ndarray) -> None:
 def _touching(world: World) -> set[tuple[int, str]]:
     """The pairs (robot index, what it touches) now; ``wall k`` names a wall.  The gripper's
     contact with the object it grips is no contact, unless the two overlap."""
-    sensed = world.obstacles()
-    boxes, names = sensed.boxes, sensed.names
+    boxes, names = world.boxes()
     wall_gap, box_gap = robot_gaps(world.pose[:, :2], world.robot_half, world.walls, boxes, None)
     # one pass over the touching pairs (a few), not one per robot and kind of obstacle
     walls = zip(*np.nonzero(wall_gap <= TOUCH), strict=True)
