@@ -9,9 +9,10 @@ hold its good) is drawn again from the same seed's generator, so every seed give
 Each scene is planned (``cosmop plan``) and, when feasible, simulated from that plan
 (``cosmop simulate --plan``) as a user runs them, one fresh process each.  A row records the
 plan's verdict, whether the run completed, the contacts while moving, the simulated and wall
-times.  Writes ``results/sweep_generated.json``.
+times.
 
-Usage: ``python benchmarks/sweep_generated.py [--seeds 0:200] [--timeout 600]``.
+Usage: ``python benchmarks/sweep_generated.py [--seeds 0:200] [--timeout 600] [--out NAME]``
+(``results/NAME.json``; default ``sweep_generated``).
 """
 
 from __future__ import annotations
@@ -85,6 +86,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", default="0:200", help="first:last (exclusive)")
     parser.add_argument("--timeout", type=float, default=600.0)
+    parser.add_argument("--out", default="sweep_generated", help="results/OUT.json")
     args = parser.parse_args(argv)
     first, last = (int(v) for v in args.seeds.split(":"))
     rows = []
@@ -92,7 +94,7 @@ def main(argv: list[str] | None = None) -> int:
         for seed in range(first, last):
             rows.append(run_seed(seed, args.timeout, Path(tmp)))
             print(json.dumps(rows[-1]), flush=True)
-    save_results("sweep_generated", rows)
+    save_results(args.out, rows)
     feasible = [r for r in rows if r["plan"] == "feasible"]
     done = [r for r in feasible if r.get("completed")]
     print(
