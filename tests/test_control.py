@@ -4,11 +4,20 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import shapely
 from hypothesis import given
 from hypothesis import strategies as st
 from shapely.geometry import LineString
 
-from cosmop.control import admissible_speed, box_gaps, is_safe, plan_path, point_segment_linf, segment_array
+from cosmop.control import (
+    admissible_speed,
+    box_gaps,
+    is_safe,
+    paths,
+    plan_path,
+    point_segment_linf,
+    segment_array,
+)
 from cosmop.planning import overlaps, swept_square
 from cosmop.planning.checker import square
 from cosmop.scene import Dynamics, Human
@@ -117,6 +126,55 @@ def test_global_path_reports_no_way():
         ]
     )
     assert plan_path((0, 0), (3000, 0), 200.0, walls, np.zeros((0, 3))) is None
+
+
+def _scattered(seed: int, side: float = 60_000.0):
+    """A wide map of scattered walls and boxes, and a start and goal a few metres apart."""
+    rng = np.random.default_rng(seed)
+    start = rng.uniform(0, side, 80)
+    walls = np.column_stack([start[:40], start[40:], start[:40], start[40:]])
+    along = rng.integers(0, 2, 40) == 0
+    length = rng.uniform(1000, 8000, 40)
+    walls[along, 2] += length[along]
+    walls[~along, 3] += length[~along]
+    boxes = np.column_stack([rng.uniform(0, side, (60, 2)), rng.uniform(100, 400, 60)])
+    a = rng.uniform(side / 3, 2 * side / 3, 2)
+    return tuple(a), tuple(a + rng.uniform(-6000, 6000, 2)), walls, boxes
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_a_route_found_near_first_costs_what_the_whole_map_search_finds(seed):
+    start, goal, walls, boxes = _scattered(seed)
+    near = plan_path(start, goal, 200.0, walls, boxes)
+    whole, cost = paths._route(np.array([start, goal]), 200.0, walls, boxes, None, 150.0, 3.0, 10.0)
+    assert (near is None) == (whole is None)
+    if near is not None:
+        assert near.points[0] == start and near.points[-1] == goal
+        # every edge of the near route is free of every obstacle of the whole map, and the
+        # route costs what the cheapest route of the whole map costs
+        grown = shapely.unary_union(paths._grown(walls, boxes, 200.0))
+        inner = paths._interior(grown)
+        edges = paths._EdgeCosts(np.array(near.points), inner, grown.boundary, 150.0, 3.0, 10.0)
+        total = 0.0
+        for u in range(len(near.points) - 1):
+            free, each, _ = edges(u, np.array([u + 1]))
+            assert list(free) == [u + 1]  # free of the whole map's obstacles
+            total += float(each[0])
+        assert total == pytest.approx(cost, rel=1e-9)
+
+
+def test_the_search_widens_until_it_finds_the_way_round():
+    # a wall 40 m long right across the way, open only at its far end: no route near the two
+    # ends, one far away
+    walls = segment_array([((0, -20_000), (0, 20_000)), ((-3000, 20_000), (3000, 20_000))])
+    path = plan_path((-1000, 0), (1000, 0), 200.0, walls, np.zeros((0, 3)))
+    assert path is not None and max(y for _, y in path.points) > 20_000
+    assert path.length > 40_000
+
+
+def test_a_goal_inside_an_obstacle_has_no_route():
+    boxes = np.array([[5000.0, 0.0, 300.0]])
+    assert plan_path((0, 0), (5100, 0), 200.0, np.zeros((0, 4)), boxes) is None
 
 
 def test_walker_follows_its_path_and_stands():

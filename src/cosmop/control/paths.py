@@ -119,6 +119,17 @@ def plan_path(
     :math:`\ell\,(1 + p\,(1 - c/m)) + q\,m\,(1 - c/m)`, so the route keeps its distance
     where it can and squeezes through where it must.
 
+    **Near first.**  The search first runs in a box around `start` and `goal`, reaching
+    :math:`\rho` beyond them (at least :data:`NEAR` and twice their distance), with only the
+    obstacles whose grown shape meets the box and only the corners inside it; a box is convex,
+    so every edge stays inside and no obstacle left out can block it.  A route leaving the box
+    is at least :math:`2\rho` long and costs at least that much (an edge costs at least its
+    length), so a route found inside costing at most :math:`2\rho` is a cheapest one of the
+    whole map; otherwise :math:`\rho` doubles, until the box holds every obstacle (the search
+    of the whole map).  The cost is the whole map's; on a map within the first box, so is
+    everything else.  A start or goal inside an obstacle has no route (every edge from or to
+    it enters the obstacle), which is seen at once.
+
     Parameters
     ----------
     start, goal : (float, float)
@@ -141,19 +152,55 @@ def plan_path(
     GlobalPath or None
         ``None`` when the goal cannot be reached even touching the obstacles.
     """
+    walls, boxes = (
+        np.asarray(walls, dtype=float).reshape(-1, 4),
+        np.asarray(boxes, dtype=float).reshape(-1, 3),
+    )
+    ends = np.array([start, goal], dtype=float)
+    lows = np.vstack([np.minimum(walls[:, :2], walls[:, 2:]) - half, boxes[:, :2] - (boxes[:, 2:] + half)])
+    highs = np.vstack([np.maximum(walls[:, :2], walls[:, 2:]) + half, boxes[:, :2] + (boxes[:, 2:] + half)])
+    for point in ends:  # inside an obstacle: every edge from or to it enters that obstacle
+        holds = np.all((lows <= point) & (highs >= point), axis=1)
+        near = _grown(walls[holds[: len(walls)]], boxes[holds[len(walls) :]], half)
+        if near and shapely.intersects_xy(_interior(shapely.unary_union(near)), *point):
+            return None
+    reach = max(NEAR, 2.0 * float(np.abs(ends[1] - ends[0]).max()))
+    while True:
+        lo, hi = ends.min(axis=0) - reach, ends.max(axis=0) + reach
+        meets = np.all((lows <= hi) & (highs >= lo), axis=1)
+        if meets.all():  # the whole map
+            return _route(ends, half, walls, boxes, None, margin, penalty, squeeze)[0]
+        inside = meets[: len(walls)], meets[len(walls) :]
+        path, cost = _route(
+            ends, half, walls[inside[0]], boxes[inside[1]], (lo, hi), margin, penalty, squeeze
+        )
+        if path is not None and cost <= 2.0 * reach:
+            return path
+        reach *= 2.0
+
+
+NEAR = 5000.0
+"""How far beyond its start and goal (mm) :func:`plan_path` looks first."""
+
+
+def _route(ends, half, walls, boxes, region, margin, penalty, squeeze) -> tuple[GlobalPath | None, float]:
+    """The cheapest route among `walls` and `boxes` with corners inside `region` (``(lo, hi)``
+    corners of a box, or ``None``: anywhere), and its cost (:func:`plan_path`)."""
     grown = shapely.unary_union(_grown(walls, boxes, half))
     # Touching is allowed: only the open interior blocks (shrink by a hair against round-off).
     inner = _interior(grown)
-    s = np.asarray(start, dtype=float)
-    g = np.asarray(goal, dtype=float)
     corners = [_corners(grown, inner, offset) for offset in (1.0, margin)]
-    nodes = np.vstack([s[None, :], g[None, :], *corners])
+    nodes = np.vstack([ends, *corners])
+    if region is not None:
+        nodes = nodes[
+            np.all((nodes >= region[0]) & (nodes <= region[1]), axis=1) | (np.arange(len(nodes)) < 2)
+        ]
     costs = _EdgeCosts(nodes, inner, None if grown.is_empty else grown.boundary, margin, penalty, squeeze)
     found = _a_star(nodes, costs)
     if found is None:
-        return None
-    route, least = found
-    return GlobalPath(tuple((float(x), float(y)) for x, y in nodes[route]), min(least, margin))
+        return None, math.inf
+    route, least, cost = found
+    return GlobalPath(tuple((float(x), float(y)) for x, y in nodes[route]), min(least, margin)), cost
 
 
 def straight_path(
@@ -165,17 +212,33 @@ def straight_path(
     allowed); the executor follows it as it is -- a shortest path among the grown obstacles
     would hug their corners, and in a passage one robot wide that puts the robot against a
     corner it cannot leave.  ``None`` when something now stands on the segment (a parked robot,
-    a person), for :func:`plan_path` to find a way around.
+    a person), for :func:`plan_path` to find a way around.  The path's margin is its clearance
+    to the grown obstacles, capped at :data:`CLEARANCE_CAP` (only obstacles that near are
+    measured).
     """
-    grown = shapely.unary_union(_grown(walls, boxes, half))
+    walls, boxes = (
+        np.asarray(walls, dtype=float).reshape(-1, 4),
+        np.asarray(boxes, dtype=float).reshape(-1, 3),
+    )
+    ends = np.array([start, goal], dtype=float)
+    lo, hi = ends.min(axis=0) - (CLEARANCE_CAP + half), ends.max(axis=0) + (CLEARANCE_CAP + half)
+    near_walls = np.all(
+        (np.minimum(walls[:, :2], walls[:, 2:]) <= hi) & (np.maximum(walls[:, :2], walls[:, 2:]) >= lo),
+        axis=1,
+    )
+    near_boxes = np.all((boxes[:, :2] - boxes[:, 2:] <= hi) & (boxes[:, :2] + boxes[:, 2:] >= lo), axis=1)
+    grown = shapely.unary_union(_grown(walls[near_walls], boxes[near_boxes], half))
+    clearance = CLEARANCE_CAP
     if not grown.is_empty:
         line = shapely.linestrings([start, goal])
         if shapely.intersects(_interior(grown), line):
             return None
-        clearance = float(shapely.distance(grown.boundary, line))
-    else:
-        clearance = float("inf")
+        clearance = min(float(shapely.distance(grown.boundary, line)), CLEARANCE_CAP)
     return GlobalPath((tuple(map(float, start)), tuple(map(float, goal))), clearance)
+
+
+CLEARANCE_CAP = 1000.0
+"""The most clearance (mm) :func:`straight_path` measures."""
 
 
 def _interior(geometry):
@@ -241,8 +304,8 @@ class _EdgeCosts:
         return others, cost, clearance
 
 
-def _a_star(nodes: np.ndarray, costs: _EdgeCosts) -> tuple[list[int], float] | None:
-    """Cheapest route from node 0 to node 1, and the least clearance along it.
+def _a_star(nodes: np.ndarray, costs: _EdgeCosts) -> tuple[list[int], float, float] | None:
+    """Cheapest route from node 0 to node 1, the least clearance along it, and its cost.
 
     A* with the straight-line distance to the goal, which never overestimates (an edge costs
     at least its length) and is consistent, so a node taken off the queue is final and the
@@ -276,4 +339,4 @@ def _a_star(nodes: np.ndarray, costs: _EdgeCosts) -> tuple[list[int], float] | N
     while route[-1] != 0:
         route.append(int(parent[route[-1]]))
     least = min((float(clear[v]) for v in route[:-1]), default=math.inf)
-    return route[::-1], least
+    return route[::-1], least, float(dist[1])
