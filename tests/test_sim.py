@@ -14,9 +14,12 @@ from hypothesis import strategies as st
 from typer.testing import CliRunner
 
 from cosmop.cli import app
+from cosmop.control.geometry import box_gaps, point_segment_linf
 from cosmop.pipeline import plan_team
-from cosmop.scenario import load_scenario
+from cosmop.planning import PlanSet
+from cosmop.scenario import load_scenario, parse_scenario
 from cosmop.sim import SIM_FORMAT, TRACE_FORMAT, SimSettings, simulate, time_limit
+from cosmop.sim.world import World
 from cosmop.traces import Trace, TraceError, _rounded, as_trace, load_trace
 from team_checks import assert_complete_word, assert_no_overlap
 
@@ -103,6 +106,31 @@ def test_the_time_limit_grows_with_the_planned_makespan(warehouse_2x2):
     assert time_limit(scenario, slow) == pytest.approx(30 * makespan)
     short = simulate(scenario, slow, settings=SimSettings(max_time=5.0))
     assert not short.completed and short.sim_time_s == pytest.approx(5.0)
+
+
+def test_static_gaps_measure_near_walls_first_and_give_the_gaps_to_every_wall():
+    # a map of 26 x 16 walls a metre apart: most walls are far from most points
+    rows = [((x, y), (x + 800.0, y)) for x in range(0, 26_000, 1000) for y in range(0, 16_000, 1000)]
+    data = {
+        "name": "many walls",
+        "scene": {
+            "obstacles": [[list(a), list(b)] for a, b in rows],
+            "robots": {"R1": {"size": 400, "pose": [500, 500, 0]}},
+            "objects": {"O1": {"size": 100, "position": [7500, 4500]}},
+            "workspaces": {"W1": {"x": [9100, 9900], "y": [9100, 9900]}},
+        },
+        "mission": {"tasks": {"R1": ["pick O1", "drop O1 at W1", "return"]}},
+    }
+    world = World(parse_scenario(data), PlanSet("many walls", True, {}), 0, SimSettings())
+    rng = np.random.default_rng(5)
+    for spread in (1.0, 80.0, 900.0, 3000.0, 40_000.0):  # one point, a way out's fan, the map
+        centre = rng.uniform(0, 26_000, 2)
+        points = centre + rng.uniform(-spread, spread, (60, 2))
+        brute = np.minimum(
+            (point_segment_linf(points, world.walls) - 200.0).min(axis=1),
+            box_gaps(points, 200.0, world.resting_boxes()).min(axis=1),
+        )
+        np.testing.assert_array_equal(world.static_gaps(points, 200.0), brute)
 
 
 def _run_seed(job):

@@ -30,6 +30,8 @@ from cosmop.sim.result import Contact, Message, SimSettings, drop_holds
 
 __all__ = ["TOUCH", "Action", "Agent", "World", "wrap_angle"]
 
+_NEAR = 1000.0  # mm: :meth:`World.static_gaps` measures the walls this near first
+
 Action = tuple[str, Any]
 """One cycle's command of a robot: ``("drive", (target, stop, room))`` for the dynamic window,
 ``("move", (v, w))`` (mm/s, rad/s) or ``("dock", (x, y, heading deg))`` for the docking creep."""
@@ -136,6 +138,8 @@ class World:
         humans = scene.humans
         self.human_ids = tuple(humans)
         self.walls = segment_array([(w.start, w.end) for w in scene.obstacles])
+        ends = self.walls.reshape(-1, 2, 2)
+        self._wall_lo, self._wall_hi = ends.min(axis=1), ends.max(axis=1)  # each wall's box
         self._init_robots(scenario)
         objects = [scene.objects[o] for o in self.object_ids]
         self.object_xy = np.array([o.position for o in objects], dtype=float).reshape(-1, 2)  # resting ones
@@ -264,7 +268,17 @@ class World:
         points = np.asarray(points, dtype=float).reshape(-1, 2)
         gap = np.full(len(points), np.inf)
         if len(self.walls):
-            gap = np.minimum(gap, (point_segment_linf(points, self.walls) - half).min(axis=1))
+            # the walls within NEAR of the points' box first: a farther wall is more than NEAR
+            # from every point, so it cannot be the nearest of a point nearer than that to one
+            # of them; the other points are measured against every wall
+            lo, hi = points.min(axis=0, initial=np.inf), points.max(axis=0, initial=-np.inf)
+            apart = np.maximum(np.maximum(self._wall_lo - hi, lo - self._wall_hi), 0.0).max(axis=1)
+            near = apart <= _NEAR
+            if near.any():
+                gap = (point_segment_linf(points, self.walls[near]) - half).min(axis=1)
+            unsure = gap > _NEAR - half
+            if unsure.any() and not near.all():
+                gap[unsure] = (point_segment_linf(points[unsure], self.walls) - half).min(axis=1)
         if (self.carried_by < 0).any():
             gap = np.minimum(gap, box_gaps(points, half, self.resting_boxes()).min(axis=1))
         return gap
