@@ -121,8 +121,9 @@ def plan_path(
 
     **Near first.**  The search first runs in a box around `start` and `goal`, reaching
     :math:`\rho` beyond them (at least :data:`NEAR` and twice their distance), with only the
-    obstacles whose grown shape meets the box and only the corners inside it; a box is convex,
-    so every edge stays inside and no obstacle left out can block it.  A route leaving the box
+    obstacles whose grown shape comes within `margin` of the box and only the corners inside
+    it; a box is convex, so every edge stays inside, and an obstacle left out can neither block
+    an edge nor change its cost (it is farther than the margin).  A route leaving the box
     is at least :math:`2\rho` long and costs at least that much (an edge costs at least its
     length), so a route found inside costing at most :math:`2\rho` is a cheapest one of the
     whole map; otherwise :math:`\rho` doubles, until the box holds every obstacle (the search
@@ -167,7 +168,8 @@ def plan_path(
     reach = max(NEAR, 2.0 * float(np.abs(ends[1] - ends[0]).max()))
     while True:
         lo, hi = ends.min(axis=0) - reach, ends.max(axis=0) + reach
-        meets = np.all((lows <= hi) & (highs >= lo), axis=1)
+        # an obstacle farther than the margin from the box changes no edge's cost inside it
+        meets = np.all((lows <= hi + margin) & (highs >= lo - margin), axis=1)
         if meets.all():  # the whole map
             return _route(ends, half, walls, boxes, None, margin, penalty, squeeze)[0]
         inside = meets[: len(walls)], meets[len(walls) :]
