@@ -10,6 +10,7 @@ from hypothesis import strategies as st
 from shapely.geometry import LineString
 
 from cosmop.control import (
+    GlobalPath,
     admissible_speed,
     box_gaps,
     is_safe,
@@ -175,6 +176,15 @@ def test_the_search_widens_until_it_finds_the_way_round():
 def test_a_goal_inside_an_obstacle_has_no_route():
     boxes = np.array([[5000.0, 0.0, 300.0]])
     assert plan_path((0, 0), (5100, 0), 200.0, np.zeros((0, 4)), boxes) is None
+
+
+def test_a_point_beyond_on_a_path_and_the_vertices_after_it():
+    path = GlobalPath(((0.0, 0.0), (1000.0, 0.0), (1000.0, 1000.0)), 5.0)
+    # from beside the first segment, 500 mm on: still on it; 1500 mm on: up the second
+    assert path.beyond((100.0, 10.0), 500.0) == ((600.0, 0.0), ((1000.0, 0.0), (1000.0, 1000.0)))
+    assert path.beyond((100.0, 10.0), 1500.0) == ((1000.0, 600.0), ((1000.0, 1000.0),))
+    assert path.beyond((100.0, 10.0), 5000.0) == (None, ())  # past the end
+    assert GlobalPath(((3.0, 4.0),), 0.0).beyond((0.0, 0.0), 1.0) == (None, ())
 
 
 def test_walker_follows_its_path_and_stands():

@@ -61,6 +61,31 @@ class GlobalPath:
         lengths = np.hypot(d[:, 0], d[:, 1])
         return a, d, lengths, np.where(lengths > 0, lengths, 1.0)
 
+    def _projection(self, position: Point) -> tuple[int, np.ndarray]:
+        """The segment nearest `position` and, for every segment, where along it (0..1) the
+        point nearest `position` lies."""
+        a, d, lengths, safe_len = self._segments
+        t = ((position[0] - a[:, 0]) * d[:, 0] + (position[1] - a[:, 1]) * d[:, 1]) / safe_len**2
+        t = np.clip(np.where(lengths > 0, t, 0.0), 0.0, 1.0)
+        proj = a + t[:, None] * d
+        return int(np.argmin(np.hypot(proj[:, 0] - position[0], proj[:, 1] - position[1]))), t
+
+    def beyond(self, position: Point, distance: float) -> tuple[Point | None, tuple[Point, ...]]:
+        """The point `distance` mm further along the path than `position`'s projection, and the
+        vertices after it; ``(None, ())`` when the path ends before (mm)."""
+        if len(self.points) == 1:
+            return None, ()
+        a, d, lengths, _ = self._segments
+        i, t = self._projection(position)
+        along = distance + t[i] * lengths[i]  # from the start of segment i
+        for k in range(i, len(lengths)):
+            if along < lengths[k]:
+                s = along / lengths[k]
+                point = (float(a[k, 0] + s * d[k, 0]), float(a[k, 1] + s * d[k, 1]))
+                return point, self.points[k + 1 :]
+            along -= lengths[k]
+        return None, ()
+
     def lookahead(self, position: Point, distance: float, corner: float = 30.0) -> tuple[Point, float]:
         """The point up to `distance` mm further along the path than `position`'s projection.
 
@@ -71,12 +96,8 @@ class GlobalPath:
         """
         if len(self.points) == 1:
             return self.points[0], 0.0
-        a, d, lengths, safe_len = self._segments
-        t = ((position[0] - a[:, 0]) * d[:, 0] + (position[1] - a[:, 1]) * d[:, 1]) / safe_len**2
-        t = np.clip(np.where(lengths > 0, t, 0.0), 0.0, 1.0)
-        proj = a + t[:, None] * d
-        dist = np.hypot(proj[:, 0] - position[0], proj[:, 1] - position[1])
-        i = int(np.argmin(dist))
+        a, d, lengths, _ = self._segments
+        i, t = self._projection(position)
         left = float((1.0 - t[i]) * lengths[i] + lengths[i + 1 :].sum())
         budget = distance
         along = t[i] * lengths[i]  # how far into segment i the projection is

@@ -50,6 +50,7 @@ REPLANNED: Action = ("replanned", None)
 _GRAZE = 1.0  # mm: a straight way closer than this to an obstacle is not trusted off the plan
 _EXIT_HEADINGS = np.radians(np.arange(0.0, 360.0, 5.0))  # directions a way out is looked for in
 _EXIT_REACH = 80  # mm: how far a way out is looked for
+_REJOIN_AHEAD = (4000.0, 8000.0, 16000.0)  # mm along the path: where a detour may rejoin it
 
 
 def brake(world: World, i: int) -> Action:
@@ -173,7 +174,10 @@ def detour(world: World, agent: Agent, goal: tuple[float, float, float]) -> None
     Two driving robots can block each other for ever, each waiting for the other to clear
     its path.  The one with more path left yields: it plans its global path around the other
     (as if that one stood still) for a while.  Ties go to the robot listed first.  Without
-    such blockers the path is simply planned again (parked robots come and go).
+    such blockers the path is simply planned again (parked robots come and go).  The way round
+    rejoins the path 4, 8 or 16 m further on where it can (the rest of the path is kept), and
+    goes to the goal only where it cannot: on a large map, a route to a far goal is a search
+    of the whole map (seconds), and round the blockers is what is needed.
     """
     s = world.settings
     i = agent.index
@@ -190,7 +194,19 @@ def detour(world: World, agent: Agent, goal: tuple[float, float, float]) -> None
     ]
     xy = (float(world.pose[i, 0]), float(world.pose[i, 1]))
     boxes = np.vstack([world.static_boxes(i, goal), world.robot_boxes()[blockers]])
-    path = plan_path(xy, (goal[0], goal[1]), float(world.robot_half[i]), world.walls, boxes)
+    half = float(world.robot_half[i])
+    path = None
+    # round the blockers back onto the path a little beyond them, not all the way to a far goal
+    # (on a large map the search for a route to the goal spans the whole map: seconds)
+    for ahead in _REJOIN_AHEAD:
+        rejoin, rest = agent.path.beyond(xy, ahead) if agent.path is not None else (None, ())
+        if rejoin is None:
+            break
+        way = plan_path(xy, rejoin, half, world.walls, boxes)
+        if way is not None:
+            path = GlobalPath(way.points + rest, way.margin)
+            break
+    path = path or plan_path(xy, (goal[0], goal[1]), half, world.walls, boxes)
     if path is None:
         return
     agent.path, agent.reseat_point = path, None
