@@ -204,7 +204,7 @@ def detour(world: World, agent: Agent, goal: tuple[float, float, float]) -> None
             break
         way = plan_path(xy, rejoin, half, world.walls, boxes)
         if way is not None:
-            path = GlobalPath(way.points + rest, way.margin)
+            path = GlobalPath(way.points + rest, min(way.margin, agent.path.margin))
             break
     path = path or plan_path(xy, (goal[0], goal[1]), half, world.walls, boxes)
     if path is None:
