@@ -79,14 +79,23 @@ def emit_scenario(data: dict, output: Path | None) -> None:
         sys.stdout.write(text)
 
 
-def generator_main(doc: str, build, sizes: tuple[str, ...], argv: list[str] | None) -> int:
-    """The command line of a scenario generator: ``SIZES... [--seed S] [-o FILE]``."""
+def generator_main(doc: str, build, sizes: tuple[str, ...], argv: list[str] | None, *, map_text=None) -> int:
+    """The command line of a scenario generator: ``SIZES... [--seed S] [-o FILE]``; with
+    `map_text` (a function giving the text of the generator's map file), also ``--map FILE``,
+    which writes that file instead of a scenario."""
     parser = argparse.ArgumentParser(description=doc.splitlines()[0])
-    for name in sizes:
-        parser.add_argument(name, type=int)
+    for name in sizes:  # (not needed for the map file alone)
+        parser.add_argument(name, type=int, nargs=None if map_text is None else "?")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("-o", "--output", type=Path)
+    if map_text is not None:
+        parser.add_argument("--map", type=Path, help="write the .map file here instead of a scenario")
     args = parser.parse_args(argv)
+    if getattr(args, "map", None):
+        args.map.write_text(map_text())
+        return 0
+    if any(getattr(args, name) is None for name in sizes):
+        parser.error(f"the scenario needs {', '.join(sizes)}")
     emit_scenario(build(*(getattr(args, name) for name in sizes), args.seed), args.output)
     return 0
 

@@ -22,7 +22,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from _harness import emit_scenario
+from _harness import generator_main
 from cosmop.maps.scene import import_map
 
 ROWS, COLS, DOCK, BLOCK_W, BLOCK_H, BLOCKS_X, BLOCKS_Y = 63, 161, 25, 10, 2, 10, 20
@@ -92,19 +92,7 @@ def movingai_warehouse(n: int, seed: int = 0) -> dict:
 
 
 def main(argv: list[str] | None = None) -> int:
-    import argparse
-
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("n", type=int, nargs="?", default=4)
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("-o", "--output", type=Path)
-    parser.add_argument("--map", type=Path, help="write the .map file here instead of a scenario")
-    args = parser.parse_args(argv)
-    if args.map:
-        args.map.write_text(map_text())
-        return 0
-    emit_scenario(movingai_warehouse(args.n, args.seed), args.output)
-    return 0
+    return generator_main(__doc__, movingai_warehouse, ("n",), argv, map_text=map_text)
 
 
 if __name__ == "__main__":
