@@ -12,13 +12,29 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["box_gaps", "per_row", "point_segment_linf", "segment_array"]
+__all__ = ["box_gaps", "per_row", "point_segment_linf", "rect_gaps", "segment_array", "segment_bounds"]
 
 
 def segment_array(segments) -> np.ndarray:
     """Segments ``[((x1, y1), (x2, y2)), ...]`` as a float array of shape ``(n, 4)``."""
     out = np.asarray([[a[0], a[1], b[0], b[1]] for a, b in segments], dtype=float)
     return out.reshape(-1, 4)
+
+
+def segment_bounds(segments: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each segment's bounding box ``x1, y1, x2, y2`` as lower and upper corners ``(n, 2)``, mm."""
+    ends = np.asarray(segments, dtype=float).reshape(-1, 2, 2)
+    return ends.min(axis=1), ends.max(axis=1)
+
+
+def rect_gaps(lo: np.ndarray, hi: np.ndarray, lows: np.ndarray, highs: np.ndarray) -> np.ndarray:
+    """L-infinity distance from the box ``[lo, hi]`` to each box ``[lows, highs]`` (0 when they meet).
+
+    It bounds from below the distance from any point of ``[lo, hi]`` to anything inside the
+    other box (a wall segment lies in its bounding box, :func:`segment_bounds`).
+    """
+    d = np.maximum(np.maximum(lows - hi, lo - highs), 0.0)
+    return d.max(axis=1) if len(d) else np.zeros(0)
 
 
 def point_segment_linf(points: np.ndarray, segments: np.ndarray) -> np.ndarray:

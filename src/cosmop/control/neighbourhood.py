@@ -52,6 +52,7 @@ from __future__ import annotations
 import numpy as np
 
 from cosmop.control.dwa import Drivers, DwaCommand, DwaSettings, Obstacles, dwa_commands
+from cosmop.control.geometry import rect_gaps, segment_bounds
 from cosmop.control.safety import stopping_horizon, stopping_margin
 
 __all__ = ["dwa_commands_near", "reach"]
@@ -101,31 +102,26 @@ def dwa_commands_near(
     xy, half = drivers.pose[:, :2], drivers.half
     side = cell if cell is not None else float(max(wall_reach.max(), box_reach.max()))
     group = _cells(xy, side)
-    w_lo, w_hi = _wall_bounds(obstacles.walls)
+    w_lo, w_hi = segment_bounds(obstacles.walls)
     centres, halves = obstacles.boxes[:, :2], obstacles.boxes[:, 2:]
     b_lo, b_hi = centres - halves, centres + halves
     walls, boxes = [], []  # per group: the indices of the walls and boxes within reach
     for g in range(int(group.max()) + 1):
         rows = np.flatnonzero(group == g)
         lo, hi = xy[rows].min(axis=0), xy[rows].max(axis=0)
-        walls.append(np.flatnonzero(_rect_gap(lo, hi, w_lo, w_hi) <= (wall_reach[rows] + half[rows]).max()))
-        boxes.append(np.flatnonzero(_rect_gap(lo, hi, b_lo, b_hi) <= (box_reach[rows] + half[rows]).max()))
+        walls.append(np.flatnonzero(rect_gaps(lo, hi, w_lo, w_hi) <= (wall_reach[rows] + half[rows]).max()))
+        boxes.append(np.flatnonzero(rect_gaps(lo, hi, b_lo, b_hi) <= (box_reach[rows] + half[rows]).max()))
     if len(walls) == 1:  # one group: one set, shared (no padding needed)
-        near = boxes[0]
-        return dwa_commands(
-            drivers,
-            obstacles.select(walls[0], near),
-            settings,
-            ignore=None if ignore is None else ignore[:, near],
-            grip=None if grip is None else grip[:, near],
-        )
-    walls, boxes = _padded(walls, len(obstacles.walls))[group], _padded(boxes, len(obstacles.boxes))[group]
+        sets, near = obstacles.select(walls[0], boxes[0]), boxes[0]
+    else:
+        walls, near = _padded(walls, len(obstacles.walls))[group], _padded(boxes, len(obstacles.boxes))[group]
+        sets = _near(obstacles, walls, near)
     return dwa_commands(
         drivers,
-        _near(obstacles, walls, boxes),
+        sets,
         settings,
-        ignore=None if ignore is None else _take(ignore, boxes),
-        grip=None if grip is None else _take(grip, boxes),
+        ignore=None if ignore is None else _take(ignore, near),
+        grip=None if grip is None else _take(grip, near),
     )
 
 
@@ -155,7 +151,10 @@ def _near(obstacles: Obstacles, walls: np.ndarray, boxes: np.ndarray) -> Obstacl
 
 
 def _take(mask: np.ndarray, boxes: np.ndarray) -> np.ndarray:
-    """Each driver's row of `mask` ``(R, M)`` at its boxes ``(R, m)`` (False for the padding)."""
+    """`mask` ``(R, M)`` at the boxes kept: one index list for every driver ``(m,)``, or one
+    row per driver ``(R, m)`` (padded: False there)."""
+    if boxes.ndim == 1:
+        return mask[:, boxes]
     padded = np.concatenate([mask, np.zeros((len(mask), 1), dtype=bool)], axis=1)
     return padded[np.arange(len(mask))[:, None], boxes]
 
@@ -167,19 +166,3 @@ def _cells(xy: np.ndarray, side: float) -> np.ndarray:
     numbers: dict[tuple[int, int], int] = {}
     keys = np.floor(xy / side).astype(np.int64).tolist()
     return np.array([numbers.setdefault((x, y), len(numbers)) for x, y in keys], dtype=np.int64)
-
-
-def _wall_bounds(walls: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Each wall segment's bounding box, as lower and upper corners ``(W, 2)``."""
-    ends = walls.reshape(-1, 2, 2)
-    return ends.min(axis=1), ends.max(axis=1)
-
-
-def _rect_gap(lo: np.ndarray, hi: np.ndarray, lows: np.ndarray, highs: np.ndarray) -> np.ndarray:
-    """L-infinity distance from the box ``[lo, hi]`` to each box ``[lows, highs]`` (0 when they meet).
-
-    It bounds from below the distance from any point of ``[lo, hi]`` to anything inside the
-    other box (a wall segment lies in its bounding box).
-    """
-    d = np.maximum(np.maximum(lows - hi, lo - highs), 0.0)
-    return d.max(axis=1) if len(d) else np.zeros(0)

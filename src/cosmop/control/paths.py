@@ -23,6 +23,7 @@ import numpy as np
 import shapely
 from shapely.geometry import Polygon
 
+from cosmop.control.geometry import segment_bounds
 from cosmop.squares import square, swept_square
 
 __all__ = ["GlobalPath", "plan_path", "straight_path"]
@@ -179,8 +180,9 @@ def plan_path(
         np.asarray(boxes, dtype=float).reshape(-1, 3),
     )
     ends = np.array([start, goal], dtype=float)
-    lows = np.vstack([np.minimum(walls[:, :2], walls[:, 2:]) - half, boxes[:, :2] - (boxes[:, 2:] + half)])
-    highs = np.vstack([np.maximum(walls[:, :2], walls[:, 2:]) + half, boxes[:, :2] + (boxes[:, 2:] + half)])
+    wall_lo, wall_hi = segment_bounds(walls)
+    lows = np.vstack([wall_lo - half, boxes[:, :2] - (boxes[:, 2:] + half)])
+    highs = np.vstack([wall_hi + half, boxes[:, :2] + (boxes[:, 2:] + half)])
     for point in ends:  # inside an obstacle: every edge from or to it enters that obstacle
         holds = np.all((lows <= point) & (highs >= point), axis=1)
         near = _grown(walls[holds[: len(walls)]], boxes[holds[len(walls) :]], half)
@@ -245,10 +247,8 @@ def straight_path(
     )
     ends = np.array([start, goal], dtype=float)
     lo, hi = ends.min(axis=0) - (CLEARANCE_CAP + half), ends.max(axis=0) + (CLEARANCE_CAP + half)
-    near_walls = np.all(
-        (np.minimum(walls[:, :2], walls[:, 2:]) <= hi) & (np.maximum(walls[:, :2], walls[:, 2:]) >= lo),
-        axis=1,
-    )
+    wall_lo, wall_hi = segment_bounds(walls)
+    near_walls = np.all((wall_lo <= hi) & (wall_hi >= lo), axis=1)
     near_boxes = np.all((boxes[:, :2] - boxes[:, 2:] <= hi) & (boxes[:, :2] + boxes[:, 2:] >= lo), axis=1)
     grown = shapely.unary_union(_grown(walls[near_walls], boxes[near_boxes], half))
     clearance = CLEARANCE_CAP

@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from cosmop.control.dwa import Obstacles
-from cosmop.control.geometry import box_gaps, point_segment_linf, segment_array
+from cosmop.control.geometry import box_gaps, point_segment_linf, rect_gaps, segment_array, segment_bounds
 from cosmop.control.paths import GlobalPath
 from cosmop.control.safety import Limits
 from cosmop.events import MESSAGE_KINDS, Event, Primitive, parse_event, realising_step
@@ -138,8 +138,7 @@ class World:
         humans = scene.humans
         self.human_ids = tuple(humans)
         self.walls = segment_array([(w.start, w.end) for w in scene.obstacles])
-        ends = self.walls.reshape(-1, 2, 2)
-        self._wall_lo, self._wall_hi = ends.min(axis=1), ends.max(axis=1)  # each wall's box
+        self._wall_lo, self._wall_hi = segment_bounds(self.walls)  # each wall's box
         self._init_robots(scenario)
         objects = [scene.objects[o] for o in self.object_ids]
         self.object_xy = np.array([o.position for o in objects], dtype=float).reshape(-1, 2)  # resting ones
@@ -272,8 +271,7 @@ class World:
             # from every point, so it cannot be the nearest of a point nearer than that to one
             # of them; the other points are measured against every wall
             lo, hi = points.min(axis=0, initial=np.inf), points.max(axis=0, initial=-np.inf)
-            apart = np.maximum(np.maximum(self._wall_lo - hi, lo - self._wall_hi), 0.0).max(axis=1)
-            near = apart <= _NEAR
+            near = rect_gaps(lo, hi, self._wall_lo, self._wall_hi) <= _NEAR
             if near.any():
                 gap = (point_segment_linf(points, self.walls[near]) - half).min(axis=1)
             unsure = gap > _NEAR - half
