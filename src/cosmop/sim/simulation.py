@@ -129,12 +129,13 @@ def simulate(
         raise ValueError(f"the plan set is infeasible: {plans.reason}")
     wall0 = time.perf_counter()
     world = World(plans.extend(scenario), plans, seed, settings)  # with the places of added tasks
+    planned = _planned_times(world.scenario, plans)  # for the time limit and the summary
     robots = len(world.robot_ids)
     recorder = Recorder()
     recorder.record(world)
     completed = False
     cycles = 0
-    for _ in range(math.ceil(time_limit(scenario, plans, settings) / world.dt)):
+    for _ in range(math.ceil(_time_limit(settings, planned) / world.dt)):
         _cycle(world)
         cycles += 1
         recorder.record(world)
@@ -144,18 +145,22 @@ def simulate(
         if done == robots and not world.v.any():  # finished, and standing
             completed = True
             break
-    return _result(world, scenario, plans, recorder.frames(world), completed, cycles, wall0)
+    return _result(world, scenario, plans, planned, recorder.frames(world), completed, cycles, wall0)
 
 
 def time_limit(scenario: Scenario, plans: PlanSet, settings: SimSettings | None = None) -> float:
     """When a run of `plans` stops unfinished, simulated s: ``settings.max_time``, or by
     default three times the plans' expected makespan and at least 900 s (:class:`SimSettings`)."""
     settings = settings or SimSettings()
+    planned = None if settings.max_time is not None else _planned_times(plans.extend(scenario), plans)
+    return _time_limit(settings, planned)
+
+
+def _time_limit(settings: SimSettings, planned: Itinerary | None) -> float:
+    """:func:`time_limit` with the plans' itinerary `planned` (None: none, or not needed)."""
     if settings.max_time is not None:
         return settings.max_time
-    planned = _planned_times(plans.extend(scenario), plans)
-    makespan = planned.makespan if planned is not None else 0.0
-    return max(DEFAULT_TIME_LIMIT, 3.0 * makespan)
+    return max(DEFAULT_TIME_LIMIT, 3.0 * (planned.makespan if planned is not None else 0.0))
 
 
 def _cycle(world: World) -> None:
@@ -242,12 +247,14 @@ def _result(
     world: World,
     scenario: Scenario,
     plans: PlanSet,
+    planned: Itinerary | None,
     frames: dict[str, np.ndarray],
     completed: bool,
     cycles: int,
     wall0: float,
 ) -> SimResult:
-    """The :class:`SimResult` of a finished run (`wall0`: its start, :func:`time.perf_counter`)."""
+    """The :class:`SimResult` of a finished run (`planned`: the plans' itinerary; `wall0`: the
+    run's start, :func:`time.perf_counter`)."""
     positions = world.object_positions()
     return SimResult(
         scenario=scenario.name,
@@ -284,7 +291,7 @@ def _result(
         replan_log=tuple(world.replan_log),
         steps=step_times(
             {rid: [s.label for s in p.steps] for rid, p in plans.robots.items()},
-            _planned_times(world.scenario, plans),
+            planned,
             {a.id: a.step_log for a in world.agents},
         ),
     )

@@ -209,21 +209,26 @@ class World:
         """What the robots sense now: the walls, and the resting objects, robots and people (in
         that order) as boxes with their speed bounds and ids; :meth:`with_motion` adds how they
         move (only the controllers need it, so the monitor does not pay for it)."""
-        boxes, names = self.boxes()
-        resting, _, agents = self._sensed_layout()
+        resting, names, agents = self._sensed_layout()
         speed = [np.zeros(len(resting)), np.where(self.parked(), 0.0, self.limits.max_speed)]
         if self.walkers:
             speed.append(self.human_speed)
-        return Obstacles(self.walls, boxes, np.concatenate(speed), agents=agents, names=names)
+        return Obstacles(
+            self.walls, self._stacked(resting), np.concatenate(speed), agents=agents, names=names
+        )
 
     def boxes(self) -> tuple[np.ndarray, tuple[str, ...]]:
         """The boxes of :meth:`obstacles` ``(n, 3)`` and their ids, without their speeds (the
         monitor's view)."""
         resting, names, _ = self._sensed_layout()
+        return self._stacked(resting), names
+
+    def _stacked(self, resting: np.ndarray) -> np.ndarray:
+        """The resting objects' boxes `resting`, then the robots', then the people's, ``(n, 3)``."""
         boxes = [resting, self.robot_boxes()]
         if self.walkers:
             boxes.append(self.people_boxes())
-        return np.vstack(boxes).reshape(-1, 3), names
+        return np.vstack(boxes).reshape(-1, 3)
 
     def _sensed_layout(self) -> tuple[np.ndarray, tuple[str, ...], np.ndarray]:
         """The resting objects' boxes, every box's name and which boxes are robots or people, as
