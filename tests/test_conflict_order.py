@@ -18,8 +18,10 @@ import random
 import pytest
 import shapely
 
-from cosmop.missions.precedence import Precedence
-from cosmop.planning.conflicts import Conflict, Occupancy, _Schedule, is_ordered, order_conflicts
+from cosmop.missions.precedence import Link, Precedence
+from cosmop.planning.conflict_order import _edges, _Implied, _propagate, _Schedule, order_conflicts
+from cosmop.planning.conflicts import Conflict, Occupancy, is_ordered
+from cosmop.planning.teamsafety import _reduce
 
 
 def _team(seed: int, robots: int = 4, steps: int = 6, conflicts: int = 24):
@@ -67,3 +69,59 @@ def test_the_sample_has_unresolvable_teams():
 def _args(seed):
     found, horizons, durations = _team(seed)
     return found, horizons, [], [], durations
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_an_implied_conflict_is_ordered_by_every_way_of_the_one_that_implies_it(seed):
+    found, horizons, durations = _team(seed, robots=3, steps=8, conflicts=40)
+    implied = _Implied(found)
+    pairs = [(stronger, c) for c in found for stronger in implied.by(c)]
+    assert pairs  # the sample has conflicts that imply others
+    for stronger, weaker in pairs:
+        for edge in _edges(stronger):
+            precedence = Precedence(horizons, (), [edge], durations)
+            if precedence.complete:
+                assert is_ordered(weaker, precedence), (stronger, weaker, edge)
+    needed = implied.needed(found)
+    assert len(needed) < len(found)
+    # what is left out is implied by something kept
+    kept = {id(c) for c in needed}
+    assert all(any(id(d) in kept for d in implied.by(c)) for c in found if id(c) not in kept)
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_the_messages_kept_are_exactly_the_orders_the_others_do_not_imply(seed):
+    # `_reduce` keeps a set of start edges that implies every edge dropped and in which no edge
+    # is implied by the others; the oracle is the vector clocks of `Precedence`
+    rng = random.Random(seed)
+    robots = [f"R{i}" for i in range(rng.randint(2, 5))]
+    horizons = {r: rng.randint(2, 8) for r in robots}
+    links = [Link("m", robots[0], 1, robots[1], horizons[robots[1]])] if seed % 2 else []
+    chosen = []
+    for _ in range(rng.randint(3, 25)):
+        a, b = rng.sample(robots, 2)
+        edge = ((a, rng.randint(1, horizons[a])), (b, rng.randint(1, horizons[b])))
+        if Precedence(horizons, links, [e for e, _ in chosen] + [edge]).complete:
+            chosen.append((edge, f"c{len(chosen)}"))
+    kept = _reduce(horizons, links, chosen)
+    kept_edges = [e for e, _ in kept]
+    together = Precedence(horizons, links, kept_edges)
+    assert all(together.before_start(*e) for e, _ in chosen)
+    for n, edge in enumerate(kept_edges):
+        others = Precedence(horizons, links, kept_edges[:n] + kept_edges[n + 1 :])
+        assert not others.before_start(*edge), edge
+
+
+def test_the_cores_propagation_finds_are_cores():
+    # each conflict set aside by propagating forced orders comes with a core: a set of
+    # conflicts that no schedule orders together (asked of Z3, which knows nothing of it)
+    cores = 0
+    for seed in range(24):
+        found, horizons, durations = _team(seed)
+        aside, found_cores = _propagate(found, horizons, [], [], durations, None)
+        assert set(found_cores) == {id(c) for c in aside}
+        schedule = _Schedule(found, horizons, [], [], durations, 200_000_000)
+        for core in found_cores.values():
+            cores += 1
+            assert schedule.solve(core) is not None, core
+    assert cores >= 5

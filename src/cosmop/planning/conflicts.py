@@ -20,10 +20,7 @@ them always ends before the other starts (:meth:`cosmop.missions.precedence.Prec
 A plan set is team-safe when every conflict is ordered: then no execution the messages allow
 puts two robots, or a robot and another robot's goods, in one place at one time.
 
-:func:`order_conflicts` orders the open conflicts by adding start edges: the occupancy that
-is expected to begin first (:mod:`cosmop.planning.timing`) goes first, unless that closes a
-cycle (a deadlock) or it never ends (a robot parked for good); an edge is never added that
-would deadlock.  Conflicts that no order can resolve are returned for re-planning.
+The orders themselves are chosen by :mod:`cosmop.planning.conflict_order`.
 """
 
 from __future__ import annotations
@@ -32,16 +29,13 @@ import itertools
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from decimal import Decimal
-from fractions import Fraction
 
-import numpy as np
 import shapely
 from shapely import STRtree
 from shapely.geometry.base import BaseGeometry
 
 from cosmop.events import Primitive
-from cosmop.missions.precedence import Link, Node, Precedence
+from cosmop.missions.precedence import Node, Precedence
 from cosmop.planning.plan import RobotPlan, State, _fmt, _point, initial_state
 from cosmop.planning.realisation import at_pose
 from cosmop.scene import Scene
@@ -52,8 +46,12 @@ __all__ = [
     "ConflictSettings",
     "Occupancy",
     "conflicts",
+    "detours",
+    "fixed_places",
+    "is_ordered",
     "occupancies",
-    "order_conflicts",
+    "ranked_detours",
+    "replan_rank",
 ]
 
 
@@ -331,343 +329,6 @@ def _before(x: Occupancy, y: Occupancy, precedence: Precedence) -> bool:
     return x.last is not None and y.first is not None and precedence.before_start(x.last, y.first)
 
 
-def order_conflicts(
-    found: Sequence[Conflict],
-    horizons: Mapping[str, int],
-    links: Sequence[Link],
-    starts: Sequence[tuple[Node, Node]],
-    durations: Mapping[str, Sequence[float]],
-    *,
-    max_backtracks: int = 200,
-    fixed: Mapping[str, Sequence[BaseGeometry]] | None = None,
-    rlimit: int = 200_000_000,
-) -> tuple[list[tuple[tuple[Node, Node], Conflict]], list[Conflict]]:
-    """Start edges that order every conflict in `found`, and the conflicts no order resolves.
-
-    First a depth-first search over the two ways of ordering each conflict (:func:`_search`),
-    fast when the conflicts are few or loosely tied.  When it finds no way to order them all,
-    the question is settled exactly as a scheduling problem (:class:`_Schedule`, Z3 over the
-    steps' start and end times): either a schedule orders every conflict, or an unsat core
-    names a set of conflicts no order resolves together, of which the most re-plannable is set
-    aside -- and the others are ordered again without it.  Z3's cores are not minimal, so a
-    conflict set aside early may be orderable once later ones are gone: each is then given
-    back, the hardest to re-plan first, while a schedule still exists.  The unresolved
-    conflicts returned are therefore irredundant: none of them could be ordered together with
-    all the ordered ones.
-
-    Returns the edges added (on top of `starts`), each with the conflict it orders, and the
-    unresolved conflicts.
-    """
-    chosen, culprit = _search(found, horizons, links, starts, durations, max_backtracks, fixed)
-    if culprit is None:
-        return chosen, []
-    schedule = _Schedule(found, horizons, links, starts, durations, rlimit)
-    unresolved: list[Conflict] = []
-    gone: set[int] = set()
-    while (core := schedule.solve([c for c in found if id(c) not in gone])) is not None:
-        if not core:  # undecided within the solver's budget: the search's culprit stays unresolved
-            return _give_up(found, culprit, horizons, links, starts, durations, max_backtracks, fixed)
-        unresolved.append(min(core, key=lambda c: _replannable(c, fixed)))
-        gone.add(id(unresolved[-1]))
-    # Cores are not minimal, so a conflict set aside early may be orderable once later ones are
-    # gone: give each back, the hardest to re-plan first, while a schedule remains (one the last
-    # schedule already orders costs no solver call).
-    for conflict in sorted(unresolved, key=lambda c: -_replannable(c, fixed)):
-        gone.discard(id(conflict))
-        if (
-            schedule.way(conflict) is None
-            and schedule.solve([c for c in found if id(c) not in gone]) is not None
-        ):
-            gone.add(id(conflict))
-        else:
-            unresolved.remove(conflict)
-    # the search's choices keep the makespan low; the schedule stands in where the search fails
-    left = [c for c in found if id(c) not in gone]
-    better, culprit = _search(left, horizons, links, starts, durations, max_backtracks, fixed)
-    return (schedule.edges(left) if culprit is not None else better), unresolved
-
-
-def _give_up(found, culprit, horizons, links, starts, durations, max_backtracks, fixed):
-    """Order what the search can, leaving each conflict it fails on unresolved (sound, not minimal)."""
-    unresolved, gone = [culprit], {id(culprit)}
-    while True:
-        left = [c for c in found if id(c) not in gone]
-        chosen, culprit = _search(left, horizons, links, starts, durations, max_backtracks, fixed)
-        if culprit is None:
-            return chosen, unresolved
-        unresolved.append(culprit)
-        gone.add(id(culprit))
-
-
-class _Schedule:
-    """The conflicts as one scheduling problem in Z3, asked again with fewer conflicts each time.
-
-    Each step *k* of robot *r* gets a start :math:`s_{rk}` and an end :math:`e_{rk}` (seconds):
-    :math:`s_{rk} \\ge e_{r,k-1}`, :math:`e_{rk} \\ge s_{rk} + \\max(d_{rk}, \\epsilon)`; a message
-    is received after it is sent, a start edge starts its step after its source ends; and every
-    conflict, under its own assumption literal, has one of its two ways, "x before y":
-    :math:`s_{y} \\ge e_{x} + \\epsilon`.  The :math:`\\epsilon` makes every cycle of the order
-    infeasible, so a schedule orders the conflicts without deadlock.  Without a schedule, the
-    unsat core over the assumed conflicts names a set no order resolves together.  Every
-    constraint bounds the difference of two times (a time against 0 for the first step), so
-    Z3's difference-logic solver decides it (about 4x faster than its simplex at 2,500
-    conflicts).
-    """
-
-    def __init__(self, found, horizons, links, starts, durations, rlimit: int) -> None:
-        import z3
-
-        self.ctx = ctx = z3.Context()
-        self.solver = z3.Solver(ctx=ctx)
-        self.solver.set("ctrl_c", False)  # Ctrl-C is Python's (KeyboardInterrupt), not "unknown"
-        self.solver.set("smt.arith.solver", 1)  # difference logic (class docstring)
-        self.solver.set("rlimit", rlimit)
-        # step (r, k) has the times s{i} and e{i}; the problem is written in SMT-LIB and parsed
-        # at once: thousands of constraints built through the Python API cost more than solving
-        self.index = {
-            node: i for i, node in enumerate((r, k) for r, n in horizons.items() for k in range(1, n + 1))
-        }
-        s = {node: f"s{i}" for node, i in self.index.items()}
-        e = {node: f"e{i}" for node, i in self.index.items()}
-        text = [f"(declare-fun {s[n]} () Real) (declare-fun {e[n]} () Real)" for n in self.index]
-        text += [f"(declare-fun c{n} () Bool)" for n in range(len(found))]
-        for r, k in self.index:
-            text.append(f"(assert (>= {s[(r, k)]} {e[(r, k - 1)] if k > 1 else 0.0}))")
-            text.append(f"(assert {_after(e[(r, k)], s[(r, k)], float(durations[r][k - 1]))})")
-        for link in links:
-            if link.send is not None and link.wait is not None:
-                text.append(f"(assert {_after(e[(link.receiver, link.wait)], e[(link.sender, link.send)])})")
-        for source, target in starts:
-            if target in s and source in e:
-                text.append(f"(assert {_after(s[target], e[source])})")
-        self.ways: dict[int, list] = {}
-        for n, c in enumerate(found):
-            ways = [
-                (x.last, y.first)
-                for x, y in ((c.a, c.b), (c.b, c.a))
-                if x.last in e and y.first in s  # (None: never ends, or from the beginning)
-            ]
-            terms = " ".join(_after(s[b], e[a]) for a, b in ways)
-            text.append(f"(assert (=> c{n} (or false {terms})))")
-            self.ways[id(c)] = ways
-        self.solver.from_string("\n".join(text))
-        self.label = {id(c): z3.Bool(f"c{n}", ctx) for n, c in enumerate(found)}
-        self.by_id = {label.get_id(): c for c, label in zip(found, self.label.values(), strict=True)}
-
-    def solve(self, conflicts: Sequence[Conflict]) -> list[Conflict] | None:
-        """``None`` when a schedule orders `conflicts` (kept for :meth:`edges`); else an unsat
-        core of them, or ``[]`` when undecided within the resource limit."""
-        import z3
-
-        verdict = _check(self.solver, [self.label[id(c)] for c in conflicts])
-        if verdict == z3.unsat:
-            core = [self.by_id[lit.get_id()] for lit in self.solver.unsat_core()]
-            return core or list(conflicts)
-        if verdict != z3.sat:
-            return []  # undecided (resource limit): the caller falls back on the search
-        self.time = _Times(self.solver.model())
-        return None
-
-    def way(self, conflict: Conflict) -> tuple[Node, Node] | None:
-        """The way the last schedule orders `conflict`, if it does (asked or not)."""
-        import z3
-
-        for a, b in self.ways[id(conflict)]:
-            begins = z3.Real(f"s{self.index[b]}", self.ctx)
-            ends = z3.Real(f"e{self.index[a]}", self.ctx)
-            if self.time(begins) >= self.time(ends) + Fraction(1, 1000):
-                return (a, b)
-        return None
-
-    def edges(self, conflicts: Sequence[Conflict]) -> list[tuple[tuple[Node, Node], Conflict]]:
-        """The way the last schedule orders each of `conflicts` (those it was asked with)."""
-        return [(self.way(c), c) for c in conflicts]
-
-
-def _check(solver, labels):
-    """``solver.check(*labels)`` without re-checking the sort of each label (thousands per call)."""
-    import z3
-
-    array = (z3.Ast * len(labels))(*(label.as_ast() for label in labels))
-    ctx = solver.ctx
-    return z3.CheckSatResult(z3.Z3_solver_check_assumptions(ctx.ref(), solver.solver, len(labels), array))
-
-
-def _after(later: str, earlier: str, gap: float = 0.0) -> str:
-    """SMT-LIB for "time `later` is at least `gap` s after time `earlier`", the gap at least
-    the schedule's epsilon (1 ms), written exactly as a decimal."""
-    return f"(>= {later} (+ {earlier} {Decimal(max(gap, 1e-3))}))"
-
-
-class _Times:
-    """A model's values of time variables, exactly (the eps of the order needs no rounding),
-    read when first asked for."""
-
-    def __init__(self, model) -> None:
-        self.model = model
-        self.seen: dict[int, Fraction] = {}
-
-    def __call__(self, var) -> Fraction:
-        key = var.get_id()
-        if key not in self.seen:
-            value = self.model.eval(var, model_completion=True)
-            self.seen[key] = Fraction(value.numerator_as_long(), value.denominator_as_long())
-        return self.seen[key]
-
-
-class _Sides:
-    """Both ways of ordering every conflict, as arrays, to ask many questions at once.
-
-    Side 0 puts occupancy ``a`` first, side 1 ``b``: "x before y" is the start edge from
-    x's last step to y's first.  A side is *possible* when x ends and y does not start at the
-    beginning; it *holds* when the order already implies it; it *closes a cycle* when y's first
-    step must already complete before x's last one does.
-    """
-
-    def __init__(self, found: Sequence[Conflict], precedence: Precedence) -> None:
-        n = len(found)
-        self.possible = np.zeros((n, 2), dtype=bool)
-        self.x_col = np.zeros((n, 2), dtype=np.int64)
-        self.x_k = np.zeros((n, 2), dtype=np.int64)
-        self.x_row = np.zeros((n, 2), dtype=np.int64)
-        self.y_col = np.zeros((n, 2), dtype=np.int64)
-        self.y_k = np.zeros((n, 2), dtype=np.int64)
-        self.y_row = np.zeros((n, 2), dtype=np.int64)
-        self.same = np.zeros((n, 2), dtype=bool)
-        for i, c in enumerate(found):
-            for side, (x, y) in enumerate(((c.a, c.b), (c.b, c.a))):
-                if x.last is None or y.first is None or y.first[1] <= 0:
-                    continue
-                (xr, xk), (yr, yk) = x.last, y.first
-                self.possible[i, side] = True
-                self.x_col[i, side], self.x_k[i, side] = precedence.column[xr], xk
-                self.x_row[i, side] = precedence.offsets[xr] + xk
-                self.y_col[i, side], self.y_k[i, side] = precedence.column[yr], yk
-                self.y_row[i, side] = precedence.offsets[yr] + min(yk, precedence.horizons[yr] + 1)
-                self.same[i, side] = xr == yr
-
-    def holds(self, precedence: Precedence) -> np.ndarray:
-        """(n, 2): whether each side is already implied."""
-        implied = precedence.begin_flat[self.y_row, self.x_col] >= self.x_k
-        return self.possible & np.where(self.same, self.x_k < self.y_k, implied)
-
-    def ways(self, precedence: Precedence) -> np.ndarray:
-        """(n, 2): whether each side can still be added without closing a cycle."""
-        cycle = precedence.done_flat[self.x_row, self.y_col] >= self.y_k
-        return self.possible & ~np.where(self.same, self.y_k <= self.x_k, cycle)
-
-
-def _search(found, horizons, links, starts, durations, max_backtracks, fixed):
-    """Depth-first search for edges ordering every conflict; ``(edges, None)`` or ``([], culprit)``.
-
-    At every point the open conflicts are checked forward: one that has no way left to be
-    ordered (both ways close a cycle, or the way left never ends) sends the search back to the
-    last choice.  A conflict with a single way left is ordered first; otherwise the one expected
-    to start first, the way that keeps the team's expected makespan lower.  The culprit is the
-    conflict without a way at the deepest dead end.  The order is updated incrementally and
-    taken back on backtracking (:meth:`~cosmop.missions.precedence.Precedence.add_start`).
-    """
-    precedence = Precedence(horizons, links, starts, durations)
-    sides = _Sides(found, precedence)
-    # priorities: the robot expected to finish first goes first, so that it clears out early;
-    # one order for all robots keeps most choices consistent (no cycles among them)
-    alone = {r: sum(durations[r]) for r in horizons}
-    rank = {r: n for n, r in enumerate(sorted(horizons, key=lambda r: (alone[r], r)))}
-    chosen: list[tuple[tuple[Node, Node], Conflict, list]] = []
-    stack: list[tuple[int, list[tuple[Node, Node]], Conflict]] = []  # (depth, untried, conflict)
-    backtracks, deepest, culprit = 0, -1, None
-    while True:
-        open_ = ~sides.holds(precedence).any(axis=1)
-        if not open_.any():
-            return [(edge, conflict) for edge, conflict, _ in chosen], None
-        counts = np.where(open_, sides.ways(precedence).sum(axis=1), -1)
-        stuck = [found[i] for i in np.flatnonzero(counts == 0)]
-        if stuck:
-            if len(chosen) > deepest:
-                edges = [(e, c) for e, c, _ in chosen]
-                worst = min(stuck, key=lambda c: _replannable(c, fixed))
-                deepest, culprit = len(chosen), _culprit(worst, horizons, links, edges, fixed)
-            if not stack or backtracks >= max_backtracks:
-                return [], culprit
-            backtracks += 1
-            depth, untried, conflict = stack[-1]
-            while len(chosen) > depth:
-                precedence.undo(chosen.pop()[2])
-            edge = untried.pop(0)
-            chosen.append((edge, conflict, precedence.add_start(edge)))
-            if not untried:
-                stack.pop()
-            continue
-        pool = np.flatnonzero(counts == 1)
-        if not len(pool):
-            pool = np.flatnonzero(open_)
-        conflict = min((found[i] for i in pool), key=lambda c: _expected_start(c, precedence))
-        options = _ways(conflict, precedence)
-        if len(options) > 1:  # the robot of higher priority first, then the lower makespan
-            options = sorted(options, key=lambda e: (rank[e[0][0]], _makespan_with(precedence, e)))
-            stack.append((len(chosen), options[1:], conflict))
-        chosen.append((options[0], conflict, precedence.add_start(options[0])))
-
-
-def _expected_start(conflict: Conflict, precedence: Precedence) -> float:
-    return min(_start(conflict.a, precedence), _start(conflict.b, precedence))
-
-
-def _start(x: Occupancy, precedence: Precedence) -> float:
-    return 0.0 if x.first is None else precedence.start_time(x.first)
-
-
-def _makespan_with(precedence: Precedence, edge: tuple[Node, Node]) -> float:
-    log = precedence.add_start(edge)
-    makespan = precedence.makespan
-    precedence.undo(log)
-    return makespan
-
-
-def _culprit(stuck: Conflict, horizons, links, chosen, fixed) -> Conflict:
-    """The conflict to re-plan around when `stuck` has no way to be ordered.
-
-    If `stuck` itself cannot be re-planned (two robots standing where their goods require), the
-    orders that close its cycles came from other conflicts: the most re-plannable of those.
-    """
-    if _replannable(stuck, fixed) < 3:
-        return stuck
-    graph: dict[Node, list[tuple[Node, Conflict | None]]] = {}
-    for robot, k in horizons.items():
-        for i in range(1, k):
-            graph.setdefault((robot, i), []).append(((robot, i + 1), None))
-    for link in links:
-        if link.send is not None and link.wait is not None:
-            graph.setdefault((link.sender, link.send), []).append(((link.receiver, link.wait), None))
-    for (source, target), conflict in chosen:
-        graph.setdefault(source, []).append((target, conflict))
-    on_cycles: list[Conflict] = []
-    for x, y in ((stuck.a, stuck.b), (stuck.b, stuck.a)):
-        if x.last is not None and y.first is not None:
-            on_cycles += _path_conflicts(graph, y.first, x.last)
-    best = min(on_cycles, key=lambda c: _replannable(c, fixed), default=stuck)
-    return best if _replannable(best, fixed) < 3 else stuck
-
-
-def _path_conflicts(graph, start: Node, goal: Node) -> list[Conflict]:
-    """The conflicts whose edges lie on a shortest path from `start` to `goal` (breadth first)."""
-    parent: dict[Node, tuple[Node, Conflict | None] | None] = {start: None}
-    queue = [start]
-    for node in queue:
-        if node == goal:
-            break
-        for nxt, conflict in graph.get(node, ()):
-            if nxt not in parent:
-                parent[nxt] = (node, conflict)
-                queue.append(nxt)
-    out, node = [], goal
-    while parent.get(node) is not None:
-        node, conflict = parent[node]
-        if conflict is not None:
-            out.append(conflict)
-    return out
-
-
 def detours(conflict: Conflict, fixed: Mapping[str, Sequence[BaseGeometry]]) -> list[tuple[str, Occupancy]]:
     """Who can be re-planned around an unresolved conflict, best first: ``(robot, what to avoid)``.
 
@@ -705,7 +366,7 @@ def fixed_places(items: Sequence[Occupancy]) -> dict[str, list[BaseGeometry]]:
     return out
 
 
-def _replannable(conflict: Conflict, fixed: Mapping[str, Sequence[BaseGeometry]] | None = None) -> int:
+def replan_rank(conflict: Conflict, fixed: Mapping[str, Sequence[BaseGeometry]] | None = None) -> int:
     """Rank of a conflict as a culprit to re-plan (lower first): a drive against something that
     stays for good, then any detour, then none (two robots standing where their goods require)."""
     options = detours(conflict, fixed or {})
@@ -713,17 +374,3 @@ def _replannable(conflict: Conflict, fixed: Mapping[str, Sequence[BaseGeometry]]
         return 3
     _, keep = options[0]
     return 0 if keep.last is None else 1
-
-
-def _ways(conflict: Conflict, precedence: Precedence) -> list[tuple[Node, Node]]:
-    """The start edges that can order `conflict`, the one expected to happen first first."""
-    a, b = conflict.a, conflict.b
-    options = sorted(((a, b), (b, a)), key=lambda xy: (_start(xy[0], precedence), _start(xy[1], precedence)))
-    out = []
-    for x, y in options:
-        if x.last is None or y.first is None:
-            continue  # x never ends, or y holds its place from the beginning
-        if precedence.would_cycle(x.last, y.first):
-            continue
-        out.append((x.last, y.first))
-    return out

@@ -2,12 +2,13 @@
 
 :func:`make_team_safe` takes plans that are each sound alone (and the messages they already
 have), finds their conflicts (:mod:`cosmop.planning.conflicts`), orders each one by a start
-edge -- the occupancy expected first goes first, never closing a cycle -- drops the edges the
-others imply, and turns the rest into messages (:mod:`cosmop.planning.messages`): the robot
-that must wait gets a ``Req`` right before the step that enters the shared place, the other a
-``Res`` right after the step that leaves it.  Conflicts no order can resolve (a robot parked
-for good where another must pass, or two orders that would wait on each other) are returned,
-for the caller to re-plan one robot around the other's space.
+edge (:mod:`cosmop.planning.conflict_order`) -- the occupancy expected first goes first, never
+closing a cycle -- drops the edges the others imply, and turns the rest into messages
+(:mod:`cosmop.planning.messages`): the robot that must wait gets a ``Req`` right before the
+step that enters the shared place, the other a ``Res`` right after the step that leaves it.
+Conflicts no order can resolve (a robot parked for good where another must pass, or two
+orders that would wait on each other) are returned, for the caller to re-plan one robot around
+the other's space.
 
 Expected times come from :mod:`cosmop.planning.timing`, so the orders follow what is likely to
 happen first and the team's makespan stays low.
@@ -23,6 +24,7 @@ import shapely
 
 from cosmop.events import parse_event
 from cosmop.missions.precedence import Link, Node, Precedence
+from cosmop.planning.conflict_order import order_conflicts
 from cosmop.planning.conflicts import (
     Conflict,
     ConflictSettings,
@@ -30,7 +32,6 @@ from cosmop.planning.conflicts import (
     fixed_places,
     is_ordered,
     occupancies,
-    order_conflicts,
     ranked_detours,
 )
 from cosmop.planning.messages import merge_drives, place_edges, split_drives
@@ -99,15 +100,25 @@ def _reduce(
     for link in links:
         if link.send is not None and link.wait is not None:
             links_out.setdefault((link.sender, link.send), []).append((link.receiver, link.wait))
-    kept = list(chosen)
-    for item in reversed(list(chosen)):
-        rest = [e for e in kept if e is not item]
-        starts: dict[Node, list[Node]] = {}
-        for (source, target), _ in rest:
-            starts.setdefault(source, []).append(target)
-        if _reaches(horizons, links_out, starts, *item[0]):
-            kept = rest
-    return kept
+    starts: dict[Node, list[Node]] = {}
+    by_pair: dict[tuple[str, str], list[tuple[int, int, int]]] = {}  # kept edges, robot to robot
+    for n, ((source, target), _) in enumerate(chosen):
+        starts.setdefault(source, []).append(target)
+        by_pair.setdefault((source[0], target[0]), []).append((source[1], target[1], n))
+    dropped: set[int] = set()
+    for n in reversed(range(len(chosen))):
+        source, target = chosen[n][0]
+        starts[source].remove(target)
+        # another kept edge from later in A's plan to earlier in B's implies it at once
+        pair = by_pair[(source[0], target[0])]
+        if any(m != n and i >= source[1] and j <= target[1] for i, j, m in pair) or _reaches(
+            horizons, links_out, starts, source, target
+        ):
+            dropped.add(n)
+            pair.remove((source[1], target[1], n))
+        else:
+            starts[source].append(target)
+    return [item for n, item in enumerate(chosen) if n not in dropped]
 
 
 def _reaches(horizons, links_out, starts, source: Node, target: Node) -> bool:
