@@ -89,7 +89,7 @@ def order() -> dict:
     }
 
 
-def aisles(n: int, seed: int, max_time: float) -> dict:
+def aisles(n: int, seed: int, max_time: float | None) -> dict:
     sys.path.insert(0, str(HERE))
     from aisle_gen import aisle_warehouse
     from cosmop.pipeline import plan_team
@@ -132,7 +132,9 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", default="10,20,50")
     parser.add_argument("--seed", type=int, default=1)
-    parser.add_argument("--max-time", type=float, default=3600.0)
+    parser.add_argument(
+        "--max-time", type=float, default=None, help="simulated s (default: the simulator's, from the plan)"
+    )
     parser.add_argument("--out", default="team", help="results/OUT.json (default: team)")
     parser.add_argument("--child", help=argparse.SUPPRESS)
     args = parser.parse_args()
@@ -147,7 +149,8 @@ def main() -> int:
         return 0
     rows = []
     for job in ["corridor", "order", *args.sizes.split(",")]:
-        row = child_row(__file__, "--child", job, "--seed", str(args.seed), "--max-time", str(args.max_time))
+        limit = [] if args.max_time is None else ["--max-time", str(args.max_time)]
+        row = child_row(__file__, "--child", job, "--seed", str(args.seed), *limit)
         rows.append(row)
         print(json.dumps(row), flush=True)
     save_results(args.out, rows)
