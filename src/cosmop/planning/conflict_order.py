@@ -50,8 +50,8 @@ def order_conflicts(
     2. unit propagation of the orders that are forced (:func:`_propagate`): where forced orders
        alone make a conflict unorderable, they give a *core* -- a set of conflicts no order
        resolves together -- without a solver, and the most re-plannable conflict of each core is
-       set aside.  If the search then orders the rest, and every conflict set aside is proven by
-       a core whose other members are all ordered, that is the answer;
+       set aside.  If the search then orders the rest, each conflict set aside is settled
+       without a solver where it can be (:func:`_without_solver`), and that is the answer;
     3. the question settled exactly as a scheduling problem (:class:`_Schedule`, Z3 over the
        steps' start and end times): either a schedule orders every conflict left, or an unsat
        core names a set no order resolves together, of which the most re-plannable is set aside
@@ -75,12 +75,10 @@ def order_conflicts(
     unresolved, cores = _propagate(implied.needed(found), horizons, links, starts, durations, fixed)
     gone = {id(c) for c in unresolved}
     if unresolved:
-        left = implied.needed([c for c in found if id(c) not in gone])
-        chosen, stuck = _search(left, horizons, links, starts, durations, max_backtracks, fixed)
-        if stuck is None and all(
-            all(id(c) not in gone for c in cores[id(u)] if c is not u) for u in unresolved
-        ):
-            return chosen, unresolved  # ordered, and each conflict set aside proven by its own core
+        team = (horizons, links, starts, durations)
+        settled = _without_solver(found, implied, unresolved, cores, team, fixed, max_backtracks)
+        if settled is not None:
+            return settled
     schedule = _Schedule(found, horizons, links, starts, durations, rlimit, implied)
     while (core := schedule.solve([c for c in found if id(c) not in gone])) is not None:
         if not core:  # undecided within the solver's budget: the search's culprit stays unresolved
@@ -107,6 +105,37 @@ def order_conflicts(
     left = implied.needed([c for c in found if id(c) not in gone])
     better, culprit = _search(left, horizons, links, starts, durations, max_backtracks, fixed)
     return (schedule.edges(left) if culprit is not None else better), unresolved
+
+
+def _without_solver(found, implied, unresolved, cores, team, fixed, max_backtracks: int):
+    """Settle the conflicts propagation set aside without Z3, if the search orders the rest.
+
+    A conflict whose core's other members are all ordered stays set aside (its core proves it).
+    Any other is given back when the search orders it with the rest, or stays set aside when
+    propagation then finds a core (which must contain it, the rest being ordered).  ``None``
+    when the search fails or a conflict is undecided: then the solver is asked.
+    """
+    gone = {id(c) for c in unresolved}
+    chosen, stuck = _search(
+        implied.needed([c for c in found if id(c) not in gone]), *team, max_backtracks, fixed
+    )
+    if stuck is not None:
+        return None
+    for conflict in sorted(unresolved, key=lambda c: -replan_rank(c, fixed)):
+        if all(id(c) not in gone for c in cores[id(conflict)] if c is not conflict):
+            continue
+        gone.discard(id(conflict))
+        left = implied.needed([c for c in found if id(c) not in gone])
+        more, stuck = _search(left, *team, max_backtracks, fixed)
+        if stuck is None:
+            chosen = more  # given back
+            continue
+        aside, found_cores = _propagate(left, *team, fixed)
+        if not aside:
+            return None
+        gone.add(id(conflict))
+        cores[id(conflict)] = found_cores[id(aside[0])]
+    return chosen, [c for c in unresolved if id(c) in gone]
 
 
 def _give_up(found, culprit, horizons, links, starts, durations, max_backtracks, fixed, implied):
