@@ -67,12 +67,11 @@ def order_conflicts(
     unresolved conflicts.
     """
     implied = _Implied(found)
-    chosen, culprit = _search(
-        implied.needed(found), horizons, links, starts, durations, max_backtracks, fixed
-    )
+    needed = implied.left(set())
+    chosen, culprit = _search(needed, horizons, links, starts, durations, max_backtracks, fixed)
     if culprit is None:
         return chosen, []
-    unresolved, cores = _propagate(implied.needed(found), horizons, links, starts, durations, fixed)
+    unresolved, cores = _propagate(needed, horizons, links, starts, durations, fixed)
     gone = {id(c) for c in unresolved}
     if unresolved:
         team = (horizons, links, starts, durations)
@@ -80,7 +79,7 @@ def order_conflicts(
         if settled is not None:
             return settled
     schedule = _Schedule(found, horizons, links, starts, durations, rlimit, implied)
-    while (core := schedule.solve([c for c in found if id(c) not in gone])) is not None:
+    while (core := schedule.solve(implied.left(gone))) is not None:
         if not core:  # undecided within the solver's budget: the search's culprit stays unresolved
             return _give_up(
                 found, culprit, horizons, links, starts, durations, max_backtracks, fixed, implied
@@ -95,14 +94,13 @@ def order_conflicts(
     for conflict in sorted(unresolved, key=lambda c: -replan_rank(c, fixed)):
         gone.discard(id(conflict))
         if all(id(c) not in gone for c in cores[id(conflict)]) or (
-            schedule.way(conflict) is None
-            and schedule.solve([c for c in found if id(c) not in gone]) is not None
+            schedule.way(conflict) is None and schedule.solve(implied.left(gone)) is not None
         ):
             gone.add(id(conflict))
         else:
             unresolved.remove(conflict)
     # the search's choices keep the makespan low; the schedule stands in where the search fails
-    left = implied.needed([c for c in found if id(c) not in gone])
+    left = implied.left(gone)
     better, culprit = _search(left, horizons, links, starts, durations, max_backtracks, fixed)
     return (schedule.edges(left) if culprit is not None else better), unresolved
 
@@ -116,16 +114,14 @@ def _without_solver(found, implied, unresolved, cores, team, fixed, max_backtrac
     when the search fails or a conflict is undecided: then the solver is asked.
     """
     gone = {id(c) for c in unresolved}
-    chosen, stuck = _search(
-        implied.needed([c for c in found if id(c) not in gone]), *team, max_backtracks, fixed
-    )
+    chosen, stuck = _search(implied.left(gone), *team, max_backtracks, fixed)
     if stuck is not None:
         return None
     for conflict in sorted(unresolved, key=lambda c: -replan_rank(c, fixed)):
         if all(id(c) not in gone for c in cores[id(conflict)] if c is not conflict):
             continue
         gone.discard(id(conflict))
-        left = implied.needed([c for c in found if id(c) not in gone])
+        left = implied.left(gone)
         more, stuck = _search(left, *team, max_backtracks, fixed)
         if stuck is None:
             chosen = more  # given back
@@ -142,7 +138,7 @@ def _give_up(found, culprit, horizons, links, starts, durations, max_backtracks,
     """Order what the search can, leaving each conflict it fails on unresolved (sound, not minimal)."""
     unresolved, gone = [culprit], {id(culprit)}
     while True:
-        left = implied.needed([c for c in found if id(c) not in gone])
+        left = implied.left(gone)
         chosen, culprit = _search(left, horizons, links, starts, durations, max_backtracks, fixed)
         if culprit is None:
             return chosen, unresolved
@@ -378,14 +374,18 @@ class _Schedule:
         return [(self.way(c), c) for c in conflicts]
 
 
-def _edges(conflict: Conflict) -> list[tuple[Node, Node]]:
-    """The start edges that can order `conflict`: "x before y" for x that ends and y that does
-    not hold its place from the beginning."""
+def _both_ways(conflict: Conflict) -> list[tuple[Node, Node] | None]:
+    """The conflict's two ways as start edges, ``a`` first then ``b`` first: "x before y" for x
+    that ends and y that does not hold its place from the beginning (else ``None``)."""
     return [
-        (x.last, y.first)
+        (x.last, y.first) if x.last is not None and y.first is not None and y.first[1] >= 1 else None
         for x, y in ((conflict.a, conflict.b), (conflict.b, conflict.a))
-        if x.last is not None and y.first is not None
     ]
+
+
+def _edges(conflict: Conflict) -> list[tuple[Node, Node]]:
+    """The start edges that can order `conflict` (its possible :func:`_both_ways`)."""
+    return [edge for edge in _both_ways(conflict) if edge is not None]
 
 
 class _Implied:
@@ -427,6 +427,10 @@ class _Implied:
         implied = np.zeros(len(self.index), dtype=bool)
         implied[self.weaker[asked[self.weaker] & asked[self.stronger]]] = True
         return [c for c in conflicts if not implied[self.index[id(c)]]]
+
+    def left(self, gone: set[int]) -> list[Conflict]:
+        """The conflicts not in `gone` (ids), without those the others imply."""
+        return self.needed([c for c in self.found if id(c) not in gone])
 
 
 def _implications(group: Sequence[Conflict]) -> np.ndarray:
@@ -503,19 +507,18 @@ class _Sides:
         # where each occupancy's expected start is read (0 when it holds from the beginning)
         self.first_row = np.zeros((n, 2), dtype=np.int64)
         self.from_start = np.ones((n, 2), dtype=bool)
-        self.edges: list[list] = [[None, None] for _ in found]  # each side as a start edge
+        self.edges = [_both_ways(c) for c in found]  # each side as a start edge, or None
         for i, c in enumerate(found):
             for side, x in enumerate((c.a, c.b)):
                 if x.first is not None and x.first[1] >= 1:
                     r, k = x.first
                     self.first_row[i, side] = precedence.offsets[r] + min(k, precedence.horizons[r] + 1)
                     self.from_start[i, side] = False
-            for side, (x, y) in enumerate(((c.a, c.b), (c.b, c.a))):
-                if x.last is None or y.first is None or y.first[1] <= 0:
+            for side, edge in enumerate(self.edges[i]):
+                if edge is None:
                     continue
-                (xr, xk), (yr, yk) = x.last, y.first
+                (xr, xk), (yr, yk) = edge
                 self.possible[i, side] = True
-                self.edges[i][side] = (x.last, y.first)
                 self.x_col[i, side], self.x_k[i, side] = precedence.column[xr], xk
                 self.x_row[i, side] = precedence.offsets[xr] + xk
                 self.y_col[i, side], self.y_k[i, side] = precedence.column[yr], yk
@@ -615,9 +618,8 @@ def _culprit(stuck: Conflict, horizons, links, starts, chosen, fixed) -> Conflic
     for edge, conflict in chosen:
         graph.push(edge, conflict)
     on_cycles: list[Conflict] = []
-    for x, y in ((stuck.a, stuck.b), (stuck.b, stuck.a)):
-        if x.last is not None and y.first is not None:
-            on_cycles += graph.path(x.last, y.first) or []
+    for edge in _edges(stuck):
+        on_cycles += graph.path(*edge) or []
     best = min(on_cycles, key=lambda c: replan_rank(c, fixed), default=stuck)
     return best if replan_rank(best, fixed) < 3 else stuck
 
