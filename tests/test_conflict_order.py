@@ -20,7 +20,8 @@ import shapely
 
 from cosmop.missions.precedence import Link, Precedence
 from cosmop.planning import conflict_order
-from cosmop.planning.conflict_order import _edges, _Implied, _propagate, _Schedule, order_conflicts
+from cosmop.planning.conflict_order import _Implied, _Schedule, order_conflicts
+from cosmop.planning.conflict_search import Culprits, backjump, ways_of
 from cosmop.planning.conflicts import Conflict, Occupancy, is_ordered
 from cosmop.planning.teamsafety import _reduce
 
@@ -55,32 +56,92 @@ def test_orders_are_sound_and_unresolved_conflicts_irredundant(seed):
 
 
 @pytest.mark.parametrize(
-    ("seed", "robots", "conflicts"), [(72, 5, 40), (147, 5, 40), (215, 4, 24), (349, 5, 40)]
+    ("seed", "robots", "conflicts"), [(0, 4, 24), (72, 5, 40), (147, 5, 40), (215, 4, 24), (349, 5, 40)]
 )
-def test_conflicts_set_aside_by_propagation_are_settled_without_the_solver(
-    seed, robots, conflicts, monkeypatch
-):
-    # teams where a conflict propagation set aside is not proven by its first core: it is given
-    # back when the search orders it with the rest, or kept when propagation finds it a new core
+def test_the_search_settles_every_conflict_without_the_solver(seed, robots, conflicts, monkeypatch):
+    # teams for which the solver was asked before (0), and conflicts set aside early that are
+    # given back later: the search proves its own dead ends
     found, horizons, durations = _team(seed, robots=robots, conflicts=conflicts)
-
-    def no_solver(*args, **kwargs):
-        raise AssertionError("the solver was asked")
-
     with monkeypatch.context() as patch:
-        patch.setattr(conflict_order, "_Schedule", no_solver)
+        patch.setattr(conflict_order, "_Schedule", _no_solver)
         answer = order_conflicts(found, horizons, [], [], durations)
     _assert_sound_and_irredundant(found, horizons, durations, answer)
 
 
-def _assert_sound_and_irredundant(found, horizons, durations, answer):
+def _tangle():
+    """Three conflicts, of robots A-B, C-D and E-F, tied by given start edges so that each way
+    of A-B leaves no way to order one of the others: A first closes both ways of C-D (through
+    C1 -> A2 -> B1 -> D2 and D1 -> A2 -> B1 -> C2), B first both of E-F.  A-B is a choice
+    (neither way closes a cycle by itself) and the search tries A first (A is the shorter)."""
+    spot = shapely.box(0, 0, 1, 1)
+
+    def held(robot):
+        return Occupancy(robot, frozenset({robot}), spot, (robot, 1), (robot, 2), f"{robot}1-2")
+
+    horizons = {r: 2 for r in "ABCDEF"}
+    durations = {"A": [0.5, 0.5], **{r: [3.0, 3.0] for r in "BCDEF"}}
+    starts = [
+        *((("C", 1), ("A", 2)), (("D", 1), ("A", 2)), (("B", 1), ("C", 2)), (("B", 1), ("D", 2))),
+        *((("E", 1), ("B", 2)), (("F", 1), ("B", 2)), (("A", 1), ("E", 2)), (("A", 1), ("F", 2))),
+    ]
+    found = [Conflict(held("A"), held("B")), Conflict(held("C"), held("D")), Conflict(held("E"), held("F"))]
+    return found, horizons, starts, durations
+
+
+def test_a_choice_that_ends_in_a_dead_end_is_taken_back(monkeypatch):
+    found, horizons, starts, durations = _tangle()
+    found = found[:2]  # A-B and C-D: B first orders both
+    team = (horizons, [], starts, durations)
+    assert backjump(found, _Implied(found), team, Culprits(None), 0)[0] is None  # A first is a dead end
+    monkeypatch.setattr(conflict_order, "_Schedule", _no_solver)
+    chosen, unresolved = order_conflicts(found, horizons, [], starts, durations)
+    assert unresolved == []
+    assert (("B", 2), ("A", 1)) in [edge for edge, _ in chosen]
+    _assert_sound_and_irredundant(found, horizons, durations, (chosen, unresolved), starts)
+
+
+def test_a_core_found_through_a_choice_taken_back_is_a_core(monkeypatch):
+    # B first, forced by the dead end of A first, leaves E-F no way: the core is all three
+    found, horizons, starts, durations = _tangle()
+    team = (horizons, [], starts, durations)
+    _, aside, cores = backjump(found, _Implied(found), team, Culprits(None), 5)
+    assert [sorted(map(found.index, core)) for core in cores.values()] == [[0, 1, 2]]
+    schedule = _Schedule(found, horizons, [], starts, durations, 200_000_000)
+    assert schedule.solve(cores[id(aside[0])]) is not None
+    monkeypatch.setattr(conflict_order, "_Schedule", _no_solver)
+    answer = order_conflicts(found, horizons, [], starts, durations)
+    assert len(answer[1]) == 1
+    _assert_sound_and_irredundant(found, horizons, durations, answer, starts)
+
+
+def test_the_solver_takes_over_when_the_search_runs_out_of_dead_ends(monkeypatch):
+    found, horizons, starts, durations = _tangle()
+    asked = []
+    schedule = conflict_order._Schedule
+
+    def counted(*args, **kwargs):
+        asked.append(1)
+        return schedule(*args, **kwargs)
+
+    monkeypatch.setattr(conflict_order, "_Schedule", counted)
+    answer = order_conflicts(found, horizons, [], starts, durations, max_backtracks=0)
+    assert asked
+    assert len(answer[1]) == 1
+    _assert_sound_and_irredundant(found, horizons, durations, answer, starts)
+
+
+def _no_solver(*args, **kwargs):
+    raise AssertionError("the solver was asked")
+
+
+def _assert_sound_and_irredundant(found, horizons, durations, answer, starts=()):
     chosen, unresolved = answer
-    edges = [edge for edge, _ in chosen]
+    edges = [*starts, *(edge for edge, _ in chosen)]
     precedence = Precedence(horizons, (), edges, durations)
     assert precedence.complete  # no deadlock
     gone = {id(c) for c in unresolved}
     assert all(is_ordered(c, precedence) for c in found if id(c) not in gone)
-    schedule = _Schedule(found, horizons, [], [], durations, 200_000_000)
+    schedule = _Schedule(found, horizons, [], list(starts), durations, 200_000_000)
     ordered = [c for c in found if id(c) not in gone]
     assert schedule.solve(ordered) is None
     for conflict in unresolved:
@@ -104,7 +165,7 @@ def test_an_implied_conflict_is_ordered_by_every_way_of_the_one_that_implies_it(
     pairs = [(stronger, c) for c in found for stronger in implied.by(c)]
     assert pairs  # the sample has conflicts that imply others
     for stronger, weaker in pairs:
-        for edge in _edges(stronger):
+        for edge in ways_of(stronger):
             precedence = Precedence(horizons, (), [edge], durations)
             if precedence.complete:
                 assert is_ordered(weaker, precedence), (stronger, weaker, edge)
@@ -138,13 +199,14 @@ def test_the_messages_kept_are_exactly_the_orders_the_others_do_not_imply(seed):
         assert not others.before_start(*edge), edge
 
 
-def test_the_cores_propagation_finds_are_cores():
-    # each conflict set aside by propagating forced orders comes with a core: a set of
-    # conflicts that no schedule orders together (asked of Z3, which knows nothing of it)
+def test_the_cores_the_search_finds_are_cores():
+    # each conflict set aside comes with a core: a set of conflicts that no schedule orders
+    # together (asked of Z3, which knows nothing of it)
     cores = 0
     for seed in range(24):
         found, horizons, durations = _team(seed)
-        aside, found_cores = _propagate(found, horizons, [], [], durations, None)
+        team = (horizons, [], [], durations)
+        _, aside, found_cores = backjump(found, _Implied(found), team, Culprits(None), 200)
         assert set(found_cores) == {id(c) for c in aside}
         schedule = _Schedule(found, horizons, [], [], durations, 200_000_000)
         for core in found_cores.values():

@@ -10,12 +10,12 @@ returned, irredundant, for re-planning.
 Two conflicts between the same robots often say the same thing more strongly or more weakly
 (:class:`_Implied`); only the strongest are searched and given to the solver.  The solver's
 work grows much faster than the conflicts (a single check of 10,000 conflicts can take a
-minute), so cores are first looked for by propagating forced orders, which needs none.
+minute), so the search proves its own dead ends (:mod:`cosmop.planning.conflict_search`) and
+the solver is asked only when the search runs out of its budget.
 """
 
 from __future__ import annotations
 
-import functools
 from collections.abc import Mapping, Sequence
 from decimal import Decimal
 from fractions import Fraction
@@ -23,8 +23,9 @@ from fractions import Fraction
 import numpy as np
 from shapely.geometry.base import BaseGeometry
 
-from cosmop.missions.precedence import Link, Node, Precedence
-from cosmop.planning.conflicts import Conflict, Occupancy, replan_rank
+from cosmop.missions.precedence import Link, Node
+from cosmop.planning.conflict_search import Culprits, Search, backjump, depth_first, ways_of
+from cosmop.planning.conflicts import Conflict
 
 __all__ = ["order_conflicts"]
 
@@ -43,22 +44,23 @@ def order_conflicts(
     """Start edges that order every conflict in `found`, and the conflicts no order resolves.
 
     Both the search and the solver see only the conflicts no other one implies
-    (:class:`_Implied`): an order of those orders the rest.  Then, in turn, while a step fails:
+    (:class:`_Implied`): an order of those orders the rest.  Then:
 
-    1. a depth-first search over the two ways of ordering each conflict (:func:`_search`), fast
-       when the conflicts are few or loosely tied;
-    2. unit propagation of the orders that are forced (:func:`_propagate`): where forced orders
-       alone make a conflict unorderable, they give a *core* -- a set of conflicts no order
-       resolves together -- without a solver, and the most re-plannable conflict of each core is
-       set aside.  If the search then orders the rest, each conflict set aside is settled
-       without a solver where it can be (:func:`_without_solver`), and that is the answer;
-    3. the question settled exactly as a scheduling problem (:class:`_Schedule`, Z3 over the
-       steps' start and end times): either a schedule orders every conflict left, or an unsat
-       core names a set no order resolves together, of which the most re-plannable is set aside
-       -- and the others are ordered again without it.  Z3's cores are not minimal, so a
-       conflict set aside early may be orderable once later ones are gone: each is then given
-       back, the hardest to re-plan first, while a schedule still exists (without a solver call
-       when its own core is back in full: the core still proves it).
+    1. a search over the two ways of ordering each conflict, with unit propagation and
+       conflict-directed backjumping (:class:`~cosmop.planning.conflict_search.Search`).  Each
+       dead end comes with the set of conflicts it follows from; one that follows from no
+       choice is a *core* -- a set of conflicts no order resolves together -- and one conflict
+       of each core is set aside (the most re-plannable, preferably of a robot already
+       re-planned: :class:`~cosmop.planning.conflict_search.Culprits`).  The cores are not
+       minimal, so each conflict set aside is then given back where the others allow it
+       (:func:`_give_back`), and that is the answer;
+    2. only if the search passes `max_backtracks` dead ends: the question settled exactly as a
+       scheduling problem (:class:`_Schedule`, Z3 over the steps' start and end times), from
+       the conflicts set aside so far.  Either a schedule orders every conflict left, or an
+       unsat core names a set no order resolves together, of which one is set aside in the same
+       way -- and the others are ordered again without it.  Each conflict set aside is then
+       given back, the hardest to re-plan first, while a schedule still exists (without a
+       solver call when its own core is back in full: the core still proves it).
 
     The unresolved conflicts returned are therefore irredundant: none of them could be ordered
     together with all the ordered ones.
@@ -66,32 +68,25 @@ def order_conflicts(
     Returns the edges added (on top of `starts`), each with the conflict it orders, and the
     unresolved conflicts.
     """
-    implied = _Implied(found)
-    needed = implied.left(set())
-    chosen, culprit = _search(needed, horizons, links, starts, durations, max_backtracks, fixed)
-    if culprit is None:
-        return chosen, []
-    unresolved, cores = _propagate(needed, horizons, links, starts, durations, fixed)
+    implied, culprits = _Implied(found), Culprits(fixed)
+    team = (horizons, links, starts, durations)
+    search = Search(found, implied, team, culprits)
+    if search.run(max_backtracks) and (settled := _give_back(search, culprits, max_backtracks)):
+        return settled
+    unresolved, cores = search.set_aside, search.cores
     gone = {id(c) for c in unresolved}
-    if unresolved:
-        team = (horizons, links, starts, durations)
-        settled = _without_solver(found, implied, unresolved, cores, team, fixed, max_backtracks)
-        if settled is not None:
-            return settled
     schedule = _Schedule(found, horizons, links, starts, durations, rlimit, implied)
     while (core := schedule.solve(implied.left(gone))) is not None:
-        if not core:  # undecided within the solver's budget: the search's culprit stays unresolved
-            return _give_up(
-                found, culprit, horizons, links, starts, durations, max_backtracks, fixed, implied
-            )
-        unresolved.append(min(core, key=lambda c: replan_rank(c, fixed)))
+        if not core:  # undecided within the solver's budget: what the search fails on stays
+            return _give_up(found, horizons, links, starts, durations, max_backtracks, fixed, implied)
+        unresolved.append(culprits.pick(core))
         gone.add(id(unresolved[-1]))
         cores[id(unresolved[-1])] = core
     # Cores are not minimal, so a conflict set aside early may be orderable once later ones are
     # gone: give each back, the hardest to re-plan first, while a schedule remains.  No solver
     # call when the last schedule already orders it, nor when its own core is all back (the
     # core still proves that no schedule orders it with the others).
-    for conflict in sorted(unresolved, key=lambda c: -replan_rank(c, fixed)):
+    for conflict in sorted(unresolved, key=lambda c: -culprits.rank(c)):
         gone.discard(id(conflict))
         if all(id(c) not in gone for c in cores[id(conflict)]) or (
             schedule.way(conflict) is None and schedule.solve(implied.left(gone)) is not None
@@ -100,178 +95,39 @@ def order_conflicts(
         else:
             unresolved.remove(conflict)
     # the search's choices keep the makespan low; the schedule stands in where the search fails
-    left = implied.left(gone)
-    better, culprit = _search(left, horizons, links, starts, durations, max_backtracks, fixed)
-    return (schedule.edges(left) if culprit is not None else better), unresolved
+    rest = [c for c in found if id(c) not in gone]
+    better, _, _ = backjump(rest, implied, team, culprits, max_backtracks)
+    return (better if better is not None else schedule.edges(implied.left(gone))), unresolved
 
 
-def _without_solver(found, implied, unresolved, cores, team, fixed, max_backtracks: int):
-    """Settle the conflicts propagation set aside without Z3, if the search orders the rest.
+def _give_back(search: Search, culprits: Culprits, budget: int):
+    """Give back the conflicts `search` set aside that an order resolves with all the others.
 
     A conflict whose core's other members are all ordered stays set aside (its core proves it).
-    Any other is given back when the search orders it with the rest, or stays set aside when
-    propagation then finds a core (which must contain it, the rest being ordered).  ``None``
-    when the search fails or a conflict is undecided: then the solver is asked.
+    Any other is given back, the hardest to re-plan first, and the search goes on from the order
+    as it is: it stays set aside if the search finds a core (which must contain it, the rest
+    being ordered).  ``(edges, unresolved)``, or ``None`` when the search runs out of `budget`.
     """
-    gone = {id(c) for c in unresolved}
-    chosen, stuck = _search(implied.left(gone), *team, max_backtracks, fixed)
-    if stuck is not None:
-        return None
-    for conflict in sorted(unresolved, key=lambda c: -replan_rank(c, fixed)):
-        if all(id(c) not in gone for c in cores[id(conflict)] if c is not conflict):
+    for conflict in sorted(search.set_aside, key=lambda c: -culprits.rank(c)):
+        core = search.cores[id(conflict)]
+        if not any(search.aside[search.number[id(c)]] for c in core if c is not conflict):
             continue
-        gone.discard(id(conflict))
-        left = implied.left(gone)
-        more, stuck = _search(left, *team, max_backtracks, fixed)
-        if stuck is None:
-            chosen = more  # given back
-            continue
-        aside, found_cores = _propagate(left, *team, fixed)
-        if not aside:
+        if search.give_back(conflict, budget) is None:
             return None
-        gone.add(id(conflict))
-        cores[id(conflict)] = found_cores[id(aside[0])]
-    return chosen, [c for c in unresolved if id(c) in gone]
+    return search.edges, search.set_aside
 
 
-def _give_up(found, culprit, horizons, links, starts, durations, max_backtracks, fixed, implied):
+def _give_up(found, horizons, links, starts, durations, max_backtracks, fixed, implied):
     """Order what the search can, leaving each conflict it fails on unresolved (sound, not minimal)."""
-    unresolved, gone = [culprit], {id(culprit)}
+    unresolved: list[Conflict] = []
+    gone: set[int] = set()
     while True:
         left = implied.left(gone)
-        chosen, culprit = _search(left, horizons, links, starts, durations, max_backtracks, fixed)
+        chosen, culprit = depth_first(left, horizons, links, starts, durations, max_backtracks, fixed)
         if culprit is None:
             return chosen, unresolved
         unresolved.append(culprit)
         gone.add(id(culprit))
-
-
-def _propagate(found, horizons, links, starts, durations, fixed) -> tuple[list[Conflict], dict[int, list]]:
-    """Set aside conflicts that forced orders alone show cannot all be ordered, with their cores.
-
-    Unit propagation: a conflict with a single way left that does not close a cycle must take
-    it.  Its *reason* is the set of conflicts whose edges close the cycle the other way would
-    (a path from the other way's target to its source, through program order, messages and
-    edges forced before it).  When a conflict has no way left, it and the reasons of the edges
-    on its cycles, followed back to the base order, form a *core*: a set of conflicts no order
-    resolves together, found without a solver and usually far smaller than the solver's.  Of
-    each core the most re-plannable conflict is set aside (what it forced is taken back), and
-    propagation goes on.  Conflicts that keep two ways are left to the solver.
-    """
-    precedence = Precedence(horizons, links, starts, durations)
-    sides = _Sides(found, precedence)
-    graph = _Graph(horizons, links, starts)
-    trail: list[tuple[int, list]] = []  # (conflict, undo log) of each forced edge, in order
-    at: dict[int, int] = {}  # conflict -> its place in the trail
-    aside = np.zeros(len(found), dtype=bool)
-    rank = functools.cache(lambda i: replan_rank(found[i], fixed))
-    out: list[Conflict] = []
-    cores: dict[int, list] = {}
-    while True:
-        open_ = ~sides.holds(precedence).any(axis=1) & ~aside
-        ways = sides.ways(precedence)
-        counts = np.where(open_, ways.sum(axis=1), -1)
-        stuck = np.flatnonzero(counts == 0)
-        if len(stuck):
-            core = _core(int(stuck[0]), sides, graph, at, len(trail))
-            # the most re-plannable; of those, the one forced last (least to take back)
-            worst = min(core, key=lambda i: (rank(i), -at.get(i, len(trail))))
-            while worst in at:  # take back what it forced, and all forced after it
-                i, log = trail.pop()
-                precedence.undo(log)
-                graph.pop()
-                del at[i]
-            aside[worst] = True
-            out.append(found[worst])
-            cores[id(found[worst])] = [found[i] for i in sorted(core)]
-            continue
-        forced = np.flatnonzero(counts == 1)
-        if not len(forced):
-            return out, cores
-        # the hardest to re-plan first: the likely culprits come last, the least to take back
-        for i in sorted(forced.tolist(), key=lambda i: -rank(i)):
-            edge = sides.edges[i][int(np.argmax(ways[i]))]
-            if precedence.would_cycle(*edge):
-                continue  # an edge of this batch closed its way: next round
-            at[i] = len(trail)
-            trail.append((i, precedence.add_start(edge)))
-            graph.push(edge, i)
-
-
-def _core(stuck: int, sides: _Sides, graph: _Graph, at: Mapping[int, int], now: int) -> set[int]:
-    """`stuck` and every conflict its dead end follows from (:func:`_propagate`)."""
-
-    def cycle(edge, before: int) -> list[int]:
-        path = graph.path(*edge, before=before)
-        if path is None:  # the clocks said the edge closes a cycle
-            raise AssertionError(f"no cycle through {edge}: the clocks and the graph disagree")
-        return path
-
-    core, todo = {stuck}, []
-    for edge in sides.edges[stuck]:
-        if edge is not None:
-            todo += cycle(edge, now)
-    while todo:
-        i = todo.pop()
-        if i in core:
-            continue
-        core.add(i)
-        chosen = graph.pushed[at[i]][:2]
-        for edge in sides.edges[i]:
-            if edge is not None and edge != chosen:
-                todo += cycle(edge, at[i])
-    return core
-
-
-class _Graph:
-    """Which step completes before which: program order, messages and given start edges, and
-    start edges pushed (and popped) in order, each labelled with what it orders."""
-
-    def __init__(self, horizons, links, starts) -> None:
-        self.succ: dict[Node, list[tuple[Node, object, int]]] = {}  # node -> (next, label, place)
-        for robot, k in horizons.items():
-            for i in range(1, k):
-                self._add((robot, i), (robot, i + 1), None, -1)
-        for link in links:
-            if link.send is not None and link.wait is not None:
-                self._add((link.sender, link.send), (link.receiver, link.wait), None, -1)
-        for source, target in starts:
-            self._add(source, target, None, -1)
-        self.pushed: list[tuple[Node, Node, object]] = []
-
-    def _add(self, source: Node, target: Node, label, place: int) -> None:
-        self.succ.setdefault(source, []).append((target, label, place))
-
-    def push(self, edge: tuple[Node, Node], label) -> None:
-        self.pushed.append((*edge, label))
-        self._add(edge[0], edge[1], label, len(self.pushed) - 1)
-
-    def pop(self) -> None:
-        source, _, _ = self.pushed.pop()
-        self.succ[source].pop()
-
-    def path(self, source: Node, target: Node, before: int | None = None) -> list | None:
-        """The labels on a shortest path from `target` to `source` -- the cycle the start edge
-        ``source -> target`` would close -- through the edges pushed before place `before`
-        (default: all); ``None`` if there is none."""
-        before = len(self.pushed) if before is None else before
-        parent: dict[Node, tuple[Node, object] | None] = {target: None}
-        queue = [target]
-        for node in queue:
-            if node == source:
-                break
-            for nxt, label, place in self.succ.get(node, ()):
-                if place < before and nxt not in parent:
-                    parent[nxt] = (node, label)
-                    queue.append(nxt)
-        if source not in parent:
-            return None
-        out, node = [], source
-        while parent[node] is not None:
-            node, label = parent[node]
-            if label is not None:
-                out.append(label)
-        return out
 
 
 class _Schedule:
@@ -319,7 +175,7 @@ class _Schedule:
             if target in s and source in e:
                 text.append(f"(assert {_after(s[target], e[source])})")
         self.solver.from_string("\n".join(text))
-        self.ways = {id(c): _edges(c) for c in found}
+        self.ways = {id(c): ways_of(c) for c in found}
         self.implied = implied if implied is not None else _Implied(found)
         self.number = {id(c): n for n, c in enumerate(found)}
         self.label: dict[int, object] = {}  # conflict -> its literal, once written
@@ -374,20 +230,6 @@ class _Schedule:
         return [(self.way(c), c) for c in conflicts]
 
 
-def _both_ways(conflict: Conflict) -> list[tuple[Node, Node] | None]:
-    """The conflict's two ways as start edges, ``a`` first then ``b`` first: "x before y" for x
-    that ends and y that does not hold its place from the beginning (else ``None``)."""
-    return [
-        (x.last, y.first) if x.last is not None and y.first is not None and y.first[1] >= 1 else None
-        for x, y in ((conflict.a, conflict.b), (conflict.b, conflict.a))
-    ]
-
-
-def _edges(conflict: Conflict) -> list[tuple[Node, Node]]:
-    """The start edges that can order `conflict` (its possible :func:`_both_ways`)."""
-    return [edge for edge in _both_ways(conflict) if edge is not None]
-
-
 class _Implied:
     """Which conflicts imply which: of two between the same robots, one may say the other.
 
@@ -428,6 +270,15 @@ class _Implied:
         implied[self.weaker[asked[self.weaker] & asked[self.stronger]]] = True
         return [c for c in conflicts if not implied[self.index[id(c)]]]
 
+    def among(self, conflicts: Sequence[Conflict]) -> tuple[np.ndarray, np.ndarray]:
+        """The pairs (stronger, weaker) of :attr:`found` that both lie in `conflicts`, as
+        indices into `conflicts`."""
+        place = np.full(len(self.found), -1, dtype=np.int64)
+        place[[self.index[id(c)] for c in conflicts]] = np.arange(len(conflicts))
+        d, c = place[self.stronger], place[self.weaker]
+        both = (d >= 0) & (c >= 0)
+        return d[both], c[both]
+
     def left(self, gone: set[int]) -> list[Conflict]:
         """The conflicts not in `gone` (ids), without those the others imply."""
         return self.needed([c for c in self.found if id(c) not in gone])
@@ -440,7 +291,7 @@ def _implications(group: Sequence[Conflict]) -> np.ndarray:
     present = np.zeros((m, 2), dtype=bool)
     ends = np.zeros((m, 2, 4), dtype=np.int64)  # per way: A, i, B, j
     for n, c in enumerate(group):
-        for w, ((a, i), (b, j)) in enumerate(_edges(c)):
+        for w, ((a, i), (b, j)) in enumerate(ways_of(c)):
             present[n, w] = True
             ends[n, w] = (robots[a], i, robots[b], j)
     d, c = ends[:, None, :, None, :], ends[None, :, None, :, :]  # [d, c, d's way, c's way, field]
@@ -483,156 +334,3 @@ class _Times:
             value = self.model.eval(var, model_completion=True)
             self.seen[key] = Fraction(value.numerator_as_long(), value.denominator_as_long())
         return self.seen[key]
-
-
-class _Sides:
-    """Both ways of ordering every conflict, as arrays, to ask many questions at once.
-
-    Side 0 puts occupancy ``a`` first, side 1 ``b``: "x before y" is the start edge from
-    x's last step to y's first.  A side is *possible* when x ends and y does not start at the
-    beginning; it *holds* when the order already implies it; it *closes a cycle* when y's first
-    step must already complete before x's last one does.
-    """
-
-    def __init__(self, found: Sequence[Conflict], precedence: Precedence) -> None:
-        n = len(found)
-        self.possible = np.zeros((n, 2), dtype=bool)
-        self.x_col = np.zeros((n, 2), dtype=np.int64)
-        self.x_k = np.zeros((n, 2), dtype=np.int64)
-        self.x_row = np.zeros((n, 2), dtype=np.int64)
-        self.y_col = np.zeros((n, 2), dtype=np.int64)
-        self.y_k = np.zeros((n, 2), dtype=np.int64)
-        self.y_row = np.zeros((n, 2), dtype=np.int64)
-        self.same = np.zeros((n, 2), dtype=bool)
-        # where each occupancy's expected start is read (0 when it holds from the beginning)
-        self.first_row = np.zeros((n, 2), dtype=np.int64)
-        self.from_start = np.ones((n, 2), dtype=bool)
-        self.edges = [_both_ways(c) for c in found]  # each side as a start edge, or None
-        for i, c in enumerate(found):
-            for side, x in enumerate((c.a, c.b)):
-                if x.first is not None and x.first[1] >= 1:
-                    r, k = x.first
-                    self.first_row[i, side] = precedence.offsets[r] + min(k, precedence.horizons[r] + 1)
-                    self.from_start[i, side] = False
-            for side, edge in enumerate(self.edges[i]):
-                if edge is None:
-                    continue
-                (xr, xk), (yr, yk) = edge
-                self.possible[i, side] = True
-                self.x_col[i, side], self.x_k[i, side] = precedence.column[xr], xk
-                self.x_row[i, side] = precedence.offsets[xr] + xk
-                self.y_col[i, side], self.y_k[i, side] = precedence.column[yr], yk
-                self.y_row[i, side] = precedence.offsets[yr] + min(yk, precedence.horizons[yr] + 1)
-                self.same[i, side] = xr == yr
-
-    def holds(self, precedence: Precedence) -> np.ndarray:
-        """(n, 2): whether each side is already implied."""
-        implied = precedence.begin_flat[self.y_row, self.x_col] >= self.x_k
-        return self.possible & np.where(self.same, self.x_k < self.y_k, implied)
-
-    def expected_start(self, precedence: Precedence, rows: np.ndarray) -> np.ndarray:
-        """The expected start of the earlier occupancy of each conflict in `rows`, s."""
-        started = np.where(self.from_start[rows], 0.0, precedence.started_flat[self.first_row[rows]])
-        return started.min(axis=1)
-
-    def ways(self, precedence: Precedence) -> np.ndarray:
-        """(n, 2): whether each side can still be added without closing a cycle."""
-        cycle = precedence.done_flat[self.x_row, self.y_col] >= self.y_k
-        return self.possible & ~np.where(self.same, self.y_k <= self.x_k, cycle)
-
-
-def _search(found, horizons, links, starts, durations, max_backtracks, fixed):
-    """Depth-first search for edges ordering every conflict; ``(edges, None)`` or ``([], culprit)``.
-
-    At every point the open conflicts are checked forward: one that has no way left to be
-    ordered (both ways close a cycle, or the way left never ends) sends the search back to the
-    last choice.  A conflict with a single way left is ordered first; otherwise the one expected
-    to start first, the way that keeps the team's expected makespan lower.  The culprit is the
-    conflict without a way at the deepest dead end.  The order is updated incrementally and
-    taken back on backtracking (:meth:`~cosmop.missions.precedence.Precedence.add_start`).
-    """
-    precedence = Precedence(horizons, links, starts, durations)
-    sides = _Sides(found, precedence)
-    # priorities: the robot expected to finish first goes first, so that it clears out early;
-    # one order for all robots keeps most choices consistent (no cycles among them)
-    alone = {r: sum(durations[r]) for r in horizons}
-    rank = {r: n for n, r in enumerate(sorted(horizons, key=lambda r: (alone[r], r)))}
-    chosen: list[tuple[tuple[Node, Node], Conflict, list]] = []
-    stack: list[tuple[int, list[tuple[Node, Node]], Conflict]] = []  # (depth, untried, conflict)
-    backtracks, deepest, culprit = 0, -1, None
-    while True:
-        open_ = ~sides.holds(precedence).any(axis=1)
-        if not open_.any():
-            return [(edge, conflict) for edge, conflict, _ in chosen], None
-        counts = np.where(open_, sides.ways(precedence).sum(axis=1), -1)
-        stuck = [found[i] for i in np.flatnonzero(counts == 0)]
-        if stuck:
-            if len(chosen) > deepest:
-                edges = [(e, c) for e, c, _ in chosen]
-                worst = min(stuck, key=lambda c: replan_rank(c, fixed))
-                deepest, culprit = len(chosen), _culprit(worst, horizons, links, starts, edges, fixed)
-            if not stack or backtracks >= max_backtracks:
-                return [], culprit
-            backtracks += 1
-            depth, untried, conflict = stack[-1]
-            while len(chosen) > depth:
-                precedence.undo(chosen.pop()[2])
-            edge = untried.pop(0)
-            chosen.append((edge, conflict, precedence.add_start(edge)))
-            if not untried:
-                stack.pop()
-            continue
-        pool = np.flatnonzero(counts == 1)
-        if not len(pool):
-            pool = np.flatnonzero(open_)
-        conflict = found[pool[np.argmin(sides.expected_start(precedence, pool))]]
-        options = _ways(conflict, precedence)
-        if len(options) > 1:  # the robot of higher priority first, then the lower makespan
-            options = sorted(options, key=lambda e: rank[e[0][0]])
-            if len({rank[e[0][0]] for e in options}) < len(options):
-                options = sorted(options, key=lambda e: (rank[e[0][0]], _makespan_with(precedence, e)))
-            stack.append((len(chosen), options[1:], conflict))
-        chosen.append((options[0], conflict, precedence.add_start(options[0])))
-
-
-def _start(x: Occupancy, precedence: Precedence) -> float:
-    return 0.0 if x.first is None else precedence.start_time(x.first)
-
-
-def _makespan_with(precedence: Precedence, edge: tuple[Node, Node]) -> float:
-    log = precedence.add_start(edge)
-    makespan = precedence.makespan
-    precedence.undo(log)
-    return makespan
-
-
-def _culprit(stuck: Conflict, horizons, links, starts, chosen, fixed) -> Conflict:
-    """The conflict to re-plan around when `stuck` has no way to be ordered.
-
-    If `stuck` itself cannot be re-planned (two robots standing where their goods require), the
-    orders that close its cycles came from other conflicts: the most re-plannable of those.
-    """
-    if replan_rank(stuck, fixed) < 3:
-        return stuck
-    graph = _Graph(horizons, links, starts)
-    for edge, conflict in chosen:
-        graph.push(edge, conflict)
-    on_cycles: list[Conflict] = []
-    for edge in _edges(stuck):
-        on_cycles += graph.path(*edge) or []
-    best = min(on_cycles, key=lambda c: replan_rank(c, fixed), default=stuck)
-    return best if replan_rank(best, fixed) < 3 else stuck
-
-
-def _ways(conflict: Conflict, precedence: Precedence) -> list[tuple[Node, Node]]:
-    """The start edges that can order `conflict`, the one expected to happen first first."""
-    a, b = conflict.a, conflict.b
-    options = sorted(((a, b), (b, a)), key=lambda xy: (_start(xy[0], precedence), _start(xy[1], precedence)))
-    out = []
-    for x, y in options:
-        if x.last is None or y.first is None:
-            continue  # x never ends, or y holds its place from the beginning
-        if precedence.would_cycle(x.last, y.first):
-            continue
-        out.append((x.last, y.first))
-    return out
