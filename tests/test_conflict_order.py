@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import random
 
+import numpy as np
 import pytest
 import shapely
 
@@ -213,3 +214,30 @@ def test_the_cores_the_search_finds_are_cores():
             cores += 1
             assert schedule.solve(core) is not None, core
     assert cores >= 5
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_start_edges_added_and_taken_back_give_the_order_built_with_them_at_once(seed):
+    # the search adds start edges one at a time and takes them back (vector clocks and times
+    # raised incrementally): the order must be the one built from scratch with the same edges
+    rng = random.Random(seed)
+    horizons = {f"R{i}": rng.randint(2, 6) for i in range(1, 5)}
+    durations = {r: [rng.uniform(0.5, 4.0) for _ in range(k)] for r, k in horizons.items()}
+    incremental = Precedence(horizons, (), (), durations)
+    added, logs = [], []
+    for _ in range(30):
+        if logs and rng.random() < 0.3:
+            incremental.undo(logs.pop())
+            added.pop()
+        else:
+            a, b = rng.sample(sorted(horizons), 2)
+            edge = ((a, rng.randint(1, horizons[a])), (b, rng.randint(1, horizons[b])))
+            if incremental.would_cycle(*edge):
+                continue
+            logs.append(incremental.add_start(edge))
+            added.append(edge)
+        at_once = Precedence(horizons, (), added, durations)
+        assert np.array_equal(incremental.done_flat, at_once.done_flat)
+        assert np.array_equal(incremental.begin_flat, at_once.begin_flat)
+        assert np.allclose(incremental.finish_flat, at_once.finish_flat)
+        assert np.allclose(incremental.started_flat, at_once.started_flat)

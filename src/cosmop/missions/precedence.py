@@ -216,15 +216,17 @@ class Precedence:
     @staticmethod
     def _raise(log, clocks, k, clock, times, t, keep: int | None = None) -> bool:
         """Raise ``clocks[k]`` to at least `clock` and ``times[k]`` to `t`; log the old values."""
-        new = np.maximum(clocks[k], clock)
+        row = clocks[k]
+        grows = clock > row
         if keep is not None:
-            new[keep] = clocks[k][keep]
-        grow_clock = bool((new != clocks[k]).any())
+            grows[keep] = False
+        grow_clock = grows.any()
         grow_time = t > times[k] + 1e-12
         if not (grow_clock or grow_time):
             return False
-        log.append(("row", clocks, k, clocks[k].copy(), times, float(times[k])))
-        clocks[k] = new
+        log.append(("row", clocks, k, row.copy(), times, float(times[k])))
+        if grow_clock:
+            np.copyto(row, clock, where=grows)  # the maximum, where it grows
         times[k] = max(float(times[k]), t)
         return True
 
