@@ -115,6 +115,31 @@ def test_a_core_found_through_a_choice_taken_back_is_a_core(monkeypatch):
     _assert_sound_and_irredundant(found, horizons, durations, answer, starts)
 
 
+def test_the_search_jumps_back_to_the_latest_choice_a_dead_end_follows_from(monkeypatch):
+    # A-B is chosen first (A first), then C-D (C first); together they close both ways of E-F
+    # (through A2 -> B1 and C2 -> D1), a dead end that follows from both choices.  The latest,
+    # C-D, is at fault: D first orders everything.  Taking A-B back instead would leave G-H no
+    # way (B first closes both of its ways) and set a conflict aside that an order resolves.
+    spot = shapely.box(0, 0, 1, 1)
+
+    def held(robot):
+        return Occupancy(robot, frozenset({robot}), spot, (robot, 1), (robot, 2), f"{robot}1-2")
+
+    horizons = {r: 2 for r in "ABCDEFGH"}
+    durations = {"A": [0.5, 0.5], "C": [0.5, 0.5], **{r: [3.0, 3.0] for r in "BDEFGH"}}
+    starts = [
+        *((("F", 1), ("A", 2)), (("E", 1), ("A", 2)), (("B", 1), ("C", 2))),
+        *((("D", 1), ("E", 2)), (("D", 1), ("F", 2))),
+        *((("G", 1), ("B", 2)), (("H", 1), ("B", 2)), (("A", 1), ("G", 2)), (("A", 1), ("H", 2))),
+    ]
+    found = [Conflict(held(a), held(b)) for a, b in ("AB", "CD", "EF", "GH")]
+    monkeypatch.setattr(conflict_order, "_Schedule", _no_solver)
+    chosen, unresolved = order_conflicts(found, horizons, [], starts, durations)
+    assert unresolved == []
+    assert {(("A", 2), ("B", 1)), (("D", 2), ("C", 1))} <= {edge for edge, _ in chosen}
+    _assert_sound_and_irredundant(found, horizons, durations, (chosen, unresolved), starts)
+
+
 def test_the_solver_takes_over_when_the_search_runs_out_of_dead_ends(monkeypatch):
     found, horizons, starts, durations = _tangle()
     asked = []
