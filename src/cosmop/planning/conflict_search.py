@@ -143,8 +143,10 @@ class Search:
             members = sorted(core, key=lambda i: -self.at.get(i, len(self.trail)))
             picked = self.culprits.pick([self.found[i] for i in members])
             places.append(self._put_aside(next(i for i in members if self.found[i] is picked), core))
+        if not places:  # every core held a conflict set aside before this round: a stale reason
+            raise AssertionError(f"dead ends {stuck} with nothing to set aside or take back")
         self._hide()  # what they implied is no longer ordered by them
-        self._back_to(min(places, default=len(self.trail)))
+        self._back_to(min(places))
         return "core" if back is None else "back"
 
     def give_back(self, conflict: Conflict, budget: int) -> bool | None:
