@@ -110,7 +110,7 @@ def _give_back(search: Search, culprits: Culprits, budget: int):
     """
     for conflict in sorted(search.set_aside, key=lambda c: -culprits.rank(c)):
         core = search.cores[id(conflict)]
-        if not any(search.aside[search.number[id(c)]] for c in core if c is not conflict):
+        if not any(search.is_aside(c) for c in core if c is not conflict):
             continue
         if search.give_back(conflict, budget) is None:
             return None

@@ -10,7 +10,6 @@ one conflict is set aside for re-planning (:class:`Culprits`).
 
 from __future__ import annotations
 
-import functools
 from collections.abc import Mapping, Sequence
 
 import numpy as np
@@ -66,7 +65,6 @@ class Search:
         self.aside = np.zeros(len(found), dtype=bool)
         self.hidden = np.zeros(len(found), dtype=bool)
         self._hide()
-        self.rank = functools.cache(lambda i: culprits.rank(found[i]))
         self.priority = _priorities(horizons, durations)
         self.cores: dict[int, list[Conflict]] = {}  # id of each conflict set aside -> its core
 
@@ -79,6 +77,9 @@ class Search:
     def set_aside(self) -> list[Conflict]:
         """The conflicts set aside, each with its core in :attr:`cores`."""
         return [self.found[i] for i in np.flatnonzero(self.aside)]
+
+    def is_aside(self, conflict: Conflict) -> bool:
+        return bool(self.aside[self.number[id(conflict)]])
 
     def run(self, budget: int, back: int | None = None) -> bool | None:
         """Order every conflict left: ``True`` when done, ``None`` past `budget` dead ends.
@@ -102,7 +103,7 @@ class Search:
                 continue
             forced = np.flatnonzero(counts == 1)
             # the hardest to re-plan first: the likely culprits come last, the least to take back
-            for i in sorted(forced.tolist(), key=lambda i: -self.rank(i)):
+            for i in sorted(forced.tolist(), key=lambda i: -self.culprits.rank(self.found[i])):
                 edge = self.sides.edges[i][int(np.argmax(ways[i]))]
                 if not self.precedence.would_cycle(*edge):  # else this batch closed it: next round
                     self._take(i, edge, True)
