@@ -156,6 +156,18 @@ def test_the_solver_takes_over_when_the_search_runs_out_of_dead_ends(monkeypatch
     _assert_sound_and_irredundant(found, horizons, durations, answer, starts)
 
 
+def test_when_neither_the_search_nor_the_solver_decides_the_answer_is_still_sound():
+    # no dead end to spare and no solver budget: the depth-first fallback orders what it can
+    # and leaves what it fails on unresolved (sound, not necessarily irredundant)
+    found, horizons, starts, durations = _tangle()
+    chosen, unresolved = order_conflicts(found, horizons, [], starts, durations, max_backtracks=0, rlimit=1)
+    assert unresolved
+    precedence = Precedence(horizons, (), [*starts, *(edge for edge, _ in chosen)], durations)
+    assert precedence.complete
+    gone = {id(c) for c in unresolved}
+    assert all(is_ordered(c, precedence) for c in found if id(c) not in gone)
+
+
 def _no_solver(*args, **kwargs):
     raise AssertionError("the solver was asked")
 
