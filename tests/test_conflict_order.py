@@ -22,7 +22,7 @@ import shapely
 from cosmop.missions.precedence import Link, Precedence
 from cosmop.planning import conflict_order
 from cosmop.planning.conflict_order import _Implied, _Schedule, order_conflicts
-from cosmop.planning.conflict_search import Culprits, backjump, ways_of
+from cosmop.planning.conflict_search import Culprits, Search, backjump, ways_of
 from cosmop.planning.conflicts import Conflict, Occupancy, is_ordered
 from cosmop.planning.teamsafety import _reduce
 
@@ -278,3 +278,76 @@ def test_start_edges_added_and_taken_back_give_the_order_built_with_them_at_once
         assert np.array_equal(incremental.begin_flat, at_once.begin_flat)
         assert np.allclose(incremental.finish_flat, at_once.finish_flat)
         assert np.allclose(incremental.started_flat, at_once.started_flat)
+
+
+def _assert_same_order(built: Precedence, at_once: Precedence) -> None:
+    assert np.array_equal(built.done_flat, at_once.done_flat)
+    assert np.array_equal(built.begin_flat, at_once.begin_flat)
+    assert np.array_equal(built.finish_flat, at_once.finish_flat)
+    assert np.array_equal(built.started_flat, at_once.started_flat)
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_start_edges_added_in_batches_give_the_order_of_one_at_a_time(seed):
+    # the search adds a run of forced edges in one pass (Precedence.add_starts): with messages
+    # between the robots, each edge refused exactly when it closes a cycle with those before it
+    rng = random.Random(seed)
+    horizons = {f"R{i}": rng.randint(3, 8) for i in range(1, 6)}
+    durations = {r: [rng.uniform(0.5, 4.0) for _ in range(k)] for r, k in horizons.items()}
+    links = []
+    for n in range(4):
+        a, b = rng.sample(sorted(horizons), 2)
+        link = Link(f"m{n}", a, rng.randint(1, horizons[a]), b, rng.randint(1, horizons[b]))
+        if Precedence(horizons, [*links, link], (), durations).complete:
+            links.append(link)
+    built, one_by_one = (Precedence(horizons, links, (), durations) for _ in range(2))
+    added, logs, refusals = [], [], 0
+    for _ in range(30):
+        if logs and rng.random() < 0.25:
+            built.undo(logs.pop())
+            del added[-1]
+            one_by_one = Precedence(horizons, links, [e for b in added for e in b], durations)
+            continue
+        batch = []
+        for _ in range(rng.randint(1, 8)):
+            a, b = rng.sample(sorted(horizons), 2)
+            batch.append(((a, rng.randint(1, horizons[a])), (b, rng.randint(1, horizons[b]))))
+        log, refused = built.add_starts(batch)
+        expected = []
+        for n, edge in enumerate(batch):
+            if one_by_one.would_cycle(*edge):
+                expected.append(n)
+            else:
+                one_by_one.add_start(edge)
+        assert refused == expected
+        refusals += len(refused)
+        logs.append(log)
+        added.append([e for n, e in enumerate(batch) if n not in refused])
+        _assert_same_order(built, one_by_one)
+        _assert_same_order(built, Precedence(horizons, links, [e for b in added for e in b], durations))
+    assert refusals and logs and links  # cycles met, with messages
+
+
+@pytest.mark.parametrize(
+    ("seed", "robots", "conflicts"), [(0, 4, 24), (72, 5, 40), (147, 5, 40), (349, 5, 40)]
+)
+def test_the_order_the_search_keeps_is_always_that_of_its_trail(seed, robots, conflicts, monkeypatch):
+    # runs of forced ways are added in one pass and taken back as one, also when the search
+    # jumps back into the middle of one: after every take-back the clocks must be those of the
+    # edges left on the trail, built from scratch
+    found, horizons, durations = _team(seed, robots=robots, conflicts=conflicts)
+    checks = []
+    back_to = Search._back_to
+
+    def checked(search, place):
+        back_to(search, place)
+        edges = [edge for _, edge, _, _ in search.trail]
+        _assert_same_order(search.precedence, Precedence(horizons, (), edges, durations))
+        checks.append(place)
+
+    monkeypatch.setattr(Search, "_back_to", checked)
+    search = Search(found, _Implied(found), (horizons, [], [], durations), Culprits(None))
+    assert search.run(budget=200) is not None
+    for conflict in list(search.set_aside):
+        search.give_back(conflict, budget=200)
+    assert checks  # the search took something back

@@ -31,7 +31,7 @@ robot starting at 0, :attr:`Precedence.finish` is the earliest completion of eac
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -183,55 +183,188 @@ class Precedence:
         complete.  Returns an undo log for :meth:`undo`.
         """
         (a, i), target = edge
-        log: list = []
-        self._into_start.setdefault(target, []).append((a, i))
-        self._succ.setdefault((a, i), []).append((target, "begin"))
-        log.append(("edge", target, (a, i)))
+        log = self._link([edge])
         work = [(target, "begin", self.done[a][i], float(self.finish[a][i]))]
-        successors = self._succ
+        begin, done, started, finish = self.begin, self.done, self.started, self.finish
         while work:
             (r, k), kind, clock, t = work.pop()
+            col = self.column[r]
             if kind == "begin":
-                changed = self._raise(log, self.begin[r], k, clock, self.started[r], t)
-                if not changed:
+                if not self._raise(log, begin[r], k, clock, started[r], t):
                     continue
-                own = self.done[r][k][self.column[r]]
-                clock2 = np.maximum(self.done[r][k], self.begin[r][k])
-                clock2[self.column[r]] = own
-                t2 = float(self.started[r][k] + self.durations[r][k - 1])
-            else:
-                clock2, t2 = clock, t
-            if not self._raise(log, self.done[r], k, clock2, self.finish[r], t2, keep=self.column[r]):
+                # done = the start's clock with the robot's own column kept; time + duration
+                clock, t = begin[r][k], float(started[r][k] + self.durations[r][k - 1])
+            if not self._raise(log, done[r], k, clock, finish[r], t, keep=col):
                 continue
+            clock, t = done[r][k], float(finish[r][k])
             if k < self.horizons[r]:
-                work.append(((r, k + 1), "begin", self.done[r][k], float(self.finish[r][k])))
+                work.append(((r, k + 1), "begin", clock, t))
             else:
-                self._raise(
-                    log, self.begin[r], k + 1, self.done[r][k], self.started[r], float(self.finish[r][k])
-                )
-            for node, kind2 in successors.get((r, k), ()):
-                work.append((node, kind2, self.done[r][k], float(self.finish[r][k])))
+                self._raise(log, begin[r], k + 1, clock, started[r], t)
+            for node, kind2 in self._succ.get((r, k), ()):
+                work.append((node, kind2, clock, t))
         return log
+
+    def add_starts(self, edges: Sequence[tuple[Node, Node]]) -> tuple[list, list[int]]:
+        """Add start edges in their order, each unless it closes a cycle with those before it,
+        as :meth:`would_cycle` then :meth:`add_start` for each in turn would, but in one pass.
+
+        The pass visits the steps the edges can reach in a topological order, recomputing a
+        step only when a step it waits for changed.  Clocks and times are the least fixpoint of
+        the edges taken, whatever the order they are added in, so they are those of one edge at
+        a time.  When the edges close cycles, only an edge between two steps left out of the
+        topological order can lie on one: the others go in the pass, those one at a time.
+
+        Returns
+        -------
+        log : list
+            The undo log for :meth:`undo`.
+        refused : list of int
+            The indices of the edges not added (each closes a cycle with those before it).
+        """
+        log = self._link(edges)
+        order, stuck = self._topological({target for _, target in edges})
+        suspects: list[int] = []
+        if stuck:
+            part = self._components(stuck)
+            self.undo(log)
+            suspects = [n for n, (s, t) in enumerate(edges) if s in part and part.get(t) == part[s]]
+            safe = [e for n, e in enumerate(edges) if n not in set(suspects)]
+            log = self._link(safe)
+            order, _ = self._topological({target for _, target in safe})
+        seeds, changed = {target for _, target in edges}, set()
+        for node in order:
+            moved = node in seeds or not changed.isdisjoint(self._before(node))
+            if moved and self._recompute(log, node):
+                changed.add(node)
+        refused = []
+        for n in suspects:
+            if self.would_cycle(*edges[n]):
+                refused.append(n)
+            else:
+                log += self.add_start(edges[n])
+        return log, refused
+
+    def _link(self, edges: Sequence[tuple[Node, Node]]) -> list:
+        """Put the start `edges` in the order's tables (clocks untouched): their undo log."""
+        log: list = []
+        for source, target in edges:
+            self._into_start.setdefault(target, []).append(source)
+            self._succ.setdefault(source, []).append((target, "begin"))
+            log.append(("edge", target, source))
+        return log
+
+    def _after(self, node: Node) -> list[Node]:
+        """The steps that wait for `node`: the robot's next step and the edges out of it."""
+        r, k = node
+        nxt = [(r, k + 1)] if k < self.horizons[r] else []
+        return nxt + [target for target, _ in self._succ.get(node, ())]
+
+    def _before(self, node: Node) -> list[Node]:
+        """The steps `node` waits for: the robot's step before and the edges into it."""
+        r, k = node
+        return [(r, k - 1), *self._into_start.get(node, ()), *self._into_done.get(node, ())]
+
+    def _topological(self, seeds: set[Node]) -> tuple[list[Node], set[Node]]:
+        """The steps reachable from `seeds` in an order the edges allow (Kahn's algorithm), and
+        those left out: the steps on a cycle, and after one (none when there is no cycle)."""
+        waiting = dict.fromkeys(seeds, 0)  # reachable step -> edges into it from reachable steps
+        stack = list(seeds)
+        while stack:
+            for nxt in self._after(stack.pop()):
+                if nxt not in waiting:
+                    waiting[nxt] = 0
+                    stack.append(nxt)
+                waiting[nxt] += 1
+        ready = [node for node, count in waiting.items() if count == 0]
+        order = []
+        while ready:
+            node = ready.pop()
+            order.append(node)
+            for nxt in self._after(node):
+                waiting[nxt] -= 1
+                if waiting[nxt] == 0:
+                    ready.append(nxt)
+        if len(order) == len(waiting):
+            return order, set()
+        return order, {node for node, count in waiting.items() if count}
+
+    def _components(self, steps: set[Node]) -> dict[Node, int]:
+        """The strongly connected components of the order among `steps` (Tarjan's algorithm,
+        without recursion): step -> a number shared by the steps of its component.  An edge
+        lies on a cycle exactly when its two ends share a component."""
+        number: dict[Node, int] = {}
+        low: dict[Node, int] = {}
+        part: dict[Node, int] = {}
+        stack: list[Node] = []
+
+        def visit(node: Node) -> tuple[Node, Iterator[Node]]:
+            number[node] = low[node] = len(number)
+            stack.append(node)
+            return node, (n for n in self._after(node) if n in steps)
+
+        for root in steps:
+            if root in number:
+                continue
+            work = [visit(root)]
+            while work:
+                node, later = work[-1]
+                for nxt in later:
+                    if nxt not in number:
+                        work.append(visit(nxt))
+                        break
+                    if nxt not in part:  # still on the stack: in the component being built
+                        low[node] = min(low[node], number[nxt])
+                else:
+                    work.pop()
+                    if work:
+                        low[work[-1][0]] = min(low[work[-1][0]], low[node])
+                    if low[node] == number[node]:
+                        while True:
+                            member = stack.pop()
+                            part[member] = number[node]
+                            if member == node:
+                                break
+        return part
+
+    def _recompute(self, log: list, node: Node) -> bool:
+        """Raise the clocks and times of `node` to what the steps it waits for give; whether
+        its completion changed (what the steps after it read)."""
+        r, k = node
+        starts = [(r, k - 1), *self._into_start.get(node, ())]
+        rows = [self.offsets[s] + i for s, i in starts]
+        clock, t = self.done_flat[rows].max(axis=0), float(self.finish_flat[rows].max())
+        self._raise(log, self.begin[r], k, clock, self.started[r], t)
+        col, dones = self.column[r], [self.offsets[s] + i for s, i in self._into_done.get(node, ())]
+        t = float(self.started[r][k] + self.durations[r][k - 1])
+        grew = self._raise(log, self.done[r], k, self.begin[r][k], self.finish[r], t, keep=col)
+        if dones:
+            clock, t = self.done_flat[dones].max(axis=0), float(self.finish_flat[dones].max())
+            grew |= self._raise(log, self.done[r], k, clock, self.finish[r], t, keep=col)
+        if not grew:
+            return False
+        if k == self.horizons[r]:  # "start of K+1": after the whole plan
+            self._raise(log, self.begin[r], k + 1, self.done[r][k], self.started[r], float(self.finish[r][k]))
+        return True
 
     @staticmethod
     def _raise(log, clocks, k, clock, times, t, keep: int | None = None) -> bool:
-        """Raise ``clocks[k]`` to at least `clock` and ``times[k]`` to `t`; log the old values."""
+        """Raise ``clocks[k]`` to at least `clock` (but for its column `keep`) and ``times[k]``
+        to `t`; log the old values.  Whether anything grew."""
         row = clocks[k]
-        grows = clock > row
+        new = np.maximum(clock, row)
         if keep is not None:
-            grows[keep] = False
-        grow_clock = grows.any()
-        grow_time = t > times[k] + 1e-12
-        if not (grow_clock or grow_time):
+            new[keep] = row[keep]
+        old = float(times[k])
+        if t <= old + 1e-12 and new.tobytes() == row.tobytes():
             return False
-        log.append(("row", clocks, k, row.copy(), times, float(times[k])))
-        if grow_clock:
-            np.copyto(row, clock, where=grows)  # the maximum, where it grows
-        times[k] = max(float(times[k]), t)
+        log.append(("row", clocks, k, row.copy(), times, old))
+        row[:] = new
+        times[k] = max(old, t)
         return True
 
     def undo(self, log: list) -> None:
-        """Take back an :meth:`add_start` (logs are undone newest first)."""
+        """Take back an :meth:`add_start` or :meth:`add_starts` (logs are undone newest first)."""
         for entry in reversed(log):
             if entry[0] == "edge":
                 self._into_start[entry[1]].pop()

@@ -11,6 +11,7 @@ one conflict is set aside for re-planning (:class:`Culprits`).
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 
 import numpy as np
 from shapely.geometry.base import BaseGeometry
@@ -103,10 +104,8 @@ class Search:
                 continue
             forced = np.flatnonzero(counts == 1)
             # the hardest to re-plan first: the likely culprits come last, the least to take back
-            for i in sorted(forced.tolist(), key=lambda i: -self.culprits.rank(self.found[i])):
-                edge = self.sides.edges[i][int(np.argmax(ways[i]))]
-                if not self.precedence.would_cycle(*edge):  # else this batch closed it: next round
-                    self._take(i, edge, True)
+            order = sorted(forced.tolist(), key=lambda i: -self.culprits.rank(self.found[i]))
+            self._take_forced([(i, self.sides.edges[i][int(np.argmax(ways[i]))]) for i in order])
             if len(forced):
                 continue
             pool = np.flatnonzero(open_)
@@ -171,17 +170,52 @@ class Search:
         self.hidden[:] = False
         self.hidden[self.weaker[~self.aside[self.stronger]]] = True
 
-    def _take(self, i: int, edge, reason) -> None:
+    def _take(self, i: int, edge, reason, log=None) -> None:
         self.at[i] = len(self.trail)
-        self.trail.append((i, edge, self.precedence.add_start(edge), reason))
+        self.trail.append((i, edge, self.precedence.add_start(edge) if log is None else log, reason))
         self.graph.push(edge, i)
 
+    def _take_forced(self, forced: list[tuple[int, tuple[Node, Node]]]) -> None:
+        """Take the forced ways, in order, each unless the ones before it close its cycle (it
+        is then stuck, and seen so next round): in one pass
+        (:meth:`~cosmop.missions.precedence.Precedence.add_starts`), taken back as one."""
+        if not forced:
+            return
+        log, refused = self.precedence.add_starts([edge for _, edge in forced])
+        taken = [way for n, way in enumerate(forced) if n not in set(refused)]
+        batch = _Batch(len(self.trail), len(taken), log)
+        for i, edge in taken:
+            self._take(i, edge, True, batch)
+
     def _back_to(self, place: int) -> None:
+        """Take back the trail from `place` on.  A batch of forced ways that `place` falls
+        inside is taken back whole, and its part before `place` taken again."""
         while len(self.trail) > place:
-            i, _, log, _ = self.trail.pop()
+            self._pop()
+        top = self.trail[-1][2] if self.trail else None
+        if isinstance(top, _Batch) and top.start + top.size > place:
+            kept = [(i, edge) for i, edge, _, _ in self.trail[top.start :]]
+            while len(self.trail) > top.start:
+                self._pop()
+            self._take_forced(kept)
+
+    def _pop(self) -> None:
+        i, _, log, _ = self.trail.pop()
+        if not isinstance(log, _Batch):
             self.precedence.undo(log)
-            self.graph.pop()
-            del self.at[i]
+        elif log.start == len(self.trail):  # a batch is taken back with its first entry
+            self.precedence.undo(log.log)
+        self.graph.pop()
+        del self.at[i]
+
+
+@dataclass(frozen=True)
+class _Batch:
+    """The entries ``start .. start + size - 1`` of the trail, added in one pass with `log`."""
+
+    start: int
+    size: int
+    log: list
 
 
 def backjump(found, implied, team, culprits, budget: int):
