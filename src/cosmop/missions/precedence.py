@@ -234,8 +234,15 @@ class Precedence:
             order, _ = self._topological({target for _, target in safe})
         seeds, changed = {target for _, target in edges}, set()
         for node in order:
-            moved = node in seeds or not changed.isdisjoint(self._before(node))
-            if moved and self._recompute(log, node):
+            # rows only grow: a step is raised by the steps it waits for that changed (a seed
+            # by all of them, for its new edges)
+            r, k = node
+            starts = [(r, k - 1), *self._into_start.get(node, ())]
+            dones = self._into_done.get(node, [])
+            if node not in seeds:
+                starts = [s for s in starts if s in changed]
+                dones = [s for s in dones if s in changed]
+            if (starts or dones) and self._recompute(log, node, starts, dones):
                 changed.add(node)
         refused = []
         for n in suspects:
@@ -259,11 +266,6 @@ class Precedence:
         r, k = node
         nxt = [(r, k + 1)] if k < self.horizons[r] else []
         return nxt + [target for target, _ in self._succ.get(node, ())]
-
-    def _before(self, node: Node) -> list[Node]:
-        """The steps `node` waits for: the robot's step before and the edges into it."""
-        r, k = node
-        return [(r, k - 1), *self._into_start.get(node, ()), *self._into_done.get(node, ())]
 
     def _topological(self, seeds: set[Node]) -> tuple[list[Node], set[Node]]:
         """The steps reachable from `seeds` in an order the edges allow (Kahn's algorithm), and
@@ -327,25 +329,31 @@ class Precedence:
                                 break
         return part
 
-    def _recompute(self, log: list, node: Node) -> bool:
-        """Raise the clocks and times of `node` to what the steps it waits for give; whether
-        its completion changed (what the steps after it read)."""
+    def _recompute(self, log: list, node: Node, starts: list[Node], dones: list[Node]) -> bool:
+        """Raise the clocks and times of `node` to what the steps `starts` (which it starts
+        after) and `dones` (which it completes after) give; whether its completion changed
+        (what the steps after it read)."""
         r, k = node
-        starts = [(r, k - 1), *self._into_start.get(node, ())]
-        rows = [self.offsets[s] + i for s, i in starts]
-        clock, t = self.done_flat[rows].max(axis=0), float(self.finish_flat[rows].max())
-        self._raise(log, self.begin[r], k, clock, self.started[r], t)
-        col, dones = self.column[r], [self.offsets[s] + i for s, i in self._into_done.get(node, ())]
-        t = float(self.started[r][k] + self.durations[r][k - 1])
-        grew = self._raise(log, self.done[r], k, self.begin[r][k], self.finish[r], t, keep=col)
+        col, grew = self.column[r], False
+        if starts:
+            clock, t = self._latest(starts)
+            if self._raise(log, self.begin[r], k, clock, self.started[r], t):
+                t = float(self.started[r][k] + self.durations[r][k - 1])
+                grew = self._raise(log, self.done[r], k, self.begin[r][k], self.finish[r], t, keep=col)
         if dones:
-            clock, t = self.done_flat[dones].max(axis=0), float(self.finish_flat[dones].max())
+            clock, t = self._latest(dones)
             grew |= self._raise(log, self.done[r], k, clock, self.finish[r], t, keep=col)
-        if not grew:
-            return False
-        if k == self.horizons[r]:  # "start of K+1": after the whole plan
+        if grew and k == self.horizons[r]:  # "start of K+1": after the whole plan
             self._raise(log, self.begin[r], k + 1, self.done[r][k], self.started[r], float(self.finish[r][k]))
-        return True
+        return grew
+
+    def _latest(self, steps: list[Node]) -> tuple[np.ndarray, float]:
+        """The clock and the time by which all of `steps` have completed."""
+        if len(steps) == 1:
+            s, i = steps[0]
+            return self.done[s][i], float(self.finish[s][i])
+        rows = [self.offsets[s] + i for s, i in steps]
+        return self.done_flat[rows].max(axis=0), float(self.finish_flat[rows].max())
 
     @staticmethod
     def _raise(log, clocks, k, clock, times, t, keep: int | None = None) -> bool:

@@ -30,6 +30,7 @@ import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
+import numpy as np
 import shapely
 from shapely import STRtree
 from shapely.geometry.base import BaseGeometry
@@ -306,16 +307,23 @@ def conflicts(items: Sequence[Occupancy]) -> list[Conflict]:
     tree = STRtree(regions)
     left, right = tree.query(regions, predicate="intersects")
     keep = left < right
-    out = []
+    pairs, first, second = [], [], []
     for i, j in zip(left[keep].tolist(), right[keep].tolist(), strict=True):
         a, b = items[i], items[j]
         if a.parties & b.parties:
             continue
         robots = a.what in a.parties and b.what in b.parties
-        ra, rb = (a.region, b.region) if robots else (a.body or a.region, b.body or b.region)
-        if shapely.intersection(ra, rb).area <= 1e-9:
-            continue  # they only touch (a robot keeps its clearance from robots, not from goods)
-        out.append(Conflict(a, b))
+        pairs.append((a, b))
+        first.append(a.region if robots else a.body or a.region)
+        second.append(b.region if robots else b.body or b.region)
+    # they may only touch (a robot keeps its clearance from robots, not from goods)
+    overlap = shapely.area(shapely.intersection(_geometries(first), _geometries(second))) > 1e-9
+    return [Conflict(a, b) for (a, b), real in zip(pairs, overlap.tolist(), strict=True) if real]
+
+
+def _geometries(shapes: list[BaseGeometry]) -> np.ndarray:
+    out = np.empty(len(shapes), dtype=object)
+    out[:] = shapes
     return out
 
 
