@@ -32,7 +32,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 from enum import StrEnum
-from functools import cached_property
+from functools import cached_property, lru_cache
 
 from cosmop.errors import EventSyntaxError
 
@@ -233,6 +233,13 @@ def parse_event(text: str, robot: str | None = None) -> Event:
     """
     if not isinstance(text, str):
         raise EventSyntaxError(f"expected an event as text, got {text!r}; {_forms()}")
+    if robot is None or isinstance(robot, str):
+        return _parse_text(text, robot)  # the same names come back many times: parsed once
+    return _parse_text.__wrapped__(text, robot)
+
+
+@lru_cache(maxsize=8192)
+def _parse_text(text: str, robot: str | None) -> Event:
     stripped = text.strip()
 
     canonical = _CANONICAL_RE.match(stripped)

@@ -31,6 +31,7 @@ robot starting at 0, :attr:`Precedence.finish` is the earliest completion of eac
 
 from __future__ import annotations
 
+import heapq
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 
@@ -179,31 +180,33 @@ class Precedence:
         """Add the start edge ``((A, i), (B, j))`` and update clocks and times incrementally.
 
         Clocks and times only grow, so the change propagates from B's step j to the steps after
-        it with maxima.  The order must stay acyclic (check :meth:`would_cycle` first) and
-        complete.  Returns an undo log for :meth:`undo`.
+        it with maxima, each step raised once, by the steps it waits for that changed.  They are
+        visited by the sum of their clock before the edge: every path from B's step j uses old
+        edges only (the order stays acyclic), and along an old edge that sum grows (the step
+        after counts itself, the one before cannot).  The order must stay acyclic (check
+        :meth:`would_cycle` first) and complete.  Returns an undo log for :meth:`undo`.
         """
-        (a, i), target = edge
+        source, target = edge
         log = self._link([edge])
-        work = [(target, "begin", self.done[a][i], float(self.finish[a][i]))]
-        begin, done, started, finish = self.begin, self.done, self.started, self.finish
-        while work:
-            (r, k), kind, clock, t = work.pop()
-            col = self.column[r]
-            if kind == "begin":
-                if not self._raise(log, begin[r], k, clock, started[r], t):
-                    continue
-                # done = the start's clock with the robot's own column kept; time + duration
-                clock, t = begin[r][k], float(started[r][k] + self.durations[r][k - 1])
-            if not self._raise(log, done[r], k, clock, finish[r], t, keep=col):
+        pending: dict[Node, tuple[list[Node], list[Node]]] = {target: ([source], [])}
+        queue = [(self._rank(target), target)]
+        while queue:
+            node = heapq.heappop(queue)[1]
+            starts, dones = pending.pop(node)
+            if not self._recompute(log, node, starts, dones):
                 continue
-            clock, t = done[r][k], float(finish[r][k])
-            if k < self.horizons[r]:
-                work.append(((r, k + 1), "begin", clock, t))
-            else:
-                self._raise(log, begin[r], k + 1, clock, started[r], t)
-            for node, kind2 in self._succ.get((r, k), ()):
-                work.append((node, kind2, clock, t))
+            r, k = node
+            after = [((r, k + 1), "begin")] if k < self.horizons[r] else []
+            for nxt, kind in after + self._succ.get(node, []):
+                if nxt not in pending:
+                    pending[nxt] = ([], [])
+                    heapq.heappush(queue, (self._rank(nxt), nxt))
+                pending[nxt][kind == "done"].append(node)
         return log
+
+    def _rank(self, node: Node) -> int:
+        r, k = node
+        return int(self.done_flat[self.offsets[r] + k].sum())
 
     def add_starts(self, edges: Sequence[tuple[Node, Node]]) -> tuple[list, list[int]]:
         """Add start edges in their order, each unless it closes a cycle with those before it,

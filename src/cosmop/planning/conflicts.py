@@ -358,7 +358,8 @@ def ranked_detours(
         if not mover.movable or mover.first is None:
             continue
         robot = mover.what if mover.what in mover.parties else mover.first[0]
-        if any(shapely.intersection(keep.region, place).area > 1e-9 for place in fixed.get(robot, ())):
+        places = _geometries(list(fixed.get(robot, ())))
+        if (shapely.area(shapely.intersection(keep.region, places)) > 1e-9).any():
             continue
         drive = mover.first == mover.last
         out.append((0 if drive and keep.last is None else 1 if drive else 2, robot, keep))
