@@ -191,18 +191,24 @@ class Precedence:
         pending: dict[Node, tuple[list[Node], list[Node]]] = {target: ([source], [])}
         queue = [(self._rank(target), target)]
         while queue:
-            node = heapq.heappop(queue)[1]
-            starts, dones = pending.pop(node)
-            if not self._recompute(log, node, starts, dones):
-                continue
-            r, k = node
-            after = [((r, k + 1), "begin")] if k < self.horizons[r] else []
-            for nxt, kind in after + self._succ.get(node, []):
-                if nxt not in pending:
-                    pending[nxt] = ([], [])
-                    heapq.heappush(queue, (self._rank(nxt), nxt))
-                pending[nxt][kind == "done"].append(node)
+            for nxt in self._settle(log, heapq.heappop(queue)[1], pending):
+                heapq.heappush(queue, (self._rank(nxt), nxt))
         return log
+
+    def _settle(self, log: list, node: Node, pending: dict) -> list[Node]:
+        """Raise `node` by the changed steps `pending` holds for it (those it starts after,
+        those it completes after); if its completion changed, it is pending for the steps that
+        wait for it.  The steps newly pending."""
+        starts, dones = pending.pop(node, ((), ()))
+        if not (starts or dones) or not self._recompute(log, node, starts, dones):
+            return []
+        new = []
+        for nxt, kind in self._successors(node):
+            if nxt not in pending:
+                pending[nxt] = ([], [])
+                new.append(nxt)
+            pending[nxt][kind == "done"].append(node)
+        return new
 
     def _rank(self, node: Node) -> int:
         r, k = node
@@ -235,18 +241,13 @@ class Precedence:
             safe = [e for n, e in enumerate(edges) if n not in set(suspects)]
             log = self._link(safe)
             order, _ = self._topological({target for _, target in safe})
-        seeds, changed = {target for _, target in edges}, set()
+        # a step is raised by the steps it waits for that changed; a seed by all of them
+        pending = {
+            (r, k): ([(r, k - 1), *self._into_start.get((r, k), ())], list(self._into_done.get((r, k), ())))
+            for r, k in {target for _, target in edges}
+        }
         for node in order:
-            # rows only grow: a step is raised by the steps it waits for that changed (a seed
-            # by all of them, for its new edges)
-            r, k = node
-            starts = [(r, k - 1), *self._into_start.get(node, ())]
-            dones = self._into_done.get(node, [])
-            if node not in seeds:
-                starts = [s for s in starts if s in changed]
-                dones = [s for s in dones if s in changed]
-            if (starts or dones) and self._recompute(log, node, starts, dones):
-                changed.add(node)
+            self._settle(log, node, pending)
         refused = []
         for n in suspects:
             if self.would_cycle(*edges[n]):
@@ -264,19 +265,23 @@ class Precedence:
             log.append(("edge", target, source))
         return log
 
-    def _after(self, node: Node) -> list[Node]:
-        """The steps that wait for `node`: the robot's next step and the edges out of it."""
+    def _successors(self, node: Node) -> list[tuple[Node, str]]:
+        """The steps that wait for `node`, each with how: the robot's next step and the start
+        edges (``"begin"``), the messages it sends (``"done"``)."""
         r, k = node
-        nxt = [(r, k + 1)] if k < self.horizons[r] else []
-        return nxt + [target for target, _ in self._succ.get(node, ())]
+        nxt = [((r, k + 1), "begin")] if k < self.horizons[r] else []
+        return nxt + self._succ.get(node, [])
 
     def _topological(self, seeds: set[Node]) -> tuple[list[Node], set[Node]]:
         """The steps reachable from `seeds` in an order the edges allow (Kahn's algorithm), and
         those left out: the steps on a cycle, and after one (none when there is no cycle)."""
         waiting = dict.fromkeys(seeds, 0)  # reachable step -> edges into it from reachable steps
+        after: dict[Node, list[Node]] = {}
         stack = list(seeds)
         while stack:
-            for nxt in self._after(stack.pop()):
+            node = stack.pop()
+            after[node] = [nxt for nxt, _ in self._successors(node)]
+            for nxt in after[node]:
                 if nxt not in waiting:
                     waiting[nxt] = 0
                     stack.append(nxt)
@@ -286,7 +291,7 @@ class Precedence:
         while ready:
             node = ready.pop()
             order.append(node)
-            for nxt in self._after(node):
+            for nxt in after[node]:
                 waiting[nxt] -= 1
                 if waiting[nxt] == 0:
                     ready.append(nxt)
@@ -306,7 +311,7 @@ class Precedence:
         def visit(node: Node) -> tuple[Node, Iterator[Node]]:
             number[node] = low[node] = len(number)
             stack.append(node)
-            return node, (n for n in self._after(node) if n in steps)
+            return node, (n for n, _ in self._successors(node) if n in steps)
 
         for root in steps:
             if root in number:
