@@ -211,6 +211,7 @@ class Precedence:
         return new
 
     def _rank(self, node: Node) -> int:
+        """The sum of the clock of `node`: it grows along every edge of the order."""
         r, k = node
         return int(self.done_flat[self.offsets[r] + k].sum())
 
@@ -221,8 +222,9 @@ class Precedence:
         The pass visits the steps the edges can reach in a topological order, recomputing a
         step only when a step it waits for changed.  Clocks and times are the least fixpoint of
         the edges taken, whatever the order they are added in, so they are those of one edge at
-        a time.  When the edges close cycles, only an edge between two steps left out of the
-        topological order can lie on one: the others go in the pass, those one at a time.
+        a time.  When the edges close cycles, only an edge inside a strongly connected component
+        of the steps left out of the topological order lies on one: the others go in the pass
+        (none of them is on a cycle, so none would be refused), those one at a time.
 
         Returns
         -------
@@ -238,7 +240,8 @@ class Precedence:
             part = self._components(stuck)
             self.undo(log)
             suspects = [n for n, (s, t) in enumerate(edges) if s in part and part.get(t) == part[s]]
-            safe = [e for n, e in enumerate(edges) if n not in set(suspects)]
+            later = set(suspects)
+            safe = [e for n, e in enumerate(edges) if n not in later]
             log = self._link(safe)
             order, _ = self._topological({target for _, target in safe})
         # a step is raised by the steps it waits for that changed; a seed by all of them

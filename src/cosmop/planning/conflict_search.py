@@ -182,7 +182,8 @@ class Search:
         if not forced:
             return
         log, refused = self.precedence.add_starts([edge for _, edge in forced])
-        taken = [way for n, way in enumerate(forced) if n not in set(refused)]
+        stuck = set(refused)
+        taken = [way for n, way in enumerate(forced) if n not in stuck]
         batch = _Batch(len(self.trail), len(taken), log)
         for i, edge in taken:
             self._take(i, edge, True, batch)

@@ -322,6 +322,7 @@ def conflicts(items: Sequence[Occupancy]) -> list[Conflict]:
 
 
 def _geometries(shapes: list[BaseGeometry]) -> np.ndarray:
+    """`shapes` as a 1-D array, for shapely's vectorised functions."""
     out = np.empty(len(shapes), dtype=object)
     out[:] = shapes
     return out
