@@ -253,6 +253,13 @@ def test_the_cores_the_search_finds_are_cores():
     assert cores >= 5
 
 
+def _assert_same_order(built: Precedence, at_once: Precedence) -> None:
+    assert np.array_equal(built.done_flat, at_once.done_flat)
+    assert np.array_equal(built.begin_flat, at_once.begin_flat)
+    assert np.array_equal(built.finish_flat, at_once.finish_flat)
+    assert np.array_equal(built.started_flat, at_once.started_flat)
+
+
 @pytest.mark.parametrize("seed", range(6))
 def test_start_edges_added_and_taken_back_give_the_order_built_with_them_at_once(seed):
     # the search adds start edges one at a time and takes them back (vector clocks and times
@@ -273,18 +280,7 @@ def test_start_edges_added_and_taken_back_give_the_order_built_with_them_at_once
                 continue
             logs.append(incremental.add_start(edge))
             added.append(edge)
-        at_once = Precedence(horizons, (), added, durations)
-        assert np.array_equal(incremental.done_flat, at_once.done_flat)
-        assert np.array_equal(incremental.begin_flat, at_once.begin_flat)
-        assert np.allclose(incremental.finish_flat, at_once.finish_flat)
-        assert np.allclose(incremental.started_flat, at_once.started_flat)
-
-
-def _assert_same_order(built: Precedence, at_once: Precedence) -> None:
-    assert np.array_equal(built.done_flat, at_once.done_flat)
-    assert np.array_equal(built.begin_flat, at_once.begin_flat)
-    assert np.array_equal(built.finish_flat, at_once.finish_flat)
-    assert np.array_equal(built.started_flat, at_once.started_flat)
+        _assert_same_order(incremental, Precedence(horizons, (), added, durations))
 
 
 @pytest.mark.parametrize("seed", range(8))
