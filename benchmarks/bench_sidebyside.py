@@ -20,6 +20,8 @@ Workloads (the paper's 10×10 example unless named otherwise):
 ``cli_simulate``
     ``python -m cosmop simulate`` of the 2×2 example with its plan, writing the trace and the
     summary: as a user runs it, process start included;
+``cli_simulate_ten``
+    the same for the paper's 10×10 with its plan: issue 13's row "as a user runs it";
 ``cli_validate``
     ``python -m cosmop validate`` of the 10×10 example (start-up and loading).
 
@@ -46,7 +48,15 @@ ROOT = HERE.parent
 TEN = ROOT / "examples" / "02_warehouse_10x10" / "scenario.yaml"
 TWO = ROOT / "examples" / "01_warehouse_2x2" / "scenario.yaml"
 PEOPLE = ROOT / "examples" / "03_people_2x2" / "scenario.yaml"
-WORKLOADS = ("synthesis", "plan", "simulate", "simulate_people", "cli_simulate", "cli_validate")
+WORKLOADS = (
+    "synthesis",
+    "plan",
+    "simulate",
+    "simulate_people",
+    "cli_simulate",
+    "cli_simulate_ten",
+    "cli_validate",
+)
 
 
 def _digest(data) -> str:
@@ -96,9 +106,10 @@ def child(workload: str, plans_dir: str) -> dict:
 
 
 def _cli(workload: str, plans_dir: Path, work: Path) -> list[str]:
-    if workload == "cli_simulate":
+    if workload.startswith("cli_simulate"):
+        scenario, plan = (TEN, "ten.json") if workload == "cli_simulate_ten" else (TWO, "two.json")
         return [
-            *("simulate", str(TWO), "--plan", str(plans_dir / "two.json")),
+            *("simulate", str(scenario), "--plan", str(plans_dir / plan)),
             *("--trace", str(work / "trace.json"), "--summary", str(work / "summary.json")),
         ]
     return ["validate", str(TEN)]

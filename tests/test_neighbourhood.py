@@ -133,3 +133,22 @@ def test_one_call_with_a_set_per_driver_equals_a_call_per_driver():
             together.safe[i],
             together.gap[i],
         )
+
+
+def test_few_obstacles_go_to_the_window_whole(monkeypatch):
+    # with few obstacles, choosing the near ones costs more than it saves: one plain call
+    drivers, obstacles, own = _crowd(1, side=6_000.0)
+    few = obstacles.select(np.arange(4), np.arange(neighbourhood._FEW - 4))
+    seen = []
+
+    def counting(drivers, sub, settings, **kw):
+        seen.append(sub)
+        return dwa_commands(drivers, sub, settings, **kw)
+
+    monkeypatch.setattr("cosmop.control.neighbourhood.dwa_commands", counting)
+    near = dwa_commands_near(drivers, few, ignore=own[:, : neighbourhood._FEW - 4])
+    assert len(seen) == 1 and seen[0] is few  # the very set, not a choice of it
+    more = obstacles.select(np.arange(5), np.arange(neighbourhood._FEW - 4))
+    dwa_commands_near(drivers, more, ignore=own[:, : neighbourhood._FEW - 4])
+    assert len(seen) == 2 and seen[1] is not more  # one more: the near ones are chosen
+    assert len(near.v) == len(drivers.v)

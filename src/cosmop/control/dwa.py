@@ -395,17 +395,12 @@ def _arcs(
     t = _instants(settings.horizon, settings.samples)  # (S,)
     th = theta[:, None, None] + W[:, :, None] * t[None, None, :]
     straight = np.abs(W) < 1e-6
-    w_safe = np.where(straight, 1.0, W)[:, :, None]
-    px = np.where(
-        straight[:, :, None],
-        V[:, :, None] * t * np.cos(theta)[:, None, None],
-        V[:, :, None] / w_safe * (np.sin(th) - np.sin(theta)[:, None, None]),
-    )
-    py = np.where(
-        straight[:, :, None],
-        V[:, :, None] * t * np.sin(theta)[:, None, None],
-        -V[:, :, None] / w_safe * (np.cos(th) - np.cos(theta)[:, None, None]),
-    )
+    sin0, cos0 = np.sin(theta)[:, None, None], np.cos(theta)[:, None, None]
+    vt = V[:, :, None] * t  # a straight arc's length
+    radius = V[:, :, None] / np.where(straight, 1.0, W)[:, :, None]  # a turning arc's (signed) radius
+    # (-v / w) * c is -(v / w * c) exactly: the sign is the only difference
+    px = np.where(straight[:, :, None], vt * cos0, radius * (np.sin(th) - sin0))
+    py = np.where(straight[:, :, None], vt * sin0, -(radius * (np.cos(th) - cos0)))
     pts = np.empty((*px.shape, 2))
     pts[..., 0] = xy[:, 0, None, None] + px
     pts[..., 1] = xy[:, 1, None, None] + py
@@ -428,20 +423,24 @@ def _clearance(
     R, K, S = pts.shape[:3]
     half, walls, boxes, movers = drivers.half, obstacles.walls, obstacles.boxes, obstacles.movers
     flat = pts.reshape(R, -1, 2)
-    clear = np.full(flat.shape[:2], np.inf)
     mover_clear = np.full((R, K), np.inf)
     if walls.shape[-2]:
         clear = (point_segment_linf(flat, walls) - half[:, None, None]).min(axis=-1)
+    else:
+        clear = np.full(flat.shape[:2], np.inf)
     if boxes.shape[-2]:
         if obstacles.velocity is None:
             bg = box_gaps(flat, half[:, None, None], boxes)  # (R, K*S, M)
         else:
-            tk = np.broadcast_to(t, (K, S)).reshape(-1, 1)  # (K*S, 1): the time of each predicted point
+            # the boxes where they are at each of the S instants (R, 1, S, M), against the
+            # points of every arc at that instant (R, K, S, 1)
             velocity = obstacles.velocity[:, None]
-            moved_x = boxes[:, None, :, 0] + tk * velocity[..., 0]  # (R, K*S, M)
-            moved_y = boxes[:, None, :, 1] + tk * velocity[..., 1]
-            d = np.maximum(np.abs(flat[:, :, None, 0] - moved_x), np.abs(flat[:, :, None, 1] - moved_y))
-            bg = d - half[:, None, None] - boxes[:, None, :, 2]
+            moved_x = boxes[:, None, :, 0] + t[:, None] * velocity[..., 0]  # (R, S, M)
+            moved_y = boxes[:, None, :, 1] + t[:, None] * velocity[..., 1]
+            d = np.maximum(
+                np.abs(pts[..., 0, None] - moved_x[:, None]), np.abs(pts[..., 1, None] - moved_y[:, None])
+            )
+            bg = (d - half[:, None, None, None] - boxes[:, None, None, :, 2]).reshape(R, K * S, -1)
         if ignore is not None:
             bg = np.where(ignore[:, None, :], np.inf, bg)
         if movers.any():

@@ -9,6 +9,7 @@ mm, mm/s, radians and rad/s, seconds.
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 
 import numpy as np
 
@@ -36,7 +37,7 @@ def integrate(world: World, v_cmd: np.ndarray, w_cmd: np.ndarray, docks: dict[in
     dt = world.dt
     acc, brk = world.limits.acceleration, world.limits.braking
     v0 = world.v
-    v1 = np.clip(v_cmd, np.maximum(0.0, v0 - brk * dt), v0 + acc * dt)
+    v1 = np.minimum(np.maximum(v_cmd, np.maximum(0.0, v0 - brk * dt)), v0 + acc * dt)  # np.clip, cheaper
     v1 = np.minimum(v1, world.limits.max_speed)
     slowing = v1 < v0
     reached = np.where(slowing, (v0 - v1) / np.maximum(brk, 1e-9), dt)  # when v1 is reached, s
@@ -44,7 +45,7 @@ def integrate(world: World, v_cmd: np.ndarray, w_cmd: np.ndarray, docks: dict[in
     # distance from the cycle's start to each sub-step's end, (n + 1, R): a ramp, or braking
     # at -b until v1 is reached and holding it after
     n = _SUBSTEPS
-    t = (np.arange(n + 1) * dt / n)[:, None]
+    t = _instants(dt, n)
     ramp = v0 * t + (v1 - v0) * t * t / (2.0 * dt)
     tb = np.minimum(t, reached)
     braked = v0 * tb - brk * tb * tb / 2.0 + v1 * np.maximum(t - reached, 0.0)
@@ -52,12 +53,19 @@ def integrate(world: World, v_cmd: np.ndarray, w_cmd: np.ndarray, docks: dict[in
     steps = covered[1:] - covered[:-1]
     start = world.pose[:, :2].copy()
     half_turn, turn = w_cmd * dt / (2 * n), w_cmd * dt / n
-    for step in steps:
-        theta = world.pose[:, 2] + half_turn
-        world.pose[:, 0] += step * np.cos(theta)
-        world.pose[:, 1] += step * np.sin(theta)
-        world.pose[:, 2] += turn
-    world.pose[:, 2] = wrap_angle(world.pose[:, 2])
+    # the n sub-steps at once: accumulate adds left to right, so every pose is the same sum,
+    # in the same order, as n updates one after the other
+    heading = np.empty((n + 1, len(turn)))
+    heading[0], heading[1:] = world.pose[:, 2], turn
+    np.add.accumulate(heading, out=heading)
+    theta = heading[:-1] + half_turn  # (n, R): each sub-step's midpoint heading
+    xy = np.empty((2, n + 1, len(turn)))
+    xy[:, 0] = world.pose[:, :2].T
+    np.multiply(steps, np.cos(theta), out=xy[0, 1:])
+    np.multiply(steps, np.sin(theta), out=xy[1, 1:])
+    np.add.accumulate(xy, axis=1, out=xy)
+    world.pose[:, :2] = xy[:, -1].T
+    world.pose[:, 2] = wrap_angle(heading[-1])
     world.v = v1
     world.w = w_cmd.copy()
     moving = v1.copy()
@@ -65,6 +73,14 @@ def integrate(world: World, v_cmd: np.ndarray, w_cmd: np.ndarray, docks: dict[in
         moving[i] = _creep(world, i, dock)
     world.distance += np.hypot(*(world.pose[:, :2] - start).T)
     return moving
+
+
+@lru_cache(maxsize=4)
+def _instants(dt: float, n: int) -> np.ndarray:
+    """The sub-steps' ends in a cycle of `dt` s, ``(n + 1, 1)`` (made once)."""
+    out = (np.arange(n + 1) * dt / n)[:, None]
+    out.flags.writeable = False
+    return out
 
 
 def _creep(world: World, i: int, dock: tuple) -> float:

@@ -194,7 +194,7 @@ class World:
 
     def robot_boxes(self) -> np.ndarray:
         """Every robot as a box ``x, y, half side`` (mm)."""
-        return np.column_stack([self.pose[:, :2], self.robot_half])
+        return np.concatenate([self.pose[:, :2], self.robot_half[:, None]], axis=1)
 
     def resting_boxes(self) -> np.ndarray:
         """Every resting (not carried) object as a box ``x, y, half side`` (mm)."""
@@ -250,7 +250,7 @@ class World:
         robots = slice(n_objects, n_objects + len(self.robot_ids))
         velocity = np.zeros((len(sensed.names), 2))
         heading = self.pose[:, 2]
-        velocity[robots] = np.column_stack([self.v * np.cos(heading), self.v * np.sin(heading)])
+        velocity[robots, 0], velocity[robots, 1] = self.v * np.cos(heading), self.v * np.sin(heading)
         for k, walker in enumerate(self.walkers):
             velocity[robots.stop + k] = walker.velocity
         acceleration = np.zeros(len(sensed.names))
