@@ -17,6 +17,9 @@ Workloads (the paper's 10×10 example unless named otherwise):
     `simulate` of a plan file made once beforehand (ε = 0.1 s); also the real-time ratio;
 ``simulate_people``
     `simulate` of the 2×2 warehouse with people crossing (five seeds);
+``simulate_crowd``
+    300 cycles of the 50-robot warehouse of ``bench_sim.bay_drives`` (every robot driving at
+    once, beside its neighbours: issue 13's stress case); also the real-time ratio;
 ``cli_simulate``
     ``python -m cosmop simulate`` of the 2×2 example with its plan, writing the trace and the
     summary: as a user runs it, process start included;
@@ -53,6 +56,7 @@ WORKLOADS = (
     "plan",
     "simulate",
     "simulate_people",
+    "simulate_crowd",
     "cli_simulate",
     "cli_simulate_ten",
     "cli_validate",
@@ -102,6 +106,16 @@ def child(workload: str, plans_dir: str) -> dict:
         results = [simulate(sc, plans, seed=seed) for seed in range(5)]
         seconds = time.perf_counter() - t0
         return {"s": seconds, "out": _digest([_trace_json(r) for r in results])}
+    if workload == "simulate_crowd":
+        sys.path.insert(0, str(HERE))
+        from bench_sim import bay_drives
+        from cosmop.sim import SimSettings
+
+        sc, plans = bay_drives(50)
+        t0 = time.perf_counter()
+        result = simulate(sc, plans, settings=SimSettings(max_time=30.0, replan=False))
+        seconds = time.perf_counter() - t0
+        return {"s": seconds, "ratio": result.sim_time_s / seconds, "out": _digest(_trace_json(result))}
     raise ValueError(f"unknown workload {workload!r}")
 
 

@@ -1,4 +1,4 @@
-"""The neighbourhood cut-off gives the dynamic window's commands bit for bit, and cuts.
+"""The neighbourhood cut-off, and the window's own pruning, give its commands bit for bit, and cut.
 
 Random crowded warehouses (seeded): drivers among walls, resting objects, moving robots and
 people, some of them inside another's standoff or against a wall so that ``safe`` fails and
@@ -12,8 +12,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from cosmop.control import neighbourhood
-from cosmop.control.dwa import Drivers, DwaSettings, Obstacles, dwa_commands
+from cosmop.control import dwa, neighbourhood
+from cosmop.control.dwa import Drivers, DwaSettings, Obstacles, dwa_commands, first_true, take_columns
 from cosmop.control.neighbourhood import dwa_commands_near, reach
 from cosmop.control.safety import Limits
 from cosmop.scene import Dynamics
@@ -121,8 +121,13 @@ def test_one_call_with_a_set_per_driver_equals_a_call_per_driver():
         np.union1d(rng.choice(M, rng.integers(1, M // 2), replace=False), np.flatnonzero(own[i]))
         for i in range(R)
     ]
-    sets = neighbourhood._near(obstacles, neighbourhood._padded(walls, W), neighbourhood._padded(boxes, M))
-    ignore = neighbourhood._take(own, neighbourhood._padded(boxes, M))
+    wall_rows, box_rows = np.zeros((R, W), dtype=bool), np.zeros((R, M), dtype=bool)
+    for i in range(R):
+        wall_rows[i, walls[i]], box_rows[i, boxes[i]] = True, True
+    wall_index, box_index = first_true(wall_rows), first_true(box_rows)
+    assert (wall_index == W).any() and (box_index == M).any()  # some sets are padded
+    sets = obstacles.take(wall_index, box_index)
+    ignore = take_columns(own, box_index)
     together = dwa_commands(drivers, sets, ignore=ignore)
     assert not together.safe.all()
     for i in range(R):
@@ -152,3 +157,71 @@ def test_few_obstacles_go_to_the_window_whole(monkeypatch):
     dwa_commands_near(drivers, more, ignore=own[:, : neighbourhood._FEW - 4])
     assert len(seen) == 2 and seen[1] is not more  # one more: the near ones are chosen
     assert len(near.v) == len(drivers.v)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_window_drops_far_boxes_without_changing_a_command(seed, monkeypatch):
+    # a crowded 8 m square: the clearance and the escape arcs measure only what can matter
+    drivers, obstacles, own = _crowd(seed, side=8_000.0)
+    widths = []
+    real = dwa._without_far
+
+    def recording(obstacles, *args):
+        kept, columns = real(obstacles, *args)
+        widths.append((obstacles.boxes.shape[-2], kept.boxes.shape[-2]))
+        return kept, columns
+
+    monkeypatch.setattr(dwa, "_without_far", recording)
+    pruned = dwa_commands(drivers, obstacles, ignore=own)
+    # the clearance once, the escape arcs once a batch: every call cut
+    assert len(widths) >= 2 and all(after < before for before, after in widths)
+    monkeypatch.setattr(dwa, "_LARGE", np.inf)  # never prune
+    whole = dwa_commands(drivers, obstacles, ignore=own)
+    assert not whole.safe.all()
+    for name in ("v", "w", "safe", "gap"):
+        np.testing.assert_array_equal(getattr(pruned, name), getattr(whole, name))
+
+
+@pytest.mark.parametrize(
+    ("seed", "side", "batch"), [(2, 8_000.0, dwa._ESCAPE_BATCH), (2, 20_000.0, 3), (0, 20_000.0, 1)]
+)
+def test_the_best_escape_is_the_best_scored_admitted_arc(seed, side, batch, monkeypatch):
+    # checking the arcs a few at a time, best first, must find what checking all of them finds
+    # (these scenes have drivers that may take some of their arcs, not all, not none)
+    drivers, obstacles, own = _crowd(seed, side=side)
+    R = len(drivers.v)
+    sets = obstacles.per_driver(R)
+    _, _, V, W = dwa._window(drivers, DwaSettings())
+    keep = np.full((R, len(obstacles.boxes)), -np.inf)
+    ok = dwa._escape_ok(drivers, V, W, sets, own, keep)
+    # many ties, and the arcs it refuses scored above those it admits: the search must go past
+    score = np.random.default_rng(seed).integers(0, 6, V.shape) + 10.0 * ~ok
+    monkeypatch.setattr(dwa, "_ESCAPE_BATCH", batch)
+    pick, found = dwa._best_escapes(drivers, V, W, score, sets, own, keep)
+    np.testing.assert_array_equal(found, ok.any(axis=1))
+    best = np.argmax(np.where(ok, score, -np.inf), axis=1)
+    np.testing.assert_array_equal(pick[found], best[found])
+    order = np.argsort(-score, axis=1, kind="stable")
+    rank = np.argmax(order == pick[:, None], axis=1)  # where each pick is in its driver's order
+    assert found.any() and (rank[found] >= batch).any()  # some searches went past the first batch
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_clearance_without_far_boxes_reads_the_same_up_to_the_caps(seed, monkeypatch):
+    # what the score reads of the clearance: up to the cap, up to the personal space for
+    # movers, and the value itself at or below zero
+    drivers, obstacles, own = _crowd(seed, side=8_000.0)
+    settings = DwaSettings()
+    sets = obstacles.per_driver(len(drivers.v))
+    _, _, V, W = dwa._window(drivers, settings)
+    t, pts, _ = dwa._arcs(drivers, V, W, settings)
+    clear, movers = dwa._clearance(drivers, sets, own, t, pts, settings)
+    monkeypatch.setattr(dwa, "_LARGE", np.inf)
+    whole_clear, whole_movers = dwa._clearance(drivers, sets, own, t, pts, settings)
+    np.testing.assert_array_equal(
+        np.minimum(clear, settings.clearance), np.minimum(whole_clear, settings.clearance)
+    )
+    np.testing.assert_array_equal(
+        np.minimum(movers, settings.personal_space), np.minimum(whole_movers, settings.personal_space)
+    )
+    assert (whole_clear <= 0).any() and (whole_movers < settings.personal_space).any()  # both caps bind

@@ -133,6 +133,29 @@ def test_static_gaps_measure_near_walls_first_and_give_the_gaps_to_every_wall():
         np.testing.assert_array_equal(world.static_gaps(points, 200.0), brute)
 
 
+def test_static_gaps_remembered_are_forgotten_when_an_object_is_picked_or_moved():
+    data = {
+        "name": "one object",
+        "scene": {
+            "obstacles": [[[0, 0], [4000, 0]]],
+            "robots": {"R1": {"size": 400, "pose": [500, 2000, 0]}},
+            "objects": {"O1": {"size": 100, "position": [2000, 1000]}},
+            "workspaces": {"W1": {"x": [3000, 3900], "y": [3000, 3900]}},
+        },
+        "mission": {"tasks": {"R1": ["pick O1", "drop O1 at W1", "return"]}},
+    }
+    world = World(parse_scenario(data), PlanSet("one object", True, {}), 0, SimSettings())
+    beside = np.array([[2000.0, 1400.0]])  # 150 mm from the object, 1.2 m from the wall
+    assert world.static_gaps(beside, 200.0)[0] == pytest.approx(150.0)
+    world.static_gaps(beside, 200.0)[0] = -1.0  # a caller's copy: the memory is not touched
+    assert world.static_gaps(beside, 200.0)[0] == pytest.approx(150.0)
+    world.carried_by[0] = 0  # picked up: only the wall is left
+    assert world.static_gaps(beside, 200.0)[0] == pytest.approx(1200.0)
+    world.carried_by[0] = -1
+    world.object_xy[0] = (2000.0, 1700.0)  # dropped elsewhere, closer
+    assert world.static_gaps(beside, 200.0)[0] == pytest.approx(50.0)
+
+
 def _run_seed(job):
     scenario, plans, seed = job
     result = simulate(scenario, plans, seed=seed, settings=SimSettings(max_time=600))

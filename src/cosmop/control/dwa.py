@@ -17,6 +17,11 @@ extended in the paper):
 
 The safety of step 2 does not depend on the score: the score only chooses *where* to go among
 arcs the safety rule admits.  Everything is vectorised over robots, arcs and obstacles.
+
+When the arrays are large, steps 2 and 4 measure less and answer the same, bit for bit: each
+drops the obstacles it has proved too far to decide anything (:func:`_far_for_the_score`,
+:func:`_far_for_escape`), and the escape arcs of step 2 are checked best score first, a few at
+a time, until one is admitted (:func:`_best_escapes`): only the best admitted arc is taken.
 Units: mm, mm/s, radians and rad/s inside; degrees at the interfaces of :mod:`cosmop.sim`.
 """
 
@@ -119,6 +124,57 @@ def robot_gaps(
     return wall_gap, box_gap
 
 
+def first_true(mask: np.ndarray) -> np.ndarray:
+    """Each row's indices of the True columns of `mask` ``(R, M)``, in order, padded with ``M``
+    to the longest row: ``(R, m)`` (the form :meth:`Obstacles.take` and :func:`take_columns`
+    take)."""
+    counts = mask.sum(axis=1)
+    width = int(counts.max(initial=0))
+    order = np.argsort(~mask, axis=1, kind="stable")[:, :width]  # the True columns first, in order
+    return np.where(np.arange(width) < counts[:, None], order, mask.shape[1])
+
+
+def take_columns(values: np.ndarray, index: np.ndarray, fill=False) -> np.ndarray:
+    """`values` ``(R, M)`` at the columns `index`: one list for every row ``(m,)``, or one per
+    row ``(R, m)`` where ``M`` (padding) gives `fill`."""
+    if index.ndim == 1:
+        return values[:, index]
+    padded = np.concatenate([values, np.full((len(values), 1), fill, dtype=values.dtype)], axis=1)
+    return padded[np.arange(len(values))[:, None], index]
+
+
+# The clearance and the escape arcs first drop the boxes too far to matter to them when their
+# arrays (points times boxes) would be larger than this; smaller, dropping costs more than it
+# saves (a dozen NumPy calls on the drivers' boxes).
+_LARGE = 50_000
+
+
+def _large(points: int, obstacles: Obstacles) -> bool:
+    """Whether measuring `points` points against every box of `obstacles` is worth a pruning."""
+    return points * obstacles.boxes.shape[-2] > _LARGE
+
+
+def _without_far(
+    obstacles: Obstacles,
+    centres: np.ndarray,
+    half: np.ndarray,
+    wall_beyond: np.ndarray,
+    box_beyond: np.ndarray,
+    *columns,
+) -> tuple[Obstacles, tuple]:
+    """Per driver, the walls and the boxes whose gap now (mm, as :func:`robot_gaps` measures
+    it) is at most `wall_beyond` ``(R, 1)`` and `box_beyond` ``(R, M)``; `columns` (``(values
+    (R, M), fill)`` pairs, over the boxes) taken alike.
+
+    A phase drops an obstacle only when it has proved that one that far never decides its
+    tests or minima; those kept are padded at infinity (:meth:`Obstacles.take`), so the
+    phase's results are those it has with every obstacle, bit for bit.
+    """
+    wall_gap, box_gap = robot_gaps(centres, half, obstacles.walls, obstacles.boxes, None)
+    walls, boxes = first_true(~(wall_gap > wall_beyond)), first_true(~(box_gap > box_beyond))
+    return obstacles.take(walls, boxes), tuple(take_columns(v, boxes, fill) for v, fill in columns)
+
+
 @dataclass(frozen=True)
 class Obstacles:
     """Everything a robot senses in one cycle: the walls and the boxes (objects, robots, people).
@@ -170,6 +226,33 @@ class Obstacles:
             pick(self.acceleration),
             pick(self.agents),
             tuple(self.names[j] for j in boxes) if self.names else (),
+        )
+
+    def take(self, walls: np.ndarray, boxes: np.ndarray) -> Obstacles:
+        """One set per driver: row ``r`` holds the walls ``walls[r]`` and the boxes ``boxes[r]``
+        (index matrices ``(R, W')`` and ``(R, M')``, from :func:`first_true`) of this shared set
+        or of this set's row ``r``.  The index one past the end is padding: a wall or box at
+        infinity (no speed, no mover), whose gaps are ``inf`` and so never decide a test or
+        attain a minimum."""
+        rows = np.arange(len(walls))[:, None] if self.walls.ndim == 3 else None
+
+        def pick(values, filler, index):
+            if values is None:
+                return None
+            axis = 0 if rows is None else 1  # the obstacles' axis
+            shape = list(values.shape)
+            shape[axis] = 1
+            pad = np.broadcast_to(np.asarray(filler, values.dtype), shape)
+            padded = np.concatenate([values, pad], axis=axis)
+            return padded[index] if rows is None else padded[rows, index]
+
+        return Obstacles(
+            pick(self.walls, [np.inf] * 4, walls),
+            pick(self.boxes, [np.inf, np.inf, 0.0], boxes),
+            pick(self.speed, 0.0, boxes),
+            pick(self.velocity, [0.0, 0.0], boxes),
+            pick(self.acceleration, 0.0, boxes),
+            pick(self.agents, False, boxes),
         )
 
     def per_driver(self, drivers: int) -> Obstacles:
@@ -327,17 +410,19 @@ def dwa_commands(
         # Not safe: only arcs whose own braking path provably keeps clear (checked below), else
         # brake along the previous arc -- the one the last cycle's check covered.
         rows = np.flatnonzero(~safe)
-        ok = _escape_ok(
+        pick, found = _best_escapes(
             drivers[rows],
             V[rows],
             W[rows],
+            score[rows],
             obstacles.rows(rows),
             None if ignore is None else skip[rows],
             _keep(box_gap[rows], obstacles.movers[rows], settings),
         )
-        score[rows] = np.where(ok, score[rows], -np.inf)
-        fallback = rows[~ok.any(axis=1)]
-        score[fallback] = -np.inf
+        admitted = np.full((len(rows), V.shape[1]), -np.inf)  # the best escape arc alone
+        admitted[found, pick[found]] = score[rows[found], pick[found]]
+        score[rows] = admitted
+        fallback = rows[~found]
         w_out[fallback] = (np.zeros(len(drivers.v)) if drivers.w is None else drivers.w)[fallback]
     best = np.argmax(score, axis=1)
     rows_all = np.arange(len(drivers.v))
@@ -421,7 +506,13 @@ def _clearance(
     the score only chooses among arcs the safety rule admits).
     """
     R, K, S = pts.shape[:3]
+    obstacles, ignore = _far_for_the_score(drivers, obstacles, ignore, t, pts, settings)
     half, walls, boxes, movers = drivers.half, obstacles.walls, obstacles.boxes, obstacles.movers
+    if ignore is not None and boxes.shape[-2]:
+        # a box ignored is one at infinity: its gaps are inf, as the masked copy of all of them
+        # would have them, at the cost of a copy of the boxes alone
+        boxes = boxes.copy()
+        boxes[..., :2][ignore] = np.inf
     flat = pts.reshape(R, -1, 2)
     mover_clear = np.full((R, K), np.inf)
     if walls.shape[-2]:
@@ -437,16 +528,51 @@ def _clearance(
             velocity = obstacles.velocity[:, None]
             moved_x = boxes[:, None, :, 0] + t[:, None] * velocity[..., 0]  # (R, S, M)
             moved_y = boxes[:, None, :, 1] + t[:, None] * velocity[..., 1]
-            d = np.maximum(
-                np.abs(pts[..., 0, None] - moved_x[:, None]), np.abs(pts[..., 1, None] - moved_y[:, None])
-            )
-            bg = (d - half[:, None, None, None] - boxes[:, None, None, :, 2]).reshape(R, K * S, -1)
-        if ignore is not None:
-            bg = np.where(ignore[:, None, :], np.inf, bg)
+            bg = pts[..., 0, None] - moved_x[:, None]  # max(|dx|, |dy|) - half - k, in place
+            dy = pts[..., 1, None] - moved_y[:, None]
+            np.abs(bg, out=bg)
+            np.maximum(bg, np.abs(dy, out=dy), out=bg)
+            bg -= half[:, None, None, None]
+            bg -= boxes[:, None, None, :, 2]
+            bg = bg.reshape(R, K * S, -1)
         if movers.any():
             mover_clear = np.where(movers[:, None, :], bg, np.inf).min(axis=-1).reshape(R, K, S).min(axis=-1)
         clear = np.minimum(clear, bg.min(axis=-1))
     return clear.reshape(R, K, S).min(axis=-1), mover_clear
+
+
+def _far_for_the_score(
+    drivers: Drivers,
+    obstacles: Obstacles,
+    ignore: np.ndarray | None,
+    t: np.ndarray,
+    pts: np.ndarray,
+    settings: DwaSettings,
+) -> tuple[Obstacles, np.ndarray | None]:
+    """`obstacles` (and `ignore`) without the boxes too far to change any arc's score.
+
+    The score reads the least gap along an arc only up to the clearance cap :math:`c`, and the
+    least gap to a mover only up to the personal space :math:`p` (so up to :math:`c` for walls
+    and resting boxes, up to :math:`\\max(c, p)` for movers); whether a gap is above zero is
+    its only other use.  The L-infinity gap is 1-Lipschitz in the L-infinity norm: at a
+    point of an arc it is at least the gap now less the point's offset from the robot, less
+    what the box moves by the last instant :math:`t_S` (at most :math:`|v_o| t_S`).  An
+    obstacle whose gap now exceeds the largest offset, its move and what its gap counts up to
+    (and 1 mm for rounding) is farther than that from every point of every arc, so it is never
+    a minimum that counts.
+    """
+    if not _large(pts.size // 2, obstacles):
+        return obstacles, ignore
+    offset = np.abs(pts - drivers.pose[:, None, None, :2]).max(axis=(1, 2, 3))  # (R,)
+    moves = 0.0
+    if obstacles.velocity is not None:
+        moves = np.hypot(obstacles.velocity[..., 0], obstacles.velocity[..., 1]) * t[-1]
+    walls = offset[:, None] + settings.clearance + 1.0  # walls count up to the cap alone
+    counts = np.where(obstacles.movers, max(settings.clearance, settings.personal_space), settings.clearance)
+    boxes = offset[:, None] + moves + counts + 1.0  # and so do resting boxes
+    columns = () if ignore is None else ((ignore, False),)
+    kept, taken = _without_far(obstacles, drivers.pose[:, :2], drivers.half, walls, boxes, *columns)
+    return kept, (taken[0] if taken else None)
 
 
 def _score(
@@ -572,6 +698,85 @@ def _instants(horizon: float, samples: int) -> np.ndarray:
     return out
 
 
+# Escape arcs are checked this many at a time, best scores first, until one is admitted.
+_ESCAPE_BATCH = 8
+
+
+def _best_escapes(
+    drivers: Drivers,
+    V: np.ndarray,
+    W: np.ndarray,
+    score: np.ndarray,
+    obstacles: Obstacles,
+    skip: np.ndarray | None,
+    keep: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
+    """For each unsafe driver, the best-scored arc that :func:`_escape_ok` admits: its index
+    ``(U,)`` and whether there is one ``(U,)``.
+
+    The arcs are checked in order of score (the lower index first among equal scores, as
+    ``argmax`` takes them), a few at a time, and a driver's search stops at its first
+    admitted arc; each arc's check depends on that arc alone (and on the longest stop of the
+    driver's whole window, passed on), so the answer is the ``argmax`` of the scores of all
+    admitted arcs, found without checking the arcs that score below it.
+    """
+    U, K = V.shape
+    order = np.argsort(-score, axis=1, kind="stable")
+    longest = (drivers.limits.cycle[:, None] + V / drivers.limits.braking[:, None]).max(axis=1)
+    pick, found = np.zeros(U, dtype=np.int64), np.zeros(U, dtype=bool)
+    for start in range(0, K, _ESCAPE_BATCH):
+        todo = np.flatnonzero(~found)
+        if not todo.size:
+            break
+        arcs = order[todo, start : start + _ESCAPE_BATCH]  # (u, b)
+        lines = np.arange(len(todo))[:, None]
+        ok = _escape_ok(
+            drivers[todo],
+            V[todo][lines, arcs],
+            W[todo][lines, arcs],
+            obstacles.rows(todo),
+            None if skip is None else skip[todo],
+            keep[todo],
+            longest=longest[todo],
+        )
+        hit = ok.any(axis=1)
+        pick[todo[hit]] = arcs[hit, ok[hit].argmax(axis=1)]
+        found[todo[hit]] = True
+    return pick, found
+
+
+def _far_for_escape(
+    drivers: Drivers,
+    pts: np.ndarray,
+    longest: np.ndarray,
+    slack: np.ndarray,
+    obstacles: Obstacles,
+    skip: np.ndarray | None,
+    keep: np.ndarray,
+) -> tuple[Obstacles, np.ndarray | None, np.ndarray]:
+    """`obstacles` (with `skip` and `keep`) without the boxes that pass every sample of every
+    escape arc (:func:`_escape_ok`; `pts` ``(U, P, 2)`` its samples, `longest` ``(U,)`` the
+    boxes' horizon, at least every arc's time to a stop, `slack` ``(U, K, 1)``).
+
+    A sample at time :math:`t` passes a box when its gap exceeds :math:`V_o t` plus the slack;
+    its gap is at least the gap now less the sample's L-infinity offset from the robot (the
+    gap is 1-Lipschitz).  So a box whose gap now exceeds the largest offset, :math:`V_o` times
+    the longest time to a stop and the largest slack (and 1 mm for rounding) passes them all;
+    the other rules of :func:`_escape_ok` only admit more, except ``keep``, and boxes with a
+    ``keep`` rule are kept.
+    """
+    if not _large(pts.shape[0] * pts.shape[1], obstacles):
+        return obstacles, skip, keep
+    longest = longest[:, None]
+    offset = np.abs(pts - drivers.pose[:, None, :2]).max(axis=(1, 2))[:, None]
+    walls = offset + slack.max(axis=(1, 2))[:, None] + 1.0  # walls stand still
+    boxes = walls + obstacles.speed_bound(longest) * longest
+    boxes = np.where(keep > -np.inf, np.inf, boxes)
+    columns = ((keep, -np.inf),) + (() if skip is None else ((skip, False),))
+    kept, taken = _without_far(obstacles, drivers.pose[:, :2], drivers.half, walls, boxes, *columns)
+    return kept, (None if skip is None else taken[1]), taken[0]
+
+
 def _escape_ok(
     drivers: Drivers,
     V: np.ndarray,
@@ -580,6 +785,7 @@ def _escape_ok(
     skip: np.ndarray | None,
     keep: np.ndarray,
     steps: int = 8,
+    longest: np.ndarray | None = None,
 ) -> np.ndarray:
     """Whether each arc's worst case keeps clear: held for one cycle, then braking to a stop.
 
@@ -602,6 +808,7 @@ def _escape_ok(
     )
     walls, boxes = obstacles.walls, obstacles.boxes
     total = eps[:, None] + V / brk[:, None]  # (U, K): time until standing still
+    longest = total.max(axis=1) if longest is None else longest  # (U,): the boxes' horizon
     dt = total / steps
     t = dt[:, :, None] * np.arange(1, steps + 1)[None, None, :]  # (U, K, n)
     e = eps[:, None, None]
@@ -616,6 +823,8 @@ def _escape_ok(
     y = pose[:, 1, None, None] + np.cumsum(step * np.sin(theta), axis=2)
     slack = step.max(axis=2, initial=0.0)[:, :, None]
     pts = np.stack([x, y], axis=-1).reshape(U, -1, 2)
+    obstacles, skip, keep = _far_for_escape(drivers, pts, longest, slack, obstacles, skip, keep)
+    walls, boxes = obstacles.walls, obstacles.boxes
     ok = np.ones((U, K), dtype=bool)
     if walls.shape[-2]:
         gap = (point_segment_linf(pts, walls) - half[:, None, None]).reshape(U, K, steps, -1)
@@ -626,7 +835,7 @@ def _escape_ok(
         ok &= fine.all(axis=(2, 3))
     if boxes.shape[-2]:
         gap = box_gaps(pts, half[:, None, None], boxes).reshape(U, K, steps, -1)
-        bound = obstacles.speed_bound(total.max(axis=1)[:, None])  # (U, M)
+        bound = obstacles.speed_bound(longest[:, None])  # (U, M)
         reach = t[..., None] * bound[:, None, None, :]
         fine = gap > reach + slack[..., None]
         # From a box that stands still (V = 0), moving away never closes the gap: an arc whose

@@ -31,10 +31,12 @@ def rect_gaps(lo: np.ndarray, hi: np.ndarray, lows: np.ndarray, highs: np.ndarra
     """L-infinity distance from the box ``[lo, hi]`` to each box ``[lows, highs]`` (0 when they meet).
 
     It bounds from below the distance from any point of ``[lo, hi]`` to anything inside the
-    other box (a wall segment lies in its bounding box, :func:`segment_bounds`).
+    other box (a wall segment lies in its bounding box, :func:`segment_bounds`).  Corners
+    ``(2,)`` against boxes ``(n, 2)`` give ``(n,)``; several boxes at once, ``(G, 1, 2)``, give
+    ``(G, n)``.
     """
     d = np.maximum(np.maximum(lows - hi, lo - highs), 0.0)
-    return d.max(axis=1) if len(d) else np.zeros(0)
+    return d.max(axis=-1)
 
 
 def point_segment_linf(points: np.ndarray, segments: np.ndarray) -> np.ndarray:
@@ -135,5 +137,10 @@ def box_gaps(centres: np.ndarray, half: float | np.ndarray, boxes: np.ndarray) -
     """
     c = np.asarray(centres, dtype=float)[..., None, :]
     b = per_row(boxes, np.ndim(centres))
-    d = np.maximum(np.abs(c[..., 0] - b[..., 0]), np.abs(c[..., 1] - b[..., 1]))
-    return d - half - b[..., 2]
+    d = c[..., 0] - b[..., 0]  # the same operations as max(|dx|, |dy|) - half - k, in place
+    dy = c[..., 1] - b[..., 1]
+    np.abs(d, out=d)
+    np.maximum(d, np.abs(dy, out=dy), out=d)
+    d -= half
+    d -= b[..., 2]
+    return d

@@ -56,7 +56,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from cosmop.control.dwa import Drivers, DwaCommand, DwaSettings, Obstacles, dwa_commands
+from cosmop.control.dwa import (
+    Drivers,
+    DwaCommand,
+    DwaSettings,
+    Obstacles,
+    dwa_commands,
+    first_true,
+    take_columns,
+)
 from cosmop.control.geometry import rect_gaps, segment_bounds
 from cosmop.control.safety import stopping_horizon, stopping_margin
 
@@ -116,59 +124,27 @@ def dwa_commands_near(
     group = _cells(xy, side)
     w_lo, w_hi = segment_bounds(obstacles.walls)
     centres, halves = obstacles.boxes[:, :2], obstacles.boxes[:, 2:]
-    b_lo, b_hi = centres - halves, centres + halves
-    walls, boxes = [], []  # per group: the indices of the walls and boxes within reach
-    for g in range(int(group.max()) + 1):
-        rows = np.flatnonzero(group == g)
-        lo, hi = xy[rows].min(axis=0), xy[rows].max(axis=0)
-        walls.append(np.flatnonzero(rect_gaps(lo, hi, w_lo, w_hi) <= (wall_reach[rows] + half[rows]).max()))
-        boxes.append(np.flatnonzero(rect_gaps(lo, hi, b_lo, b_hi) <= (box_reach[rows] + half[rows]).max()))
-    if len(walls) == 1:  # one group: one set, shared (no padding needed)
+    # per group: the bounding box of its drivers and their largest reach, then the walls and
+    # boxes within that reach of the bounding box, all groups at once
+    order = np.argsort(group, kind="stable")
+    starts = np.searchsorted(group[order], np.arange(int(group.max()) + 1))
+    lo, hi = (f.reduceat(xy[order], starts, axis=0)[:, None, :] for f in (np.minimum, np.maximum))
+    far = [np.maximum.reduceat((r + half)[order], starts)[:, None] for r in (wall_reach, box_reach)]
+    wall_far, box_far = far
+    walls = first_true(rect_gaps(lo, hi, w_lo, w_hi) <= wall_far)
+    boxes = first_true(rect_gaps(lo, hi, centres - halves, centres + halves) <= box_far)
+    if len(walls) == 1:  # one group: one set, shared (no padding: a single row is never padded)
         sets, near = obstacles.select(walls[0], boxes[0]), boxes[0]
     else:
-        walls, near = _padded(walls, len(obstacles.walls))[group], _padded(boxes, len(obstacles.boxes))[group]
-        sets = _near(obstacles, walls, near)
+        walls, near = walls[group], boxes[group]
+        sets = obstacles.take(walls, near)
     return dwa_commands(
         drivers,
         sets,
         settings,
-        ignore=None if ignore is None else _take(ignore, near),
-        grip=None if grip is None else _take(grip, near),
+        ignore=None if ignore is None else take_columns(ignore, near),
+        grip=None if grip is None else take_columns(grip, near),
     )
-
-
-def _padded(indices: list[np.ndarray], missing: int) -> np.ndarray:
-    """The index lists as the rows of one matrix, filled up with `missing` (the padding)."""
-    out = np.full((len(indices), max((len(i) for i in indices), default=0)), missing, dtype=np.int64)
-    for row, i in enumerate(indices):
-        out[row, : len(i)] = i
-    return out
-
-
-def _near(obstacles: Obstacles, walls: np.ndarray, boxes: np.ndarray) -> Obstacles:
-    """Each driver's own set: the walls and boxes at its row of `walls` ``(R, W)`` and `boxes`
-    ``(R, M)``; the index one past the end is a wall or box at infinity (no speed, no mover)."""
-
-    def pad(values, filler):
-        return None if values is None else np.concatenate([values, [filler]])[boxes]
-
-    return Obstacles(
-        np.concatenate([obstacles.walls, np.full((1, 4), np.inf)])[walls],
-        pad(obstacles.boxes, [np.inf, np.inf, 0.0]),
-        pad(obstacles.speed, 0.0),
-        pad(obstacles.velocity, [0.0, 0.0]),
-        pad(obstacles.acceleration, 0.0),
-        pad(obstacles.agents, False),
-    )
-
-
-def _take(mask: np.ndarray, boxes: np.ndarray) -> np.ndarray:
-    """`mask` ``(R, M)`` at the boxes kept: one index list for every driver ``(m,)``, or one
-    row per driver ``(R, m)`` (padded: False there)."""
-    if boxes.ndim == 1:
-        return mask[:, boxes]
-    padded = np.concatenate([mask, np.zeros((len(mask), 1), dtype=bool)], axis=1)
-    return padded[np.arange(len(mask))[:, None], boxes]
 
 
 def _cells(xy: np.ndarray, side: float) -> np.ndarray:

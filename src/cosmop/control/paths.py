@@ -62,12 +62,21 @@ class GlobalPath:
         lengths = np.hypot(d[:, 0], d[:, 1])
         return a, d, lengths, np.where(lengths > 0, lengths, 1.0)
 
+    @cached_property
+    def _projecting(self) -> tuple[np.ndarray, np.ndarray]:
+        """Each segment's squared length (1 for a zero one) and whether it has a length."""
+        _, _, lengths, safe_len = self._segments
+        return safe_len**2, lengths > 0
+
     def _projection(self, position: Point) -> tuple[int, np.ndarray]:
         """The segment nearest `position` and, for every segment, where along it (0..1) the
         point nearest `position` lies."""
-        a, d, lengths, safe_len = self._segments
-        t = ((position[0] - a[:, 0]) * d[:, 0] + (position[1] - a[:, 1]) * d[:, 1]) / safe_len**2
-        t = np.clip(np.where(lengths > 0, t, 0.0), 0.0, 1.0)
+        a, d, _, _ = self._segments
+        squared, long = self._projecting
+        t = ((position[0] - a[:, 0]) * d[:, 0] + (position[1] - a[:, 1]) * d[:, 1]) / squared
+        t = np.minimum(np.maximum(np.where(long, t, 0.0), 0.0), 1.0)  # np.clip, cheaper
+        if len(t) == 1:  # one segment: it is the nearest (most drives are a straight line)
+            return 0, t
         proj = a + t[:, None] * d
         return int(np.argmin(np.hypot(proj[:, 0] - position[0], proj[:, 1] - position[1]))), t
 

@@ -31,6 +31,7 @@ from cosmop.sim.result import Contact, Message, SimSettings, drop_holds
 __all__ = ["TOUCH", "Action", "Agent", "World", "wrap_angle"]
 
 _NEAR = 1000.0  # mm: :meth:`World.static_gaps` measures the walls this near first
+_MEMO = 4096  # static gaps remembered at most (cleared when full: old layouts are dead)
 
 Action = tuple[str, Any]
 """One cycle's command of a robot: ``("drive", (target, stop, room))`` for the dynamic window,
@@ -174,6 +175,7 @@ class World:
         }
         self.t = 0.0  # simulated time, s
         self._layout_key: tuple[bytes, bytes] | None = None  # what the sensed layout was made for
+        self._static_memo: dict[tuple, np.ndarray] = {}  # static_gaps by points, half and layout
 
     def _init_robots(self, scenario: Scenario) -> None:
         """The robots' arrays: sizes, limits, poses at rest."""
@@ -268,8 +270,22 @@ class World:
         return own
 
     def static_gaps(self, points: np.ndarray, half: float) -> np.ndarray:
-        """L-infinity gaps (mm) of squares of half side `half` at `points` to walls and resting objects."""
+        """L-infinity gaps (mm) of squares of half side `half` at `points` to walls and resting objects.
+
+        Remembered until an object is picked up or dropped: a driving robot asks about the
+        same waypoints every cycle.
+        """
         points = np.asarray(points, dtype=float).reshape(-1, 2)
+        key = (points.tobytes(), float(half), self.carried_by.tobytes(), self.object_xy.tobytes())
+        gap = self._static_memo.get(key)
+        if gap is None:
+            if len(self._static_memo) >= _MEMO:
+                self._static_memo.clear()
+            gap = self._static_memo[key] = self._measure_static_gaps(points, half)
+        return gap.copy()
+
+    def _measure_static_gaps(self, points: np.ndarray, half: float) -> np.ndarray:
+        """:meth:`static_gaps`, measured (`points` ``(n, 2)``)."""
         gap = np.full(len(points), np.inf)
         if len(self.walls):
             # the walls within NEAR of the points' box first: a farther wall is more than NEAR
