@@ -206,16 +206,27 @@ def test_the_best_escape_is_the_best_scored_admitted_arc(seed, side, batch, monk
     assert found.any() and (rank[found] >= batch).any()  # some searches went past the first batch
 
 
-@pytest.mark.parametrize("seed", range(4))
-def test_the_clearance_without_far_boxes_reads_the_same_up_to_the_caps(seed, monkeypatch):
+@pytest.mark.parametrize(
+    ("seed", "one"), [(0, None), (1, None), (2, None), (3, None), (0, 8), (1, 16), (3, 2)]
+)
+def test_the_clearance_without_far_obstacles_reads_the_same_up_to_the_caps(seed, one, monkeypatch):
     # what the score reads of the clearance: up to the cap, up to the personal space for
-    # movers, and the value itself at or below zero
+    # movers, and the value itself at or below zero; all drivers at once (large arrays: far
+    # walls and boxes dropped) or one (small arrays: the walls dropped when all are far)
     drivers, obstacles, own = _crowd(seed, side=8_000.0)
+    if one is not None:
+        drivers, own = drivers[[one]], own[[one]]
     settings = DwaSettings()
     sets = obstacles.per_driver(len(drivers.v))
     _, _, V, W = dwa._window(drivers, settings)
     t, pts, _ = dwa._arcs(drivers, V, W, settings)
-    clear, movers = dwa._clearance(drivers, sets, own, t, pts, settings)
+    wall_gap, _ = dwa.robot_gaps(drivers.pose[:, :2], drivers.half, sets.walls, sets.boxes, None)
+    measured = []
+    real = dwa.point_segment_linf
+    monkeypatch.setattr(dwa, "point_segment_linf", lambda *a: measured.append(a) or real(*a))
+    clear, movers = dwa._clearance(drivers, sets, own, t, pts, settings, wall_gap)
+    if (seed, one) in ((0, 8), (1, 16)):
+        assert not measured  # every wall too far: none measured
     monkeypatch.setattr(dwa, "_LARGE", np.inf)
     whole_clear, whole_movers = dwa._clearance(drivers, sets, own, t, pts, settings)
     np.testing.assert_array_equal(
@@ -224,4 +235,5 @@ def test_the_clearance_without_far_boxes_reads_the_same_up_to_the_caps(seed, mon
     np.testing.assert_array_equal(
         np.minimum(movers, settings.personal_space), np.minimum(whole_movers, settings.personal_space)
     )
-    assert (whole_clear <= 0).any() and (whole_movers < settings.personal_space).any()  # both caps bind
+    if one is None:
+        assert (whole_clear <= 0).any() and (whole_movers < settings.personal_space).any()  # both caps bind

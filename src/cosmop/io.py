@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import gc
 import os
 import shutil
 import tempfile
@@ -11,7 +12,7 @@ from pathlib import Path
 
 from cosmop.errors import CosmopInputError, OutputPathError
 
-__all__ = ["atomic_path", "check_writable", "uninterrupted", "write_atomic"]
+__all__ = ["atomic_path", "check_writable", "collector_paused", "uninterrupted", "write_atomic"]
 
 
 @contextlib.contextmanager
@@ -69,6 +70,24 @@ def check_writable(path: str | os.PathLike[str] | None, option: str, *, folder: 
         raise OutputPathError(missing, file=target, field=option)
     if not os.access(parent, os.W_OK | os.X_OK):
         raise OutputPathError(f"the folder {parent} is not writable", file=target, field=option)
+
+
+@contextlib.contextmanager
+def collector_paused() -> Iterator[None]:
+    """Pause Python's cyclic garbage collector while a large output that holds no cycles is
+    built, and restore it as it was, whatever happens.
+
+    A trace's JSON is some 100,000 dicts and lists that all stay alive until it is written;
+    the collector would walk them again and again and free nothing (a quarter of the time of
+    building the 10×10's trace).
+    """
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if enabled:
+            gc.enable()
 
 
 def write_atomic(path: str | os.PathLike[str], data: str | bytes) -> None:

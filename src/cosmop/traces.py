@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 
 from cosmop.errors import CosmopInputError
-from cosmop.io import read_text, write_atomic
+from cosmop.io import collector_paused, read_text, write_atomic
 from cosmop.reading import load_json
 from cosmop.units import INTERNAL_UNITS, check_units_field
 
@@ -399,7 +399,9 @@ class Trace:
 
     def save(self, path: str | os.PathLike[str]) -> None:
         """Write :meth:`to_json` to `path` as compact JSON, atomically (:func:`cosmop.io.write_atomic`)."""
-        write_atomic(path, json.dumps(self.to_json(), separators=(",", ":")) + "\n")
+        with collector_paused():
+            text = json.dumps(self.to_json(), separators=(",", ":")) + "\n"
+        write_atomic(path, text)
 
 
 def _rounded(values: np.ndarray | None, digits: int) -> np.ndarray | None:

@@ -33,7 +33,7 @@ from functools import lru_cache
 import numpy as np
 
 from cosmop.control.geometry import box_gaps, point_segment_linf
-from cosmop.control.safety import Limits, is_safe, obstacle_speed, stopping_horizon
+from cosmop.control.safety import Limits, obstacle_speed, own_margin, stopping_horizon
 
 __all__ = ["Drivers", "DwaCommand", "DwaSettings", "Obstacles", "dwa_commands", "robot_gaps"]
 
@@ -403,7 +403,7 @@ def dwa_commands(
         drivers = _retreat(drivers, obstacles, box_gap, ~safe, settings)
     low, high, V, W = _window(drivers, settings)
     t, pts, th = _arcs(drivers, V, W, settings)
-    clear, mover_clear = _clearance(drivers, obstacles, ignore, t, pts, settings)
+    clear, mover_clear = _clearance(drivers, obstacles, ignore, t, pts, settings, wall_gap)
     score = _score(drivers, settings, high, V, pts, th, clear, mover_clear)
     w_out = np.zeros(len(drivers.v))
     if not safe.all():
@@ -442,10 +442,12 @@ def _passive_safety(
     stopping horizon when their velocities and accelerations are known.
     """
     limits, v = drivers.limits.column(), drivers.v[:, None]
-    safe = np.all(is_safe(wall_gap, v, 0.0, limits), axis=1)  # walls stand still
+    # stopping_margin(v, V_o) is own + V_o * horizon, summed in that order: each part once
+    own, horizon = own_margin(v, limits), stopping_horizon(v, limits)
+    safe = np.all(wall_gap > own, axis=1)  # walls stand still
     if obstacles.boxes.shape[-2]:
         gap = box_gap - settings.standoff * obstacles.movers
-        safe &= np.all(is_safe(gap, v, obstacles.speed_bound(stopping_horizon(v, limits)), limits), axis=1)
+        safe &= np.all(gap > own + obstacles.speed_bound(horizon) * horizon, axis=1)
     return safe
 
 
@@ -499,14 +501,17 @@ def _clearance(
     t: np.ndarray,
     pts: np.ndarray,
     settings: DwaSettings,
+    wall_gap: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """The least gap along each arc to anything, and to movers alone, ``(R, K)`` each, mm.
 
     Moving boxes are extrapolated with their velocities when known (else grown by nothing:
-    the score only chooses among arcs the safety rule admits).
+    the score only chooses among arcs the safety rule admits).  `wall_gap` (``(R, W)``, mm):
+    the gaps now, if known, so that walls too far to count are not measured
+    (:func:`_far_for_the_score`).
     """
     R, K, S = pts.shape[:3]
-    obstacles, ignore = _far_for_the_score(drivers, obstacles, ignore, t, pts, settings)
+    obstacles, ignore = _far_for_the_score(drivers, obstacles, ignore, t, pts, settings, wall_gap)
     half, walls, boxes, movers = drivers.half, obstacles.walls, obstacles.boxes, obstacles.movers
     if ignore is not None and boxes.shape[-2]:
         # a box ignored is one at infinity: its gaps are inf, as the masked copy of all of them
@@ -520,24 +525,21 @@ def _clearance(
     else:
         clear = np.full(flat.shape[:2], np.inf)
     if boxes.shape[-2]:
-        if obstacles.velocity is None:
-            bg = box_gaps(flat, half[:, None, None], boxes)  # (R, K*S, M)
-        else:
-            # the boxes where they are at each of the S instants (R, 1, S, M), against the
-            # points of every arc at that instant (R, K, S, 1)
-            velocity = obstacles.velocity[:, None]
-            moved_x = boxes[:, None, :, 0] + t[:, None] * velocity[..., 0]  # (R, S, M)
-            moved_y = boxes[:, None, :, 1] + t[:, None] * velocity[..., 1]
-            bg = pts[..., 0, None] - moved_x[:, None]  # max(|dx|, |dy|) - half - k, in place
-            dy = pts[..., 1, None] - moved_y[:, None]
-            np.abs(bg, out=bg)
-            np.maximum(bg, np.abs(dy, out=dy), out=bg)
-            bg -= half[:, None, None, None]
-            bg -= boxes[:, None, None, :, 2]
-            bg = bg.reshape(R, K * S, -1)
+        # the gaps with the boxes' axis first (M, R, K, S): the minima over the boxes then run
+        # across whole rows, far faster than along a short last axis
+        bx, by = boxes[..., 0].T[:, :, None, None], boxes[..., 1].T[:, :, None, None]
+        if obstacles.velocity is not None:  # each box where it is at each instant (M, R, 1, S)
+            bx = bx + t * obstacles.velocity[..., 0].T[:, :, None, None]
+            by = by + t * obstacles.velocity[..., 1].T[:, :, None, None]
+        bg = pts[..., 0] - bx  # max(|dx|, |dy|) - half - k, in place
+        dy = pts[..., 1] - by
+        np.abs(bg, out=bg)
+        np.maximum(bg, np.abs(dy, out=dy), out=bg)
+        bg -= half[:, None, None]
+        bg -= boxes[..., 2].T[:, :, None, None]
         if movers.any():
-            mover_clear = np.where(movers[:, None, :], bg, np.inf).min(axis=-1).reshape(R, K, S).min(axis=-1)
-        clear = np.minimum(clear, bg.min(axis=-1))
+            mover_clear = np.where(movers.T[:, :, None, None], bg, np.inf).min(axis=0).min(axis=-1)
+        clear = np.minimum(clear, bg.min(axis=0).reshape(R, K * S))
     return clear.reshape(R, K, S).min(axis=-1), mover_clear
 
 
@@ -548,8 +550,9 @@ def _far_for_the_score(
     t: np.ndarray,
     pts: np.ndarray,
     settings: DwaSettings,
+    wall_gap: np.ndarray | None = None,
 ) -> tuple[Obstacles, np.ndarray | None]:
-    """`obstacles` (and `ignore`) without the boxes too far to change any arc's score.
+    """`obstacles` (and `ignore`) without the walls and boxes too far to change any arc's score.
 
     The score reads the least gap along an arc only up to the clearance cap :math:`c`, and the
     least gap to a mover only up to the personal space :math:`p` (so up to :math:`c` for walls
@@ -560,14 +563,19 @@ def _far_for_the_score(
     obstacle whose gap now exceeds the largest offset, its move and what its gap counts up to
     (and 1 mm for rounding) is farther than that from every point of every arc, so it is never
     a minimum that counts.
+
+    Small arrays are not worth choosing from; there only the walls are dropped, all of them,
+    when `wall_gap` (``(R, W)``, the gaps now) shows every one of them too far.
     """
-    if not _large(pts.size // 2, obstacles):
-        return obstacles, ignore
     offset = np.abs(pts - drivers.pose[:, None, None, :2]).max(axis=(1, 2, 3))  # (R,)
+    walls = offset[:, None] + settings.clearance + 1.0  # walls count up to the cap alone
+    if not _large(pts.size // 2, obstacles):
+        if wall_gap is not None and wall_gap.size and (wall_gap > walls).all():
+            obstacles = replace(obstacles, walls=obstacles.walls[..., :0, :])
+        return obstacles, ignore
     moves = 0.0
     if obstacles.velocity is not None:
         moves = np.hypot(obstacles.velocity[..., 0], obstacles.velocity[..., 1]) * t[-1]
-    walls = offset[:, None] + settings.clearance + 1.0  # walls count up to the cap alone
     counts = np.where(obstacles.movers, max(settings.clearance, settings.personal_space), settings.clearance)
     boxes = offset[:, None] + moves + counts + 1.0  # and so do resting boxes
     columns = () if ignore is None else ((ignore, False),)
@@ -590,10 +598,11 @@ def _score(
     xy, target = drivers.pose[:, :2], drivers.target
     end, end_heading = pts[:, :, -1, :], th[:, :, -1]
     d_now = np.hypot(target[:, 0] - xy[:, 0], target[:, 1] - xy[:, 1])
-    d_end = np.hypot(target[:, None, 0] - end[..., 0], target[:, None, 1] - end[..., 1])
+    dx, dy = target[:, None, 0] - end[..., 0], target[:, None, 1] - end[..., 1]  # end to target
+    d_end = np.hypot(dx, dy)
     # Progress relative to the best the window allows, so that it also decides at low speed.
     progress = (d_now[:, None] - d_end) / np.maximum(high * settings.horizon, 1.0)[:, None]
-    bearing = np.arctan2(target[:, None, 1] - end[..., 1], target[:, None, 0] - end[..., 0])
+    bearing = np.arctan2(dy, dx)
     heading = 1.0 - np.abs(np.angle(np.exp(1j * (bearing - end_heading)))) / np.pi
     heading = np.where(d_end < 1.0, 1.0, heading)
     R = len(drivers.v)
@@ -604,7 +613,7 @@ def _score(
     )
     cap = np.maximum(cap, 0.0)[:, None]
     room = np.where(cap > 0, np.minimum(clear, cap) / np.maximum(cap, 1e-9), 1.0)
-    room = np.minimum(room, np.clip(mover_clear / settings.personal_space, 0.0, 1.0))
+    room = np.minimum(room, np.minimum(np.maximum(mover_clear / settings.personal_space, 0.0), 1.0))  # clip
     score = (
         settings.progress_weight * progress
         + settings.heading_weight * heading

@@ -43,7 +43,15 @@ import numpy as np
 
 from cosmop.scene import Dynamics
 
-__all__ = ["Limits", "admissible_speed", "is_safe", "obstacle_speed", "stopping_horizon", "stopping_margin"]
+__all__ = [
+    "Limits",
+    "admissible_speed",
+    "is_safe",
+    "obstacle_speed",
+    "own_margin",
+    "stopping_horizon",
+    "stopping_margin",
+]
 
 
 @dataclass(frozen=True)
@@ -110,12 +118,14 @@ def stopping_margin(v, speed_bound, dynamics: Dynamics | Limits):
     dynamics : Dynamics or Limits
         :math:`A`, :math:`b`, :math:`\\varepsilon` (arrays broadcast with `v` and `speed_bound`).
     """
+    return own_margin(v, dynamics) + speed_bound * stopping_horizon(v, dynamics)
+
+
+def own_margin(v, dynamics: Dynamics | Limits):
+    """:func:`stopping_margin` before an obstacle moves (:math:`V_o = 0`): the robot's own
+    stopping distance, mm, :math:`(A/b + 1)(A\varepsilon^2/2 + \varepsilon v) + v^2/2b`."""
     a, b, eps = dynamics.acceleration, dynamics.braking, dynamics.cycle
-    return (
-        (a / b + 1.0) * (a / 2.0 * eps**2 + eps * v)
-        + v * v / (2.0 * b)
-        + speed_bound * (eps + (v + a * eps) / b)
-    )
+    return (a / b + 1.0) * (a / 2.0 * eps**2 + eps * v) + v * v / (2.0 * b)
 
 
 def stopping_horizon(v, dynamics: Dynamics | Limits):

@@ -254,12 +254,15 @@ def _drop_clear(world: World, i: int, j: int, spot: np.ndarray) -> bool:
 
 def let_go(world: World) -> None:
     """Free the gripper of every robot that has crept more than 1 mm off the object it dropped."""
-    for agent in world.agents:
-        j = agent.gripped
-        if j is None or world.carried_by[j] >= 0 or agent.dock_stage is not None:
-            continue
-        box = np.array([[*world.object_xy[j], world.object_half[j]]])
-        if float(box_gaps(world.pose[agent.index, :2], world.robot_half[agent.index], box)[0]) > 1.0:
+    held = [a for a in world.agents if a.gripped is not None and a.dock_stage is None]
+    held = [a for a in held if world.carried_by[a.gripped] < 0]  # dropped, not picked
+    if not held:
+        return
+    robots, objects = [a.index for a in held], [a.gripped for a in held]
+    boxes = np.column_stack([world.object_xy[objects], world.object_half[objects]])[:, None, :]  # one each
+    gaps = box_gaps(world.pose[robots, :2], world.robot_half[robots][:, None], boxes)[:, 0]
+    for agent, gap in zip(held, gaps.tolist(), strict=True):
+        if gap > 1.0:
             agent.gripped = None
 
 

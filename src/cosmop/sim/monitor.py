@@ -41,13 +41,14 @@ def _touching(world: World) -> set[tuple[int, str]]:
     contact with the object it grips is no contact, unless the two overlap."""
     boxes, names = world.boxes()
     wall_gap, box_gap = robot_gaps(world.pose[:, :2], world.robot_half, world.walls, boxes, None)
+    R = len(world.robot_ids)
+    own = len(names) - R - len(world.walkers) + np.arange(R)  # each robot's own box: no contact
+    box_gap[np.arange(R), own] = np.inf
     # one pass over the touching pairs (a few), not one per robot and kind of obstacle
     walls = zip(*np.nonzero(wall_gap <= TOUCH), strict=True)
     now: set[tuple[int, str]] = {(int(i), f"wall {int(w)}") for i, w in walls}
     for i, b in zip(*np.nonzero(box_gap <= TOUCH), strict=True):
         agent, name = world.agents[i], names[b]
-        if name == agent.id:
-            continue
         gripped = agent.gripped is not None and name == world.object_ids[agent.gripped]
         if gripped and box_gap[i, b] >= -TOUCH:
             continue

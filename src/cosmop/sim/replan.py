@@ -22,7 +22,6 @@ from cosmop.control.geometry import box_gaps
 from cosmop.events import Event, Primitive
 from cosmop.planning.checker import check_robot_plan
 from cosmop.planning.plan import ObjectState, RobotPlan, State
-from cosmop.planning.synthesis import synthesize
 from cosmop.scene import Scene, Wall
 from cosmop.sim.recoordinate import recoordinate_world
 
@@ -75,6 +74,9 @@ def replan(
         A plan that passes :func:`~cosmop.planning.checker.check_robot_plan` from `start`, or
         ``None`` when there is none within the bound.
     """
+    # the solver (and Z3) load only when a robot replans: most runs never do
+    from cosmop.planning.synthesis import synthesize
+
     world = sensed_scene(scene, sensed)
     result = synthesize(
         world,

@@ -1,0 +1,26 @@
+"""Helpers of :mod:`cosmop.io` that the commands' tests do not reach on their own."""
+
+from __future__ import annotations
+
+import gc
+
+import pytest
+
+from cosmop.io import collector_paused
+
+
+def test_the_collector_is_paused_and_restored_as_it_was():
+    assert gc.isenabled()
+    with collector_paused():
+        assert not gc.isenabled()
+    assert gc.isenabled()
+    with pytest.raises(RuntimeError), collector_paused():
+        raise RuntimeError("a failure while building")
+    assert gc.isenabled()  # restored after a failure too
+    gc.disable()
+    try:
+        with collector_paused():
+            pass
+        assert not gc.isenabled()  # a caller's choice is kept
+    finally:
+        gc.enable()
