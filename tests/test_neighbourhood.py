@@ -159,10 +159,14 @@ def test_few_obstacles_go_to_the_window_whole(monkeypatch):
     assert len(near.v) == len(drivers.v)
 
 
-@pytest.mark.parametrize("seed", range(4))
-def test_the_window_drops_far_boxes_without_changing_a_command(seed, monkeypatch):
-    # a crowded 8 m square: the clearance and the escape arcs measure only what can matter
+@pytest.mark.parametrize(("seed", "clearance"), [(0, 60.0), (1, 60.0), (2, 60.0), (3, 60.0), (20, -400.0)])
+def test_the_window_drops_far_boxes_without_changing_a_command(seed, clearance, monkeypatch):
+    # a crowded 8 m square: the clearance and the escape arcs measure only what can matter; a
+    # negative clearance cap (no room wanted) still reads the gaps at or below zero
     drivers, obstacles, own = _crowd(seed, side=8_000.0)
+    settings = DwaSettings(clearance=clearance)
+    grip = np.zeros_like(own)
+    grip[np.arange(4), np.arange(4)] = True  # four drivers hold an object
     widths = []
     real = dwa._without_far
 
@@ -172,11 +176,14 @@ def test_the_window_drops_far_boxes_without_changing_a_command(seed, monkeypatch
         return kept, columns
 
     monkeypatch.setattr(dwa, "_without_far", recording)
-    pruned = dwa_commands(drivers, obstacles, ignore=own)
+    pruned = dwa_commands(drivers, obstacles, settings, ignore=own, grip=grip)
     # the clearance once, the escape arcs once a batch: every call cut
     assert len(widths) >= 2 and all(after < before for before, after in widths)
-    monkeypatch.setattr(dwa, "_LARGE", np.inf)  # never prune
-    whole = dwa_commands(drivers, obstacles, ignore=own)
+    # everything measured: no obstacle dropped, every escape arc checked at once
+    monkeypatch.setattr(dwa, "_far_for_the_score", lambda d, o, ignore, *rest: (o, ignore))
+    monkeypatch.setattr(dwa, "_far_for_escape", lambda d, pts, longest, slack, o, skip, keep: (o, skip, keep))
+    monkeypatch.setattr(dwa, "_ESCAPE_BATCH", 10**6)
+    whole = dwa_commands(drivers, obstacles, settings, ignore=own, grip=grip)
     assert not whole.safe.all()
     for name in ("v", "w", "safe", "gap"):
         np.testing.assert_array_equal(getattr(pruned, name), getattr(whole, name))
@@ -193,7 +200,9 @@ def test_the_best_escape_is_the_best_scored_admitted_arc(seed, side, batch, monk
     sets = obstacles.per_driver(R)
     _, _, V, W = dwa._window(drivers, DwaSettings())
     keep = np.full((R, len(obstacles.boxes)), -np.inf)
-    ok = dwa._escape_ok(drivers, V, W, sets, own, keep)
+    with monkeypatch.context() as whole:  # every arc against every box
+        whole.setattr(dwa, "_LARGE", np.inf)
+        ok = dwa._escape_ok(drivers, V, W, sets, own, keep)
     # many ties, and the arcs it refuses scored above those it admits: the search must go past
     score = np.random.default_rng(seed).integers(0, 6, V.shape) + 10.0 * ~ok
     monkeypatch.setattr(dwa, "_ESCAPE_BATCH", batch)
@@ -237,3 +246,18 @@ def test_the_clearance_without_far_obstacles_reads_the_same_up_to_the_caps(seed,
     )
     if one is None:
         assert (whole_clear <= 0).any() and (whole_movers < settings.personal_space).any()  # both caps bind
+
+
+def test_a_nan_score_is_taken_first_as_argmax_takes_it(monkeypatch):
+    drivers, obstacles, own = _crowd(2, side=8_000.0)
+    R = len(drivers.v)
+    sets = obstacles.per_driver(R)
+    _, _, V, W = dwa._window(drivers, DwaSettings())
+    keep = np.full((R, len(obstacles.boxes)), -np.inf)
+    ok = dwa._escape_ok(drivers, V, W, sets, own, keep)
+    row = int(np.flatnonzero(ok.any(axis=1) & ~ok.all(axis=1))[0])  # some arcs admitted, not all
+    score = np.tile(np.arange(V.shape[1], dtype=float), (R, 1))
+    admitted = np.flatnonzero(ok[row])
+    score[row, admitted[len(admitted) // 2]] = np.nan  # an admitted arc with no score
+    pick, found = dwa._best_escapes(drivers, V, W, score, sets, own, keep)
+    assert found[row] and pick[row] == np.argmax(np.where(ok, score, -np.inf), axis=1)[row]

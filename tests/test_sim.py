@@ -149,6 +149,7 @@ def test_static_gaps_remembered_are_forgotten_when_an_object_is_picked_or_moved(
     assert world.static_gaps(beside, 200.0)[0] == pytest.approx(150.0)
     world.static_gaps(beside, 200.0)[0] = -1.0  # a caller's copy: the memory is not touched
     assert world.static_gaps(beside, 200.0)[0] == pytest.approx(150.0)
+    assert world.static_gaps(beside, 100.0)[0] == pytest.approx(250.0)  # another robot's size
     world.carried_by[0] = 0  # picked up: only the wall is left
     assert world.static_gaps(beside, 200.0)[0] == pytest.approx(1200.0)
     world.carried_by[0] = -1

@@ -568,7 +568,8 @@ def _far_for_the_score(
     when `wall_gap` (``(R, W)``, the gaps now) shows every one of them too far.
     """
     offset = np.abs(pts - drivers.pose[:, None, None, :2]).max(axis=(1, 2, 3))  # (R,)
-    walls = offset[:, None] + settings.clearance + 1.0  # walls count up to the cap alone
+    cap = max(settings.clearance, 0.0)  # the cap, and at least the gaps at or below zero
+    walls = offset[:, None] + cap + 1.0  # walls count up to the cap alone
     if not _large(pts.size // 2, obstacles):
         if wall_gap is not None and wall_gap.size and (wall_gap > walls).all():
             obstacles = replace(obstacles, walls=obstacles.walls[..., :0, :])
@@ -576,7 +577,7 @@ def _far_for_the_score(
     moves = 0.0
     if obstacles.velocity is not None:
         moves = np.hypot(obstacles.velocity[..., 0], obstacles.velocity[..., 1]) * t[-1]
-    counts = np.where(obstacles.movers, max(settings.clearance, settings.personal_space), settings.clearance)
+    counts = np.where(obstacles.movers, max(cap, settings.personal_space), cap)
     boxes = offset[:, None] + moves + counts + 1.0  # and so do resting boxes
     columns = () if ignore is None else ((ignore, False),)
     kept, taken = _without_far(obstacles, drivers.pose[:, :2], drivers.half, walls, boxes, *columns)
@@ -730,7 +731,8 @@ def _best_escapes(
     admitted arcs, found without checking the arcs that score below it.
     """
     U, K = V.shape
-    order = np.argsort(-score, axis=1, kind="stable")
+    # best first, ties by index; NaN before all, as argmax takes the first NaN as the largest
+    order = np.argsort(np.where(np.isnan(score), -np.inf, -score), axis=1, kind="stable")
     longest = (drivers.limits.cycle[:, None] + V / drivers.limits.braking[:, None]).max(axis=1)
     pick, found = np.zeros(U, dtype=np.int64), np.zeros(U, dtype=bool)
     for start in range(0, K, _ESCAPE_BATCH):

@@ -141,6 +141,6 @@ def box_gaps(centres: np.ndarray, half: float | np.ndarray, boxes: np.ndarray) -
     dy = c[..., 1] - b[..., 1]
     np.abs(d, out=d)
     np.maximum(d, np.abs(dy, out=dy), out=d)
-    d -= half
+    d = d - half  # (`half` may broadcast to more axes than the gaps have)
     d -= b[..., 2]
     return d

@@ -32,6 +32,7 @@ __all__ = ["TOUCH", "Action", "Agent", "World", "wrap_angle"]
 
 _NEAR = 1000.0  # mm: :meth:`World.static_gaps` measures the walls this near first
 _MEMO = 4096  # static gaps remembered at most (cleared when full: old layouts are dead)
+_MEMO_POINTS = 8  # only questions about this few points are remembered (waypoints, not fans)
 
 Action = tuple[str, Any]
 """One cycle's command of a robot: ``("drive", (target, stop, room))`` for the dynamic window,
@@ -272,10 +273,12 @@ class World:
     def static_gaps(self, points: np.ndarray, half: float) -> np.ndarray:
         """L-infinity gaps (mm) of squares of half side `half` at `points` to walls and resting objects.
 
-        Remembered until an object is picked up or dropped: a driving robot asks about the
-        same waypoints every cycle.
+        Answers about a few points are remembered until an object is picked up or dropped: a
+        driving robot asks about the same waypoints every cycle.
         """
         points = np.asarray(points, dtype=float).reshape(-1, 2)
+        if len(points) > _MEMO_POINTS:
+            return self._measure_static_gaps(points, half)
         key = (points.tobytes(), float(half), self.carried_by.tobytes(), self.object_xy.tobytes())
         gap = self._static_memo.get(key)
         if gap is None:
