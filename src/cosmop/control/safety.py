@@ -123,7 +123,7 @@ def stopping_margin(v, speed_bound, dynamics: Dynamics | Limits):
 
 def own_margin(v, dynamics: Dynamics | Limits):
     """:func:`stopping_margin` before an obstacle moves (:math:`V_o = 0`): the robot's own
-    stopping distance, mm, :math:`(A/b + 1)(A\varepsilon^2/2 + \varepsilon v) + v^2/2b`."""
+    stopping distance, mm, :math:`(A/b + 1)(A\\varepsilon^2/2 + \\varepsilon v) + v^2/2b`."""
     a, b, eps = dynamics.acceleration, dynamics.braking, dynamics.cycle
     return (a / b + 1.0) * (a / 2.0 * eps**2 + eps * v) + v * v / (2.0 * b)
 
