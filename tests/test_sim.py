@@ -399,3 +399,23 @@ def test_robot_stopped_beside_its_waypoint_creeps_back_onto_the_segment():
     assert result.contacts_while_moving == 0
     west = result.frames["pose"][:, 0, 0].min()
     assert west <= -1500 + SimSettings().pass_tolerance  # it drove the segment, not around
+
+
+def test_own_boxes_of_some_robots_are_those_rows_of_all():
+    data = {
+        "name": "three robots",
+        "scene": {
+            "obstacles": [[[0, 0], [6000, 0]]],
+            "robots": {
+                r: {"size": 400, "pose": [1000 + 1500 * k, 2000, 0]} for k, r in enumerate(("A", "B", "C"))
+            },
+            "objects": {"O1": {"size": 100, "position": [2000, 1000]}},
+            "workspaces": {"W1": {"x": [3000, 3900], "y": [3000, 3900]}},
+        },
+        "mission": {"tasks": {"A": ["pick O1", "drop O1 at W1", "return"]}},
+    }
+    world = World(parse_scenario(data), PlanSet("three robots", True, {}), 0, SimSettings())
+    sensed = world.obstacles()
+    every = world.own_boxes(sensed)
+    assert every.sum() == 3 and [sensed.names[j] for j in every.argmax(axis=1)] == ["A", "B", "C"]
+    np.testing.assert_array_equal(world.own_boxes(sensed, np.array([2, 0])), every[[2, 0]])

@@ -237,7 +237,7 @@ def _dynamic_window(world: World, sensed: Obstacles, commands: _Commands) -> Non
     )
     window = dwa_commands_near if world.settings.neighbourhood else dwa_commands
     cmd = window(
-        drivers, world.with_motion(sensed), world.settings.dwa, ignore=world.own_boxes(sensed)[idx], grip=grip
+        drivers, world.with_motion(sensed), world.settings.dwa, ignore=world.own_boxes(sensed, idx), grip=grip
     )
     commands.v[idx] = cmd.v
     commands.w[idx] = cmd.w

@@ -11,7 +11,6 @@ keep their heading in radians), seconds; degrees where a plan's pose is read.
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -231,7 +230,7 @@ class World:
         boxes = [resting, self.robot_boxes()]
         if self.walkers:
             boxes.append(self.people_boxes())
-        return np.vstack(boxes).reshape(-1, 3)
+        return np.concatenate([b.reshape(-1, 3) for b in boxes])
 
     def _sensed_layout(self) -> tuple[np.ndarray, tuple[str, ...], np.ndarray]:
         """The resting objects' boxes, every box's name and which boxes are robots or people, as
@@ -259,15 +258,19 @@ class World:
         acceleration = np.zeros(len(sensed.names))
         acceleration[robots] = np.where(self.parked(), 0.0, self.limits.acceleration)
         acceleration[robots.stop :] = np.inf
-        return replace(sensed, velocity=velocity, acceleration=acceleration)
+        # (built directly: dataclasses.replace costs more than the arrays, every cycle)
+        return Obstacles(
+            sensed.walls, sensed.boxes, sensed.speed, velocity, acceleration, sensed.agents, sensed.names
+        )
 
-    def own_boxes(self, sensed: Obstacles) -> np.ndarray:
-        """Which box of `sensed` (of :meth:`obstacles`) is each robot itself, ``(R, n)``: the
-        robots' boxes follow the resting objects', in robot order."""
-        R = len(self.robot_ids)
-        first = len(sensed.names) - R - len(self.walkers)
-        own = np.zeros((R, len(sensed.names)), dtype=bool)
-        own[np.arange(R), first + np.arange(R)] = True
+    def own_boxes(self, sensed: Obstacles, robots: np.ndarray | None = None) -> np.ndarray:
+        """Which box of `sensed` (of :meth:`obstacles`) is each robot itself, ``(R, n)``, or
+        each of the robots `robots` only: the robots' boxes follow the resting objects', in
+        robot order."""
+        rows = np.arange(len(self.robot_ids)) if robots is None else np.asarray(robots)
+        first = len(sensed.names) - len(self.robot_ids) - len(self.walkers)
+        own = np.zeros((len(rows), len(sensed.names)), dtype=bool)
+        own[np.arange(len(rows)), first + rows] = True
         return own
 
     def static_gaps(self, points: np.ndarray, half: float) -> np.ndarray:
@@ -330,7 +333,7 @@ class World:
                     half[inside], np.maximum(reach[inside] - self.robot_half[robot], 1.0)
                 )
             boxes.append(np.column_stack([self.pose[parked, :2], half]))
-        return np.vstack(boxes).reshape(-1, 3)
+        return np.concatenate([b.reshape(-1, 3) for b in boxes])
 
     def gaps_to_robots(self, i: int) -> np.ndarray:
         """L-infinity gaps (mm) of robot `i`'s square to every robot's (itself included)."""
