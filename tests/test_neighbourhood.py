@@ -233,11 +233,11 @@ def test_the_clearance_without_far_obstacles_reads_the_same_up_to_the_caps(seed,
     measured = []
     real = dwa.point_segment_linf
     monkeypatch.setattr(dwa, "point_segment_linf", lambda *a: measured.append(a) or real(*a))
-    clear, movers = dwa._clearance(drivers, sets, own, t, pts, settings, wall_gap)
+    near, near_own = dwa._far_for_the_score(drivers, sets, own, t, pts, settings, wall_gap)
+    clear, movers = dwa._clearance(drivers, near, near_own, t, pts)
     if (seed, one) in ((0, 8), (1, 16)):
         assert not measured  # every wall too far: none measured
-    monkeypatch.setattr(dwa, "_LARGE", np.inf)
-    whole_clear, whole_movers = dwa._clearance(drivers, sets, own, t, pts, settings)
+    whole_clear, whole_movers = dwa._clearance(drivers, sets, own, t, pts)  # everything
     np.testing.assert_array_equal(
         np.minimum(clear, settings.clearance), np.minimum(whole_clear, settings.clearance)
     )

@@ -403,7 +403,8 @@ def dwa_commands(
         drivers = _retreat(drivers, obstacles, box_gap, ~safe, settings)
     low, high, V, W = _window(drivers, settings)
     t, pts, th = _arcs(drivers, V, W, settings)
-    clear, mover_clear = _clearance(drivers, obstacles, ignore, t, pts, settings, wall_gap)
+    near, near_ignore = _far_for_the_score(drivers, obstacles, ignore, t, pts, settings, wall_gap)
+    clear, mover_clear = _clearance(drivers, near, near_ignore, t, pts)
     score = _score(drivers, settings, high, V, pts, th, clear, mover_clear)
     w_out = np.zeros(len(drivers.v))
     if not safe.all():
@@ -495,23 +496,15 @@ def _arcs(
 
 
 def _clearance(
-    drivers: Drivers,
-    obstacles: Obstacles,
-    ignore: np.ndarray | None,
-    t: np.ndarray,
-    pts: np.ndarray,
-    settings: DwaSettings,
-    wall_gap: np.ndarray | None = None,
+    drivers: Drivers, obstacles: Obstacles, ignore: np.ndarray | None, t: np.ndarray, pts: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
     """The least gap along each arc to anything, and to movers alone, ``(R, K)`` each, mm.
 
     Moving boxes are extrapolated with their velocities when known (else grown by nothing:
-    the score only chooses among arcs the safety rule admits).  `wall_gap` (``(R, W)``, mm):
-    the gaps now, if known, so that walls too far to count are not measured
-    (:func:`_far_for_the_score`).
+    the score only chooses among arcs the safety rule admits).  The window passes only the
+    obstacles that can count (:func:`_far_for_the_score`).
     """
     R, K, S = pts.shape[:3]
-    obstacles, ignore = _far_for_the_score(drivers, obstacles, ignore, t, pts, settings, wall_gap)
     half, walls, boxes, movers = drivers.half, obstacles.walls, obstacles.boxes, obstacles.movers
     if ignore is not None and boxes.shape[-2]:
         # a box ignored is one at infinity: its gaps are inf, as the masked copy of all of them
