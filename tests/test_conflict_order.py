@@ -237,6 +237,17 @@ def test_the_messages_kept_are_exactly_the_orders_the_others_do_not_imply(seed):
         assert not others.before_start(*edge), edge
 
 
+def test_of_two_equal_orders_the_first_is_kept():
+    # each message protects the conflict it was chosen for: the first of two equal edges stays
+    horizons = {"A": 4, "B": 4, "C": 4}
+    edge, other = (("A", 2), ("B", 3)), (("C", 1), ("B", 2))
+    chosen = [(edge, "first"), (other, "other"), (edge, "second")]
+    assert _reduce(horizons, [], chosen) == [(edge, "first"), (other, "other")]
+    # and one implied through the other robot's plan and a message goes
+    links = [Link("m", "A", 1, "C", 1)]
+    assert _reduce(horizons, links, [(other, "x"), ((("A", 1), ("B", 4)), "implied")]) == [(other, "x")]
+
+
 def test_the_cores_the_search_finds_are_cores():
     # each conflict set aside comes with a core: a set of conflicts that no schedule orders
     # together (asked of Z3, which knows nothing of it)

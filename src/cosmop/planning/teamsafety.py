@@ -95,7 +95,18 @@ def _reduce(
 
     The edge ``(A, i) -> start of (B, j)`` is implied when, without it, a path leads from A's
     step *i* to a step of B before *j* or to another edge into the start of B's step *j*.
+    Such a path leaves A's step *i* by one of its other edges: its next step, a message it
+    sends, or another kept edge from it.  So the edge is implied iff one of those successors
+    completes before B's step *j* starts, which the vector clocks of the order with every
+    chosen edge decide (:meth:`~cosmop.missions.precedence.Precedence.before_start`).  That
+    order has the same paths as the kept edges at every point, because an edge is dropped only
+    when the others imply it; and no path from a successor of A's step *i* runs through the
+    edge itself, since the order has no cycle (the chosen orders are deadlock-free).  The edges
+    are looked at from the last chosen to the first, and of two equal edges the first stays.
     """
+    order = Precedence(horizons, links, [edge for edge, _ in chosen])
+    if not order.complete:
+        raise ValueError("the chosen orders deadlock")
     links_out: dict[Node, list[Node]] = {}
     for link in links:
         if link.send is not None and link.wait is not None:
@@ -111,8 +122,8 @@ def _reduce(
         starts[source].remove(target)
         # another kept edge from later in A's plan to earlier in B's implies it at once
         pair = by_pair[(source[0], target[0])]
-        if any(m != n and i >= source[1] and j <= target[1] for i, j, m in pair) or _reaches(
-            horizons, links_out, starts, source, target
+        if any(m != n and i >= source[1] and j <= target[1] for i, j, m in pair) or _implied(
+            order, horizons, links_out, starts, source, target
         ):
             dropped.add(n)
             pair.remove((source[1], target[1], n))
@@ -121,25 +132,17 @@ def _reduce(
     return [item for n, item in enumerate(chosen) if n not in dropped]
 
 
-def _reaches(horizons, links_out, starts, source: Node, target: Node) -> bool:
-    """Whether `source` completes before `target` starts through program order, links, `starts`."""
-    robot, j = target
-    seen, todo = {source}, [source]
-    while todo:
-        r, k = todo.pop()
-        if r == robot and k < j:
-            return True
-        nxt = [(r, k + 1)] if k < horizons[r] else []
-        nxt += links_out.get((r, k), [])
-        for into in starts.get((r, k), ()):
-            if into == target:
-                return True
-            nxt.append(into)
-        for node in nxt:
-            if node not in seen:
-                seen.add(node)
-                todo.append(node)
-    return False
+def _implied(order: Precedence, horizons, links_out, starts, source: Node, target: Node) -> bool:
+    """Whether `source` completes before `target` starts by a way that leaves it through its
+    next step, a message it sends or a kept edge in `starts` (:func:`_reduce`)."""
+    (r, k), (robot, j) = source, target
+    if r == robot and k < j:
+        return True
+    onward = starts.get(source, [])
+    if target in onward:  # an equal edge, kept
+        return True
+    nxt = [(r, k + 1)] if k < horizons[r] else []
+    return any(order.before_start(node, target) for node in (*nxt, *links_out.get(source, ()), *onward))
 
 
 def make_team_safe(
