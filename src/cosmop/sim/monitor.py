@@ -42,7 +42,7 @@ def _touching(world: World) -> set[tuple[int, str]]:
     boxes, names = world.boxes()
     wall_gap, box_gap = robot_gaps(world.pose[:, :2], world.robot_half, world.walls, boxes, None)
     R = len(world.robot_ids)
-    own = len(names) - R - len(world.walkers) + np.arange(R)  # each robot's own box: no contact
+    own = world.first_robot_box(len(names)) + np.arange(R)  # each robot's own box: no contact
     box_gap[np.arange(R), own] = np.inf
     # one pass over the touching pairs (a few), not one per robot and kind of obstacle
     walls = zip(*np.nonzero(wall_gap <= TOUCH), strict=True)

@@ -236,7 +236,7 @@ class World:
         """The resting objects' boxes, every box's name and which boxes are robots or people, as
         :meth:`obstacles` lists them; they change only when an object is picked or dropped, so
         they are kept until then."""
-        key = (self.carried_by.tobytes(), self.object_xy.tobytes())
+        key = self._layout_now()
         if self._layout_key != key:
             resting = np.flatnonzero(self.carried_by < 0)
             names = tuple(self.object_ids[j] for j in resting) + self.robot_ids + self.human_ids
@@ -244,12 +244,21 @@ class World:
             self._layout = (self.resting_boxes(), names, np.arange(len(names)) >= len(resting))
         return self._layout
 
+    def _layout_now(self) -> tuple[bytes, bytes]:
+        """Where the objects are and who carries them: the layout changes only when it does."""
+        return self.carried_by.tobytes(), self.object_xy.tobytes()
+
+    def first_robot_box(self, count: int) -> int:
+        """Where the robots' boxes begin among `count` sensed boxes (:meth:`obstacles`,
+        :meth:`boxes`): after the resting objects', before the people's, in robot order."""
+        return count - len(self.robot_ids) - len(self.walkers)
+
     def with_motion(self, sensed: Obstacles) -> Obstacles:
         """`sensed` with the velocities (mm/s; sensed, for prediction only) and acceleration
         limits (mm/s^2) its boxes have now: resting objects and parked robots 0, people an
         unknown acceleration (``inf``)."""
-        n_objects = len(sensed.names) - len(self.robot_ids) - len(self.walkers)
-        robots = slice(n_objects, n_objects + len(self.robot_ids))
+        first = self.first_robot_box(len(sensed.names))
+        robots = slice(first, first + len(self.robot_ids))
         velocity = np.zeros((len(sensed.names), 2))
         heading = self.pose[:, 2]
         velocity[robots, 0], velocity[robots, 1] = self.v * np.cos(heading), self.v * np.sin(heading)
@@ -268,7 +277,7 @@ class World:
         each of the robots `robots` only: the robots' boxes follow the resting objects', in
         robot order."""
         rows = np.arange(len(self.robot_ids)) if robots is None else np.asarray(robots)
-        first = len(sensed.names) - len(self.robot_ids) - len(self.walkers)
+        first = self.first_robot_box(len(sensed.names))
         own = np.zeros((len(rows), len(sensed.names)), dtype=bool)
         own[np.arange(len(rows)), first + rows] = True
         return own
@@ -282,7 +291,7 @@ class World:
         points = np.asarray(points, dtype=float).reshape(-1, 2)
         if len(points) > _MEMO_POINTS:
             return self._measure_static_gaps(points, half)
-        key = (points.tobytes(), float(half), self.carried_by.tobytes(), self.object_xy.tobytes())
+        key = (points.tobytes(), float(half), *self._layout_now())
         gap = self._static_memo.get(key)
         if gap is None:
             if len(self._static_memo) >= _MEMO:
