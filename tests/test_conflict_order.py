@@ -265,8 +265,8 @@ def test_the_cores_the_search_finds_are_cores():
 
 
 def _assert_same_order(built: Precedence, at_once: Precedence) -> None:
-    assert np.array_equal(built.done_flat, at_once.done_flat)
-    assert np.array_equal(built.begin_flat, at_once.begin_flat)
+    assert np.array_equal(built.done_bits, at_once.done_bits)
+    assert np.array_equal(built.begin_bits, at_once.begin_bits)
     assert np.array_equal(built.finish_flat, at_once.finish_flat)
     assert np.array_equal(built.started_flat, at_once.started_flat)
 

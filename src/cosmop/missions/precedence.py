@@ -24,6 +24,14 @@ its predecessors are complete, every execution that blocks ends in the same stat
 edges allow is therefore a shortest blocking word (every blocking run completes all of
 :math:`M`).
 
+**Representation.** Every step has a row (robot by robot, instants 0 to K+1), and its clocks
+are kept as sets of rows, bit masks in Python integers: the steps that complete before it
+starts, and those that complete by its completion.  A set closed under each robot's program
+order is the vector clock (the number of a robot's steps in it is its entry), and the maximum of
+two clocks is the union of the sets: one integer operation, where a vector of one entry per
+robot costs a NumPy call.  Packed copies in NumPy (:attr:`Precedence.done_bits`,
+:attr:`Precedence.begin_bits`) answer many questions at once.
+
 Times: with the expected duration of every step (:mod:`cosmop.planning.timing`) and every
 robot starting at 0, :attr:`Precedence.finish` is the earliest completion of each step and
 :attr:`Precedence.makespan` the team's.
@@ -32,7 +40,7 @@ robot starting at 0, :attr:`Precedence.finish` is the earliest completion of eac
 from __future__ import annotations
 
 import heapq
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -42,7 +50,7 @@ __all__ = ["Link", "Node", "Precedence"]
 Node = tuple[str, int]
 """A step of a plan: ``(robot, instant)``, instants 1..K (0 is the start)."""
 
-_NEVER: Node = ("", -1)  # the source of a message nobody sends
+_NEVER = -1  # the row of the source of a message nobody sends
 
 
 @dataclass(frozen=True)
@@ -82,8 +90,24 @@ class Precedence:
         When not complete: robot -> the first instant it can never complete.
     order : list of Node
         The steps that can complete, in an order the edges allow.
-    finish : dict
-        Robot -> array of earliest completion times, index = instant (0 for the start).
+    finish, started : dict
+        Robot -> array of earliest completion (start) times, index = instant (0 for the start;
+        ``started`` also at K+1, the end of the plan).
+    offsets : dict
+        Robot -> the row of its instant 0; instant *k* is the row ``offsets[robot] + k``.
+    done_bits, begin_bits : numpy.ndarray
+        ``(rows, bytes)`` uint8: row by row, the steps that complete by the step's completion
+        (before its start), as little-endian bit sets of rows (:meth:`completes_before`).
+    finish_flat, started_flat : numpy.ndarray
+        The times of all rows.
+
+    Examples
+    --------
+    >>> order = Precedence({"A": 2, "B": 2}, [Link("m", "A", 1, "B", 2)])
+    >>> order.precedes(("A", 1), ("B", 2)), order.precedes(("A", 2), ("B", 2))
+    (True, False)
+    >>> order.makespan
+    2.0
     """
 
     def __init__(
@@ -96,83 +120,115 @@ class Precedence:
         self.robots = tuple(horizons)
         self.column = {r: n for n, r in enumerate(self.robots)}
         self.horizons = dict(horizons)
-        self._into_done: dict[Node, list[Node]] = {}
-        self._into_start: dict[Node, list[Node]] = {}
-        for link in links:
-            if link.wait is not None and link.receiver in self.column:
-                source = (link.sender, link.send) if link.send is not None else _NEVER
-                self._into_done.setdefault((link.receiver, link.wait), []).append(source)
-        for source, target in starts:
-            self._into_start.setdefault(target, []).append(source)
-        self._succ: dict[Node, list[tuple[Node, str]]] = {}
-        for kind, table in (("begin", self._into_start), ("done", self._into_done)):
-            for target, sources in table.items():
-                for source in sources:
-                    self._succ.setdefault(source, []).append((target, kind))
+        sizes = [self.horizons[r] + 2 for r in self.robots]
+        self.offsets = dict(zip(self.robots, np.cumsum([0, *sizes]).tolist()[:-1], strict=True))
+        self.size = sum(sizes)
         self.durations = {
             r: np.asarray(durations[r] if durations is not None else np.ones(k), dtype=float)
             for r, k in self.horizons.items()
         }
+        self._node: list[Node] = [(r, k) for r in self.robots for k in range(self.horizons[r] + 2)]
+        self._next: list[int | None] = [None] * self.size  # the robot's next step
+        self._dur = [0.0] * self.size
+        self._last = {o + self.horizons[r] for r, o in self.offsets.items() if self.horizons[r]}
+        for r, o in self.offsets.items():
+            for k in range(self.horizons[r]):
+                self._next[o + k] = o + k + 1
+                self._dur[o + k + 1] = float(self.durations[r][k])
+        self._into_done: dict[int, list[int]] = {}
+        self._into_start: dict[int, list[int]] = {}
+        self._succ: dict[int, list[tuple[int, bool]]] = {}  # row -> (row after it, whether done)
+        for link in links:
+            if link.wait is not None and link.receiver in self.column:
+                source = self._source((link.sender, link.send)) if link.send is not None else _NEVER
+                target = self._row((link.receiver, link.wait))
+                self._into_done.setdefault(target, []).append(source)
+                self._succ.setdefault(source, []).append((target, True))
+        self._link([(self._source(s), self._row(t)) for s, t in starts if t[0] in self.column])
         self._run()
+        n = (self.size + 7) // 8
+        self.done_bits = np.zeros((self.size, n), dtype=np.uint8)
+        self.begin_bits = np.zeros((self.size, n), dtype=np.uint8)
+        self.finish_flat = np.zeros(self.size)
+        self.started_flat = np.zeros(self.size)
+        everything = list(range(self.size))
+        self._mirror(everything, everything)
+        self.finish = {r: self.finish_flat[o : o + self.horizons[r] + 1] for r, o in self.offsets.items()}
+        self.started = {r: self.started_flat[o : o + self.horizons[r] + 2] for r, o in self.offsets.items()}
+
+    def _row(self, node: Node) -> int:
+        r, k = node
+        return self.offsets[r] + min(max(k, 0), self.horizons[r] + 1)
+
+    def _source(self, node: Node) -> int:
+        """The row of a step edges leave from; a step that never completes is :data:`_NEVER`."""
+        r, k = node
+        return _NEVER if r not in self.column or k > self.horizons[r] else self._row(node)
 
     # -- construction -------------------------------------------------------------------------
 
     def _run(self) -> None:
-        n = len(self.robots)
-        # one flat table per quantity (rows: robot by robot), with per-robot views into it, so
-        # that many queries can be answered at once (:attr:`done_rows`, :attr:`begin_rows`)
-        sizes = [self.horizons[r] + 2 for r in self.robots]
-        self.offsets = dict(zip(self.robots, np.cumsum([0, *sizes]).tolist()[:-1], strict=True))
-        self.done_flat = np.zeros((sum(sizes), n), dtype=np.int64)
-        self.begin_flat = np.zeros((sum(sizes), n), dtype=np.int64)
-        self.finish_flat = np.zeros(sum(sizes))
-        self.started_flat = np.zeros(sum(sizes))
-        self.done, self.begin, self.finish, self.started = {}, {}, {}, {}
-        for r, k in self.horizons.items():
-            o = self.offsets[r]
-            self.done[r] = self.done_flat[o : o + k + 1]
-            self.begin[r] = self.begin_flat[o : o + k + 2]
-            self.finish[r] = self.finish_flat[o : o + k + 1]
-            self.started[r] = self.started_flat[o : o + k + 2]
+        self._D, self._B = [0] * self.size, [0] * self.size  # the clocks as sets of rows
+        self._F, self._S = [0.0] * self.size, [0.0] * self.size  # finish and start times
         progress = dict.fromkeys(self.robots, 0)  # instants completed
         self.order: list[Node] = []
         changed = True
         while changed:
             changed = False
             for r in self.robots:
-                while progress[r] < self.horizons[r] and self._ready((r, progress[r] + 1), progress):
+                o = self.offsets[r]
+                while progress[r] < self.horizons[r] and self._ready(o + progress[r] + 1, progress):
                     progress[r] += 1
-                    self._complete(r, progress[r])
+                    self._complete(o + progress[r])
                     changed = True
         for r in self.robots:  # "start of K+1" = after the whole plan
-            k = progress[r]
+            k, o = progress[r], self.offsets[r]
             if k == self.horizons[r]:
-                self.begin[r][k + 1] = self.done[r][k]
-                self.started[r][k + 1] = self.finish[r][k]
+                self._B[o + k + 1], self._S[o + k + 1] = self._D[o + k], self._F[o + k]
         self.stuck = {r: progress[r] + 1 for r in self.robots if progress[r] < self.horizons[r]}
         self.complete = not self.stuck
+        # a topological order of the steps (kept by _place): the starts, the steps in the order
+        # they completed, then the rest
+        first = [self.offsets[r] for r in self.robots] + [self._row(node) for node in self.order]
+        self._ord = [0] * self.size
+        for position, row in enumerate(dict.fromkeys([*first, *range(self.size)])):
+            self._ord[row] = position
 
-    def _ready(self, node: Node, progress: Mapping[str, int]) -> bool:
-        sources = self._into_start.get(node, []) + self._into_done.get(node, [])
-        return all(s != _NEVER and s[0] in progress and progress[s[0]] >= s[1] for s in sources)
+    def _ready(self, row: int, progress: Mapping[str, int]) -> bool:
+        sources = self._into_start.get(row, []) + self._into_done.get(row, [])
+        node = self._node
+        return all(s != _NEVER and progress[node[s][0]] >= node[s][1] for s in sources)
 
-    def _complete(self, r: str, k: int) -> None:
-        clock = self.done[r][k - 1].copy()
-        t = self.finish[r][k - 1]
-        for s, i in self._into_start.get((r, k), ()):
-            np.maximum(clock, self.done[s][i], out=clock)
-            t = max(t, self.finish[s][i])
-        self.begin[r][k] = clock
-        self.started[r][k] = t
-        done = clock.copy()
-        t_done = t + self.durations[r][k - 1]
-        for s, i in self._into_done.get((r, k), ()):
-            np.maximum(done, self.done[s][i], out=done)
-            t_done = max(t_done, self.finish[s][i])
-        done[self.column[r]] = k
-        self.done[r][k] = done
-        self.finish[r][k] = t_done
-        self.order.append((r, k))
+    def _complete(self, row: int) -> None:
+        D, F = self._D, self._F
+        clock, t = D[row - 1], F[row - 1]
+        for s in self._into_start.get(row, ()):
+            clock, t = clock | D[s], max(t, F[s])
+        self._B[row], self._S[row] = clock, t
+        done, t_done = clock | (1 << row), t + self._dur[row]
+        for s in self._into_done.get(row, ()):
+            done, t_done = done | D[s], max(t_done, F[s])
+        D[row], F[row] = done, t_done
+        self.order.append(self._node[row])
+
+    def _mirror(self, done: list[int], begin: list[int]) -> None:
+        """Copy the clocks and times of the rows `done` (completion) and `begin` (start) to
+        the NumPy tables."""
+        n = self.done_bits.shape[1]
+        for rows, masks, times, bits, flat in (
+            (done, self._D, self._F, self.done_bits, self.finish_flat),
+            (begin, self._B, self._S, self.begin_bits, self.started_flat),
+        ):
+            if rows:
+                packed = b"".join([masks[r].to_bytes(n, "little") for r in rows])
+                bits[rows] = np.frombuffer(packed, dtype=np.uint8).reshape(len(rows), n)
+                flat[rows] = [times[r] for r in rows]
+
+    def _mirror_log(self, log: list) -> None:
+        """:meth:`_mirror` the rows an undo log changed."""
+        D = self._D
+        changed = [(entry[0], entry[1] is D) for entry in log if entry[0] is not None]
+        self._mirror([r for r, done in changed if done], [r for r, done in changed if not done])
 
     # -- adding start edges one at a time (the ordering search) ---------------------------------
 
@@ -180,51 +236,27 @@ class Precedence:
         """Add the start edge ``((A, i), (B, j))`` and update clocks and times incrementally.
 
         Clocks and times only grow, so the change propagates from B's step j to the steps after
-        it with maxima, each step raised once, by the steps it waits for that changed.  They are
-        visited by the sum of their clock before the edge: every path from B's step j uses old
-        edges only (the order stays acyclic), and along an old edge that sum grows (the step
-        after counts itself, the one before cannot).  The order must stay acyclic (check
+        it with maxima, each step raised once, by the steps it waits for that changed, in the
+        order's topological order (:meth:`_place`).  The order must stay acyclic (check
         :meth:`would_cycle` first) and complete.  Returns an undo log for :meth:`undo`.
         """
-        source, target = edge
-        log = self._link([edge])
-        pending: dict[Node, tuple[list[Node], list[Node]]] = {target: ([source], [])}
-        queue = [(self._rank(target), target)]
-        while queue:
-            for nxt in self._settle(log, heapq.heappop(queue)[1], pending):
-                heapq.heappush(queue, (self._rank(nxt), nxt))
+        source, target = self._source(edge[0]), self._row(edge[1])
+        if not self._place(source, target):
+            raise ValueError(f"the start edge {edge} closes a cycle")
+        log = self._link([(source, target)])
+        self._propagate(log, {target: ([source], [])})
+        self._mirror_log(log)
         return log
-
-    def _settle(self, log: list, node: Node, pending: dict) -> list[Node]:
-        """Raise `node` by the changed steps `pending` holds for it (those it starts after,
-        those it completes after); if its completion changed, it is pending for the steps that
-        wait for it.  The steps newly pending."""
-        starts, dones = pending.pop(node, ((), ()))
-        if not (starts or dones) or not self._recompute(log, node, starts, dones):
-            return []
-        new = []
-        for nxt, kind in self._successors(node):
-            if nxt not in pending:
-                pending[nxt] = ([], [])
-                new.append(nxt)
-            pending[nxt][kind == "done"].append(node)
-        return new
-
-    def _rank(self, node: Node) -> int:
-        """The sum of the clock of `node`: it grows along every edge of the order."""
-        r, k = node
-        return int(self.done_flat[self.offsets[r] + k].sum())
 
     def add_starts(self, edges: Sequence[tuple[Node, Node]]) -> tuple[list, list[int]]:
         """Add start edges in their order, each unless it closes a cycle with those before it,
         as :meth:`would_cycle` then :meth:`add_start` for each in turn would, but in one pass.
 
-        The pass visits the steps the edges can reach in a topological order, recomputing a
-        step only when a step it waits for changed.  Clocks and times are the least fixpoint of
-        the edges taken, whatever the order they are added in, so they are those of one edge at
-        a time.  When the edges close cycles, only an edge inside a strongly connected component
-        of the steps left out of the topological order lies on one: the others go in the pass
-        (none of them is on a cycle, so none would be refused), those one at a time.
+        The edges are placed in the topological order one by one (:meth:`_place` finds those
+        that close a cycle), then the steps they reach are visited in that order, each
+        recomputed once, when a step it waits for changed.  Clocks and times are the least
+        fixpoint of the edges taken, whatever the order they are added in, so they are those of
+        one edge at a time.
 
         Returns
         -------
@@ -233,167 +265,147 @@ class Precedence:
         refused : list of int
             The indices of the edges not added (each closes a cycle with those before it).
         """
-        log = self._link(edges)
-        order, stuck = self._topological({target for _, target in edges})
-        suspects: list[int] = []
-        if stuck:
-            part = self._components(stuck)
-            self.undo(log)
-            suspects = [n for n, (s, t) in enumerate(edges) if s in part and part.get(t) == part[s]]
-            later = set(suspects)
-            safe = [e for n, e in enumerate(edges) if n not in later]
-            log = self._link(safe)
-            order, _ = self._topological({target for _, target in safe})
-        # a step is raised by the steps it waits for that changed; a seed by all of them
-        pending = {
-            (r, k): ([(r, k - 1), *self._into_start.get((r, k), ())], list(self._into_done.get((r, k), ())))
-            for r, k in {target for _, target in edges}
-        }
-        for node in order:
-            self._settle(log, node, pending)
-        refused = []
-        for n in suspects:
-            if self.would_cycle(*edges[n]):
-                refused.append(n)
+        log, refused, targets = [], [], set()
+        for n, (s, t) in enumerate(edges):
+            source, target = self._source(s), self._row(t)
+            if self._place(source, target):
+                log += self._link([(source, target)])
+                targets.add(target)
             else:
-                log += self.add_start(edges[n])
+                refused.append(n)
+        # a step is raised by the steps it waits for that changed; a seed by all of them
+        self._propagate(
+            log,
+            {t: ([t - 1, *self._into_start.get(t, ())], list(self._into_done.get(t, ()))) for t in targets},
+        )
+        self._mirror_log(log)
         return log, refused
 
-    def _link(self, edges: Sequence[tuple[Node, Node]]) -> list:
-        """Put the start `edges` in the order's tables (clocks untouched): their undo log."""
+    def _propagate(self, log: list, pending: dict[int, tuple[list[int], list[int]]]) -> None:
+        """Settle the `pending` steps and every step they change, in topological order.
+
+        `pending` maps a step to the changed steps it starts after and completes after; a step
+        whose completion changes is pending for the steps that wait for it (:meth:`_successors`).
+        """
+        place, recompute, successors = self._ord, self._recompute, self._successors
+        queue = [(place[row], row) for row in pending]
+        heapq.heapify(queue)
+        while queue:
+            row = heapq.heappop(queue)[1]
+            if not recompute(log, row, *pending.pop(row)):
+                continue
+            for after, done in successors(row):
+                if after not in pending:
+                    pending[after] = ([], [])
+                    heapq.heappush(queue, (place[after], after))
+                pending[after][done].append(row)
+
+    def _place(self, source: int, target: int) -> bool:
+        """Keep :attr:`_ord` a topological order with the edge ``source -> target``; ``False``
+        (and nothing changed) when the edge closes a cycle.
+
+        Pearce and Kelly's dynamic topological order: when `target` comes first, the steps it
+        reaches that come before `source` and the steps that reach `source` that come after
+        `target` are the only ones out of order; they swap into the same positions, those that
+        reach `source` first.  Taking an edge back leaves the order topological.
+        """
+        place = self._ord
+        if source == _NEVER or place[source] < place[target]:
+            return True
+        low, high = place[target], place[source]
+        ahead, stack = {target}, [target]
+        while stack:  # reached from target, not after source
+            row = stack.pop()
+            if row == source:
+                return False
+            for nxt, _ in self._successors(row):
+                if nxt not in ahead and place[nxt] <= high:
+                    ahead.add(nxt)
+                    stack.append(nxt)
+        behind, stack = {source}, [source]
+        while stack:  # reaching source, not before target
+            row = stack.pop()
+            for prv in self._predecessors(row):
+                if prv not in behind and place[prv] > low:
+                    behind.add(prv)
+                    stack.append(prv)
+        moved = sorted(behind, key=place.__getitem__) + sorted(ahead, key=place.__getitem__)
+        for row, position in zip(moved, sorted(place[row] for row in moved), strict=True):
+            place[row] = position
+        return True
+
+    def _link(self, edges: Sequence[tuple[int, int]]) -> list:
+        """Put the start `edges` (rows) in the order's tables (clocks untouched): their undo log."""
         log: list = []
         for source, target in edges:
             self._into_start.setdefault(target, []).append(source)
-            self._succ.setdefault(source, []).append((target, "begin"))
-            log.append(("edge", target, source))
+            self._succ.setdefault(source, []).append((target, False))
+            log.append((None, target, source))
         return log
 
-    def _successors(self, node: Node) -> list[tuple[Node, str]]:
-        """The steps that wait for `node`, each with how: the robot's next step and the start
-        edges (``"begin"``), the messages it sends (``"done"``)."""
-        r, k = node
-        nxt = [((r, k + 1), "begin")] if k < self.horizons[r] else []
-        return nxt + self._succ.get(node, [])
+    def _successors(self, row: int) -> list[tuple[int, bool]]:
+        """The steps that wait for `row`, each with whether for its completion: the robot's
+        next step and the start edges (``False``), the messages it sends (``True``)."""
+        nxt = self._next[row]
+        after = self._succ.get(row, [])
+        return after if nxt is None else [(nxt, False), *after]
 
-    def _topological(self, seeds: set[Node]) -> tuple[list[Node], set[Node]]:
-        """The steps reachable from `seeds` in an order the edges allow (Kahn's algorithm), and
-        those left out: the steps on a cycle, and after one (none when there is no cycle)."""
-        waiting = dict.fromkeys(seeds, 0)  # reachable step -> edges into it from reachable steps
-        after: dict[Node, list[Node]] = {}
-        stack = list(seeds)
-        while stack:
-            node = stack.pop()
-            after[node] = [nxt for nxt, _ in self._successors(node)]
-            for nxt in after[node]:
-                if nxt not in waiting:
-                    waiting[nxt] = 0
-                    stack.append(nxt)
-                waiting[nxt] += 1
-        ready = [node for node, count in waiting.items() if count == 0]
-        order = []
-        while ready:
-            node = ready.pop()
-            order.append(node)
-            for nxt in after[node]:
-                waiting[nxt] -= 1
-                if waiting[nxt] == 0:
-                    ready.append(nxt)
-        if len(order) == len(waiting):
-            return order, set()
-        return order, {node for node, count in waiting.items() if count}
+    def _predecessors(self, row: int) -> list[int]:
+        """The steps `row` waits for: the robot's step before, start edges and messages."""
+        before = self._into_start.get(row, []) + [s for s in self._into_done.get(row, ()) if s != _NEVER]
+        return before if self._node[row][1] == 0 else [row - 1, *before]
 
-    def _components(self, steps: set[Node]) -> dict[Node, int]:
-        """The strongly connected components of the order among `steps` (Tarjan's algorithm,
-        without recursion): step -> a number shared by the steps of its component.  An edge
-        lies on a cycle exactly when its two ends share a component."""
-        number: dict[Node, int] = {}
-        low: dict[Node, int] = {}
-        part: dict[Node, int] = {}
-        stack: list[Node] = []
-
-        def visit(node: Node) -> tuple[Node, Iterator[Node]]:
-            number[node] = low[node] = len(number)
-            stack.append(node)
-            return node, (n for n, _ in self._successors(node) if n in steps)
-
-        for root in steps:
-            if root in number:
-                continue
-            work = [visit(root)]
-            while work:
-                node, later = work[-1]
-                for nxt in later:
-                    if nxt not in number:
-                        work.append(visit(nxt))
-                        break
-                    if nxt not in part:  # still on the stack: in the component being built
-                        low[node] = min(low[node], number[nxt])
-                else:
-                    work.pop()
-                    if work:
-                        low[work[-1][0]] = min(low[work[-1][0]], low[node])
-                    if low[node] == number[node]:
-                        while True:
-                            member = stack.pop()
-                            part[member] = number[node]
-                            if member == node:
-                                break
-        return part
-
-    def _recompute(self, log: list, node: Node, starts: list[Node], dones: list[Node]) -> bool:
-        """Raise the clocks and times of `node` to what the steps `starts` (which it starts
+    def _recompute(self, log: list, row: int, starts: list[int], dones: list[int]) -> bool:
+        """Raise the clocks and times of step `row` to what the steps `starts` (which it starts
         after) and `dones` (which it completes after) give; whether its completion changed
-        (what the steps after it read)."""
-        r, k = node
-        col, grew = self.column[r], False
+        (what the steps after it read).  Each raise is :func:`_raise`, written out: this runs
+        once per step an edge changes."""
+        D, F, B, S, grew = self._D, self._F, self._B, self._S, False
         if starts:
-            clock, t = self._latest(starts)
-            if self._raise(log, self.begin[r], k, clock, self.started[r], t):
-                t = float(self.started[r][k] + self.durations[r][k - 1])
-                grew = self._raise(log, self.done[r], k, self.begin[r][k], self.finish[r], t, keep=col)
+            clock, t = D[starts[0]], F[starts[0]]
+            for s in starts[1:]:
+                clock, t = clock | D[s], max(t, F[s])
+            old, old_t = B[row], S[row]
+            if not (t <= old_t + 1e-12 and old | clock == old):
+                log.append((row, B, old, S, old_t))
+                clock, t = old | clock, max(old_t, t)
+                B[row], S[row] = clock, t
+                old, old_t, t = D[row], F[row], t + self._dur[row]
+                if not (t <= old_t + 1e-12 and old | clock == old):
+                    log.append((row, D, old, F, old_t))
+                    D[row], F[row], grew = old | clock, max(old_t, t), True
         if dones:
-            clock, t = self._latest(dones)
-            grew |= self._raise(log, self.done[r], k, clock, self.finish[r], t, keep=col)
-        if grew and k == self.horizons[r]:  # "start of K+1": after the whole plan
-            self._raise(log, self.begin[r], k + 1, self.done[r][k], self.started[r], float(self.finish[r][k]))
+            clock, t = D[dones[0]], F[dones[0]]
+            for s in dones[1:]:
+                clock, t = clock | D[s], max(t, F[s])
+            old, old_t = D[row], F[row]
+            if not (t <= old_t + 1e-12 and old | clock == old):
+                log.append((row, D, old, F, old_t))
+                D[row], F[row], grew = old | clock, max(old_t, t), True
+        if grew and row in self._last:  # "start of K+1": after the whole plan
+            _raise(log, B, S, row + 1, D[row], F[row])
         return grew
-
-    def _latest(self, steps: list[Node]) -> tuple[np.ndarray, float]:
-        """The clock and the time by which all of `steps` have completed."""
-        if len(steps) == 1:
-            s, i = steps[0]
-            return self.done[s][i], float(self.finish[s][i])
-        rows = [self.offsets[s] + i for s, i in steps]
-        return self.done_flat[rows].max(axis=0), float(self.finish_flat[rows].max())
-
-    @staticmethod
-    def _raise(log, clocks, k, clock, times, t, keep: int | None = None) -> bool:
-        """Raise ``clocks[k]`` to at least `clock` (but for its column `keep`) and ``times[k]``
-        to `t`; log the old values.  Whether anything grew."""
-        row = clocks[k]
-        new = np.maximum(clock, row)
-        if keep is not None:
-            new[keep] = row[keep]
-        old = float(times[k])
-        if t <= old + 1e-12 and new.tobytes() == row.tobytes():
-            return False
-        log.append(("row", clocks, k, row.copy(), times, old))
-        row[:] = new
-        times[k] = max(old, t)
-        return True
 
     def undo(self, log: list) -> None:
         """Take back an :meth:`add_start` or :meth:`add_starts` (logs are undone newest first)."""
         for entry in reversed(log):
-            if entry[0] == "edge":
+            if entry[0] is None:
                 self._into_start[entry[1]].pop()
                 self._succ[entry[2]].pop()
             else:
-                _, clocks, k, old, times, t = entry
-                clocks[k] = old
-                times[k] = t
+                row, masks, old, times, t = entry
+                masks[row], times[row] = old, t
+        self._mirror_log(log)
 
     # -- queries -------------------------------------------------------------------------------
+
+    def _has(self, masks: list[int], row: int, node: Node) -> bool:
+        """Whether the set of `row` in `masks` holds ``node = (A, i)``: A's steps up to i (all
+        for ``i <= 0``, none past A's plan)."""
+        a, i = node
+        if i <= 0:
+            return True
+        return i <= self.horizons[a] and bool(masks[row] >> (self.offsets[a] + i) & 1)
 
     def before_start(self, first: Node, then: Node) -> bool:
         """Whether ``first = (A, i)`` always completes before ``then = (B, j)`` starts.
@@ -401,18 +413,18 @@ class Precedence:
         ``j`` may be ``K_B + 1`` (after B's plan); ``j = 0`` is the beginning (never).
         """
         (a, i), (b, j) = first, then
-        if j <= 0 or b not in self.begin or a not in self.column:
+        if j <= 0 or b not in self.column or a not in self.column:
             return False
         if a == b:
             return i < j
-        return bool(self.begin[b][min(j, len(self.begin[b]) - 1)][self.column[a]] >= i)
+        return self._has(self._B, self._row(then), first)
 
     def precedes(self, first: Node, then: Node) -> bool:
         """Whether ``first = (A, i)`` always completes before ``then = (B, j)`` completes."""
         (a, i), (b, j) = first, then
         if a == b:
             return i <= j
-        return bool(j >= 1 and self.done[b][j][self.column[a]] >= i)
+        return j >= 1 and self._has(self._D, self._row(then), first)
 
     def would_cycle(self, first: Node, then: Node) -> bool:
         """Whether the start edge ``first -> then`` closes a cycle: ``then`` must already
@@ -420,14 +432,42 @@ class Precedence:
         (a, i), (b, j) = first, then
         if a == b:
             return j <= i
-        return bool(self.done[a][i][self.column[b]] >= j)
+        return self._has(self._D, self._row(first), then)
+
+    def completed(self, step: Node, robot: str) -> int:
+        """How many of `robot`'s steps always complete by the completion of `step` (its entry
+        in the step's vector clock)."""
+        o, k = self.offsets[robot], self.horizons[robot]
+        return (self._D[self._row(step)] >> (o + 1) & ((1 << k) - 1)).bit_count()
+
+    def places(self, steps: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Where :meth:`completes_before` reads whether the step of row ``steps[n]`` completes
+        before the step of row ``rows[n]``: the byte in the flattened tables and the bit in it.
+        Rows are ``offsets[robot] + instant``; those of instants 0 and K+1 are in no set."""
+        return rows * self.done_bits.shape[1] + (steps >> 3), (steps & 7).astype(np.uint8)
+
+    def completes_before(self, at: np.ndarray, shift: np.ndarray, *, start: bool = False) -> np.ndarray:
+        """Vectorised :meth:`precedes` (:meth:`before_start` with `start`) at the :meth:`places`
+        ``(at, shift)``: whether each step completes before the other completes (starts)."""
+        table = self.begin_bits if start else self.done_bits
+        return (table.reshape(-1)[at] >> shift) & 1 == 1
 
     @property
     def makespan(self) -> float:
         """Earliest time the whole team is done (with the given durations)."""
-        return max((float(f[-1]) for f in self.finish.values()), default=0.0)
+        return max((self._F[o + self.horizons[r]] for r, o in self.offsets.items()), default=0.0)
 
     def start_time(self, node: Node) -> float:
         """Earliest start of step ``(robot, k)`` (``k = K + 1``: the end of its plan)."""
-        r, k = node
-        return float(self.started[r][min(k, len(self.started[r]) - 1)]) if k >= 1 else 0.0
+        return self._S[self._row(node)] if node[1] >= 1 else 0.0
+
+
+def _raise(log: list, masks: list[int], times: list[float], row: int, clock: int, t: float) -> bool:
+    """Raise the set ``masks[row]`` to hold `clock` and ``times[row]`` to `t`; log the old
+    values.  Whether anything grew (a time by more than rounding)."""
+    old, new, old_t = masks[row], masks[row] | clock, times[row]
+    if t <= old_t + 1e-12 and new == old:
+        return False
+    log.append((row, masks, old, times, old_t))
+    masks[row], times[row] = new, max(old_t, t)
+    return True

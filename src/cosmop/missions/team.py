@@ -197,9 +197,7 @@ def _factor_counterexample(factor: DFA, words: Mapping[str, Sequence[str]], prec
     column = factor.event_index()
     needs = {  # occurrence -> per robot, how many of its occurrences must be done before
         (r, p): [
-            sum(1 for k, _ in occurrences[o] if k <= precedence.done[r][kk][precedence.column[o]])
-            if o != r
-            else p
+            sum(1 for k, _ in occurrences[o] if k <= precedence.completed((r, kk), o)) if o != r else p
             for o in robots
         ]
         for r in robots

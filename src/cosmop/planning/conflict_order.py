@@ -242,19 +242,33 @@ class _Implied:
 
     def __init__(self, found: Sequence[Conflict]) -> None:
         self.index = {id(c): n for n, c in enumerate(found)}
-        by_pair: dict[frozenset, list[int]] = {}
-        for n, c in enumerate(found):
-            by_pair.setdefault(frozenset(c.robots), []).append(n)
+        self.found = list(found)
+        # every conflict's ways as (A, i, B, j), robots numbered; its pair of robots numbered in
+        # the order they first appear
+        robots: dict[str, int] = {}
+        pairs: dict[frozenset, int] = {}
+        pair = np.array([pairs.setdefault(frozenset(c.robots), len(pairs)) for c in found], dtype=np.int64)
+        ways = [
+            (n, w, robots.setdefault(a, len(robots)), i, robots.setdefault(b, len(robots)), j)
+            for n, c in enumerate(found)
+            for w, ((a, i), (b, j)) in enumerate(ways_of(c))
+        ]
+        present = np.zeros((len(found), 2), dtype=bool)
+        ends = np.zeros((len(found), 2, 4), dtype=np.int64)
+        if ways:
+            table = np.array(ways, dtype=np.int64)
+            present[table[:, 0], table[:, 1]] = True
+            ends[table[:, 0], table[:, 1]] = table[:, 2:]
         weaker, stronger = [], []
-        for group in by_pair.values():
-            implies = _implications([found[n] for n in group])
+        order = np.argsort(pair, kind="stable")
+        for group in np.split(order, np.flatnonzero(np.diff(pair[order])) + 1) if len(order) else []:
+            implies = _implications(present[group], ends[group])
             # strictly: of two that imply each other, the earlier stands for both
             strict = implies & ((np.arange(len(group))[:, None] < np.arange(len(group))) | ~implies.T)
             np.fill_diagonal(strict, False)
             d, c = np.nonzero(strict)
-            stronger.append(np.asarray(group)[d])
-            weaker.append(np.asarray(group)[c])
-        self.found = list(found)
+            stronger.append(group[d])
+            weaker.append(group[c])
         self.stronger = np.concatenate(stronger) if stronger else np.zeros(0, dtype=np.int64)
         self.weaker = np.concatenate(weaker) if weaker else np.zeros(0, dtype=np.int64)
 
@@ -284,16 +298,10 @@ class _Implied:
         return self.needed([c for c in self.found if id(c) not in gone])
 
 
-def _implications(group: Sequence[Conflict]) -> np.ndarray:
-    """``[d, c]``: whether each way of conflict *d* implies a way of *c* (see :func:`_implied_by`)."""
-    m = len(group)
-    robots = {r: n for n, r in enumerate(sorted({r for c in group for r in c.robots}))}
-    present = np.zeros((m, 2), dtype=bool)
-    ends = np.zeros((m, 2, 4), dtype=np.int64)  # per way: A, i, B, j
-    for n, c in enumerate(group):
-        for w, ((a, i), (b, j)) in enumerate(ways_of(c)):
-            present[n, w] = True
-            ends[n, w] = (robots[a], i, robots[b], j)
+def _implications(present: np.ndarray, ends: np.ndarray) -> np.ndarray:
+    """``[d, c]``: whether each way of conflict *d* implies a way of *c* (:class:`_Implied`),
+    for conflicts between the same two robots: `present` ``(m, 2)`` says which ways they have,
+    `ends` ``(m, 2, 4)`` each way as ``(A, i, B, j)`` with the robots numbered."""
     d, c = ends[:, None, :, None, :], ends[None, :, None, :, :]  # [d, c, d's way, c's way, field]
     match = (
         present[None, :, None, :]

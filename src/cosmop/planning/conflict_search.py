@@ -65,6 +65,7 @@ class Search:
         self.at: dict[int, int] = {}  # conflict -> its place in the trail
         self.aside = np.zeros(len(found), dtype=bool)
         self.hidden = np.zeros(len(found), dtype=bool)
+        self.every = self.live = np.arange(len(found))  # the conflicts not known to be ordered yet
         self._hide()
         self.priority = _priorities(horizons, durations)
         self.cores: dict[int, list[Conflict]] = {}  # id of each conflict set aside -> its core
@@ -90,10 +91,13 @@ class Search:
         """
         dead_ends, kept = 0, True
         while True:
-            open_ = ~self.sides.holds(self.precedence).any(axis=1) & ~self.aside & ~self.hidden
-            ways = self.sides.ways(self.precedence)
-            counts = np.where(open_, ways.sum(axis=1), -1)
-            stuck = np.flatnonzero(counts == 0)
+            # a side that holds keeps holding until something is taken back (_pop)
+            held = self.sides.holds(self.precedence, self.live)
+            live = self.live = self.live[~(held[:, 0] | held[:, 1])]
+            open_ = ~self.aside[live] & ~self.hidden[live]
+            ways = self.sides.ways(self.precedence, live)
+            counts = np.where(open_, ways[:, 0].astype(np.int64) + ways[:, 1], -1)
+            stuck = live[counts == 0]
             if len(stuck):
                 verdict = self._dead_ends(stuck.tolist(), back)
                 if verdict == "choice":
@@ -102,13 +106,14 @@ class Search:
                         return None
                 kept &= verdict != "back"
                 continue
-            forced = np.flatnonzero(counts == 1)
+            at = np.flatnonzero(counts == 1)
+            side = dict(zip(live[at].tolist(), ways[at, 1].tolist(), strict=True))  # the way left
             # the hardest to re-plan first: the likely culprits come last, the least to take back
-            order = sorted(forced.tolist(), key=lambda i: -self.culprits.rank(self.found[i]))
-            self._take_forced([(i, self.sides.edges[i][int(np.argmax(ways[i]))]) for i in order])
-            if len(forced):
+            order = sorted(side, key=lambda i: -self.culprits.rank(self.found[i]))
+            self._take_forced([(i, self.sides.edges[i][int(side[i])]) for i in order])
+            if len(at):
                 continue
-            pool = np.flatnonzero(open_)
+            pool = live[open_]
             if not len(pool):
                 return kept
             i = int(pool[np.argmin(self.sides.expected_start(self.precedence, pool))])
@@ -202,6 +207,7 @@ class Search:
 
     def _pop(self) -> None:
         i, _, log, _ = self.trail.pop()
+        self.live = self.every  # what held may not now
         if not isinstance(log, _Batch):
             self.precedence.undo(log)
         elif log.start == len(self.trail):  # a batch is taken back with its first entry
@@ -358,49 +364,57 @@ class _Sides:
 
     def __init__(self, found: Sequence[Conflict], precedence: Precedence) -> None:
         n = len(found)
-        self.possible = np.zeros((n, 2), dtype=bool)
-        self.x_col = np.zeros((n, 2), dtype=np.int64)
-        self.x_k = np.zeros((n, 2), dtype=np.int64)
-        self.x_row = np.zeros((n, 2), dtype=np.int64)
-        self.y_col = np.zeros((n, 2), dtype=np.int64)
-        self.y_k = np.zeros((n, 2), dtype=np.int64)
-        self.y_row = np.zeros((n, 2), dtype=np.int64)
-        self.same = np.zeros((n, 2), dtype=bool)
-        # where each occupancy's expected start is read (0 when it holds from the beginning)
-        self.first_row = np.zeros((n, 2), dtype=np.int64)
-        self.from_start = np.ones((n, 2), dtype=bool)
         self.edges = [both_ways(c) for c in found]  # each side as a start edge, or None
+        # each side's x last step and y first step: their instants and their rows (also their
+        # bits in the order's sets of steps); where each occupancy's expected start is read
+        x_k, y_k, x_row, y_row = (np.zeros((n, 2), dtype=np.int64) for _ in range(4))
+        possible, same = np.zeros((n, 2), dtype=bool), np.zeros((n, 2), dtype=bool)
+        self.first_row = np.zeros((n, 2), dtype=np.int64)
+        self.from_start = np.ones((n, 2), dtype=bool)  # held from the beginning: starts at 0
         for i, c in enumerate(found):
             for side, x in enumerate((c.a, c.b)):
                 if x.first is not None and x.first[1] >= 1:
-                    r, k = x.first
-                    self.first_row[i, side] = precedence.offsets[r] + min(k, precedence.horizons[r] + 1)
+                    self.first_row[i, side] = _row(precedence, *x.first)
                     self.from_start[i, side] = False
             for side, edge in enumerate(self.edges[i]):
-                if edge is None:
-                    continue
-                (xr, xk), (yr, yk) = edge
-                self.possible[i, side] = True
-                self.x_col[i, side], self.x_k[i, side] = precedence.column[xr], xk
-                self.x_row[i, side] = precedence.offsets[xr] + xk
-                self.y_col[i, side], self.y_k[i, side] = precedence.column[yr], yk
-                self.y_row[i, side] = precedence.offsets[yr] + min(yk, precedence.horizons[yr] + 1)
-                self.same[i, side] = xr == yr
+                if edge is not None:
+                    (xr, xk), (yr, yk) = edge
+                    possible[i, side], same[i, side] = True, xr == yr
+                    x_k[i, side], y_k[i, side] = xk, yk
+                    x_row[i, side], y_row[i, side] = _row(precedence, xr, xk), _row(precedence, yr, yk)
+        # a side within one robot's plan holds or closes a cycle by program order; else as the
+        # order's sets say: x's last step completes before y's first starts (it holds), or y's
+        # first completes before x's last does (it closes a cycle)
+        self.fixed_hold = possible & np.where(same, x_k < y_k, x_k <= 0)
+        self.fixed_way = possible & same & (y_k > x_k)
+        self.by_order = possible & ~same
+        self.hold_at = precedence.places(x_row, y_row)
+        self.cycle_at = precedence.places(y_row, x_row)
 
-    def holds(self, precedence: Precedence) -> np.ndarray:
-        """(n, 2): whether each side is already implied."""
-        implied = precedence.begin_flat[self.y_row, self.x_col] >= self.x_k
-        return self.possible & np.where(self.same, self.x_k < self.y_k, implied)
+    def holds(self, precedence: Precedence, rows: np.ndarray | None = None) -> np.ndarray:
+        """(n, 2): whether each side (of the conflicts `rows`, default all) is already implied."""
+        rows = slice(None) if rows is None else rows
+        at, shift = self.hold_at[0][rows], self.hold_at[1][rows]
+        implied = precedence.completes_before(at, shift, start=True)
+        return self.fixed_hold[rows] | (self.by_order[rows] & implied)
 
     def expected_start(self, precedence: Precedence, rows: np.ndarray) -> np.ndarray:
         """The expected start of the earlier occupancy of each conflict in `rows`, s."""
         started = np.where(self.from_start[rows], 0.0, precedence.started_flat[self.first_row[rows]])
         return started.min(axis=1)
 
-    def ways(self, precedence: Precedence) -> np.ndarray:
-        """(n, 2): whether each side can still be added without closing a cycle."""
-        cycle = precedence.done_flat[self.x_row, self.y_col] >= self.y_k
-        return self.possible & ~np.where(self.same, self.y_k <= self.x_k, cycle)
+    def ways(self, precedence: Precedence, rows: np.ndarray | None = None) -> np.ndarray:
+        """(n, 2): whether each side (of the conflicts `rows`, default all) can still be added
+        without closing a cycle."""
+        rows = slice(None) if rows is None else rows
+        at, shift = self.cycle_at[0][rows], self.cycle_at[1][rows]
+        return self.fixed_way[rows] | (self.by_order[rows] & ~precedence.completes_before(at, shift))
+
+
+def _row(precedence: Precedence, robot: str, k: int) -> int:
+    """The row of ``(robot, k)`` in `precedence`, instants clamped to 0..K+1 (whose bits are
+    in no set: before the plan, and after it)."""
+    return precedence.offsets[robot] + min(max(k, 0), precedence.horizons[robot] + 1)
 
 
 def both_ways(conflict: Conflict) -> list[tuple[Node, Node] | None]:

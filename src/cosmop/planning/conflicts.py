@@ -40,7 +40,7 @@ from cosmop.missions.precedence import Node, Precedence
 from cosmop.planning.plan import RobotPlan, State, _fmt, _point, initial_state
 from cosmop.planning.realisation import at_pose
 from cosmop.scene import Scene
-from cosmop.squares import square, swept_square
+from cosmop.squares import overlap_depths, square, swept_square
 
 __all__ = [
     "Conflict",
@@ -307,6 +307,9 @@ def conflicts(items: Sequence[Occupancy]) -> list[Conflict]:
     tree = STRtree(regions)
     left, right = tree.query(regions, predicate="intersects")
     keep = left < right
+    # shape n is item n's region, shape N + n its body (a robot keeps its clearance from
+    # robots, not from goods)
+    shapes = _geometries(regions + [item.body or item.region for item in items])
     pairs, first, second = [], [], []
     for i, j in zip(left[keep].tolist(), right[keep].tolist(), strict=True):
         a, b = items[i], items[j]
@@ -314,11 +317,25 @@ def conflicts(items: Sequence[Occupancy]) -> list[Conflict]:
             continue
         robots = a.what in a.parties and b.what in b.parties
         pairs.append((a, b))
-        first.append(a.region if robots else a.body or a.region)
-        second.append(b.region if robots else b.body or b.region)
-    # they may only touch (a robot keeps its clearance from robots, not from goods)
-    overlap = shapely.area(shapely.intersection(_geometries(first), _geometries(second))) > 1e-9
-    return [Conflict(a, b) for (a, b), real in zip(pairs, overlap.tolist(), strict=True) if real]
+        first.append(i if robots else len(items) + i)
+        second.append(j if robots else len(items) + j)
+    overlap = _overlap(shapes, first, second)
+    return [Conflict(a, b) for (a, b), real in zip(pairs, overlap, strict=True) if real]
+
+
+def _overlap(shapes: np.ndarray, first: list[int], second: list[int]) -> list[bool]:
+    """Whether the interiors of each pair of `shapes` overlap: the area of their intersection
+    is above 1e-9 mm² (they may only touch).  Convex polygons (all the occupancies' regions)
+    are decided by their overlap depth (:func:`~cosmop.squares.overlap_depths`) unless it is
+    within 1e-6 mm of 0, where they may only touch; those and any other shape by the area."""
+    first_, second_ = np.asarray(first, dtype=np.int64), np.asarray(second, dtype=np.int64)
+    depth = overlap_depths(shapes, first_, second_)
+    overlap = depth > 1e-6
+    unsure = ~(np.abs(depth) > 1e-6)  # NaN too
+    if unsure.any():
+        a, b = shapes[first_[unsure]], shapes[second_[unsure]]
+        overlap[unsure] = shapely.area(shapely.intersection(a, b)) > 1e-9
+    return overlap.tolist()
 
 
 def _geometries(shapes: list[BaseGeometry]) -> np.ndarray:

@@ -180,9 +180,10 @@ def make_team_safe(
     t0 = time.perf_counter()
     settings = settings or ConflictSettings()
     waypoints = {r: {(s.robot[0], s.robot[1]) for s in p.steps} for r, p in plans.items()}
+    walls = shapely.MultiLineString([[w.start, w.end] for w in scene.obstacles]) if scene.obstacles else None
     plans = {
         r: split_drives(
-            p, start_pose(scene, r, starts), settings.segment, _roomy(scene, r, settings.clearance)
+            p, start_pose(scene, r, starts), settings.segment, _roomy(walls, scene, r, settings.clearance)
         )
         for r, p in plans.items()
     }
@@ -224,9 +225,9 @@ def make_team_safe(
     )
 
 
-def _roomy(scene: Scene, robot: str, room: float):
-    """Whether the robot's square at ``(x, y)`` keeps `room` (mm) from every wall."""
-    walls = shapely.MultiLineString([[w.start, w.end] for w in scene.obstacles]) if scene.obstacles else None
+def _roomy(walls, scene: Scene, robot: str, room: float):
+    """Whether the robot's square at ``(x, y)`` keeps `room` (mm) from every wall (`walls`, the
+    scene's obstacles as one geometry, or ``None``)."""
     half = scene.robots[robot].size / 2.0 + room
 
     def roomy(x: float, y: float) -> bool:
