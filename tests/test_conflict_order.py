@@ -358,3 +358,38 @@ def test_the_order_the_search_keeps_is_always_that_of_its_trail(seed, robots, co
     for conflict in list(search.set_aside):
         search.give_back(conflict, budget=200)
     assert checks  # the search took something back
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_the_order_stays_topological_and_answers_in_bulk_as_one_step_at_a_time(seed):
+    # the order keeps its steps in a topological order as edges come and go (each batch, each
+    # take-back), and its packed tables say what `precedes`, `before_start` and `completed` say
+    rng = random.Random(seed)
+    horizons = {f"R{i}": rng.randint(2, 7) for i in range(1, 6)}
+    order = Precedence(horizons, [Link("m", "R1", 1, "R2", 2)])
+    logs = []
+    for _ in range(25):
+        if logs and rng.random() < 0.3:
+            order.undo(logs.pop())
+        else:
+            batch = []
+            for _ in range(rng.randint(1, 5)):
+                a, b = rng.sample(sorted(horizons), 2)
+                batch.append(((a, rng.randint(1, horizons[a])), (b, rng.randint(1, horizons[b]))))
+            logs.append(order.add_starts(batch)[0])
+        place = order._ord
+        for row in range(order.size):
+            assert all(place[row] < place[after] for after, _ in order._successors(row))
+        steps = [(r, k) for r, n in horizons.items() for k in range(1, n + 1)]
+        pairs = [(x, y) for x in steps for y in steps if x[0] != y[0]]
+        rows = np.array([order.offsets[r] + k for r, k in (y for _, y in pairs)])
+        bits = np.array([order.offsets[r] + k for r, k in (x for x, _ in pairs)])
+        done = order.completes_before(*order.places(bits, rows))
+        begun = order.completes_before(*order.places(bits, rows), start=True)
+        assert done.tolist() == [order.precedes(x, y) for x, y in pairs]
+        assert begun.tolist() == [order.before_start(x, y) for x, y in pairs]
+        for step in steps:
+            for robot in horizons:
+                before = [k for r, k in steps if r == robot and order.precedes((r, k), step)]
+                assert order.completed(step, robot) == max(before, default=0)
+    assert any(order.completes_before(*order.places(bits, rows)))  # some steps were ordered

@@ -24,3 +24,16 @@ def test_the_collector_is_paused_and_restored_as_it_was():
         assert not gc.isenabled()  # a caller's choice is kept
     finally:
         gc.enable()
+
+
+def test_the_collector_is_paused_while_a_decorated_function_runs():
+    seen = []
+
+    @collector_paused()
+    def work(n):
+        seen.append(gc.isenabled())
+        return n + 1
+
+    assert work(1) == 2 and work(2) == 3  # each call pauses it anew
+    assert seen == [False, False]
+    assert gc.isenabled()

@@ -24,7 +24,15 @@ import numpy as np
 from shapely.geometry.base import BaseGeometry
 
 from cosmop.missions.precedence import Link, Node
-from cosmop.planning.conflict_search import Culprits, Search, backjump, depth_first, ways_of
+from cosmop.planning.conflict_search import (
+    Culprits,
+    Search,
+    backjump,
+    both_ways,
+    depth_first,
+    way_table,
+    ways_of,
+)
 from cosmop.planning.conflicts import Conflict
 
 __all__ = ["order_conflicts"]
@@ -243,22 +251,11 @@ class _Implied:
     def __init__(self, found: Sequence[Conflict]) -> None:
         self.index = {id(c): n for n, c in enumerate(found)}
         self.found = list(found)
-        # every conflict's ways as (A, i, B, j), robots numbered; its pair of robots numbered in
-        # the order they first appear
-        robots: dict[str, int] = {}
+        # every conflict's ways as (A, i, B, j), robots numbered; its robots numbered in the
+        # order they first appear
         pairs: dict[frozenset, int] = {}
         pair = np.array([pairs.setdefault(frozenset(c.robots), len(pairs)) for c in found], dtype=np.int64)
-        ways = [
-            (n, w, robots.setdefault(a, len(robots)), i, robots.setdefault(b, len(robots)), j)
-            for n, c in enumerate(found)
-            for w, ((a, i), (b, j)) in enumerate(ways_of(c))
-        ]
-        present = np.zeros((len(found), 2), dtype=bool)
-        ends = np.zeros((len(found), 2, 4), dtype=np.int64)
-        if ways:
-            table = np.array(ways, dtype=np.int64)
-            present[table[:, 0], table[:, 1]] = True
-            ends[table[:, 0], table[:, 1]] = table[:, 2:]
+        present, ends = way_table([both_ways(c) for c in found], {})
         weaker, stronger = [], []
         order = np.argsort(pair, kind="stable")
         for group in np.split(order, np.flatnonzero(np.diff(pair[order])) + 1) if len(order) else []:

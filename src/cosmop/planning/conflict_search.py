@@ -19,7 +19,7 @@ from shapely.geometry.base import BaseGeometry
 from cosmop.missions.precedence import Node, Precedence
 from cosmop.planning.conflicts import Conflict, Occupancy, detours, replan_rank
 
-__all__ = ["Culprits", "Search", "backjump", "both_ways", "depth_first", "ways_of"]
+__all__ = ["Culprits", "Search", "backjump", "both_ways", "depth_first", "way_table", "ways_of"]
 
 
 class Search:
@@ -363,25 +363,25 @@ class _Sides:
     """
 
     def __init__(self, found: Sequence[Conflict], precedence: Precedence) -> None:
-        n = len(found)
         self.edges = [both_ways(c) for c in found]  # each side as a start edge, or None
+        offset = np.array([precedence.offsets[r] for r in precedence.robots], dtype=np.int64)
+        end = np.array([precedence.horizons[r] + 1 for r in precedence.robots], dtype=np.int64)
+
+        def row(robot: np.ndarray, k: np.ndarray) -> np.ndarray:  # instants clamped to 0..K+1
+            return offset[robot] + np.clip(k, 0, end[robot])
+
+        # where each occupancy's expected start is read (0 when it holds from the beginning)
+        column = precedence.column
+        firsts = [(column[x.first[0]], x.first[1]) if x.first else (0, 0) for c in found for x in (c.a, c.b)]
+        first = np.array(firsts, dtype=np.int64).reshape(len(found), 2, 2)
+        self.from_start = first[..., 1] < 1
+        self.first_row = np.where(self.from_start, 0, row(first[..., 0], first[..., 1]))
         # each side's x last step and y first step: their instants and their rows (also their
-        # bits in the order's sets of steps); where each occupancy's expected start is read
-        x_k, y_k, x_row, y_row = (np.zeros((n, 2), dtype=np.int64) for _ in range(4))
-        possible, same = np.zeros((n, 2), dtype=bool), np.zeros((n, 2), dtype=bool)
-        self.first_row = np.zeros((n, 2), dtype=np.int64)
-        self.from_start = np.ones((n, 2), dtype=bool)  # held from the beginning: starts at 0
-        for i, c in enumerate(found):
-            for side, x in enumerate((c.a, c.b)):
-                if x.first is not None and x.first[1] >= 1:
-                    self.first_row[i, side] = _row(precedence, *x.first)
-                    self.from_start[i, side] = False
-            for side, edge in enumerate(self.edges[i]):
-                if edge is not None:
-                    (xr, xk), (yr, yk) = edge
-                    possible[i, side], same[i, side] = True, xr == yr
-                    x_k[i, side], y_k[i, side] = xk, yk
-                    x_row[i, side], y_row[i, side] = _row(precedence, xr, xk), _row(precedence, yr, yk)
+        # bits in the order's sets of steps)
+        possible, ends = way_table(self.edges, dict(column))
+        x_k, y_k = ends[..., 1], ends[..., 3]
+        x_row, y_row = row(ends[..., 0], x_k), row(ends[..., 2], y_k)
+        same = ends[..., 0] == ends[..., 2]
         # a side within one robot's plan holds or closes a cycle by program order; else as the
         # order's sets say: x's last step completes before y's first starts (it holds), or y's
         # first completes before x's last does (it closes a cycle)
@@ -411,10 +411,21 @@ class _Sides:
         return self.fixed_way[rows] | (self.by_order[rows] & ~precedence.completes_before(at, shift))
 
 
-def _row(precedence: Precedence, robot: str, k: int) -> int:
-    """The row of ``(robot, k)`` in `precedence`, instants clamped to 0..K+1 (whose bits are
-    in no set: before the plan, and after it)."""
-    return precedence.offsets[robot] + min(max(k, 0), precedence.horizons[robot] + 1)
+def way_table(ways: Sequence[list], number: dict[str, int]) -> tuple[np.ndarray, np.ndarray]:
+    """Every conflict's two ways (:func:`both_ways`) as arrays: whether each exists ``(n, 2)``,
+    and each as ``(A, i, B, j)`` ``(n, 2, 4)``, the robots numbered by `number` (robots it
+    lacks are added, numbered in the order they come)."""
+    table = []
+    for pair in ways:
+        for way in pair:
+            if way is None:
+                table.append((0, 0, 0, 0))
+            else:
+                (a, i), (b, j) = way
+                table.append((number.setdefault(a, len(number)), i, number.setdefault(b, len(number)), j))
+    ends = np.array(table, dtype=np.int64).reshape(len(ways), 2, 4)
+    possible = np.array([way is not None for pair in ways for way in pair], dtype=bool)
+    return possible.reshape(len(ways), 2), ends
 
 
 def both_ways(conflict: Conflict) -> list[tuple[Node, Node] | None]:

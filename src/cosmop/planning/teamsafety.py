@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 import shapely
 
 from cosmop.events import parse_event
+from cosmop.io import collector_paused
 from cosmop.missions.precedence import Link, Node, Precedence
 from cosmop.planning.conflict_order import order_conflicts
 from cosmop.planning.conflicts import (
@@ -145,6 +146,7 @@ def _implied(order: Precedence, horizons, links_out, starts, source: Node, targe
     return any(order.before_start(node, target) for node in (*nxt, *links_out.get(source, ()), *onward))
 
 
+@collector_paused()
 def make_team_safe(
     scene: Scene,
     plans: Mapping[str, RobotPlan],
