@@ -200,15 +200,13 @@ class Precedence:
         return all(s != _NEVER and progress[node[s][0]] >= node[s][1] for s in sources)
 
     def _complete(self, row: int) -> None:
-        D, F = self._D, self._F
-        clock, t = D[row - 1], F[row - 1]
-        for s in self._into_start.get(row, ()):
-            clock, t = clock | D[s], max(t, F[s])
+        clock, t = self._latest([row - 1, *self._into_start.get(row, ())])
         self._B[row], self._S[row] = clock, t
         done, t_done = clock | (1 << row), t + self._dur[row]
-        for s in self._into_done.get(row, ()):
-            done, t_done = done | D[s], max(t_done, F[s])
-        D[row], F[row] = done, t_done
+        if row in self._into_done:
+            more, later = self._latest(self._into_done[row])
+            done, t_done = done | more, max(t_done, later)
+        self._D[row], self._F[row] = done, t_done
         self.order.append(self._node[row])
 
     def _mirror(self, done: list[int], begin: list[int]) -> None:
@@ -358,33 +356,23 @@ class Precedence:
     def _recompute(self, log: list, row: int, starts: list[int], dones: list[int]) -> bool:
         """Raise the clocks and times of step `row` to what the steps `starts` (which it starts
         after) and `dones` (which it completes after) give; whether its completion changed
-        (what the steps after it read).  Each raise is :func:`_raise`, written out: this runs
-        once per step an edge changes."""
-        D, F, B, S, grew = self._D, self._F, self._B, self._S, False
-        if starts:
-            clock, t = D[starts[0]], F[starts[0]]
-            for s in starts[1:]:
-                clock, t = clock | D[s], max(t, F[s])
-            old, old_t = B[row], S[row]
-            if not (t <= old_t + 1e-12 and old | clock == old):
-                log.append((row, B, old, S, old_t))
-                clock, t = old | clock, max(old_t, t)
-                B[row], S[row] = clock, t
-                old, old_t, t = D[row], F[row], t + self._dur[row]
-                if not (t <= old_t + 1e-12 and old | clock == old):
-                    log.append((row, D, old, F, old_t))
-                    D[row], F[row], grew = old | clock, max(old_t, t), True
+        (what the steps after it read)."""
+        D, F, grew = self._D, self._F, False
+        if starts and _raise(log, self._B, self._S, row, *self._latest(starts)):
+            grew = _raise(log, D, F, row, self._B[row], self._S[row] + self._dur[row])
         if dones:
-            clock, t = D[dones[0]], F[dones[0]]
-            for s in dones[1:]:
-                clock, t = clock | D[s], max(t, F[s])
-            old, old_t = D[row], F[row]
-            if not (t <= old_t + 1e-12 and old | clock == old):
-                log.append((row, D, old, F, old_t))
-                D[row], F[row], grew = old | clock, max(old_t, t), True
+            grew |= _raise(log, D, F, row, *self._latest(dones))
         if grew and row in self._last:  # "start of K+1": after the whole plan
-            _raise(log, B, S, row + 1, D[row], F[row])
+            _raise(log, self._B, self._S, row + 1, D[row], F[row])
         return grew
+
+    def _latest(self, rows: Sequence[int]) -> tuple[int, float]:
+        """The clock and the time by which all of `rows` have completed."""
+        D, F = self._D, self._F
+        clock, t = D[rows[0]], F[rows[0]]
+        for s in rows[1:]:
+            clock, t = clock | D[s], max(t, F[s])
+        return clock, t
 
     def undo(self, log: list) -> None:
         """Take back an :meth:`add_start` or :meth:`add_starts` (logs are undone newest first)."""
