@@ -810,7 +810,6 @@ def _escape_ok(
         drivers.limits.braking,
         drivers.limits.cycle,
     )
-    walls, boxes = obstacles.walls, obstacles.boxes
     total = eps[:, None] + V / brk[:, None]  # (U, K): time until standing still
     longest = total.max(axis=1) if longest is None else longest  # (U,): the boxes' horizon
     dt = total / steps

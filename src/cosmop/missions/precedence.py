@@ -350,7 +350,7 @@ class Precedence:
 
     def _predecessors(self, row: int) -> list[int]:
         """The steps `row` waits for: the robot's step before, start edges and messages."""
-        before = self._into_start.get(row, []) + [s for s in self._into_done.get(row, ()) if s != _NEVER]
+        before = [s for s in (*self._into_start.get(row, ()), *self._into_done.get(row, ())) if s != _NEVER]
         return before if self._node[row][1] == 0 else [row - 1, *before]
 
     def _recompute(self, log: list, row: int, starts: list[int], dones: list[int]) -> bool:
