@@ -189,6 +189,41 @@ def test_the_window_drops_far_boxes_without_changing_a_command(seed, clearance, 
         np.testing.assert_array_equal(getattr(pruned, name), getattr(whole, name))
 
 
+@pytest.mark.parametrize("seed", [0, 1, 3])
+def test_one_driver_drops_far_obstacles_without_changing_a_command(seed, monkeypatch):
+    # small arrays (one driver, as most cycles of a small map): one choice of walls and boxes
+    # for the window's score, the same commands as with everything
+    drivers, obstacles, own = _crowd(seed, side=20_000.0)
+    widths = []
+    real = dwa._clearance
+
+    def measuring(d, o, *rest):
+        widths.append(o.boxes.shape[-2])
+        return real(d, o, *rest)
+
+    monkeypatch.setattr(dwa, "_clearance", measuring)
+    rows = [np.array([r]) for r in range(len(drivers.v))]
+    pruned = [dwa_commands(drivers[r], obstacles, ignore=own[r]) for r in rows]
+    assert max(widths) < len(obstacles.boxes) and min(widths) == 0  # some far boxes, at times all
+    settings = DwaSettings()
+    crowd, crowded, crowd_own = _crowd(seed, side=8_000.0)  # boxes near the caps
+    for r in rows:  # what the score reads of the clearance, driver by driver
+        one, sets = crowd[r], crowded.per_driver(1)
+        _, _, V, W = dwa._window(one, settings)
+        t, pts, _ = dwa._arcs(one, V, W, settings)
+        gaps = dwa.robot_gaps(one.pose[:, :2], one.half, sets.walls, sets.boxes, None)
+        near = dwa._far_for_the_score(one, sets, crowd_own[r], t, pts, settings, gaps)
+        caps = (settings.clearance, settings.personal_space)
+        cut, whole = real(one, *near, t, pts), real(one, sets, crowd_own[r], t, pts)
+        for a, b, cap in zip(cut, whole, caps, strict=True):
+            np.testing.assert_array_equal(np.minimum(a, cap), np.minimum(b, cap))
+    monkeypatch.setattr(dwa, "_far_for_the_score", lambda d, o, ignore, *rest: (o, ignore))
+    for r, cut in zip(rows, pruned, strict=True):
+        whole = dwa_commands(drivers[r], obstacles, ignore=own[r])
+        for name in ("v", "w", "safe", "gap"):
+            np.testing.assert_array_equal(getattr(cut, name), getattr(whole, name))
+
+
 @pytest.mark.parametrize(
     ("seed", "side", "batch"), [(2, 8_000.0, dwa._ESCAPE_BATCH), (2, 20_000.0, 3), (0, 20_000.0, 1)]
 )
@@ -221,7 +256,7 @@ def test_the_best_escape_is_the_best_scored_admitted_arc(seed, side, batch, monk
 def test_the_clearance_without_far_obstacles_reads_the_same_up_to_the_caps(seed, one, monkeypatch):
     # what the score reads of the clearance: up to the cap, up to the personal space for
     # movers, and the value itself at or below zero; all drivers at once (large arrays: far
-    # walls and boxes dropped) or one (small arrays: the walls dropped when all are far)
+    # walls and boxes dropped row by row) or one (small arrays: one choice for all rows)
     drivers, obstacles, own = _crowd(seed, side=8_000.0)
     if one is not None:
         drivers, own = drivers[[one]], own[[one]]
@@ -229,14 +264,17 @@ def test_the_clearance_without_far_obstacles_reads_the_same_up_to_the_caps(seed,
     sets = obstacles.per_driver(len(drivers.v))
     _, _, V, W = dwa._window(drivers, settings)
     t, pts, _ = dwa._arcs(drivers, V, W, settings)
-    wall_gap, _ = dwa.robot_gaps(drivers.pose[:, :2], drivers.half, sets.walls, sets.boxes, None)
+    gaps = dwa.robot_gaps(drivers.pose[:, :2], drivers.half, sets.walls, sets.boxes, None)
     measured = []
     real = dwa.point_segment_linf
     monkeypatch.setattr(dwa, "point_segment_linf", lambda *a: measured.append(a) or real(*a))
-    near, near_own = dwa._far_for_the_score(drivers, sets, own, t, pts, settings, wall_gap)
+    near, near_own = dwa._far_for_the_score(drivers, sets, own, t, pts, settings, gaps)
     clear, movers = dwa._clearance(drivers, near, near_own, t, pts)
     if (seed, one) in ((0, 8), (1, 16)):
         assert not measured  # every wall too far: none measured
+    if one is not None:  # small arrays: the boxes too far for the one driver are dropped too
+        assert 0 < near.boxes.shape[-2] < sets.boxes.shape[-2] // 2
+        assert near_own.shape == near.speed.shape
     whole_clear, whole_movers = dwa._clearance(drivers, sets, own, t, pts)  # everything
     np.testing.assert_array_equal(
         np.minimum(clear, settings.clearance), np.minimum(whole_clear, settings.clearance)

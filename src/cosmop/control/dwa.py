@@ -213,18 +213,19 @@ class Obstacles:
     names: tuple[str, ...] = ()
 
     def select(self, walls: np.ndarray, boxes: np.ndarray) -> Obstacles:
-        """The walls and boxes at the indices `walls` and `boxes` (kept in their order)."""
+        """The walls and boxes at the indices `walls` and `boxes` (kept in their order); of
+        one shared set, or of every row of per-driver sets alike."""
 
         def pick(values):
-            return None if values is None else values[boxes]
+            return None if values is None else values[..., boxes, :]
 
         return Obstacles(
-            self.walls[walls],
-            self.boxes[boxes],
-            self.speed[boxes],
+            self.walls[..., walls, :],
+            self.boxes[..., boxes, :],
+            self.speed[..., boxes],
             pick(self.velocity),
-            pick(self.acceleration),
-            pick(self.agents),
+            None if self.acceleration is None else self.acceleration[..., boxes],
+            None if self.agents is None else self.agents[..., boxes],
             tuple(self.names[j] for j in boxes) if self.names else (),
         )
 
@@ -394,7 +395,10 @@ def dwa_commands(
     """
     obstacles = obstacles.per_driver(len(drivers.v))  # one set per driver from here on
     skip = ignore if grip is None else (grip if ignore is None else ignore | grip)
-    wall_gap, box_gap = robot_gaps(drivers.pose[:, :2], drivers.half, obstacles.walls, obstacles.boxes, skip)
+    gaps = robot_gaps(drivers.pose[:, :2], drivers.half, obstacles.walls, obstacles.boxes, None)
+    wall_gap, box_gap = gaps
+    if skip is not None and box_gap.size:
+        box_gap = np.where(skip, np.inf, box_gap)
     safe = _passive_safety(drivers, obstacles, wall_gap, box_gap, settings)
     min_gap = np.minimum(wall_gap.min(axis=1, initial=np.inf), box_gap.min(axis=1, initial=np.inf))
     if not safe.all() and obstacles.boxes.shape[-2]:
@@ -403,7 +407,7 @@ def dwa_commands(
         drivers = _retreat(drivers, obstacles, box_gap, ~safe, settings)
     low, high, V, W = _window(drivers, settings)
     t, pts, th = _arcs(drivers, V, W, settings)
-    near, near_ignore = _far_for_the_score(drivers, obstacles, ignore, t, pts, settings, wall_gap)
+    near, near_ignore = _far_for_the_score(drivers, obstacles, ignore, t, pts, settings, gaps)
     clear, mover_clear = _clearance(drivers, near, near_ignore, t, pts)
     score = _score(drivers, settings, high, V, pts, th, clear, mover_clear)
     w_out = np.zeros(len(drivers.v))
@@ -543,7 +547,7 @@ def _far_for_the_score(
     t: np.ndarray,
     pts: np.ndarray,
     settings: DwaSettings,
-    wall_gap: np.ndarray | None = None,
+    gaps: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> tuple[Obstacles, np.ndarray | None]:
     """`obstacles` (and `ignore`) without the walls and boxes too far to change any arc's score.
 
@@ -557,24 +561,35 @@ def _far_for_the_score(
     (and 1 mm for rounding) is farther than that from every point of every arc, so it is never
     a minimum that counts.
 
-    Small arrays are not worth choosing from; there only the walls are dropped, all of them,
-    when `wall_gap` (``(R, W)``, the gaps now) shows every one of them too far.
+    Large arrays are pruned row by row (:func:`_without_far`).  Small ones are not worth it;
+    there the gaps now, `gaps` (``(R, W)`` and ``(R, M)`` as :func:`robot_gaps` measures them,
+    nothing ignored), drop the walls and boxes too far for every row (one selection for all
+    rows: most cycles, most of the boxes and all of the walls).
     """
     offset = np.abs(pts - drivers.pose[:, None, None, :2]).max(axis=(1, 2, 3))  # (R,)
     cap = max(settings.clearance, 0.0)  # the cap, and at least the gaps at or below zero
     walls = offset[:, None] + cap + 1.0  # walls count up to the cap alone
-    if not _large(pts.size // 2, obstacles):
-        if wall_gap is not None and wall_gap.size and (wall_gap > walls).all():
-            obstacles = replace(obstacles, walls=obstacles.walls[..., :0, :])
-        return obstacles, ignore
     moves = 0.0
     if obstacles.velocity is not None:
         moves = np.hypot(obstacles.velocity[..., 0], obstacles.velocity[..., 1]) * t[-1]
     counts = np.where(obstacles.movers, max(cap, settings.personal_space), cap)
     boxes = offset[:, None] + moves + counts + 1.0  # and so do resting boxes
-    columns = () if ignore is None else ((ignore, False),)
-    kept, taken = _without_far(obstacles, drivers.pose[:, :2], drivers.half, walls, boxes, *columns)
-    return kept, (taken[0] if taken else None)
+    if _large(pts.size // 2, obstacles):
+        columns = () if ignore is None else ((ignore, False),)
+        kept, taken = _without_far(obstacles, drivers.pose[:, :2], drivers.half, walls, boxes, *columns)
+        return kept, (taken[0] if taken else None)
+    if gaps is None:
+        return obstacles, ignore
+    wall_gap, box_gap = gaps
+    if ignore is not None and box_gap.size:
+        box_gap = np.where(ignore, np.inf, box_gap)  # an ignored box is never a minimum
+    # kept: what is not provably too far for some row (a NaN gap is kept)
+    wall_kept, box_kept = ~(wall_gap > walls).all(axis=0), ~(box_gap > boxes).all(axis=0)
+    if wall_kept.all() and box_kept.all():
+        return obstacles, ignore
+    box_index = np.flatnonzero(box_kept)
+    near = obstacles.select(np.flatnonzero(wall_kept), box_index)
+    return near, (None if ignore is None else ignore[:, box_index])
 
 
 def _score(
