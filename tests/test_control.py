@@ -216,3 +216,24 @@ def test_random_walk_is_seeded_and_stays_in_its_area():
         runs.append(np.array(track))
     assert np.array_equal(runs[0], runs[1]) and not np.array_equal(runs[0], runs[2])
     assert (np.abs(runs[0][:, 0]) <= 1000 + 1e-9).all() and (np.abs(runs[0][:, 1]) <= 500 + 1e-9).all()
+
+
+@pytest.mark.parametrize("per_row", [False, True])
+def test_the_retreat_steps_away_else_aside_farther_from_the_box_else_stays(per_row):
+    from cosmop.control.dwa import _open_retreat
+
+    xy = np.array([[0.0, 0.0], [0.0, 5000.0], [0.0, 5000.0], [0.0, 10000.0]])
+    away = np.tile([1.0, 0.0], (4, 1))  # each away from a box on its left
+    delta = np.array([[300.0, 0.0], [300.0, 50.0], [300.0, -50.0], [300.0, 0.0]])  # box to robot
+    walls = np.array(
+        [
+            [250.0, 4000.0, 250.0, 11000.0],  # right of rows 1 to 3: away is blocked
+            [-500.0, 10250.0, 500.0, 10250.0],  # above and below row 3: boxed in
+            [-500.0, 9750.0, 500.0, 9750.0],
+        ]
+    )
+    if per_row:
+        walls = np.repeat(walls[None], 4, axis=0)
+    out = _open_retreat(xy, np.full(4, 100.0), away, delta, walls, 200.0)
+    # free: away; blocked: aside, the side the robot already stands off the box first; else put
+    np.testing.assert_array_equal(out, [[200.0, 0.0], [0.0, 5200.0], [0.0, 4800.0], [0.0, 10000.0]])

@@ -18,10 +18,11 @@ extended in the paper):
 The safety of step 2 does not depend on the score: the score only chooses *where* to go among
 arcs the safety rule admits.  Everything is vectorised over robots, arcs and obstacles.
 
-When the arrays are large, steps 2 and 4 measure less and answer the same, bit for bit: each
-drops the obstacles it has proved too far to decide anything (:func:`_far_for_the_score`,
-:func:`_far_for_escape`), and the escape arcs of step 2 are checked best score first, a few at
-a time, until one is admitted (:func:`_best_escapes`): only the best admitted arc is taken.
+Steps 2 and 4 measure less and answer the same, bit for bit: each drops the obstacles it has
+proved too far to decide anything (:func:`_far_for_the_score`, :func:`_far_for_escape`; on
+small arrays only the score does, with one choice for all robots), and the escape arcs of step
+2 are checked best score first, a few at a time, until one is admitted (:func:`_best_escapes`):
+only the best admitted arc is taken.
 Units: mm, mm/s, radians and rad/s inside; degrees at the interfaces of :mod:`cosmop.sim`.
 """
 
@@ -647,20 +648,13 @@ def _open_retreat(xy, half, away, delta, walls, reach: float) -> np.ndarray:
     other = np.where(away[:, :1] != 0, [[0.0, 1.0]], [[1.0, 0.0]])
     side = np.sign((delta * other).sum(axis=1, keepdims=True))
     side[side == 0] = 1.0
-    options = [away, other * side, -other * side]
-    out = xy.copy()
-    chosen = np.zeros(len(xy), dtype=bool)
-    for direction in options:
-        point = xy + direction * reach
-        free = (
-            np.ones(len(xy), dtype=bool)
-            if not walls.shape[-2]
-            else (point_segment_linf(point, walls).min(axis=1) - half) >= 0.0
-        )
-        take = free & ~chosen
-        out[take] = point[take]
-        chosen |= take
-    return out
+    points = xy[:, None, :] + np.stack([away, other * side, -other * side], axis=1) * reach  # (U, 3, 2)
+    if not walls.shape[-2]:
+        return points[:, 0]
+    free = (point_segment_linf(points, walls).min(axis=-1) - half[:, None]) >= 0.0  # all three at once
+    first = np.argmax(free, axis=1)  # the first free option, in order
+    rows = np.arange(len(xy))
+    return np.where(free[rows, first][:, None], points[rows, first], xy)
 
 
 def _window(drivers: Drivers, settings: DwaSettings) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
