@@ -179,3 +179,18 @@ def test_the_reason_names_a_minimal_set_of_obstacles_and_the_sides_tried(small):
     res = synthesize(small.scene, "R1", small.mission.tasks["R1"], max_horizon=6)
     assert not res.feasible and 0 < len(res.blocking) <= 3
     assert not any(b.startswith("wall 0") or b.startswith("wall 1") for b in res.blocking)
+
+
+def test_a_synthesis_runs_with_the_collector_paused(small, monkeypatch):
+    # the encoding makes many objects and next to no cycles: the collector waits (it walked
+    # the whole heap again and again, a quarter of a synthesis in a Dask worker)
+    import gc
+
+    import cosmop.planning.synthesis as synthesis
+
+    seen = []
+    real = synthesis._shortest_plan
+    monkeypatch.setattr(synthesis, "_shortest_plan", lambda *a: seen.append(gc.isenabled()) or real(*a))
+    res = synthesize(small.scene, "R2", small.mission.tasks["R2"])
+    assert res.feasible and seen == [False]
+    assert gc.isenabled()  # and running again after it
