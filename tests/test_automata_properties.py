@@ -1071,3 +1071,28 @@ def test_explore_matches_breadth_first_search() -> None:
     stopped = _index.explore(0, successors, 2, stop=lambda c: c == 150)
     assert stopped.codes[stopped.stopped_at] == 150
     assert len(stopped.word_to(stopped.stopped_at)) == 7  # depth of 150 in the tree
+
+
+@pytest.mark.parametrize("n", [1000, (1 << 16) + 3])
+def test_coreachable_is_the_same_on_both_sides_of_16_bit_state_numbers(n: int) -> None:
+    # up to 2**16 states the targets are sorted as 16-bit keys (radix), above as they are
+    from cosmop.automata._index import coreachable
+
+    rng = np.random.default_rng(n)
+    delta = rng.integers(-1, n, (n, 3)).astype(np.int32)
+    delta[rng.random((n, 3)) < 0.6] = -1  # sparse: many states reach no target
+    targets = rng.choice(n, 5, replace=False)
+    seen = np.zeros(n, dtype=bool)  # the same question by a plain backward search
+    todo = list(targets)
+    seen[targets] = True
+    sources = [[] for _ in range(n)]
+    for s, t in zip(*np.nonzero(delta >= 0), strict=True):
+        sources[delta[s, t]].append(s)
+    while todo:
+        for s in sources[todo.pop()]:
+            if not seen[s]:
+                seen[s] = True
+                todo.append(s)
+    got = coreachable(delta, targets)
+    np.testing.assert_array_equal(got, seen)
+    assert 0 < got.sum() < n

@@ -258,7 +258,9 @@ def coreachable(delta: np.ndarray, targets: np.ndarray) -> np.ndarray:
     valid = flat >= 0
     edges = np.flatnonzero(valid)
     dst = flat[edges]  # int32: sorts about twice as fast as int64
-    rsrc = edges[np.argsort(dst, kind="stable")] // m  # sources grouped by target
+    # up to 2**16 states the targets fit 16 bits, which NumPy sorts stably by radix (linear)
+    keys = dst.astype(np.uint16) if n <= 1 << 16 else dst
+    rsrc = edges[np.argsort(keys, kind="stable")] // m  # sources grouped by target
     ptr = np.zeros(n + 1, dtype=np.int64)
     np.cumsum(np.bincount(dst, minlength=n), out=ptr[1:])
     seen = np.zeros(n, dtype=bool)
