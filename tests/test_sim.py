@@ -292,6 +292,24 @@ def test_a_trace_of_another_tool_may_name_other_things_in_other_frames(tmp_path)
         trace.poses[0, 0, 0] = 1.0
 
 
+def test_a_long_trace_is_written_block_by_block_as_one_document(tmp_path, people_2x2, monkeypatch):
+    # frames go to the file a block at a time; the bytes are those of the whole document at
+    # once, across blocks with and without frames that leave a robot or a speed out
+    import cosmop.traces as traces
+
+    scenario, plans = people_2x2
+    data = simulate(scenario, plans, seed=3, settings=SimSettings(max_time=12)).trace().to_json()
+    for frame in data["frames"][30:45]:  # frames of the second and third blocks below
+        del frame["robots"]["R1"]
+        frame["robots"]["R2"].pop("v")
+    trace = as_trace(data)
+    monkeypatch.setattr(traces, "_FRAMES_PER_BLOCK", 17)
+    trace.save(tmp_path / "t.json")
+    whole = json.dumps(trace.to_json(), separators=(",", ":")) + "\n"
+    assert (tmp_path / "t.json").read_text() == whole
+    assert len(trace.t) > 3 * 17 and "R1" not in json.loads(whole)["frames"][40]["robots"]
+
+
 def test_a_bad_trace_names_the_file_and_the_field(tmp_path):
     bad = {"format": TRACE_FORMAT, "frames": [_frame(0, {"R1": {"pose": [0, 0, 0], "v": "fast"}})]}
     (tmp_path / "bad.json").write_text(json.dumps(bad))
