@@ -1073,7 +1073,7 @@ def test_explore_matches_breadth_first_search() -> None:
     assert len(stopped.word_to(stopped.stopped_at)) == 7  # depth of 150 in the tree
 
 
-@pytest.mark.parametrize("n", [1000, (1 << 16) + 3])
+@pytest.mark.parametrize("n", [1000, 1 << 16, (1 << 16) + 3])
 def test_coreachable_is_the_same_on_both_sides_of_16_bit_state_numbers(n: int) -> None:
     # up to 2**16 states the targets are sorted as 16-bit keys (radix), above as they are
     from cosmop.automata._index import coreachable

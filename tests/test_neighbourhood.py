@@ -224,6 +224,54 @@ def test_one_driver_drops_far_obstacles_without_changing_a_command(seed, monkeyp
             np.testing.assert_array_equal(getattr(cut, name), getattr(whole, name))
 
 
+def _small_scene(rng: np.random.Generator) -> tuple[Drivers, Obstacles, np.ndarray, np.ndarray | None]:
+    """A few drivers among a few walls and boxes (small arrays), some values odd: NaN or inf
+    positions and sizes, some sets per driver (padded), ignored and gripped boxes."""
+    R, W, M = int(rng.integers(1, 4)), int(rng.integers(0, 6)), int(rng.integers(1, 12))
+    side = float(rng.choice([1500.0, 4000.0]))
+    xy = rng.uniform(0, side, (R, 2))
+    start, along = rng.uniform(0, side, (W, 2)), rng.uniform(-3000, 3000, (W, 2))
+    along[np.arange(W), rng.integers(0, 2, W)] = 0.0
+    boxes = np.column_stack([rng.uniform(0, side, (M, 2)), rng.uniform(0, 300, M)])
+    boxes[: min(M, R), :2] = xy[: min(M, R)]  # the drivers' own boxes
+    j = int(rng.integers(0, M))
+    boxes[j, int(rng.integers(0, 3))] = rng.choice([np.nan, np.inf])  # one odd value
+    velocity = rng.uniform(-1500, 1500, (M, 2))
+    obstacles = Obstacles(
+        np.hstack([start, start + along]), boxes, rng.uniform(0, 1500, M), velocity, np.full(M, 500.0)
+    )
+    if R > 1 and rng.random() < 0.5:
+        obstacles = obstacles.take(first_true(rng.random((R, W)) < 0.7), first_true(rng.random((R, M)) < 0.7))
+    M = obstacles.boxes.shape[-2]
+    v = rng.uniform(0, 800, R)
+    drivers = Drivers(
+        pose=np.column_stack([xy, rng.uniform(-np.pi, np.pi, R)]),
+        v=v,
+        half=np.full(R, 200.0),
+        limits=Limits.of([Dynamics()] * R),
+        target=xy + rng.uniform(-3000, 3000, (R, 2)),
+        stop_distance=np.full(R, np.inf),
+        w=np.zeros(R),
+    )
+    ignore = rng.random((R, M)) < 0.3
+    grip = (rng.random((R, M)) < 0.1) if rng.random() < 0.5 else None
+    return drivers, obstacles, ignore, grip
+
+
+def test_small_arrays_drop_far_obstacles_without_changing_a_command(monkeypatch):
+    # several drivers, one choice of columns for all (a union), and odd values: an ignored box
+    # of unknown size is measured as NaN, as it always was, not dropped
+    rng = np.random.default_rng(5)
+    scenes = [_small_scene(rng) for _ in range(150)]
+    with np.errstate(invalid="ignore"):  # the odd values: inf - inf
+        pruned = [dwa_commands(d, o, ignore=ignore, grip=grip) for d, o, ignore, grip in scenes]
+        monkeypatch.setattr(dwa, "_far_for_the_score", lambda d, o, ignore, *rest: (o, ignore))
+        wholes = [dwa_commands(d, o, ignore=ignore, grip=grip) for d, o, ignore, grip in scenes]
+    for cut, whole in zip(pruned, wholes, strict=True):
+        for name in ("v", "w", "safe", "gap"):
+            np.testing.assert_array_equal(getattr(cut, name), getattr(whole, name))
+
+
 @pytest.mark.parametrize(
     ("seed", "side", "batch"), [(2, 8_000.0, dwa._ESCAPE_BATCH), (2, 20_000.0, 3), (0, 20_000.0, 1)]
 )

@@ -583,7 +583,9 @@ def _far_for_the_score(
         return obstacles, ignore
     wall_gap, box_gap = gaps
     if ignore is not None and box_gap.size:
-        box_gap = np.where(ignore, np.inf, box_gap)  # an ignored box is never a minimum
+        # an ignored box is measured at infinity, so it is never a minimum (with a size that is
+        # not finite its gap there is NaN, as :func:`_clearance` measures it: kept)
+        box_gap = np.where(ignore & np.isfinite(obstacles.boxes[..., 2]), np.inf, box_gap)
     # kept: what is not provably too far for some row (a NaN gap is kept)
     wall_kept, box_kept = ~(wall_gap > walls).all(axis=0), ~(box_gap > boxes).all(axis=0)
     if wall_kept.all() and box_kept.all():
