@@ -211,7 +211,7 @@ def test_one_driver_drops_far_obstacles_without_changing_a_command(seed, monkeyp
         one, sets = crowd[r], crowded.per_driver(1)
         _, _, V, W = dwa._window(one, settings)
         t, pts, _ = dwa._arcs(one, V, W, settings)
-        gaps = dwa.robot_gaps(one.pose[:, :2], one.half, sets.walls, sets.boxes, None)
+        gaps = dwa.robot_gaps(one.pose[:, :2], one.half, sets.walls, sets.boxes)
         near = dwa._far_for_the_score(one, sets, crowd_own[r], t, pts, settings, gaps)
         caps = (settings.clearance, settings.personal_space)
         cut, whole = real(one, *near, t, pts), real(one, sets, crowd_own[r], t, pts)
@@ -312,7 +312,7 @@ def test_the_clearance_without_far_obstacles_reads_the_same_up_to_the_caps(seed,
     sets = obstacles.per_driver(len(drivers.v))
     _, _, V, W = dwa._window(drivers, settings)
     t, pts, _ = dwa._arcs(drivers, V, W, settings)
-    gaps = dwa.robot_gaps(drivers.pose[:, :2], drivers.half, sets.walls, sets.boxes, None)
+    gaps = dwa.robot_gaps(drivers.pose[:, :2], drivers.half, sets.walls, sets.boxes)
     measured = []
     real = dwa.point_segment_linf
     monkeypatch.setattr(dwa, "point_segment_linf", lambda *a: measured.append(a) or real(*a))

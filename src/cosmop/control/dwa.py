@@ -109,19 +109,16 @@ class DwaCommand:
 
 
 def robot_gaps(
-    centres: np.ndarray, half: np.ndarray, walls: np.ndarray, boxes: np.ndarray, ignore: np.ndarray | None
+    centres: np.ndarray, half: np.ndarray, walls: np.ndarray, boxes: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
-    """L-infinity gaps of robot squares to walls ``(R, W)`` and to boxes ``(R, M)``.
-
-    `ignore` (shape ``(R, M)``) masks boxes a robot does not sense as obstacles (itself, the
-    object in its gripper); their gap is ``inf``.  `walls` and `boxes` are shared by every
-    robot, or one set per robot (:meth:`Obstacles.per_driver`).
+    """L-infinity gaps of robot squares to walls ``(R, W)`` and to boxes ``(R, M)``, every box
+    measured (a caller hides the boxes a robot does not sense for each use of the gaps).
+    `walls` and `boxes` are shared by every robot, or one set per robot
+    (:meth:`Obstacles.per_driver`).
     """
     R = len(centres)
     wall_gap = point_segment_linf(centres, walls) - half[:, None] if walls.shape[-2] else np.zeros((R, 0))
     box_gap = box_gaps(centres, half[:, None], boxes) if boxes.shape[-2] else np.zeros((R, 0))
-    if ignore is not None and box_gap.size:
-        box_gap = np.where(ignore, np.inf, box_gap)
     return wall_gap, box_gap
 
 
@@ -171,7 +168,7 @@ def _without_far(
     tests or minima; those kept are padded at infinity (:meth:`Obstacles.take`), so the
     phase's results are those it has with every obstacle, bit for bit.
     """
-    wall_gap, box_gap = robot_gaps(centres, half, obstacles.walls, obstacles.boxes, None)
+    wall_gap, box_gap = robot_gaps(centres, half, obstacles.walls, obstacles.boxes)
     walls, boxes = first_true(~(wall_gap > wall_beyond)), first_true(~(box_gap > box_beyond))
     return obstacles.take(walls, boxes), tuple(take_columns(v, boxes, fill) for v, fill in columns)
 
@@ -396,7 +393,7 @@ def dwa_commands(
     """
     obstacles = obstacles.per_driver(len(drivers.v))  # one set per driver from here on
     skip = ignore if grip is None else (grip if ignore is None else ignore | grip)
-    gaps = robot_gaps(drivers.pose[:, :2], drivers.half, obstacles.walls, obstacles.boxes, None)
+    gaps = robot_gaps(drivers.pose[:, :2], drivers.half, obstacles.walls, obstacles.boxes)
     wall_gap, box_gap = gaps
     if skip is not None and box_gap.size:
         box_gap = np.where(skip, np.inf, box_gap)

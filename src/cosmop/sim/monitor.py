@@ -40,7 +40,7 @@ def _touching(world: World) -> set[tuple[int, str]]:
     """The pairs (robot index, what it touches) now; ``wall k`` names a wall.  The gripper's
     contact with the object it grips is no contact, unless the two overlap."""
     boxes, names = world.boxes()
-    wall_gap, box_gap = robot_gaps(world.pose[:, :2], world.robot_half, world.walls, boxes, None)
+    wall_gap, box_gap = robot_gaps(world.pose[:, :2], world.robot_half, world.walls, boxes)
     R = len(world.robot_ids)
     own = world.first_robot_box(len(names)) + np.arange(R)  # each robot's own box: no contact
     box_gap[np.arange(R), own] = np.inf
