@@ -336,18 +336,20 @@ class Trace:
         """The robot states of the frames `rows` as the file writes them (this trace already
         :meth:`rounded`)."""
         objects, names = [*self.object_ids, None], self.primitive_names  # carrying -1: objects[-1], None
-        poses = self.poses[rows]
-        v, w = (None if a is None else a[rows] for a in (self.v, self.w))
+        poses, v, w, carrying, primitive, waiting = (
+            None if a is None else a[rows]
+            for a in (self.poses, self.v, self.w, self.carrying, self.primitive, self.waiting)
+        )
         columns = {"pose": poses.tolist()}
         for key, array, to_json in (
-            ("v", self.v, None),
-            ("w", self.w, None),
-            ("carrying", self.carrying, objects.__getitem__),
-            ("primitive", self.primitive, names.__getitem__),
-            ("waiting", self.waiting, None),
+            ("v", v, None),
+            ("w", w, None),
+            ("carrying", carrying, objects.__getitem__),
+            ("primitive", primitive, names.__getitem__),
+            ("waiting", waiting, None),
         ):
             if array is not None:
-                values = array[rows].tolist()
+                values = array.tolist()
                 columns[key] = values if to_json is None else [list(map(to_json, row)) for row in values]
         # NaN (not shown) is looked for value by value only in the arrays that have one
         holes = any(np.isnan(a).any() for a in (poses, v, w) if a is not None and a.dtype.kind == "f")
