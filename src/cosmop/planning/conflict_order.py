@@ -256,18 +256,25 @@ class _Implied:
         pairs: dict[frozenset, int] = {}
         pair = np.array([pairs.setdefault(frozenset(c.robots), len(pairs)) for c in found], dtype=np.int64)
         present, ends = way_table([both_ways(c) for c in found], {})
-        weaker, stronger = [], []
         order = np.argsort(pair, kind="stable")
-        for group in np.split(order, np.flatnonzero(np.diff(pair[order])) + 1) if len(order) else []:
-            implies = _implications(present[group], ends[group])
+        groups = np.split(order, np.flatnonzero(np.diff(pair[order])) + 1) if len(order) else []
+        by_size: dict[int, list[int]] = {}
+        for n, group in enumerate(groups):
+            if len(group) > 1:
+                by_size.setdefault(len(group), []).append(n)
+        found_pairs = [np.zeros((0, 3), dtype=np.int64)]  # (group, stronger, weaker)
+        for size, numbers in by_size.items():  # the groups of one size at once
+            rows = np.stack([groups[n] for n in numbers])
+            implies = _implications(present[rows], ends[rows])
             # strictly: of two that imply each other, the earlier stands for both
-            strict = implies & ((np.arange(len(group))[:, None] < np.arange(len(group))) | ~implies.T)
-            np.fill_diagonal(strict, False)
-            d, c = np.nonzero(strict)
-            stronger.append(group[d])
-            weaker.append(group[c])
-        self.stronger = np.concatenate(stronger) if stronger else np.zeros(0, dtype=np.int64)
-        self.weaker = np.concatenate(weaker) if weaker else np.zeros(0, dtype=np.int64)
+            ahead = np.arange(size)[:, None] < np.arange(size)
+            strict = implies & (ahead | ~implies.transpose(0, 2, 1))
+            strict[:, np.arange(size), np.arange(size)] = False
+            g, d, c = np.nonzero(strict)
+            found_pairs.append(np.stack([np.asarray(numbers)[g], rows[g, d], rows[g, c]], axis=1))
+        table = np.concatenate(found_pairs)
+        table = table[np.lexsort((table[:, 2], table[:, 1], table[:, 0]))]  # group by group
+        self.stronger, self.weaker = table[:, 1].copy(), table[:, 2].copy()
 
     def by(self, conflict: Conflict) -> list[Conflict]:
         """The conflicts that imply `conflict`."""
@@ -296,18 +303,20 @@ class _Implied:
 
 
 def _implications(present: np.ndarray, ends: np.ndarray) -> np.ndarray:
-    """``[d, c]``: whether each way of conflict *d* implies a way of *c* (:class:`_Implied`),
-    for conflicts between the same two robots: `present` ``(m, 2)`` says which ways they have,
-    `ends` ``(m, 2, 4)`` each way as ``(A, i, B, j)`` with the robots numbered."""
-    d, c = ends[:, None, :, None, :], ends[None, :, None, :, :]  # [d, c, d's way, c's way, field]
+    """``[..., d, c]``: whether each way of conflict *d* implies a way of *c*
+    (:class:`_Implied`), for conflicts between the same two robots: `present` ``(..., m, 2)``
+    says which ways they have, `ends` ``(..., m, 2, 4)`` each way as ``(A, i, B, j)`` with the
+    robots numbered (leading axes: groups of conflicts, each on its own)."""
+    # [..., d, c, d's way, c's way, field]
+    d, c = ends[..., :, None, :, None, :], ends[..., None, :, None, :, :]
     match = (
-        present[None, :, None, :]
+        present[..., None, :, None, :]
         & (d[..., 0] == c[..., 0])
         & (d[..., 2] == c[..., 2])
         & (d[..., 1] >= c[..., 1])
         & (d[..., 3] <= c[..., 3])
     )
-    return (match.any(axis=3) | ~present[:, None, :]).all(axis=2)
+    return (match.any(axis=-1) | ~present[..., :, None, :]).all(axis=-1)
 
 
 def _check(solver, labels):
