@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 import shapely
 
-from cosmop.missions.precedence import Link, Precedence
+from cosmop.missions.precedence import Link, Precedence, TakenBack
 from cosmop.planning import conflict_order
 from cosmop.planning.conflict_order import _Implied, _Schedule, order_conflicts
 from cosmop.planning.conflict_search import Culprits, Search, backjump, ways_of
@@ -335,29 +335,149 @@ def test_start_edges_added_in_batches_give_the_order_of_one_at_a_time(seed):
     assert refusals and logs and links  # cycles met, with messages
 
 
+def _assert_trail_holds(search: Search, horizons, durations) -> None:
+    """The search's order is that of its trail's edges, built from scratch; its places and
+    graph follow the trail; every way forced by a cycle has that cycle before it."""
+    edges = [edge for _, edge, _, _ in search.trail]
+    _assert_same_order(search.precedence, Precedence(horizons, (), edges, durations))
+    assert search.at == {i: n for n, (i, _, _, _) in enumerate(search.trail)}
+    assert [pushed[:2] for pushed in search.graph.pushed] == [search.precedence.rows(e) for e in edges]
+    for n, (i, edge, _, reason) in enumerate(search.trail):
+        for other in search.sides.edges[i] if reason is True else ():
+            if other is not None and other != edge and other[0][0] != other[1][0]:
+                assert search.graph.path(*other, before=n) is not None, (n, other)
+
+
 @pytest.mark.parametrize(
-    ("seed", "robots", "conflicts"), [(0, 4, 24), (72, 5, 40), (147, 5, 40), (349, 5, 40)]
+    ("seed", "robots", "conflicts"), [(0, 4, 24), (72, 5, 40), (147, 5, 40), (349, 5, 40), (3, 8, 120)]
 )
 def test_the_order_the_search_keeps_is_always_that_of_its_trail(seed, robots, conflicts, monkeypatch):
     # runs of forced ways are added in one pass and taken back as one, also when the search
-    # jumps back into the middle of one: after every take-back the clocks must be those of the
-    # edges left on the trail, built from scratch
+    # jumps back into the middle of one; a dead end takes back only what needs what goes and
+    # keeps the rest in place: after every take-back the clocks must be those of the edges left
+    # on the trail, built from scratch, and every reason kept must still hold
     found, horizons, durations = _team(seed, robots=robots, conflicts=conflicts)
     checks = []
-    back_to = Search._back_to
+    back_to, retract = Search._back_to, Search._retract
 
-    def checked(search, place):
+    def checked_back_to(search, place):
         back_to(search, place)
-        edges = [edge for _, edge, _, _ in search.trail]
-        _assert_same_order(search.precedence, Precedence(horizons, (), edges, durations))
-        checks.append(place)
+        _assert_trail_holds(search, horizons, durations)
+        checks.append("back")
 
-    monkeypatch.setattr(Search, "_back_to", checked)
+    def checked_retract(search, place, gone, first=None):
+        kept_before = [e[:2] for e in search.trail[:place]]
+        retract(search, place, gone, first)
+        assert [e[:2] for e in search.trail[:place]] == kept_before[: len(search.trail)]
+        _assert_trail_holds(search, horizons, durations)
+        checks.append("choice" if first else "core")
+
+    monkeypatch.setattr(Search, "_back_to", checked_back_to)
+    monkeypatch.setattr(Search, "_retract", checked_retract)
     search = Search(found, _Implied(found), (horizons, [], [], durations), Culprits(None))
     assert search.run(budget=200) is not None
     for conflict in list(search.set_aside):
         search.give_back(conflict, budget=200)
-    assert checks  # the search took something back
+    assert "core" in checks  # the search took something back
+    search._back_to(0)  # the undo logs of what was kept in place restore the order without edges
+    _assert_same_order(search.precedence, Precedence(horizons, (), (), durations))
+
+
+def _conflict(a: tuple[str, int, int], b: tuple[str, int, int]) -> Conflict:
+    def occupancy(robot: str, first: int, last: int) -> Occupancy:
+        return Occupancy(
+            robot, frozenset({robot}), shapely.box(0, 0, 1, 1), (robot, first), (robot, last), robot
+        )
+
+    return Conflict(occupancy(*a), occupancy(*b))
+
+
+def test_a_choice_kept_after_a_flip_that_lost_its_other_way_counts_as_forced():
+    # after a choice takes its other way, later choices are kept in place; one of them may have
+    # lost its other way to a cycle by then.  A dead end through it must not jump back to it
+    # (its other way would close a cycle): it counts as forced, and the set is traced again
+    found = [
+        _conflict(("A", 1, 1), ("B", 3, 3)),  # 0: A1 -> B3
+        _conflict(("B", 1, 1), ("A", 3, 3)),  # 1: B1 -> A3
+        _conflict(("A", 1, 2), ("B", 2, 3)),  # 2: A2 -> B2; its other way B3 -> A1 closes a cycle with 0
+        _conflict(("A", 1, 4), ("B", 1, 2)),  # 3: A4 -> B1 closes one with 1, B2 -> A1 one with 2
+    ]
+    horizons, durations = {"A": 4, "B": 4}, {"A": [1.0] * 4, "B": [1.0] * 4}
+    search = Search(found, _Implied(found), (horizons, [], [], durations), Culprits(None))
+    for i in range(3):
+        search._take(i, search.sides.edges[i][0], None)
+    assert search.precedence.would_cycle(*search.sides.edges[2][1])
+    core, choices = search._dead_end_set(3)
+    assert core == {0, 1, 2, 3}
+    assert sorted(choices) == [0, 1]
+    assert search.trail[2][3] is True
+    _assert_trail_holds(search, horizons, durations)
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_start_edges_taken_back_from_the_middle_leave_the_order_of_the_rest(seed):
+    # a dead end keeps in place what does not need the edges that go (Precedence.take_back):
+    # the order must be that of the edges left, built from scratch, and the one undo log it
+    # returns must restore the order before the first of them, also after a second take-back
+    rng = random.Random(seed)
+    horizons = {f"R{i}": rng.randint(2, 7) for i in range(1, 6)}
+    durations = {r: [rng.uniform(0.5, 4.0) for _ in range(k)] for r, k in horizons.items()}
+    links = [Link("m", "R1", 1, "R2", 2)]
+    order = Precedence(horizons, links, (), durations)
+
+    def batch() -> tuple[list, list]:
+        edges = []
+        for _ in range(rng.randint(1, 6)):
+            a, b = rng.sample(sorted(horizons), 2)
+            edges.append(((a, rng.randint(1, horizons[a])), (b, rng.randint(1, horizons[b]))))
+        log, refused = order.add_starts(edges)
+        return log, [e for n, e in enumerate(edges) if n not in refused]
+
+    before = [e for _ in range(3) for e in batch()[1]]
+    saved = Precedence(horizons, links, before, durations)
+    logs, edges = zip(*(batch() for _ in range(6)), strict=True)
+    since = [e for added in edges for e in added]
+    gone = rng.sample(since, len(since) // 2)
+    merged = order.take_back(list(logs), gone)
+    left = list(since)
+    for edge in gone:
+        del left[len(left) - 1 - left[::-1].index(edge)]
+    _assert_same_order(order, Precedence(horizons, links, before + left, durations))
+    log, more = batch()
+    again = order.take_back([merged, log], more[:1])
+    _assert_same_order(order, Precedence(horizons, links, before + left + more[1:], durations))
+    order.undo(again)
+    _assert_same_order(order, saved)
+    assert gone and left  # edges went and stayed
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_a_cycle_no_edge_taken_back_may_pass_stays_when_they_go(seed):
+    # TakenBack says which cycles may run through edges about to go; one it clears must
+    # survive their going (the test is one-sided: it may flag a cycle that survives too)
+    rng = random.Random(seed)
+    horizons = {f"R{i}": rng.randint(3, 7) for i in range(1, 5)}
+    edges = []
+    order = Precedence(horizons)
+    for _ in range(14):
+        a, b = rng.sample(sorted(horizons), 2)
+        edge = ((a, rng.randint(1, horizons[a])), (b, rng.randint(1, horizons[b])))
+        if not order.would_cycle(*edge):
+            order.add_start(edge)
+            edges.append(edge)
+    gone = rng.sample(edges, len(edges) // 3)
+    through = TakenBack(order)
+    for edge in gone:
+        through.take(*order.rows(edge))
+    rest = list(edges)
+    for edge in gone:
+        rest.remove(edge)
+    after = Precedence(horizons, starts=rest)
+    steps = [(r, k) for r, n in horizons.items() for k in range(1, n + 1)]
+    closing = [(x, y) for x in steps for y in steps if x[0] != y[0] and order.would_cycle(x, y)]
+    cleared = [e for e in closing if not through.may_pass(*order.rows(e))]
+    assert all(after.would_cycle(*e) for e in cleared)
+    assert cleared and len(cleared) < len(closing)  # both answers were met
 
 
 @pytest.mark.parametrize("seed", range(6))
@@ -384,12 +504,12 @@ def test_the_order_stays_topological_and_answers_in_bulk_as_one_step_at_a_time(s
         pairs = [(x, y) for x in steps for y in steps if x[0] != y[0]]
         rows = np.array([order.offsets[r] + k for r, k in (y for _, y in pairs)])
         bits = np.array([order.offsets[r] + k for r, k in (x for x, _ in pairs)])
-        done = order.completes_before(*order.places(bits, rows))
-        begun = order.completes_before(*order.places(bits, rows), start=True)
+        done = order.completes_before(order.places(bits, rows))
+        begun = order.completes_before(order.places(bits, rows), start=True)
         assert done.tolist() == [order.precedes(x, y) for x, y in pairs]
         assert begun.tolist() == [order.before_start(x, y) for x, y in pairs]
         for step in steps:
             for robot in horizons:
                 before = [k for r, k in steps if r == robot and order.precedes((r, k), step)]
                 assert order.completed(step, robot) == max(before, default=0)
-    assert any(order.completes_before(*order.places(bits, rows)))  # some steps were ordered
+    assert any(order.completes_before(order.places(bits, rows)))  # some steps were ordered

@@ -45,7 +45,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Link", "Node", "Precedence"]
+__all__ = ["Link", "Node", "Precedence", "TakenBack"]
 
 Node = tuple[str, int]
 """A step of a plan: ``(robot, instant)``, instants 1..K (0 is the start)."""
@@ -147,8 +147,13 @@ class Precedence:
         self._link([(self._source(s), self._row(t)) for s, t in starts if t[0] in self.column])
         self._run()
         n = (self.size + 7) // 8
-        self.done_bits = np.zeros((self.size, n), dtype=np.uint8)
-        self.begin_bits = np.zeros((self.size, n), dtype=np.uint8)
+        # the tables flat, with two bytes after them: 0 (never) and 255 (always)
+        self._flat = {start: np.zeros(self.size * n + 2, dtype=np.uint8) for start in (False, True)}
+        for flat in self._flat.values():
+            flat[-1] = 255
+        self.done_bits = self._flat[False][:-2].reshape(self.size, n)
+        self.begin_bits = self._flat[True][:-2].reshape(self.size, n)
+        self.never, self.always = self.size * n * 8, (self.size * n + 1) * 8
         self.finish_flat = np.zeros(self.size)
         self.started_flat = np.zeros(self.size)
         everything = list(range(self.size))
@@ -164,6 +169,11 @@ class Precedence:
         """The row of a step edges leave from; a step that never completes is :data:`_NEVER`."""
         r, k = node
         return _NEVER if r not in self.column or k > self.horizons[r] else self._row(node)
+
+    def rows(self, edge: tuple[Node, Node]) -> tuple[int, int]:
+        """The rows of the start edge ``(A, i) -> (B, j)``: A's step i (:data:`_NEVER` if it
+        never completes) and B's step j."""
+        return self._source(edge[0]), self._row(edge[1])
 
     # -- construction -------------------------------------------------------------------------
 
@@ -200,14 +210,18 @@ class Precedence:
         return all(s != _NEVER and progress[node[s][0]] >= node[s][1] for s in sources)
 
     def _complete(self, row: int) -> None:
+        self._B[row], self._S[row], self._D[row], self._F[row] = self._anew(row)
+        self.order.append(self._node[row])
+
+    def _anew(self, row: int) -> tuple[int, float, int, float]:
+        """Step `row`'s clocks and times from those of the steps it waits for: the set and time
+        of its start, then of its completion."""
         clock, t = self._latest([row - 1, *self._into_start.get(row, ())])
-        self._B[row], self._S[row] = clock, t
         done, t_done = clock | (1 << row), t + self._dur[row]
         if row in self._into_done:
             more, later = self._latest(self._into_done[row])
             done, t_done = done | more, max(t_done, later)
-        self._D[row], self._F[row] = done, t_done
-        self.order.append(self._node[row])
+        return clock, t, done, t_done
 
     def _mirror(self, done: list[int], begin: list[int]) -> None:
         """Copy the clocks and times of the rows `done` (completion) and `begin` (start) to
@@ -284,19 +298,60 @@ class Precedence:
 
         `pending` maps a step to the changed steps it starts after and completes after; a step
         whose completion changes is pending for the steps that wait for it (:meth:`_successors`).
+        A step's start is raised to what the steps it starts after give; if it grew, its
+        completion to that start and its duration; its completion to what the steps it completes
+        after give; each change logged (a time only when it grows by more than rounding).  The
+        step's completion changed if it grew, and then the start of "K+1" follows the robot's
+        last step.  Written out in one loop: it is most of the ordering search's time.
         """
-        place, recompute, successors = self._ord, self._recompute, self._successors
+        place, succ, nxt, dur, last = self._ord, self._succ, self._next, self._dur, self._last
+        D, F, B, S = self._D, self._F, self._B, self._S
         queue = [(place[row], row) for row in pending]
         heapq.heapify(queue)
+        pop, push = heapq.heappop, heapq.heappush
         while queue:
-            row = heapq.heappop(queue)[1]
-            if not recompute(log, row, *pending.pop(row)):
+            row = pop(queue)[1]
+            starts, dones = pending.pop(row)
+            done, t_done = D[row], F[row]
+            grew = False
+            if starts:
+                clock, t = D[starts[0]], F[starts[0]]
+                for s in starts[1:]:
+                    clock |= D[s]
+                    if F[s] > t:
+                        t = F[s]
+                old, old_t = B[row], S[row]
+                if t > old_t + 1e-12 or clock | old != old:
+                    log.append((row, B, old, S, old_t))
+                    B[row], S[row] = clock | old, max(old_t, t)
+                    clock, t = B[row], S[row] + dur[row]
+                    grew = t > t_done + 1e-12 or clock | done != done
+                    if grew:
+                        log.append((row, D, done, F, t_done))
+                        done, t_done = clock | done, max(t_done, t)
+                        D[row], F[row] = done, t_done
+            if dones:
+                clock, t = D[dones[0]], F[dones[0]]
+                for s in dones[1:]:
+                    clock |= D[s]
+                    if F[s] > t:
+                        t = F[s]
+                if t > t_done + 1e-12 or clock | done != done:
+                    log.append((row, D, done, F, t_done))
+                    D[row], F[row] = clock | done, max(t_done, t)
+                    grew = True
+            if not grew:
                 continue
-            for after, done in successors(row):
-                if after not in pending:
-                    pending[after] = ([], [])
-                    heapq.heappush(queue, (place[after], after))
-                pending[after][done].append(row)
+            if row in last:  # "start of K+1": after the whole plan
+                _raise(log, B, S, row + 1, D[row], F[row])
+            after = succ.get(row, ())
+            if nxt[row] is not None:
+                after = [(nxt[row], False), *after]
+            for then, is_done in after:
+                if then not in pending:
+                    pending[then] = ([], [])
+                    push(queue, (place[then], then))
+                pending[then][is_done].append(row)
 
     def _place(self, source: int, target: int) -> bool:
         """Keep :attr:`_ord` a topological order with the edge ``source -> target``; ``False``
@@ -353,19 +408,6 @@ class Precedence:
         before = [s for s in (*self._into_start.get(row, ()), *self._into_done.get(row, ())) if s != _NEVER]
         return before if self._node[row][1] == 0 else [row - 1, *before]
 
-    def _recompute(self, log: list, row: int, starts: list[int], dones: list[int]) -> bool:
-        """Raise the clocks and times of step `row` to what the steps `starts` (which it starts
-        after) and `dones` (which it completes after) give; whether its completion changed
-        (what the steps after it read)."""
-        D, F, grew = self._D, self._F, False
-        if starts and _raise(log, self._B, self._S, row, *self._latest(starts)):
-            grew = _raise(log, D, F, row, self._B[row], self._S[row] + self._dur[row])
-        if dones:
-            grew |= _raise(log, D, F, row, *self._latest(dones))
-        if grew and row in self._last:  # "start of K+1": after the whole plan
-            _raise(log, self._B, self._S, row + 1, D[row], F[row])
-        return grew
-
     def _latest(self, rows: Sequence[int]) -> tuple[int, float]:
         """The clock and the time by which all of `rows` have completed."""
         D, F = self._D, self._F
@@ -384,6 +426,72 @@ class Precedence:
                 row, masks, old, times, t = entry
                 masks[row], times[row] = old, t
         self._mirror_log(log)
+
+    def take_back(self, logs: Sequence[list], edges: Sequence[tuple[Node, Node]]) -> list:
+        """Remove some of the start edges that `logs` added, keeping the others where they are.
+
+        `logs` are the undo logs of every :meth:`add_start` and :meth:`add_starts` since some
+        state *S*, oldest first; `edges` are to go.  The clocks and times they reach are computed
+        again, in topological order, from the edges that stay (a step that changes passes the
+        change on).  Values only fall, and never below those of *S*, so a step that changes was
+        changed since *S* and the logs hold its value in *S*: their entries, without the links
+        of the edges gone and with only the oldest value of each step, are one undo log that
+        restores *S*, returned for :meth:`undo`.  The order must be complete.
+        """
+        gone: dict[tuple[int, int], int] = {}
+        for s, t in edges:
+            key = (self._source(s), self._row(t))
+            gone[key] = gone.get(key, 0) + 1
+        links, values, seeds, D = [], {}, set(), self._D
+        for log in logs:
+            if isinstance(log, _Compact):  # from an earlier take_back: its values by step
+                entries = log[: log.links]
+                if values:
+                    for key, entry in log.values.items():
+                        values.setdefault(key, entry)
+                else:
+                    values = dict(log.values)
+            else:
+                entries = log
+            for entry in entries:
+                if entry[0] is not None:  # only a step's oldest value is needed to restore S
+                    values.setdefault((entry[0], entry[1] is D), entry)
+                elif gone.get(key := (entry[2], entry[1])):
+                    gone[key] -= 1
+                    _drop_last(self._into_start[entry[1]], entry[2])
+                    _drop_last(self._succ[entry[2]], (entry[1], False))
+                    seeds.add(entry[1])
+                else:
+                    links.append(entry)
+        done, begin = self._settle(seeds)
+        self._mirror(done, begin)
+        return _Compact(links, values)
+
+    def _settle(self, seeds: set[int]) -> tuple[list[int], list[int]]:
+        """Compute the steps `seeds`, and those after them that change, again from the steps
+        they wait for; the rows whose completion (start) changed."""
+        place, D, F, B, S = self._ord, self._D, self._F, self._B, self._S
+        queue = [(place[row], row) for row in seeds]
+        heapq.heapify(queue)
+        seen, done, begin = set(seeds), [], []
+        while queue:
+            row = heapq.heappop(queue)[1]
+            start, t_start, clock, t = self._anew(row)
+            if start != B[row] or abs(t_start - S[row]) > 1e-12:
+                B[row], S[row] = start, t_start
+                begin.append(row)
+            if clock == D[row] and abs(t - F[row]) <= 1e-12:
+                continue
+            D[row], F[row] = clock, t
+            done.append(row)
+            if row in self._last:  # "start of K+1": after the whole plan
+                B[row + 1], S[row + 1] = self._latest([row, *self._into_start.get(row + 1, ())])
+                begin.append(row + 1)
+            for after, _ in self._successors(row):
+                if after not in seen:
+                    seen.add(after)
+                    heapq.heappush(queue, (place[after], after))
+        return done, begin
 
     # -- queries -------------------------------------------------------------------------------
 
@@ -428,17 +536,17 @@ class Precedence:
         o, k = self.offsets[robot], self.horizons[robot]
         return (self._D[self._row(step)] >> (o + 1) & ((1 << k) - 1)).bit_count()
 
-    def places(self, steps: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def places(self, steps: np.ndarray, rows: np.ndarray) -> np.ndarray:
         """Where :meth:`completes_before` reads whether the step of row ``steps[n]`` completes
-        before the step of row ``rows[n]``: the byte in the flattened tables and the bit in it.
-        Rows are ``offsets[robot] + instant``; those of instants 0 and K+1 are in no set."""
-        return rows * self.done_bits.shape[1] + (steps >> 3), (steps & 7).astype(np.uint8)
+        before the step of row ``rows[n]``: the bit in the flattened tables.  Rows are
+        ``offsets[robot] + instant``; those of instants 0 and K+1 are in no set.  The places
+        :attr:`never` and :attr:`always` read ``False`` and ``True``."""
+        return rows * (self.done_bits.shape[1] * 8) + steps
 
-    def completes_before(self, at: np.ndarray, shift: np.ndarray, *, start: bool = False) -> np.ndarray:
+    def completes_before(self, at: np.ndarray, *, start: bool = False) -> np.ndarray:
         """Vectorised :meth:`precedes` (:meth:`before_start` with `start`) at the :meth:`places`
-        ``(at, shift)``: whether each step completes before the other completes (starts)."""
-        table = self.begin_bits if start else self.done_bits
-        return (table.reshape(-1)[at] >> shift) & 1 == 1
+        `at`: whether each step completes before the other completes (starts)."""
+        return (self._flat[start][at >> 3] >> (at & 7)) & 1 == 1
 
     @property
     def makespan(self) -> float:
@@ -448,6 +556,75 @@ class Precedence:
     def start_time(self, node: Node) -> float:
         """Earliest start of step ``(robot, k)`` (``k = K + 1``: the end of its plan)."""
         return self._S[self._row(node)] if node[1] >= 1 else 0.0
+
+
+class TakenBack:
+    """Start edges about to be taken back from a :class:`Precedence`, and which cycles of its
+    order may run through them.  Edges are given as rows (:meth:`Precedence.rows`).
+
+    The edge ``(A, i) -> (B, j)`` closes a cycle when B's step j completes before A's step i
+    does: a path runs from the one to the other.  That path may use a start edge
+    ``(C, k) -> (D, l)`` only if the path reaches C's step k and leaves from D's step l (its
+    start leads nowhere but to its completion), so only if :math:`(B, j) \\preceq (C, k)` and
+    :math:`(D, l) \\preceq (A, i)` in the order as it is.  If no edge taken back passes that
+    test, every such path avoids them all, and the cycle stays when they are gone.  The test is
+    one-sided: an edge that passes it may still not be needed.
+
+    Examples
+    --------
+    >>> order = Precedence({"A": 2, "B": 2}, starts=[(("A", 1), ("B", 1)), (("B", 2), ("A", 2))])
+    >>> gone = TakenBack(order)
+    >>> gone.may_pass(*order.rows((("B", 2), ("A", 1))))
+    False
+    >>> gone.take(*order.rows((("A", 1), ("B", 1))))
+    >>> gone.may_pass(*order.rows((("B", 2), ("A", 1)))), gone.may_pass(*order.rows((("A", 2), ("B", 1))))
+    (True, False)
+    """
+
+    def __init__(self, precedence: Precedence) -> None:
+        self.done = precedence._D
+        self.targets = 0  # the rows edges taken back lead to, as a set
+        self.before: dict[int, int] = {}  # such a row -> the rows that complete before a source
+
+    def take(self, source: int, target: int) -> None:
+        """Count the edge ``source -> target`` as taken back."""
+        if source != _NEVER:
+            self.targets |= 1 << target
+            self.before[target] = self.before.get(target, 0) | self.done[source]
+
+    def may_pass(self, source: int, target: int) -> bool:
+        """Whether a cycle that the edge ``source -> target`` closes may run through an edge
+        taken back."""
+        if source == _NEVER:
+            return False
+        reach = self.done[source] & self.targets
+        while reach:
+            low = reach & -reach
+            if self.before[low.bit_length() - 1] >> target & 1:
+                return True
+            reach ^= low
+        return False
+
+
+class _Compact(list):
+    """An undo log of :meth:`Precedence.take_back`: its links, then one value per step (the
+    oldest), also kept by step in :attr:`values`."""
+
+    __slots__ = ("links", "values")
+
+    def __init__(self, links: list, values: dict) -> None:
+        super().__init__(links)
+        self += values.values()
+        self.links, self.values = len(links), values
+
+
+def _drop_last(items: list, item) -> None:
+    """Remove the last occurrence of `item` from `items`."""
+    for n in range(len(items) - 1, -1, -1):
+        if items[n] == item:
+            del items[n]
+            return
+    raise ValueError(f"{item!r} is not in the list")
 
 
 def _raise(log: list, masks: list[int], times: list[float], row: int, clock: int, t: float) -> bool:

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from shapely.geometry.base import BaseGeometry
 
-from cosmop.missions.precedence import Node, Precedence
+from cosmop.missions.precedence import Node, Precedence, TakenBack
 from cosmop.planning.conflicts import Conflict, Occupancy, detours, replan_rank
 
 __all__ = ["Culprits", "Search", "backjump", "both_ways", "depth_first", "way_table", "ways_of"]
@@ -57,12 +57,12 @@ class Search:
         self.number = {id(c): i for i, c in enumerate(found)}
         self.precedence = Precedence(horizons, links, starts, durations)
         self.sides = _Sides(found, self.precedence)
-        self.graph = _Graph(horizons, links, starts)
+        self.at: dict[int, int] = {}  # conflict -> its place in the trail
+        self.graph = _Graph(self.precedence, links, starts, self.at)
         self.stronger, self.weaker = implied.among(found)
         # (conflict, edge, undo log, reason): None for a choice, True when forced by its cycle,
         # or the set of a dead end when forced by it
         self.trail: list[tuple[int, tuple[Node, Node], list, object]] = []
-        self.at: dict[int, int] = {}  # conflict -> its place in the trail
         self.aside = np.zeros(len(found), dtype=bool)
         self.hidden = np.zeros(len(found), dtype=bool)
         self.every = self.live = np.arange(len(found))  # the conflicts not known to be ordered yet
@@ -127,32 +127,49 @@ class Search:
         one conflict of each is set aside (a core that holds one set aside already waits for the
         next round); then the order is taken back once, to the earliest place any of them needs.
         """
-        places = []
+        places, gone = [], set()
         for s in stuck:
-            core = _core(s, self.sides, self.graph, self.trail, self.at)
+            core, choices = self._dead_end_set(s)
             if self.aside[list(core)].any():
                 continue  # it held a conflict set aside in this round: asked again next round
-            choices = [self.at[i] for i in core if i in self.at and self.trail[self.at[i]][3] is None]
             if choices and places:
                 break  # the set-asides first; if it is still a dead end, it comes back
             if choices:
                 i, edge = self.trail[max(choices)][:2]
-                self._back_to(max(choices))
                 other = next(e for e in self.sides.edges[i] if e is not None and e != edge)
-                self._take(i, other, frozenset(core))
+                self._retract(max(choices), {i}, (i, other, frozenset(core)))
                 return "choice"
             if back is not None:
+                gone.add(back)
                 places.append(self._put_aside(back, core))
                 break
             # on a tie, the one taken last (the least to take back): not taken yet, then the latest
             members = sorted(core, key=lambda i: -self.at.get(i, len(self.trail)))
             picked = self.culprits.pick([self.found[i] for i in members])
-            places.append(self._put_aside(next(i for i in members if self.found[i] is picked), core))
+            culprit = next(i for i in members if self.found[i] is picked)
+            gone.add(culprit)
+            places.append(self._put_aside(culprit, core))
         if not places:  # every core held a conflict set aside before this round: a stale reason
             raise AssertionError(f"dead ends {stuck} with nothing to set aside or take back")
         self._hide()  # what they implied is no longer ordered by them
-        self._back_to(min(places))
+        self._retract(min(places), gone)
         return "core" if back is None else "back"
+
+    def _dead_end_set(self, stuck: int) -> tuple[set[int], list[int]]:
+        """The set of conflicts the dead end of `stuck` follows from (:func:`_core`) and the
+        places of the choices in it.  A choice taken again after another one changed its way
+        (:meth:`_retract`) may have lost its other way to a cycle since: it counts as forced
+        from then on, and the set is traced again."""
+        while True:
+            core = _core(stuck, self.sides, self.graph, self.trail, self.at)
+            choices = [self.at[i] for i in core if i in self.at and self.trail[self.at[i]][3] is None]
+            if not choices:
+                return core, choices
+            i, edge, log, _ = self.trail[max(choices)]
+            other = next(e for e in self.sides.edges[i] if e is not None and e != edge)
+            if self.graph.path(*other, before=max(choices)) is None:
+                return core, choices
+            self.trail[max(choices)] = (i, edge, log, True)
 
     def give_back(self, conflict: Conflict, budget: int) -> bool | None:
         """Search on with `conflict` no longer set aside: ``True`` when it is ordered with the
@@ -182,16 +199,108 @@ class Search:
 
     def _take_forced(self, forced: list[tuple[int, tuple[Node, Node]]]) -> None:
         """Take the forced ways, in order, each unless the ones before it close its cycle (it
-        is then stuck, and seen so next round): in one pass
-        (:meth:`~cosmop.missions.precedence.Precedence.add_starts`), taken back as one."""
-        if not forced:
+        is then stuck, and seen so next round)."""
+        self._take_batch([(i, edge, True) for i, edge in forced])
+
+    def _take_batch(self, entries: list[tuple[int, tuple[Node, Node], object]], prefix: bool = False) -> None:
+        """Take ``(conflict, edge, reason)`` entries in order, each unless the ones before it
+        close its cycle: in one pass (:meth:`~cosmop.missions.precedence.Precedence.add_starts`),
+        taken back as one.  With `prefix`, only those before the first that closes a cycle
+        (what comes after it may need it)."""
+        if not entries:
             return
-        log, refused = self.precedence.add_starts([edge for _, edge in forced])
+        log, refused = self.precedence.add_starts([edge for _, edge, _ in entries])
+        if prefix and refused:
+            self.precedence.undo(log)
+            entries = entries[: refused[0]]
+            log, refused = (
+                self.precedence.add_starts([edge for _, edge, _ in entries]) if entries else ([], [])
+            )
         stuck = set(refused)
-        taken = [way for n, way in enumerate(forced) if n not in stuck]
+        taken = [entry for n, entry in enumerate(entries) if n not in stuck]
+        if not taken:
+            return
         batch = _Batch(len(self.trail), len(taken), log)
-        for i, edge in taken:
-            self._take(i, edge, True, batch)
+        for i, edge, reason in taken:
+            self._take(i, edge, reason, batch)
+
+    def _retract(self, place: int, gone: set[int], first=None) -> None:
+        """Take back the trail from `place` on with the conflicts `gone` (set aside, or a choice
+        that takes its other way: `first`, the entry that takes it), keeping every entry whose
+        reason does not need what goes (:meth:`_needing`).
+
+        The entries kept stay in the trail, in their order, as one batch, and the order drops
+        the edges that go (:meth:`~cosmop.missions.precedence.Precedence.take_back`).  `first`
+        comes after them; if they close its cycle, it comes where its choice was, and they are
+        taken again after it up to the first that closes a cycle then (what comes after that one
+        may need it): the rest is left to the search.
+        """
+        start, kept, dropped = self._needing(place, gone)
+        if kept and self.precedence.complete:
+            self._drop(start, kept, dropped)
+            if first is None:
+                return
+            if not self.precedence.would_cycle(*first[1]):
+                self._take(*first)
+                return
+            self._back_to(start)  # the entries before the choice come back with their batch
+            self._take_batch(kept[: place - start])
+        else:
+            self._back_to(place)
+        if first is not None:
+            self._take(*first)
+        self._take_batch(kept[place - start :], prefix=True)
+
+    def _needing(self, place: int, gone: set[int]) -> tuple[int, list, set[int]]:
+        """Which entries from `place` on need the conflicts `gone`: ``(start, kept, dropped)``,
+        the entries from `start` (`place`, or where the batch it falls in starts) that stay as
+        ``(conflict, edge, reason)`` and the conflicts of those that go.
+
+        An entry goes when its conflict is gone, when it was forced by a dead end's set that
+        holds a conflict that goes, or when it was forced by a cycle that may run through an
+        edge that goes (:class:`~cosmop.missions.precedence.TakenBack`, one-sided).  Choices
+        need nothing.  What stays keeps its reason: all it used stays before it.
+        """
+        log = self.trail[place][2] if place < len(self.trail) else None
+        start = log.start if isinstance(log, _Batch) else place  # a batch goes back whole
+        through, dropped, kept = TakenBack(self.precedence), set(gone), []
+        for n, (i, edge, _, reason) in enumerate(self.trail[start:], start):
+            if n < place:
+                needs = False
+            elif i in gone or reason is None:
+                needs = i in gone
+            elif isinstance(reason, frozenset):
+                needs = not reason.isdisjoint(dropped)
+            else:
+                needs = any(
+                    e is not None and e != edge and through.may_pass(*rows)
+                    for e, rows in zip(self.sides.edges[i], self.sides.rows[i], strict=True)
+                )
+            if needs:
+                through.take(*self.precedence.rows(edge))
+                dropped.add(i)
+            else:
+                kept.append((i, edge, reason))
+        return start, kept, dropped
+
+    def _drop(self, start: int, kept: list, dropped: set[int]) -> None:
+        """Remove the entries of `dropped` from the trail from `start` on; the rest, `kept`,
+        stay in place as one batch."""
+        tail = self.trail[start:]
+        logs = [
+            log.log if isinstance(log, _Batch) else log
+            for n, (_, _, log, _) in enumerate(tail, start)
+            if not isinstance(log, _Batch) or log.start == n
+        ]
+        away = [edge for i, edge, _, _ in tail if i in dropped]
+        batch = _Batch(start, len(kept), self.precedence.take_back(logs, away))
+        self.graph.remove(start, dropped)
+        for i in dropped:
+            self.at.pop(i, None)  # (a conflict set aside need not have been taken)
+        self.trail[start:] = [(i, edge, batch, reason) for i, edge, reason in kept]
+        for n in range(start, len(self.trail)):
+            self.at[self.trail[n][0]] = n
+        self.live = self.every  # what held may not now
 
     def _back_to(self, place: int) -> None:
         """Take back the trail from `place` on.  A batch of forced ways that `place` falls
@@ -200,10 +309,10 @@ class Search:
             self._pop()
         top = self.trail[-1][2] if self.trail else None
         if isinstance(top, _Batch) and top.start + top.size > place:
-            kept = [(i, edge) for i, edge, _, _ in self.trail[top.start :]]
+            kept = [(i, edge, reason) for i, edge, _, reason in self.trail[top.start :]]
             while len(self.trail) > top.start:
                 self._pop()
-            self._take_forced(kept)
+            self._take_batch(kept)
 
     def _pop(self) -> None:
         i, _, log, _ = self.trail.pop()
@@ -304,50 +413,71 @@ class Culprits:
 
 class _Graph:
     """Which step completes before which: program order, messages and given start edges, and
-    start edges pushed (and popped) in order, each labelled with what it orders."""
+    start edges pushed (and popped, or removed) in order, each labelled with what it orders.
 
-    def __init__(self, horizons, links, starts) -> None:
-        self.succ: dict[Node, list[tuple[Node, object, int]]] = {}  # node -> (next, label, place)
-        for robot, k in horizons.items():
+    Steps are the rows of `precedence`, whose clocks prune the search for a path: only a step
+    that completes before the path's end can be on it.  With `at` (label -> place, kept by the
+    caller), :meth:`path` can stop at a place; the clocks must then be those of an order that
+    holds every edge pushed."""
+
+    def __init__(self, precedence: Precedence, links, starts, at: Mapping | None = None) -> None:
+        self.precedence, self.at = precedence, at
+        self.succ: dict[int, list[tuple[int, object]]] = {}  # row -> (next row, label)
+        for robot, k in precedence.horizons.items():
+            o = precedence.offsets[robot]
             for i in range(1, k):
-                self._add((robot, i), (robot, i + 1), None, -1)
+                self.succ[o + i] = [(o + i + 1, None)]
         for link in links:
             if link.send is not None and link.wait is not None:
-                self._add((link.sender, link.send), (link.receiver, link.wait), None, -1)
-        for source, target in starts:
-            self._add(source, target, None, -1)
-        self.pushed: list[tuple[Node, Node, object]] = []
+                self._add(((link.sender, link.send), (link.receiver, link.wait)), None)
+        for edge in starts:
+            self._add(edge, None)
+        self.pushed: list[tuple[int, int, object]] = []  # (source, target, label) pushed
 
-    def _add(self, source: Node, target: Node, label, place: int) -> None:
-        self.succ.setdefault(source, []).append((target, label, place))
+    def _add(self, edge: tuple[Node, Node], label) -> tuple[int, int, object]:
+        source, target = self.precedence.rows(edge)
+        self.succ.setdefault(source, []).append((target, label))
+        return source, target, label
 
     def push(self, edge: tuple[Node, Node], label) -> None:
-        self.pushed.append((*edge, label))
-        self._add(edge[0], edge[1], label, len(self.pushed) - 1)
+        self.pushed.append(self._add(edge, label))
 
     def pop(self) -> None:
-        source, _, _ = self.pushed.pop()
-        self.succ[source].pop()
+        self.succ[self.pushed.pop()[0]].pop()
+
+    def remove(self, start: int, labels: set) -> None:
+        """Take out the edges pushed from place `start` on whose labels are in `labels` (a
+        label names one edge pushed)."""
+        tail = self.pushed[start:]
+        for source in {source for source, _, label in tail if label in labels}:
+            self.succ[source] = [edge for edge in self.succ[source] if edge[1] not in labels]
+        self.pushed[start:] = [edge for edge in tail if edge[2] not in labels]
 
     def path(self, source: Node, target: Node, before: int | None = None) -> list | None:
         """The labels on a shortest path from `target` to `source` -- the cycle the start edge
         ``source -> target`` would close -- through the edges pushed before place `before`
         (default: all); ``None`` if there is none."""
-        before = len(self.pushed) if before is None else before
-        parent: dict[Node, tuple[Node, object] | None] = {target: None}
-        queue = [target]
-        for node in queue:
-            if node == source:
-                break
-            for nxt, label, place in self.succ.get(node, ()):
-                if place < before and nxt not in parent:
-                    parent[nxt] = (node, label)
-                    queue.append(nxt)
-        if source not in parent:
+        end, start = self.precedence.rows((source, target))
+        on_way = self.precedence._D[end] if end >= 0 else 0  # the steps that complete before `end`
+        if not on_way >> start & 1:
             return None
-        out, node = [], source
-        while parent[node] is not None:
-            node, label = parent[node]
+        at = self.at if before is not None else None
+        parent: dict[int, tuple[int, object] | None] = {start: None}
+        queue = [start]
+        for row in queue:
+            if row == end:
+                break
+            for nxt, label in self.succ.get(row, ()):
+                if not on_way >> nxt & 1 or nxt in parent:
+                    continue
+                if label is None or at is None or at[label] < before:
+                    parent[nxt] = (row, label)
+                    queue.append(nxt)
+        if end not in parent:
+            return None
+        out, row = [], end
+        while parent[row] is not None:
+            row, label = parent[row]
             if label is not None:
                 out.append(label)
         return out
@@ -385,18 +515,23 @@ class _Sides:
         # a side within one robot's plan holds or closes a cycle by program order; else as the
         # order's sets say: x's last step completes before y's first starts (it holds), or y's
         # first completes before x's last does (it closes a cycle)
-        self.fixed_hold = possible & np.where(same, x_k < y_k, x_k <= 0)
-        self.fixed_way = possible & same & (y_k > x_k)
-        self.by_order = possible & ~same
-        self.hold_at = precedence.places(x_row, y_row)
-        self.cycle_at = precedence.places(y_row, x_row)
+        # (where they read, with the places that always or never hold standing for the rest)
+        fixed_hold = possible & np.where(same, x_k < y_k, x_k <= 0)
+        fixed_way = possible & same & (y_k > x_k)
+        by_order = possible & ~same
+        never, always = precedence.never, precedence.always
+        hold = precedence.places(x_row, y_row)
+        self.hold_at = np.where(fixed_hold, always, np.where(by_order, hold, never))
+        cycle = precedence.places(y_row, x_row)
+        self.cycle_at = np.where(fixed_way, never, np.where(by_order, cycle, always))
+        # each side's edge as rows (Precedence.rows: -1 for a step past the plan), as lists
+        x_source = np.where(x_k > end[ends[..., 0]] - 1, -1, x_row)
+        self.rows = np.stack([x_source, y_row], axis=-1).tolist()
 
     def holds(self, precedence: Precedence, rows: np.ndarray | None = None) -> np.ndarray:
         """(n, 2): whether each side (of the conflicts `rows`, default all) is already implied."""
         rows = slice(None) if rows is None else rows
-        at, shift = self.hold_at[0][rows], self.hold_at[1][rows]
-        implied = precedence.completes_before(at, shift, start=True)
-        return self.fixed_hold[rows] | (self.by_order[rows] & implied)
+        return precedence.completes_before(self.hold_at[rows], start=True)
 
     def expected_start(self, precedence: Precedence, rows: np.ndarray) -> np.ndarray:
         """The expected start of the earlier occupancy of each conflict in `rows`, s."""
@@ -407,8 +542,7 @@ class _Sides:
         """(n, 2): whether each side (of the conflicts `rows`, default all) can still be added
         without closing a cycle."""
         rows = slice(None) if rows is None else rows
-        at, shift = self.cycle_at[0][rows], self.cycle_at[1][rows]
-        return self.fixed_way[rows] | (self.by_order[rows] & ~precedence.completes_before(at, shift))
+        return ~precedence.completes_before(self.cycle_at[rows])
 
 
 def way_table(ways: Sequence[list], number: dict[str, int]) -> tuple[np.ndarray, np.ndarray]:
@@ -468,7 +602,7 @@ def depth_first(found, horizons, links, starts, durations, max_backtracks, fixed
             if len(chosen) > deepest:
                 edges = [(e, c) for e, c, _ in chosen]
                 worst = min(stuck, key=lambda c: replan_rank(c, fixed))
-                deepest, culprit = len(chosen), _culprit(worst, horizons, links, starts, edges, fixed)
+                deepest, culprit = len(chosen), _culprit(worst, precedence, links, starts, edges, fixed)
             if not stack or backtracks >= max_backtracks:
                 return [], culprit
             backtracks += 1
@@ -519,7 +653,7 @@ def _makespan_with(precedence: Precedence, edge: tuple[Node, Node]) -> float:
     return makespan
 
 
-def _culprit(stuck: Conflict, horizons, links, starts, chosen, fixed) -> Conflict:
+def _culprit(stuck: Conflict, precedence: Precedence, links, starts, chosen, fixed) -> Conflict:
     """The conflict to re-plan around when `stuck` has no way to be ordered.
 
     If `stuck` itself cannot be re-planned (two robots standing where their goods require), the
@@ -527,7 +661,7 @@ def _culprit(stuck: Conflict, horizons, links, starts, chosen, fixed) -> Conflic
     """
     if replan_rank(stuck, fixed) < 3:
         return stuck
-    graph = _Graph(horizons, links, starts)
+    graph = _Graph(precedence, links, starts)
     for edge, conflict in chosen:
         graph.push(edge, conflict)
     on_cycles: list[Conflict] = []
