@@ -11,8 +11,9 @@ Three workloads, each in a fresh subprocess:
   messages added, the time of the conflict step against synthesis, re-plans, and the simulated
   run (complete? contacts while moving?).
 
-``python benchmarks/bench_team.py [--sizes 10,20,50] [--seed S] [--max-time S] [--out NAME]``
-writes ``results/team.json`` (or ``results/NAME.json``).
+``python benchmarks/bench_team.py [--sizes 10,20,50] [--seed S | --seeds 1:10] [--aisles-only]
+[--max-time S] [--out NAME]`` writes ``results/team.json`` (or ``results/NAME.json``); with
+``--seeds``, every size is run on every seed of the range (end excluded).
 """
 
 from __future__ import annotations
@@ -132,6 +133,8 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", default="10,20,50")
     parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--seeds", help="a range of seeds, START:END (END excluded), instead of --seed")
+    parser.add_argument("--aisles-only", action="store_true", help="without the corridor and order examples")
     parser.add_argument(
         "--max-time", type=float, default=None, help="simulated s (default: the simulator's, from the plan)"
     )
@@ -148,9 +151,11 @@ def main() -> int:
         print(json.dumps(row))
         return 0
     rows = []
-    for job in ["corridor", "order", *args.sizes.split(",")]:
-        limit = [] if args.max_time is None else ["--max-time", str(args.max_time)]
-        row = child_row(__file__, "--child", job, "--seed", str(args.seed), *limit)
+    seeds = range(*map(int, args.seeds.split(":"))) if args.seeds else [args.seed]
+    examples = [] if args.aisles_only else [("corridor", seeds[0]), ("order", seeds[0])]
+    limit = [] if args.max_time is None else ["--max-time", str(args.max_time)]
+    for job, seed in [*examples, *((size, seed) for seed in seeds for size in args.sizes.split(","))]:
+        row = child_row(__file__, "--child", job, "--seed", str(seed), *limit)
         rows.append(row)
         print(json.dumps(row), flush=True)
     save_results(args.out, rows)

@@ -308,18 +308,14 @@ class Precedence:
         D, F, B, S = self._D, self._F, self._B, self._S
         queue = [(place[row], row) for row in pending]
         heapq.heapify(queue)
-        pop, push = heapq.heappop, heapq.heappush
+        pop, push, latest = heapq.heappop, heapq.heappush, self._latest
         while queue:
             row = pop(queue)[1]
             starts, dones = pending.pop(row)
             done, t_done = D[row], F[row]
             grew = False
             if starts:
-                clock, t = D[starts[0]], F[starts[0]]
-                for s in starts[1:]:
-                    clock |= D[s]
-                    if F[s] > t:
-                        t = F[s]
+                clock, t = latest(starts)
                 old, old_t = B[row], S[row]
                 if t > old_t + 1e-12 or clock | old != old:
                     log.append((row, B, old, S, old_t))
@@ -331,11 +327,7 @@ class Precedence:
                         done, t_done = clock | done, max(t_done, t)
                         D[row], F[row] = done, t_done
             if dones:
-                clock, t = D[dones[0]], F[dones[0]]
-                for s in dones[1:]:
-                    clock |= D[s]
-                    if F[s] > t:
-                        t = F[s]
+                clock, t = latest(dones)
                 if t > t_done + 1e-12 or clock | done != done:
                     log.append((row, D, done, F, t_done))
                     D[row], F[row] = clock | done, max(t_done, t)
@@ -413,7 +405,9 @@ class Precedence:
         D, F = self._D, self._F
         clock, t = D[rows[0]], F[rows[0]]
         for s in rows[1:]:
-            clock, t = clock | D[s], max(t, F[s])
+            clock |= D[s]
+            if F[s] > t:
+                t = F[s]
         return clock, t
 
     def undo(self, log: list) -> None:
