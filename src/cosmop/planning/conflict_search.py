@@ -559,7 +559,17 @@ class _Sides:
 @dataclass(frozen=True)
 class WayTable:
     """Every conflict's two ways (:func:`both_ways`), and the same as arrays (:func:`way_table`):
-    computed once for the search and :class:`~cosmop.planning.conflict_order._Implied`."""
+    computed once for the search and :class:`~cosmop.planning.conflict_order._Implied`.
+
+    Attributes
+    ----------
+    edges : list
+        Per conflict, its two ways as start edges (``None`` where a way is not possible).
+    possible : numpy.ndarray
+        ``(n, 2)`` bool: which ways exist.
+    ends : numpy.ndarray
+        ``(n, 2, 4)`` int: each way as ``(A, i, B, j)``, the robots numbered.
+    """
 
     edges: list
     possible: np.ndarray
