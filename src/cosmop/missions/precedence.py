@@ -128,6 +128,7 @@ class Precedence:
             for r, k in self.horizons.items()
         }
         self._node: list[Node] = [(r, k) for r in self.robots for k in range(self.horizons[r] + 2)]
+        self._rows = {node: row for row, node in enumerate(self._node)}
         self._next: list[int | None] = [None] * self.size  # the robot's next step
         self._dur = [0.0] * self.size
         self._last = {o + self.horizons[r] for r, o in self.offsets.items() if self.horizons[r]}
@@ -162,8 +163,11 @@ class Precedence:
         self.started = {r: self.started_flat[o : o + self.horizons[r] + 2] for r, o in self.offsets.items()}
 
     def _row(self, node: Node) -> int:
-        r, k = node
-        return self.offsets[r] + min(max(k, 0), self.horizons[r] + 1)
+        row = self._rows.get(node)  # (asked for millions of times by the ordering search)
+        if row is None:
+            r, k = node
+            row = self.offsets[r] + min(max(k, 0), self.horizons[r] + 1)
+        return row
 
     def _source(self, node: Node) -> int:
         """The row of a step edges leave from; a step that never completes is :data:`_NEVER`."""
@@ -319,18 +323,18 @@ class Precedence:
                 old, old_t = B[row], S[row]
                 if t > old_t + 1e-12 or clock | old != old:
                     log.append((row, B, old, S, old_t))
-                    B[row], S[row] = clock | old, max(old_t, t)
+                    B[row], S[row] = clock | old, t if t > old_t else old_t
                     clock, t = B[row], S[row] + dur[row]
                     grew = t > t_done + 1e-12 or clock | done != done
                     if grew:
                         log.append((row, D, done, F, t_done))
-                        done, t_done = clock | done, max(t_done, t)
+                        done, t_done = clock | done, t if t > t_done else t_done
                         D[row], F[row] = done, t_done
             if dones:
                 clock, t = latest(dones)
                 if t > t_done + 1e-12 or clock | done != done:
                     log.append((row, D, done, F, t_done))
-                    D[row], F[row] = clock | done, max(t_done, t)
+                    D[row], F[row] = clock | done, t if t > t_done else t_done
                     grew = True
             if not grew:
                 continue
