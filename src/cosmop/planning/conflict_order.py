@@ -251,8 +251,8 @@ class _Implied:
     def __init__(self, found: Sequence[Conflict], table: WayTable | None = None) -> None:
         self.index = {id(c): n for n, c in enumerate(found)}
         self.found = list(found)
-        # every conflict's ways as (A, i, B, j), robots numbered; its robots numbered in the
-        # order they first appear
+        # every conflict's ways as (A, i, B, j), robots numbered (WayTable); each pair of robots
+        # numbered in the order it first appears
         pairs: dict[frozenset, int] = {}
         pair = np.array([pairs.setdefault(frozenset(c.robots), len(pairs)) for c in found], dtype=np.int64)
         table = table if table is not None else WayTable.of(found, ())
@@ -273,9 +273,9 @@ class _Implied:
             strict[:, np.arange(size), np.arange(size)] = False
             g, d, c = np.nonzero(strict)
             found_pairs.append(np.stack([np.asarray(numbers)[g], rows[g, d], rows[g, c]], axis=1))
-        table = np.concatenate(found_pairs)
-        table = table[np.lexsort((table[:, 2], table[:, 1], table[:, 0]))]  # group by group
-        self.stronger, self.weaker = table[:, 1].copy(), table[:, 2].copy()
+        implied = np.concatenate(found_pairs)
+        implied = implied[np.lexsort((implied[:, 2], implied[:, 1], implied[:, 0]))]  # group by group
+        self.stronger, self.weaker = implied[:, 1].copy(), implied[:, 2].copy()
 
     def by(self, conflict: Conflict) -> list[Conflict]:
         """The conflicts that imply `conflict`."""

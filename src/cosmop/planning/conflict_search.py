@@ -144,7 +144,7 @@ class Search:
                 break  # the set-asides first; if it is still a dead end, it comes back
             if choices:
                 i, edge = self.trail[max(choices)][:2]
-                other = next(e for e in self.sides.edges[i] if e is not None and e != edge)
+                other = self.sides.edges[i][self.sides.others(i, edge)[0]]
                 self._retract(max(choices), {i}, (i, other, frozenset(core)))
                 return "choice"
             if back is not None:
@@ -174,7 +174,7 @@ class Search:
             if not choices:
                 return core, choices
             i, edge, log, _ = self.trail[max(choices)]
-            other = next(e for e in self.sides.edges[i] if e is not None and e != edge)
+            other = self.sides.edges[i][self.sides.others(i, edge)[0]]
             if self.graph.path(*other, before=max(choices)) is None:
                 return core, choices
             self.trail[max(choices)] = (i, edge, log, True)
@@ -280,10 +280,7 @@ class Search:
             elif isinstance(reason, frozenset):
                 needs = not reason.isdisjoint(dropped)
             else:
-                needs = any(
-                    e is not None and e != edge and through.may_pass(*rows)
-                    for e, rows in zip(self.sides.edges[i], self.sides.rows[i], strict=True)
-                )
+                needs = any(through.may_pass(*self.sides.rows[i][n]) for n in self.sides.others(i, edge))
             if needs:
                 through.take(*self.precedence.rows(edge))
                 dropped.add(i)
@@ -378,9 +375,8 @@ def _core(stuck: int, sides: _Sides, graph: _Graph, trail: list, at: Mapping[int
         if isinstance(reason, frozenset):
             core |= reason
         elif reason is True:
-            for edge in sides.edges[i]:
-                if edge is not None and edge != chosen:
-                    todo += cycle(edge, at[i])
+            for n in sides.others(i, chosen):
+                todo += cycle(sides.edges[i][n], at[i])
     return core
 
 
@@ -538,6 +534,10 @@ class _Sides:
         # each side's edge as rows (Precedence.rows: -1 for a step past the plan), as lists
         x_source = np.where(x_k > end[ends[..., 0]] - 1, -1, x_row)
         self.rows = np.stack([x_source, y_row], axis=-1).tolist()
+
+    def others(self, i: int, taken: tuple[Node, Node]) -> list[int]:
+        """The sides of conflict `i` that exist other than the way `taken`."""
+        return [n for n, edge in enumerate(self.edges[i]) if edge is not None and edge != taken]
 
     def holds(self, precedence: Precedence, rows: np.ndarray | None = None) -> np.ndarray:
         """(n, 2): whether each side (of the conflicts `rows`, default all) is already implied."""
