@@ -437,3 +437,27 @@ def test_own_boxes_of_some_robots_are_those_rows_of_all():
     every = world.own_boxes(sensed)
     assert every.sum() == 3 and [sensed.names[j] for j in every.argmax(axis=1)] == ["A", "B", "C"]
     np.testing.assert_array_equal(world.own_boxes(sensed, np.array([2, 0])), every[[2, 0]])
+
+
+def test_a_robot_waiting_for_a_message_holds_no_robot_that_must_send_it():
+    # Example 08 with R2 listed first: R2 waits for R1's message, parked within R1's standoff
+    # while R1's gripper works.  Were R2 to hold R1 there (it is listed first), R1 could never
+    # finish and send what R2 waits for; once the message is out, R2 may leave and holds R1.
+    import yaml
+
+    data = yaml.safe_load((EXAMPLES / "08_ordered" / "scenario.yaml").read_text())
+    data["scene"]["robots"] = dict(reversed(list(data["scene"]["robots"].items())))
+    scenario = parse_scenario(data)
+    world = World(scenario, plan_team(scenario).plans, 0, SimSettings())
+    r2, r1 = world.agents  # R2 first
+    r1.step_index = next(k for k, s in enumerate(r1.steps) if s.primitive == "DropOff")
+    r1.dock_stage = "handle"
+    r2.step_index = next(k for k, s in enumerate(r2.steps) if s.primitive == "Req")
+    r2.waiting = True
+    world.pose[r1.index] = [*r1.step.robot[:2], r1.step.robot[2]]
+    world.pose[r2.index] = world.pose[r1.index] + [0.0, 400.0 + 50.0, 0.0]  # 50 mm apart
+    world.v[:] = 0.0
+    assert world.parked().all() and not world.received(r2, r2.step)
+    assert not world.crowded(r1.index)
+    world.sent_messages.add(r2.step.message)
+    assert world.crowded(r1.index)  # R2 may leave now: R1 keeps its promise

@@ -382,16 +382,23 @@ class World:
 
     def crowded(self, i: int) -> bool:
         """Whether robot `i` must stay parked: another robot that may still move is within its
-        standoff.  A robot that has finished never moves again and does not count; of two parked
-        robots close together the one listed first may leave (the other keeps its promise), so
-        that two waiting robots never hold each other for ever."""
+        standoff.  A robot that has finished never moves again and does not count, nor does a
+        parked one whose message has not come (it cannot leave; were it to hold `i`, and its
+        message wait on `i`, neither would ever move); of two other parked robots close
+        together the one listed first may leave (the other keeps its promise), so that two
+        waiting robots never hold each other for ever."""
         gaps = self.gaps_to_robots(i)
         gaps[i] = np.inf
         parked = self.parked()
         for agent in self.agents:
-            if agent.done or (parked[agent.index] and agent.index > i):
+            if agent.done or (parked[agent.index] and (agent.index > i or self._held(agent))):
                 gaps[agent.index] = np.inf
         return bool((gaps < self.settings.dwa.standoff).any())
+
+    def _held(self, agent: Agent) -> bool:
+        """Whether `agent` waits for a message that has not been sent."""
+        step = agent.step
+        return agent.waiting and step.primitive == Primitive.REQ and not self.received(agent, step)
 
     # -- messages and mission events ---------------------------------------------------------------
 
