@@ -31,6 +31,13 @@ of :math:`\\Phi` has fewer.  :math:`\\square`
 
 Which obstacles start in :math:`S` changes only the number of rounds, never the answer: those
 within reach of the box around the robot's start, home, its goods and its drop places.
+
+A wall or object to drives is also a second obstacle of :math:`O`,
+:func:`~cosmop.planning.specification.past_its_ends`: its GoTo part with departures from past
+its ends made to pass them clear.  It implies the first; the claim holds with both in
+:math:`O`.  It is never in :math:`S` at the start: the solver pays for it only where a plan
+passes an end too close, which a numeric pre-test (:func:`_passes_ends`) rules out for most
+obstacles and models before the exact one.
 """
 
 from __future__ import annotations
@@ -48,13 +55,17 @@ from cosmop.logic import Formula, conj, failing, to_fraction
 from cosmop.planning.regions import square_sides, wall_regions
 from cosmop.planning.specification import (
     HANDLING_CLEARANCE,
+    PASSING,
+    PAST_AN_END,
     RobotProblem,
     object_key,
+    past_its_ends,
     specification,
     wall_key,
 )
 
 _OBSTACLE = (
+    re.compile(r"^((?:wall \d+|object \S+) past its ends)\b"),  # GoTo passing the ends clear
     re.compile(r"^(wall \d+)\b"),  # GoTo clear of wall i
     re.compile(r"\bclear of (wall \d+)$"),  # the gripper and a drop, clear of wall i
     re.compile(r"^object (\S+)$"),  # GoTo clear of object o
@@ -75,13 +86,16 @@ def obstacle_of(name: str) -> str | None:
     ('wall 3', 'wall 3 while handling')
     >>> obstacle_of("O1 dropped clear of O2")
     'object O2'
+    >>> obstacle_of("wall 3 past its ends [[0, 0], [1, 0]]"), obstacle_of("object O2 past its ends")
+    ('wall 3 past its ends', 'object O2 past its ends')
     >>> obstacle_of("PickUp O1") is None
     True
     """
     for i, pattern in enumerate(_OBSTACLE):
         found = pattern.search(name)
         if found:
-            return (found.group(1), f"{found.group(1)} while handling", f"object {found.group(1)}")[min(i, 2)]
+            key = found.group(1)
+            return (key, key, f"{key} while handling", f"object {key}")[min(i, 3)]
     return None
 
 
@@ -119,6 +133,7 @@ class Geometry:
         walls = range(len(p.scene.obstacles))
         keys = [wall_key(i, handling) for handling in (False, True) for i in walls]
         keys += [object_key(o) for o in p.scene.objects]
+        keys += [past_its_ends(k) for k in [*map(wall_key, walls), *map(object_key, p.scene.objects)]]
         held = set(keys) if not lazy else _near_route(p) | {object_key(o) for o in p.own_objects}
         self._p, self._events = p, events
         self.held = conj(f for _, f in specification(replace(p, obstacles=frozenset(held)), events))
@@ -133,7 +148,9 @@ class Geometry:
             return []
         near = self._sides.unsure(self._waiting, trace)
         self._write([k for k in near if k not in self._written])
-        return [near[i] for i in failing([self._written[k] for k in near], trace)]
+        broken = [near[i] for i in failing([self._written[k] for k in near], trace)]
+        # an obstacle driven through needs its own part first; its stronger one may follow
+        return [k for k in broken if _base(k) == k or _base(k) not in broken]
 
     def admit(self, keys: Sequence[str]) -> Formula:
         """Move the obstacles `keys` into the solver's share: their parts, to assert."""
@@ -156,6 +173,11 @@ class Geometry:
         self._written.update({k: conj(fs) for k, fs in groups.items()})
 
 
+def _base(key: str) -> str:
+    """The obstacle whose GoTo part the part named `key` strengthens, or `key` itself."""
+    return key.removesuffix(past_its_ends(""))
+
+
 _GAP = 1e-3
 """mm by which the numeric one-side test must clear a half-plane (floating point is not exact)."""
 
@@ -175,11 +197,13 @@ class _Sides:
         side, margin = p.side, p.margin
         goods = {o: to_fraction(p.scene.objects[o].size) for o in p.own_objects}
         planes: dict[str, list] = {}
+        touching: dict[str, list] = {}  # each obstacle's sides for the robot's square, touching
         self._roles: dict[str, int] = {}  # 0: a wall to drives, 1: to picks and drops, 2: an object
         self._handling = {a.code for a in p.actions if a.primitive in (Primitive.PICKUP, Primitive.DROPOFF)}
-        for i, wall in enumerate(p.scene.obstacles):
-            regions = [wall_regions(wall.start, wall.end, g) for g in (side + 2 * margin, *goods.values())]
+        for i, w in enumerate(p.scene.obstacles):
+            regions = [wall_regions(w.start, w.end, g) for g in (side + 2 * margin, *goods.values())]
             planes[wall_key(i)] = [[(h.a, h.b, h.c) for h in body] for body in regions]
+            touching[wall_key(i)] = [(h.a, h.b, h.c) for h in wall_regions(w.start, w.end, side)]
             self._roles[wall_key(i)], self._roles[wall_key(i, handling=True)] = 0, 1
         robot_gap = max(margin, HANDLING_CLEARANCE)
         for o, ob in p.scene.objects.items():
@@ -190,14 +214,20 @@ class _Sides:
             robot = list(square_sides(ox, oy, (size + side) / 2 + robot_gap))
             carried = [list(square_sides(ox, oy, (size + g) / 2)) for g in goods.values()]
             planes[object_key(o)] = [robot, *carried]
+            touching[object_key(o)] = list(square_sides(ox, oy, (size + side) / 2))
             self._roles[object_key(o)] = 2
         self._keys = list(planes)
         self._row = {k: n for n, k in enumerate(self._keys)}
         for i in range(len(p.scene.obstacles)):  # a wall's handling parts: robot and goods
             self._row[wall_key(i, handling=True)] = self._row[wall_key(i)]
+        for key in list(self._keys):  # the stronger GoTo part: kept clear by the same sides
+            self._row[past_its_ends(key)], self._roles[past_its_ends(key)] = self._row[key], 0
         table = np.array([planes[k] for k in self._keys], dtype=float)  # (obstacles, bodies, 4 sides, abc)
         table /= np.abs(table[..., :2]).sum(axis=-1, keepdims=True)
         self._table = table
+        touch = np.array([touching[k] for k in self._keys], dtype=float)  # (obstacles, 4 sides, abc)
+        self._touching = touch / np.abs(touch[..., :2]).sum(axis=-1, keepdims=True)
+        self._margin = float(margin)
         self._goods = list(goods)
 
     def unsure(self, keys: Sequence[str], trace: Sequence[Mapping[str, Any]]) -> list[str]:
@@ -209,6 +239,15 @@ class _Sides:
         """
         if not keys:
             return []
+        fixed = [k for k in keys if k in self._row]  # not the robot's own goods: they move
+        ok = dict.fromkeys(keys, False)
+        ok.update(zip(fixed, self._one_side(fixed, trace), strict=True))
+        return [k for k in keys if not ok[k]]
+
+    def _one_side(self, keys: Sequence[str], trace: Sequence[Mapping[str, Any]]) -> np.ndarray:
+        """Per obstacle of `keys` (all with sides), whether the plan `trace` surely keeps its parts."""
+        if not keys:
+            return np.zeros(0, dtype=bool)
         p = self._p
         handled = [k for k in range(len(trace) - 1) if trace[k + 1]["pi"] in self._handling]
         at = sorted({j for k in handled for j in (k, k + 1)})
@@ -220,7 +259,43 @@ class _Sides:
         for b, o in enumerate(self._goods, start=1):
             goods &= _clear(rows[:, b], [tuple(float(v) for v in p.obj(o).read(trace[j])[:2]) for j in at])
         clear = np.where(role == 0, robot_all, np.where(role == 1, robot_handling & goods, robot_all & goods))
-        return [k for k, ok in zip(keys, clear.any(axis=1), strict=True) if not ok]
+        ok = clear.any(axis=1)
+        ends = np.array([_base(k) != k for k in keys])
+        if ends.any():  # the stronger part differs only for starts past an end, near a side
+            rows = [self._row[k] for k, stronger in zip(keys, ends, strict=True) if stronger]
+            ok[ends] |= _passes_ends(self._touching[rows], robot, self._margin)
+        return ok
+
+
+_SIDE_AND_END = np.array([(0, 2), (0, 3), (1, 2), (1, 3), (2, 0), (2, 1), (3, 0), (3, 1)])
+"""Each side of an obstacle with each of its neighbours (sides 0, 1 and 2, 3 are opposite)."""
+
+
+def _passes_ends(sides: np.ndarray, robot: Sequence[tuple[float, float]], margin: float) -> np.ndarray:
+    """Per obstacle (`sides`: obstacles x 4 x abc, touching, scaled as in :class:`_Sides`),
+    whether every motion of `robot` surely meets what
+    :func:`~cosmop.planning.specification.past_its_ends` adds to the obstacle's own part.
+
+    That is asked only of a motion that leaves a side for the margin from nearer (and may be
+    a departure), from past one of the side's ends; it holds when the start is
+    :data:`PASSING` margins off both, or the motion is one of :data:`PAST_AN_END`'s.  The
+    test is numeric with the safety gap :data:`_GAP`: it may send an obstacle to the exact
+    test needlessly, never skip one.
+    """
+    if len(robot) < 2:
+        return np.ones(len(sides), dtype=bool)
+    xy = np.asarray(robot)
+    value = sides[..., 0, None] * xy[:, 0] + sides[..., 1, None] * xy[:, 1] - sides[..., 2, None]
+    start, end = value[..., :-1], value[..., 1:]  # (obstacles, 4 sides, motions)
+    side, past = _SIDE_AND_END[:, 0], _SIDE_AND_END[:, 1]
+    v, g = start[:, side], start[:, past]
+    gain, towards = end[:, side] - v, g - end[:, past]
+    leaves = (v > -_GAP) & (v < margin + _GAP) & (end[:, side] > margin - _GAP) & (g > -_GAP)
+    passing = float(PASSING) * margin + _GAP
+    fine = (v >= passing) & (g >= passing)
+    for rate, margins in PAST_AN_END:
+        fine |= (towards <= rate * gain - (rate + 1) * _GAP) & (g >= margins * margin + _GAP)
+    return ~(leaves & ~fine).any(axis=(1, 2))
 
 
 def _clear(planes: np.ndarray, points: Sequence[tuple[float, float]]) -> np.ndarray:

@@ -172,6 +172,15 @@ def object_key(obj: str) -> str:
     return f"object {obj}"
 
 
+def past_its_ends(key: str) -> str:
+    """The name of the stronger GoTo part for obstacle `key` (a wall to drives or an object):
+    departures from past its ends pass them clear (:data:`PAST_AN_END`), ``"wall 3 past its ends"``.
+
+    It implies the obstacle's own GoTo part, and costs the solver more: lazy geometry
+    (:mod:`cosmop.planning.obstacles`) adds it only for the obstacles a plan passes too close."""
+    return f"{key} past its ends"
+
+
 @dataclass(frozen=True)
 class Action:
     """A primitive applied to an object (``None`` for GoTo), with its code in :math:`\\pi`."""
@@ -210,7 +219,8 @@ class RobotProblem:
         :data:`MOTION_MARGIN`; 0 lets a motion slide along what it touches).
     obstacles : frozenset of str, optional
         Write the parts of only these obstacles (:func:`wall_key`, :func:`object_key`; a wall
-        is two, one to drives and one to picks and drops); every wall and object by default.
+        is two, one to drives and one to picks and drops; :func:`past_its_ends` of either names
+        the stronger GoTo part); every wall and object by default.
         Lazy geometry (:mod:`cosmop.planning.obstacles`) writes the parts it needs only.
 
     Attributes
@@ -319,17 +329,18 @@ class RobotProblem:
         """:math:`\\epsilon`, the mission event the step performs: 1 + its index in `mission`, 0 none."""
         return Var("event", "int")
 
+    def written(self, key: str) -> bool:
+        """Whether the parts of obstacle `key` are written (:attr:`obstacles`)."""
+        return self.obstacles is None or key in self.obstacles
+
     def walls(self, handling: bool = False) -> list[tuple[int, Any]]:
         """``(index, wall)`` of the walls whose parts for drives (or for picks and drops, when
         `handling`) are written (:attr:`obstacles`)."""
-        every = self.obstacles is None
-        walls = enumerate(self.scene.obstacles)
-        return [(i, w) for i, w in walls if every or wall_key(i, handling) in self.obstacles]
+        return [(i, w) for i, w in enumerate(self.scene.obstacles) if self.written(wall_key(i, handling))]
 
     def obstacle_objects(self) -> list[str]:
         """The objects whose parts as obstacles are written (:attr:`obstacles`)."""
-        every = self.obstacles is None
-        return [o for o in self.scene.objects if every or object_key(o) in self.obstacles]
+        return [o for o in self.scene.objects if self.written(object_key(o))]
 
     def at_start(self, obj: str) -> tuple[tuple[float, float], bool, bool]:
         """``(position, carried, away)`` of `obj` at instant 0: in `start`, else the scenario's."""
@@ -545,8 +556,9 @@ STEEPNESS = 4
 """A motion that ends touching a face comes 1 mm closer to it per at most this many mm along it
 (it meets the face at 14 degrees or more).  A shallow approach would hold the robot within a
 millimetre or two of the face for a long way, which a controller cannot follow any better than
-a slide.  A departure needs no such bound: the executor first creeps straight out from the
-exact pose it stands on, and the motion then gains the margin from there."""
+a slide.  A departure abreast of what it leaves needs no such bound: the executor first creeps
+straight out from the exact pose it stands on, and the motion then gains the margin from there
+(one from past an obstacle's end passes the end clear: :data:`PAST_AN_END`)."""
 
 
 @dataclass(frozen=True)
@@ -571,26 +583,72 @@ class _Face:
         return self.a * dy - self.b * dx
 
 
+PASSING = Fraction(1, 10)
+"""A motion that leaves a side of an obstacle from past the obstacle's end passes that end at
+least this share of the margin away (2 mm), unless it leaves steeply (:data:`PAST_AN_END`).
+
+A square robot that passes an end closer cannot correct its heading without its corner
+touching the end: the controller stops there.  Abreast of the obstacle the question does not
+arise (the gap only grows), and the solver, which puts points on the boundaries of what it is
+allowed, would otherwise start such motions exactly on the side's line, right past the end."""
+
+PAST_AN_END = ((STEEPNESS, 0), (49, 5), (499, 50))
+"""``(r, k)``: ways to leave a side of an obstacle from past its end, less than
+:data:`PASSING` margins from both: at least 1 mm away from the side per `r` mm towards the end,
+from at least `k` margins past it.
+
+The two gaps meet, as the motion passes the end, at a mean of the gap past the end and the
+side's, weighted by the rates they change at: at least ``k / (r + 1)`` margins, which is
+:data:`PASSING`; any slope as steep as an approach may start right at the end (it passes it
+briefly, and the executor first creeps out of a start that close)."""
+
+
+def _level(face: _Face, far: _Face, x, y, share) -> Formula:
+    """The robot centre :math:`(x, y)` is at least `share` margins inside `face` (`far` at one)."""
+    return face.a * x + face.b * y >= (1 - share) * face.c + share * far.c
+
+
+def _past_an_end(side: tuple[_Face, _Face], end: tuple[_Face, _Face], x, y, dx, dy, gain) -> Formula:
+    """The departure from `side` at :math:`(x, y)` by :math:`(dx, dy)`, gaining `gain` on it,
+    passes the neighbouring side `end` (each: touching and at the margin) clear (:data:`PASSING`)."""
+    towards = -end[0].away(dx, dy)  # how much nearer the end the motion comes
+    out = [end[0].a * x + end[0].b * y <= end[0].c]  # abreast of the obstacle, or beyond this end
+    out.append(_level(*side, x, y, PASSING) & _level(*end, x, y, PASSING))
+    for rate, margins in PAST_AN_END:
+        slope = towards <= rate * gain
+        out.append(slope & _level(*end, x, y, margins) if margins else slope)
+    return disj(out)
+
+
 @lru_cache(maxsize=16384)  # robots of one size share their walls' formulas (pure, hashable)
-def _apart(x, y, faces: tuple[tuple[_Face, _Face], ...]) -> Formula:
+def _apart(x, y, faces: tuple[tuple[_Face, _Face], ...], ends: bool = False) -> Formula:
     """A straight motion from :math:`(x, y)` to :math:`\\bigcirc(x, y)` clear of one obstacle.
 
     `faces` pairs each side on which a square touching the obstacle may lie with the same side
-    moved away by the margin (which lies inside it).  Both ends lie on one side (then so does
-    the swept hull: it is convex), and the motion either ends at the margin or beyond (it
-    keeps it, or departs from touching), or starts there and approaches the side's boundary at
-    least :data:`STEEPNESS` steep.  The gap is never held near zero along the way.
+    moved away by the margin (which lies inside it); sides 0 and 1 are opposite, as are 2 and
+    3.  Both ends lie on one side (then so does the swept hull: it is convex), and the motion
+    either keeps the margin, or starts there and approaches the side's boundary at least
+    :data:`STEEPNESS` steep, or departs from the side's boundary to the margin.  Abreast of the
+    obstacle (not strictly inside either neighbouring side) the nearest part of the obstacle is
+    the side itself, so a departure's gap only grows.  With `ends`, a departure from past an
+    end must also pass that end clear (:func:`_past_an_end`); this formula implies the one
+    without, and is what :func:`past_its_ends` names.  The gap is never held near zero.
     """
     nx, ny = x.next(), y.next()
     dx, dy = nx - x, ny - y
     out = []
-    for touch, far in faces:
+    for k, (touch, far) in enumerate(faces):
         if far is touch:
             out.append(touch.holds(x, y) & touch.holds(nx, ny))
             continue
         gain, along = touch.away(dx, dy), touch.along(dx, dy)
         steep = (along <= -STEEPNESS * gain) & (-along <= -STEEPNESS * gain)
-        out.append((touch.holds(x, y) & far.holds(nx, ny)) | (far.holds(x, y) & touch.holds(nx, ny) & steep))
+        leaves = touch.holds(x, y) & far.holds(nx, ny)  # keeps the margin, or departs
+        if ends:
+            ends_of = faces[2:] if k < 2 else faces[:2]
+            passed = [_past_an_end((touch, far), e, x, y, dx, dy, gain) for e in ends_of]
+            leaves = leaves & (far.holds(x, y) | conj(passed))
+        out.append(leaves | (far.holds(x, y) & touch.holds(nx, ny) & steep))
     return disj(out)
 
 
@@ -615,7 +673,8 @@ class GoTo(Encoding):
 
     Touching is allowed at either end of the motion; otherwise it keeps
     :attr:`RobotProblem.margin`, departs from touching to it, or approaches from it steeply
-    (:data:`MOTION_MARGIN`, :data:`STEEPNESS`, :func:`_apart`).
+    (:data:`MOTION_MARGIN`, :data:`STEEPNESS`, :func:`_apart`).  The part named
+    :func:`past_its_ends` also passes the obstacle's ends clear (:data:`PAST_AN_END`).
     """
 
     name = Primitive.GOTO
@@ -626,14 +685,23 @@ class GoTo(Encoding):
     def parts(self, p, obj):
         x, y = p.x, p.y
         out = [("GoTo keeps the objects", _objects_static(p))]
-        for i, wall in p.walls():
-            sides = _wall_sides(p, wall, wall_key(i))
-            out.append((f"{wall_key(i)} {[list(wall.start), list(wall.end)]}", _apart(x, y, sides)))
-        for o in p.obstacle_objects():
-            v, d = p.obj(o), p.clearance(o)
-            clear = _apart(x, y, _object_sides(v, d, p.margin))
-            out.append((object_key(o), Implies(v.resting, clear)))
+        for i, wall in enumerate(p.scene.obstacles):
+            for name, ends in _goto_parts(p, wall_key(i)):
+                clear = _apart(x, y, _wall_sides(p, wall, wall_key(i)), ends=ends)
+                out.append((f"{name} {[list(wall.start), list(wall.end)]}", clear))
+        for o in p.scene.objects:
+            for name, ends in _goto_parts(p, object_key(o)):
+                v = p.obj(o)
+                clear = _apart(x, y, _object_sides(v, p.clearance(o), p.margin), ends=ends)
+                out.append((name, Implies(v.resting, clear)))
         return out
+
+
+def _goto_parts(p: RobotProblem, key: str) -> list[tuple[str, bool]]:
+    """``(name, ends)`` of the GoTo parts written for obstacle `key`: its stronger one
+    (:func:`past_its_ends`), its own, or both, in that order (an unsat core shrunk by deleting
+    parts in order then keeps the obstacle's own part where that alone blocks)."""
+    return [(name, ends) for name, ends in ((past_its_ends(key), True), (key, False)) if p.written(name)]
 
 
 class PickUp(Encoding):
