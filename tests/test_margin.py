@@ -152,11 +152,12 @@ def test_a_motion_from_past_a_walls_end_never_grazes_the_end():
 
 
 def _about_an_end(rng, n):
-    """`n` centres: in turn one level with a side of the wall's end (0, 0) or of O2, a little
+    """`n` centres: in turn one level with a side of the wall's end (0, 0), of O2 or of O1
+    where it starts (R1's own good: it moves, and is tested where it lies), a little
     past the end, and one a long way back past it, a little further off the side."""
     out = []
     while len(out) < n:
-        cx, cy, d = rng.choice([(0, 0, 200), (1500, -1500, 250)])
+        cx, cy, d = rng.choice([(0, 0, 200), (1500, -1500, 250), (500, -2000, 250)])
         sx, sy = rng.choice([-1, 1]), 1 if cx == 0 else rng.choice([-1, 1])
         x = cx + sx * (d + rng.choice([0, 1, 2, 3, 15, 25]))
         y = cy + sy * (d + rng.choice([0, 1, 5, 20, 100, 300]))
@@ -176,7 +177,7 @@ def test_the_numeric_test_of_the_ends_never_passes_what_the_formula_breaks(monke
     monkeypatch.setattr(obstacles.Geometry, "broken", lambda g, t: seen.append((g, t)) or broken(g, t))
     synthesize(scene, "R1", MISSION, max_horizon=12)
     geometry, trace = seen[-1]
-    walls = [wall_key(i) for i in range(len(scene.obstacles))] + [object_key("O2")]
+    walls = [wall_key(i) for i in range(len(scene.obstacles))] + [object_key("O2"), object_key("O1")]
     keys = [past_its_ends(k) for k in walls]
     geometry._write([k for k in walls + keys if k not in geometry._written])
     rng = random.Random(7)

@@ -240,9 +240,25 @@ class _Sides:
         if not keys:
             return []
         fixed = [k for k in keys if k in self._row]  # not the robot's own goods: they move
-        ok = dict.fromkeys(keys, False)
+        own = [k for k in keys if k not in self._row]  # their stronger parts
+        ok = {k: self._own_ends(_base(k).removeprefix(object_key("")), trace) for k in own}
         ok.update(zip(fixed, self._one_side(fixed, trace), strict=True))
         return [k for k in keys if not ok[k]]
+
+    def _own_ends(self, obj: str, trace: Sequence[Mapping[str, Any]]) -> bool:
+        """Whether the motions that start where the robot's own good `obj` rests surely pass its
+        ends clear (:func:`_passes_ends`, with the good where it lies then)."""
+        p = self._p
+        v, d = p.obj(obj), float((to_fraction(p.scene.objects[obj].size) + p.side) / 2)
+        for k in range(len(trace) - 1):
+            x, y, carried, away = v.read(trace[k])
+            if carried or away:
+                continue
+            sides = np.array([square_sides(float(x), float(y), d)], dtype=float)  # |a| + |b| = 1
+            motion = [(float(s["x"]), float(s["y"])) for s in trace[k : k + 2]]
+            if not _passes_ends(sides, motion, self._margin)[0]:
+                return False
+        return True
 
     def _one_side(self, keys: Sequence[str], trace: Sequence[Mapping[str, Any]]) -> np.ndarray:
         """Per obstacle of `keys` (all with sides), whether the plan `trace` surely keeps its parts."""
