@@ -197,13 +197,11 @@ class _Sides:
         side, margin = p.side, p.margin
         goods = {o: to_fraction(p.scene.objects[o].size) for o in p.own_objects}
         planes: dict[str, list] = {}
-        touching: dict[str, list] = {}  # each obstacle's sides for the robot's square, touching
         self._roles: dict[str, int] = {}  # 0: a wall to drives, 1: to picks and drops, 2: an object
         self._handling = {a.code for a in p.actions if a.primitive in (Primitive.PICKUP, Primitive.DROPOFF)}
         for i, w in enumerate(p.scene.obstacles):
             regions = [wall_regions(w.start, w.end, g) for g in (side + 2 * margin, *goods.values())]
             planes[wall_key(i)] = [[(h.a, h.b, h.c) for h in body] for body in regions]
-            touching[wall_key(i)] = [(h.a, h.b, h.c) for h in wall_regions(w.start, w.end, side)]
             self._roles[wall_key(i)], self._roles[wall_key(i, handling=True)] = 0, 1
         robot_gap = max(margin, HANDLING_CLEARANCE)
         for o, ob in p.scene.objects.items():
@@ -214,7 +212,6 @@ class _Sides:
             robot = list(square_sides(ox, oy, (size + side) / 2 + robot_gap))
             carried = [list(square_sides(ox, oy, (size + g) / 2)) for g in goods.values()]
             planes[object_key(o)] = [robot, *carried]
-            touching[object_key(o)] = list(square_sides(ox, oy, (size + side) / 2))
             self._roles[object_key(o)] = 2
         self._keys = list(planes)
         self._row = {k: n for n, k in enumerate(self._keys)}
@@ -225,8 +222,9 @@ class _Sides:
         table = np.array([planes[k] for k in self._keys], dtype=float)  # (obstacles, bodies, 4 sides, abc)
         table /= np.abs(table[..., :2]).sum(axis=-1, keepdims=True)
         self._table = table
-        touch = np.array([touching[k] for k in self._keys], dtype=float)  # (obstacles, 4 sides, abc)
-        self._touching = touch / np.abs(touch[..., :2]).sum(axis=-1, keepdims=True)
+        grown = np.array([float(margin if k.startswith("wall") else robot_gap) for k in self._keys])
+        self._touching = table[:, 0].copy()  # the robot's sides above, moved back to touching
+        self._touching[..., 2] -= grown[:, None]
         self._margin = float(margin)
         self._goods = list(goods)
 
