@@ -528,6 +528,11 @@ class Precedence:
             return j <= i
         return self._has(self._D, self._row(first), then)
 
+    def done_before(self, row: int) -> int:
+        """The steps that always complete before the step of `row` completes (its vector clock
+        as a set of rows, one bit each; 0 for a row past a plan, ``-1``)."""
+        return self._D[row] if row >= 0 else 0
+
     def completed(self, step: Node, robot: str) -> int:
         """How many of `robot`'s steps always complete by the completion of `step` (its entry
         in the step's vector clock)."""

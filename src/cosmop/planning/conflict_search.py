@@ -144,7 +144,7 @@ class Search:
                 break  # the set-asides first; if it is still a dead end, it comes back
             if choices:
                 i, edge = self.trail[max(choices)][:2]
-                other = self.sides.edges[i][self.sides.others(i, edge)[0]]
+                other = self.sides.other_way(i, edge)
                 self._retract(max(choices), {i}, (i, other, frozenset(core)))
                 return "choice"
             if back is not None:
@@ -174,7 +174,7 @@ class Search:
             if not choices:
                 return core, choices
             i, edge, log, _ = self.trail[max(choices)]
-            other = self.sides.edges[i][self.sides.others(i, edge)[0]]
+            other = self.sides.other_way(i, edge)
             if self.graph.path(*other, before=max(choices)) is None:
                 return core, choices
             self.trail[max(choices)] = (i, edge, log, True)
@@ -462,7 +462,7 @@ class _Graph:
         ``source -> target`` would close -- through the edges pushed before place `before`
         (default: all); ``None`` if there is none."""
         end, start = self.precedence.rows((source, target))
-        on_way = self.precedence._D[end] if end >= 0 else 0  # the steps that complete before `end`
+        on_way = self.precedence.done_before(end)  # only these can be on the path
         if not on_way >> start & 1:
             return None
         at = self.at if before is not None else None
@@ -538,6 +538,10 @@ class _Sides:
     def others(self, i: int, taken: tuple[Node, Node]) -> list[int]:
         """The sides of conflict `i` that exist other than the way `taken`."""
         return [n for n, edge in enumerate(self.edges[i]) if edge is not None and edge != taken]
+
+    def other_way(self, i: int, taken: tuple[Node, Node]) -> tuple[Node, Node]:
+        """The start edge of conflict `i`'s way other than `taken` (it has two)."""
+        return self.edges[i][self.others(i, taken)[0]]
 
     def holds(self, precedence: Precedence, rows: np.ndarray | None = None) -> np.ndarray:
         """(n, 2): whether each side (of the conflicts `rows`, default all) is already implied."""

@@ -222,7 +222,7 @@ class _Sides:
         table = np.array([planes[k] for k in self._keys], dtype=float)  # (obstacles, bodies, 4 sides, abc)
         table /= np.abs(table[..., :2]).sum(axis=-1, keepdims=True)
         self._table = table
-        grown = np.array([float(margin if k.startswith("wall") else robot_gap) for k in self._keys])
+        grown = np.array([float(margin if self._roles[k] == 0 else robot_gap) for k in self._keys])
         self._touching = table[:, 0].copy()  # the robot's sides above, moved back to touching
         self._touching[..., 2] -= grown[:, None]
         self._margin = float(margin)

@@ -686,14 +686,15 @@ class GoTo(Encoding):
         x, y = p.x, p.y
         out = [("GoTo keeps the objects", _objects_static(p))]
         for i, wall in enumerate(p.scene.obstacles):
-            for name, ends in _goto_parts(p, wall_key(i)):
-                clear = _apart(x, y, _wall_sides(p, wall, wall_key(i)), ends=ends)
-                out.append((f"{name} {[list(wall.start), list(wall.end)]}", clear))
+            if written := _goto_parts(p, wall_key(i)):
+                sides = _wall_sides(p, wall, wall_key(i))
+                coordinates = [list(wall.start), list(wall.end)]
+                out += [(f"{name} {coordinates}", _apart(x, y, sides, ends=ends)) for name, ends in written]
         for o in p.scene.objects:
-            for name, ends in _goto_parts(p, object_key(o)):
+            if written := _goto_parts(p, object_key(o)):
                 v = p.obj(o)
-                clear = _apart(x, y, _object_sides(v, p.clearance(o), p.margin), ends=ends)
-                out.append((name, Implies(v.resting, clear)))
+                sides = _object_sides(v, p.clearance(o), p.margin)
+                out += [(name, Implies(v.resting, _apart(x, y, sides, ends=ends))) for name, ends in written]
         return out
 
 
