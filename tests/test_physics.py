@@ -109,7 +109,7 @@ def test_a_scene_in_metres_says_metres():
     )
 
 
-def test_one_robot_moves_each_object_in_a_task_list():
+def test_goods_in_two_task_lists_need_an_order():
     def twice(d):
         d["mission"]["tasks"]["R2"] = list(d["mission"]["tasks"]["R1"][:2]) + d["mission"]["tasks"]["R2"]
 
@@ -120,7 +120,8 @@ def test_one_robot_moves_each_object_in_a_task_list():
     with pytest.raises(ScenarioError) as err:
         parse_scenario(data)
     assert err.value.field == "mission.tasks.R2[0]"
-    assert "O1 is already moved by R1 (mission.tasks.R1[0])" in str(err.value)
+    assert "O1 is moved by R1 (mission.tasks.R1[0]) and by R2 with no order between them" in str(err.value)
+    assert "msg(R1,R2,TAG)" in str(err.value)
 
 
 def test_tasks_name_at_least_one_robot():

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import os
 
-__all__ = ["CosmopInputError", "EventSyntaxError", "OutputPathError", "ScenarioError"]
+__all__ = ["CosmopInputError", "EventSyntaxError", "MissionTooLargeError", "OutputPathError", "ScenarioError"]
 
 
 class CosmopInputError(Exception):
@@ -85,3 +85,8 @@ class EventSyntaxError(ValueError):
 
     The message quotes the offending text and lists the accepted forms.
     """
+
+
+class MissionTooLargeError(ScenarioError):
+    """A mission beyond what the top-down layer decides within its bounds (team states explored,
+    counterexamples used): the user can split it or write it more compactly."""

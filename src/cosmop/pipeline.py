@@ -35,13 +35,15 @@ import shapely
 
 from cosmop.allocate import allocate
 from cosmop.automata import DFA
-from cosmop.events import Event, parse_event
+from cosmop.errors import MissionTooLargeError
+from cosmop.events import Event, Primitive, parse_event
 from cosmop.missions.allocation import Choice
 from cosmop.missions.coordination import Coordinated, coordinate
 from cosmop.missions.decomposition import decompose
+from cosmop.missions.handover import Handover, Handovers, handovers
 from cosmop.missions.mission import GlobalMission, sequence_of
 from cosmop.missions.team import TeamVerdict, blocking_word, check_words
-from cosmop.planning.aside import ROOM, place_aside
+from cosmop.planning.aside import ROOM, dock_slots, handover_spot, place_aside
 from cosmop.planning.checker import CheckReport, check_plan
 from cosmop.planning.conflicts import ConflictSettings
 from cosmop.planning.plan import MAX_STEPS, AddedTask, Coordination, PlanMessage, PlanSet, RobotPlan
@@ -115,6 +117,7 @@ class _Job:
     rlimit: int
     unrequestable: frozenset[str] = frozenset()
     explain: bool = True  # an infeasible answer says why (costs more solver calls)
+    spots: tuple[tuple[Event, tuple[float, float]], ...] = ()  # drops pinned for a hand-over
 
 
 def _automaton_key(dfa: DFA) -> tuple:
@@ -132,6 +135,7 @@ def _synthesize(job: _Job) -> Synthesis:
         rlimit=job.rlimit,
         unrequestable=job.unrequestable,
         explain=job.explain,
+        spots=job.spots,
     )
 
 
@@ -167,28 +171,53 @@ class _Planner:
         self.forbidden: dict[str, frozenset[str]] = {}
         self.added: list[AddedTask] = []  # goods moved aside; their places extend the scenario
         self.obstacles: dict[str, tuple[Wall, ...]] = {}
+        # hand-overs: goods a robot picks where another drops them (its model starts with them
+        # there), and the giver's drop held to that spot
+        self.placed: dict[str, dict[str, tuple[float, float]]] = {}
+        self.spots: dict[str, dict[Event, tuple[float, float]]] = {}
         self.cache: dict[tuple, Synthesis] = {}  # the same question is never solved twice
+
+    def restrictions(self, robot: str) -> tuple:
+        """Everything besides the mission that decides `robot`'s synthesis."""
+        return (
+            self.forbidden.get(robot, frozenset()),
+            self.obstacles.get(robot, ()),
+            tuple(sorted(self.placed.get(robot, {}).items())),
+            tuple(sorted(self.spots.get(robot, {}).items())),
+        )
 
     def key(self, robot: str, events: tuple[Event, ...] | DFA, explain: bool = True) -> tuple:
         mission = _automaton_key(events) if isinstance(events, DFA) else tuple(events)
-        restrictions = (self.forbidden.get(robot, frozenset()), self.obstacles.get(robot, ()))
-        return (robot, mission, *restrictions, *(() if explain else ("unexplained",)))
+        return (robot, mission, *self.restrictions(robot), *(() if explain else ("unexplained",)))
 
     def remember(self, robot: str, events: tuple[Event, ...], forbidden: frozenset[str], result: Synthesis):
         """Keep `result` as the answer for `events` with `forbidden` (one it answers exactly)."""
-        self.cache[(robot, tuple(events), forbidden, self.obstacles.get(robot, ()))] = result
+        self.cache[(robot, tuple(events), forbidden, *self.restrictions(robot)[1:])] = result
+
+    def hand_over(self, handover: Handover, spot: tuple[float, float]) -> None:
+        """From now on the receiver's model has the goods at `spot` from the start, and the
+        giver's drop puts them exactly there."""
+        self.placed.setdefault(handover.receiver, {})[handover.obj] = spot
+        self.spots.setdefault(handover.giver, {})[handover.drop] = spot
 
     def job(self, robot: str, events: tuple[Event, ...] | DFA, explain: bool = True) -> _Job:
         scene = self.scenario.scene
         extra = self.obstacles.get(robot, ())
         if extra:
             scene = replace(scene, obstacles=scene.obstacles + extra)
+        placed = self.placed.get(robot)
+        if placed:
+            objects = {o: replace(v, position=placed.get(o, v.position)) for o, v in scene.objects.items()}
+            scene = replace(scene, objects=objects)
         branching = isinstance(events, DFA)
         # a branching mission gets the horizon of its alphabet: no word of it has more events
         mission = tuple(parse_event(e) for e in events.alphabet) if branching else tuple(events)
         horizon = self.max_horizon if self.max_horizon is not None else default_horizon(mission)
         forbidden = self.forbidden.get(robot, frozenset())
-        return _Job(scene, robot, events if branching else mission, horizon, self.rlimit, forbidden, explain)
+        spots = tuple(sorted(self.spots.get(robot, {}).items()))
+        return _Job(
+            scene, robot, events if branching else mission, horizon, self.rlimit, forbidden, explain, spots
+        )
 
     def run(self, jobs: Mapping[str, tuple[Event, ...]], explain: bool = True) -> dict[str, Synthesis]:
         """Each robot's synthesis; with `explain` false an infeasible one only says so (trials)."""
@@ -264,7 +293,10 @@ def plan_team(
     phases = dict.fromkeys(PHASES, 0.0)
     t = time.perf_counter()
     mission = GlobalMission.from_scenario(scenario)
-    words, notes, reasons = _local_words(scenario, mission)
+    try:
+        words, notes, reasons = _local_words(scenario, mission)
+    except MissionTooLargeError as err:
+        raise _in_file(err, scenario) from None
     phases["decompose"] = time.perf_counter() - t
     pool = None
     if executor is None:
@@ -277,7 +309,10 @@ def plan_team(
         if words is None:  # the mission leaves choices open: commit to the cheapest way
             t = time.perf_counter()
             before = phases["synthesize"]
-            words, notes, reasons, choice = allocate(scenario, mission, planner)
+            try:
+                words, notes, reasons, choice = allocate(scenario, mission, planner)
+            except MissionTooLargeError as err:
+                raise _in_file(err, scenario) from None
             phases["allocate"] = time.perf_counter() - t - (phases["synthesize"] - before)
         return _loop(scenario, mission, words, notes, reasons, planner, max_iterations, conflicts, choice)
     except BaseException:  # an interrupt or an error: do not wait for the workers' syntheses
@@ -291,6 +326,11 @@ def plan_team(
     finally:
         if pool is not None:
             pool.shutdown()
+
+
+def _in_file(err: MissionTooLargeError, scenario: Scenario) -> MissionTooLargeError:
+    """`err` naming the scenario's file."""
+    return MissionTooLargeError(err.expected, file=scenario.source, field=err.field)
 
 
 def _local_words(
@@ -343,8 +383,12 @@ def _loop(
     replans: list[str] = []
     results: dict[str, Synthesis] = {}
     coordinated, current, iterations, converged = None, dict(base), 0, False
+    givers = handovers(base)
+    reasons.extend(givers.refused)
     if not reasons:
-        results = planner.run(dict(base))
+        reasons.extend(_pack_docks(base, planner))
+    if not reasons:
+        results = _plan_in_turn(base, givers, planner)
         coordinated, current, iterations, converged = _coordinate_requests(
             base, results, planner, max_iterations, reasons, replans
         )
@@ -390,6 +434,107 @@ def _loop(
         replans=tuple(replans),
         allocation=choice,
     )
+
+
+def _pack_docks(base: Mapping[str, tuple[Event, ...]], planner: _Planner) -> list[str]:
+    """Give goods that several robots drop into one workspace a slot each; why not (``[]``: done).
+
+    Each robot picks its own drop spot when planned alone, and robots sharing a dock would
+    pick the same one: the goods are packed first (:func:`cosmop.planning.aside.dock_slots`),
+    each robot's drop is pinned to its goods' slot, and a robot knows the goods packed before
+    its own in their slots from the start (it docks beside them).  The conflict step then
+    orders the drops.
+    """
+    drops: dict[str, dict[str, tuple[str, Event]]] = {}
+    for robot, word in base.items():
+        for event in word:
+            if event.kind == "drop" and event.robot == robot:
+                drops.setdefault(event.workspace, {}).setdefault(event.obj, (robot, event))
+    why_not = []
+    scene = planner.scenario.scene
+    for workspace, goods in drops.items():
+        if len({robot for robot, _ in goods.values()}) < 2:
+            continue  # one robot's model holds all its goods: its plan packs them itself
+        packing = dock_slots(scene, workspace, {o: robot for o, (robot, _) in goods.items()})
+        if packing.left_out:
+            size = scene.workspaces[workspace]
+            why_not.append(
+                f"{workspace} holds {len(packing.slots)} of the {len(goods)} goods dropped there: no "
+                f"room to dock {', '.join(packing.left_out)} beside the others "
+                f"({_extent(size)}, goods {', '.join(f'{o} {scene.objects[o].size:g}' for o in goods)})"
+            )
+            continue
+        for n, (obj, spot) in enumerate(packing.slots):
+            robot, event = goods[obj]
+            planner.spots.setdefault(robot, {})[event] = spot
+            for later, _ in packing.slots[n + 1 :]:
+                if goods[later][0] != robot:
+                    planner.placed.setdefault(goods[later][0], {})[obj] = spot
+    return why_not
+
+
+def _extent(workspace) -> str:
+    """A rectangular workspace's size in words (mm)."""
+    (x0, x1), (y0, y1) = workspace.ranges
+    return f"{x1 - x0:g} x {y1 - y0:g} mm"
+
+
+def _plan_in_turn(
+    base: Mapping[str, tuple[Event, ...]], givers: Handovers, planner: _Planner
+) -> dict[str, Synthesis]:
+    """Every robot's first plan, givers of goods before their receivers.
+
+    Robots that receive nothing are planned together; once a giver is planned, the spot where
+    its plan drops the goods becomes the receiver's (:meth:`_Planner.hand_over`), and the
+    receiver is planned in a later turn.  A receiver that cannot pick them there, and a cycle
+    of givers and receivers, get a spot chosen for both
+    (:func:`cosmop.planning.aside.handover_spot`): the giver is planned again to drop there.
+    """
+    results: dict[str, Synthesis] = {}
+    for robots, chosen in givers.turns(tuple(base)):
+        for h in chosen:
+            _choose_spot(h, planner)
+        results.update(planner.run({r: base[r] for r in robots}))
+        for h in givers.items:
+            if h.giver not in robots:
+                continue
+            pinned = planner.spots.get(h.giver, {}).get(h.drop)
+            plan = results[h.giver].plan
+            spot = pinned if pinned is not None else _drop_spot(plan, h) if plan is not None else None
+            if spot is None:
+                continue
+            planner.hand_over(h, spot)
+            if pinned is None:  # its plan drops there already: its answer with the spot pinned too
+                planner.cache[planner.key(h.giver, base[h.giver])] = results[h.giver]
+        stuck = [h for h in givers.items if h.receiver in robots and not results[h.receiver].feasible]
+        for h in stuck:  # the giver's spot does not suit the receiver: one for both
+            if _choose_spot(h, planner):
+                results.update(planner.run({r: base[r] for r in (h.giver, h.receiver)}))
+    return results
+
+
+def _choose_spot(handover: Handover, planner: _Planner) -> bool:
+    """Give `handover` a spot both robots can dock to, clear of the spots other goods are
+    handed over at; whether there is a new one."""
+    scene = planner.scenario.scene
+    spots = {o: p for placed in planner.placed.values() for o, p in placed.items() if o != handover.obj}
+    if spots:
+        objects = {o: replace(v, position=spots.get(o, v.position)) for o, v in scene.objects.items()}
+        scene = replace(scene, objects=objects)
+    robots = (handover.giver, handover.receiver)
+    spot = handover_spot(scene, handover.obj, handover.drop.workspace, robots)
+    if spot is None or planner.placed.get(handover.receiver, {}).get(handover.obj) == spot:
+        return False
+    planner.hand_over(handover, spot)
+    return True
+
+
+def _drop_spot(plan: RobotPlan, handover: Handover) -> tuple[float, float] | None:
+    """Where `plan` puts the goods of `handover` down: its `nth` DropOff of them."""
+    drops = [s for s in plan.steps if s.primitive == Primitive.DROPOFF and s.object == handover.obj]
+    if handover.nth >= len(drops):
+        return None
+    return tuple(drops[handover.nth].objects[handover.obj].position)
 
 
 def _plan_messages(plans: Mapping[str, RobotPlan], notes: Mapping[str, tuple[str, str]]) -> list[PlanMessage]:
@@ -546,7 +691,8 @@ def _move_aside(
             results[helper] = result
             # the others never see the goods move (their models keep them where they were):
             # from now on their plans keep out of the place, as from a wall
-            walls = _walls_around(square(*task.point, planner.scenario.scene.objects[obj].size), _AROUND)
+            where = square(*task.point, planner.scenario.scene.objects[obj].size)
+            walls = _walls_around(where, _AROUND, f"the place {helper} sets {obj} down at")
             for other in base:
                 if other != helper:
                     planner.obstacles[other] = planner.obstacles.get(other, ()) + walls
@@ -703,7 +849,9 @@ def _detour(planner, current, moves, settings, replans) -> tuple[dict[str, Synth
     saved = dict(planner.obstacles)
     objects = frozenset(planner.scenario.scene.objects)
     for robot, items in moves.items():
-        walls = tuple(w for _, keep in items for w in _walls_around(keep.region, settings))
+        walls = tuple(
+            w for _, keep in items for w in _walls_around(keep.region, settings, f"the space of {keep.label}")
+        )
         planner.obstacles[robot] = planner.obstacles.get(robot, ()) + walls
         # the requests are settled: a detour may ask only for what the robot already asks for
         asked = {e.obj for e in current[robot] if e.kind == "away" and e.receiver == robot}
@@ -721,12 +869,13 @@ def _detour(planner, current, moves, settings, replans) -> tuple[dict[str, Synth
     return fresh, failed
 
 
-def _walls_around(region, settings: ConflictSettings) -> tuple[Wall, ...]:
-    """Wall segments around `region`, grown by half the clearance (for a robot to keep out)."""
+def _walls_around(region, settings: ConflictSettings, label: str) -> tuple[Wall, ...]:
+    """Wall segments around `region`, grown by half the clearance (for a robot to keep out),
+    labelled with what they keep it out of (reasons name that, never the piece)."""
     grown = region.buffer(settings.clearance / 2.0, join_style="mitre")
     ring = list(shapely.get_coordinates(grown.exterior))
     return tuple(
-        Wall((float(p[0]), float(p[1])), (float(q[0]), float(q[1])))
+        Wall((float(p[0]), float(p[1])), (float(q[0]), float(q[1])), label)
         for p, q in itertools.pairwise(ring)
         if tuple(p) != tuple(q)
     )

@@ -332,10 +332,16 @@ class Human:
 
 @dataclass(frozen=True)
 class Wall:
-    """A wall: the straight segment from `start` to `end` (mm; the end points differ)."""
+    """A wall: the straight segment from `start` to `end` (mm; the end points differ).
+
+    `label` names a wall the planner adds itself (around another robot's space, say), so that
+    a reason never names an internal piece as if the user had drawn it; a wall of the file has
+    none and is named by its index there.  It takes no part in comparisons.
+    """
 
     start: Point
     end: Point
+    label: str | None = field(default=None, compare=False)
 
     @property
     def length(self) -> float:

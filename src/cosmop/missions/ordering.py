@@ -36,6 +36,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 from cosmop.automata import Composition
+from cosmop.errors import MissionTooLargeError
 from cosmop.events import message, parse_event
 
 __all__ = [
@@ -154,7 +155,11 @@ def _explore(team: _Team, max_states: int) -> tuple[list, dict, dict]:
         for _, nxt in moves[state]:
             if nxt is not None and nxt not in seen:
                 if len(seen) >= max_states:
-                    raise RuntimeError(f"more than {max_states} team states; the mission is too large")
+                    raise MissionTooLargeError(
+                        f"ordering the robots' events explores more than {max_states} team states; "
+                        "split the mission or write it with fewer orders between robots",
+                        field="mission",
+                    )
                 seen.add(nxt)
                 order.append(nxt)
                 queue.append(nxt)
@@ -174,7 +179,7 @@ def order_words(
     words: Mapping[str, Sequence[str]],
     *,
     max_states: int = 2_000_000,
-    max_rounds: int = 500,
+    max_rounds: int | None = None,
 ) -> WordOrder:
     """Edges that make every run of the words a complete word of `mission` (module docstring).
 
@@ -185,7 +190,13 @@ def order_words(
     words : Mapping[str, sequence of str]
         Each robot's word (event names), with the messages it already has.
     max_states, max_rounds : int
-        Bounds on the explored product and on the counterexamples used.
+        Bounds on the explored product and on the counterexamples used (by default four per
+        event of the words: each counterexample orders one more pair of events).
+
+    Raises
+    ------
+    MissionTooLargeError
+        When a bound is reached before the order settles.
 
     Returns
     -------
@@ -194,6 +205,8 @@ def order_words(
     base = message_edges(words)
     added: list[Edge] = []
     rounds = 0
+    if max_rounds is None:
+        max_rounds = 16 + 4 * sum(len(w) for w in words.values())
     while True:
         team = _Team(mission, words, base + added)
         order, moves, good = _explore(team, max_states)
@@ -206,7 +219,11 @@ def order_words(
         if bad is None:
             break
         if rounds >= max_rounds:
-            raise RuntimeError(f"ordering did not settle within {max_rounds} counterexamples")
+            raise MissionTooLargeError(
+                f"the order between the robots' events did not settle within {max_rounds} "
+                "counterexamples; split the mission or write it with fewer orders between robots",
+                field="mission",
+            )
         rounds += 1
         state, x = bad
         y = next(n for n, nxt in moves[state] if nxt in good)

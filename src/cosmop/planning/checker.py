@@ -54,7 +54,7 @@ coordinator only adds ``away`` events), and request/response pairs agree with th
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Collection, Iterable
 from typing import Any
 
 from shapely.geometry import LineString
@@ -151,12 +151,19 @@ def _nth(n: int) -> str:
 class _RobotChecker:
     """Checks one robot's plan; collects violations."""
 
-    def __init__(self, scene: Scene, robot_id: str, plan: RobotPlan, start: State | None = None) -> None:
+    def __init__(
+        self,
+        scene: Scene,
+        robot_id: str,
+        plan: RobotPlan,
+        start: State | None = None,
+        moved: Collection[str] | None = None,
+    ) -> None:
         self.scene = scene
         self.robot_id = robot_id
         self.plan = plan
         self.side = scene.robots[robot_id].size
-        self.initial = initial_state(scene, robot_id) if start is None else start
+        self.initial = initial_state(scene, robot_id, plan, moved) if start is None else start
         self.home = scene.robots[robot_id].pose
         self.states: list[State] = [self.initial, *(step.state for step in plan.steps)]
         self.walls = [(wall, _wall_line(wall)) for wall in scene.obstacles]
@@ -591,7 +598,11 @@ def _workspace_text(scene: Scene, wid: str) -> str:
 
 
 def check_robot_plan(
-    scene: Scene, robot_id: str, plan: RobotPlan, start: State | None = None
+    scene: Scene,
+    robot_id: str,
+    plan: RobotPlan,
+    start: State | None = None,
+    moved: Collection[str] | None = None,
 ) -> list[Violation]:
     """Check one robot's plan against the scene: every transition, and the plan's own mission.
 
@@ -606,6 +617,10 @@ def check_robot_plan(
     start : State, optional
         Instant 0 when it is not the scenario (a plan made mid-mission, :mod:`cosmop.sim`);
         ``return`` still means the scenario's initial pose.
+    moved : collection of str, optional
+        Goods the team moves: the plan may know them elsewhere than the scenario at instant 0
+        (:func:`~cosmop.planning.plan.initial_state`; the team's checker verifies where they
+        really are).  By default the goods the plan picks up.
 
     Returns
     -------
@@ -623,7 +638,7 @@ def check_robot_plan(
                 f"({', '.join(scene.robots) or 'none'})",
             )
         ]
-    return _RobotChecker(scene, robot_id, plan, start).run()
+    return _RobotChecker(scene, robot_id, plan, start, moved).run()
 
 
 # ----------------------------------------------------------------------------------------------
@@ -678,8 +693,9 @@ def check_plan(scenario: Scenario, plan: PlanSet) -> CheckReport:
             )
         )
     checked = 0
+    moved = {s.object for p in plan.robots.values() for s in p.steps if s.primitive == Primitive.PICKUP}
     for robot_id, robot_plan in plan.robots.items():
-        violations.extend(check_robot_plan(scene, robot_id, robot_plan))
+        violations.extend(check_robot_plan(scene, robot_id, robot_plan, moved=moved))
         if robot_id in scene.robots:
             checked += robot_plan.horizon
     tasks = scenario.mission.tasks

@@ -38,7 +38,7 @@ from shapely.geometry.base import BaseGeometry
 from cosmop.events import Primitive
 from cosmop.missions.precedence import Node, Precedence
 from cosmop.planning.plan import RobotPlan, State, _fmt, _point, initial_state
-from cosmop.planning.realisation import at_pose
+from cosmop.planning.realisation import TOLERANCE, at_pose
 from cosmop.scene import Scene
 from cosmop.squares import overlap_depths, square, swept_square
 
@@ -103,6 +103,12 @@ class Occupancy:
     body : shapely geometry, optional
         The region without the clearance robots keep from each other (a robot may pass goods
         as close as its plan allows); by default `region`.
+    states : tuple of (int, int), optional
+        A robot's occupancy: the first and last instants of its plan whose states it spans.
+    unseen : tuple of (str, frozenset of int)
+        Goods at rest: per robot that moves them, the instants of its plan at which its model
+        does not have them lying here although they may be (see :func:`_unseen`).  Only at
+        those instants is the robot's plan not already checked against them.
     """
 
     what: str
@@ -113,6 +119,21 @@ class Occupancy:
     label: str
     movable: bool = True
     body: BaseGeometry | None = field(default=None, repr=False)
+    states: tuple[int, int] | None = None
+    unseen: tuple[tuple[str, frozenset[int]], ...] = ()
+
+    def accounts_for(self, other: Occupancy) -> bool:
+        """Whether this occupancy and `other` never need an order: they are the same robot's,
+        or both goods', or a robot's whose own plan keeps clear of the goods at rest at every
+        instant it spans (its model has them lying there, :func:`_unseen`)."""
+        if not self.parties & other.parties:
+            return False
+        goods, robot = (self, other) if other.states is not None else (other, self)
+        if robot.states is None or goods.states is not None:
+            return True  # two goods, or one robot's two occupancies
+        blind = dict(goods.unseen).get(robot.what, frozenset())
+        first, last = robot.states
+        return not any(first <= k <= last for k in blind)
 
 
 @dataclass(frozen=True)
@@ -191,6 +212,7 @@ def _robot_occupancies(
                 f"{robot} standing at {_point((x, y))} {where}",
                 not fixed,
                 square(x, y, side - grow + 2 * rest),
+                (k, end),
             )
         )
         k = end + 1
@@ -207,6 +229,7 @@ def _robot_occupancies(
                     f"{robot}'s GoTo at instant {k} from {_point(p[:2])} to {_point(q[:2])}",
                     True,
                     swept_square(p, q, side - grow),
+                    (k - 1, k),
                 )
             )
     return out
@@ -216,11 +239,15 @@ def _object_occupancies(
     scene: Scene,
     plans: Mapping[str, RobotPlan],
     precedence: Precedence,
+    models: Mapping[str, Sequence[State]],
     positions: Mapping[str, tuple[float, float] | None] | None = None,
 ) -> tuple[list[Occupancy], list[str]]:
     """Where every moved object rests between the steps that handle it; problems found.
 
-    `positions` gives where objects are at the start (``None``: carried); by default the scene's.
+    `models` gives each robot's states, instant 0 first (what its plan knows of the objects);
+    `positions` where objects are at the start (``None``: carried), by default the scene's.
+    The handlings of an object must be ordered, and each pick must find the object where the
+    team's order leaves it: where the last drop before it put it (or where it starts).
     """
     out, problems = [], []
     for oid, spec in scene.objects.items():
@@ -244,35 +271,86 @@ def _object_occupancies(
         for robot, k, primitive in handling:
             if primitive == Primitive.PICKUP:
                 if position is not None:
-                    where = "at its start" if first is None else f"from {first[0]}'s instant {first[1]}"
-                    out.append(
-                        Occupancy(
-                            oid,
-                            parties,
-                            square(*position, spec.size),
-                            first,
-                            (robot, k),
-                            f"{oid} resting at {_point(position)} {where}",
-                            first is not None,
-                        )
-                    )
+                    out.append(_resting(oid, spec.size, parties, position, first, (robot, k), models))
+                    problems += _misplaced(models[robot], robot, k, oid, position, first)
                 position = None
             else:
                 position, first = plans[robot].steps[k - 1].objects[oid].position, (robot, k)
         if position is not None:
-            where = "at its start" if first is None else f"from {first[0]}'s instant {first[1]}"
-            out.append(
-                Occupancy(
-                    oid,
-                    parties,
-                    square(*position, spec.size),
-                    first,
-                    None,
-                    f"{oid} resting at {_point(position)} {where}",
-                    first is not None,
-                )
-            )
+            out.append(_resting(oid, spec.size, parties, position, first, None, models))
     return out, problems
+
+
+def _resting(
+    oid: str,
+    size: float,
+    parties: frozenset[str],
+    position: Sequence[float],
+    first: Node | None,
+    last: Node | None,
+    models: Mapping[str, Sequence[State]],
+) -> Occupancy:
+    """Goods `oid` at rest at `position` from the start of step `first` (``None``: from the
+    beginning) to the completion of step `last` (``None``: for good), moved by `parties`."""
+    where = "at its start" if first is None else f"from {first[0]}'s instant {first[1]}"
+    unseen = ((r, _unseen(models[r], oid, position, first, last, r)) for r in sorted(parties))
+    return Occupancy(
+        oid,
+        parties,
+        square(*position, size),
+        first,
+        last,
+        f"{oid} resting at {_point(position)} {where}",
+        first is not None,
+        unseen=tuple((r, k) for r, k in unseen if k),
+    )
+
+
+def _lying(state: State, oid: str, position: Sequence[float]) -> bool:
+    """Whether `state` has `oid` at rest at `position` (within the checker's tolerance)."""
+    known = state.objects.get(oid)
+    return (
+        known is not None
+        and not known.carried
+        and not known.away
+        and all(abs(a - b) <= TOLERANCE for a, b in zip(known.position, position, strict=True))
+    )
+
+
+def _unseen(
+    model: Sequence[State],
+    oid: str,
+    position: Sequence[float],
+    first: Node | None,
+    last: Node | None,
+    robot: str,
+) -> frozenset[int]:
+    """The instants of `robot`'s plan (states `model`) at which the goods may lie at `position`
+    (from the start of step `first` to the completion of step `last`) but its model does not
+    have them there: its plan was not checked against them then.
+
+    The robot's own drop that puts them there and its own pick that takes them bound the
+    instants that matter.  At instant 0 the model is the robot's belief, checked against
+    nothing: goods put there by another robot are unseen then.
+    """
+    lo = first[1] if first is not None and first[0] == robot else 0
+    hi = last[1] - 1 if last is not None and last[0] == robot else len(model) - 1
+    out = {k for k in range(lo, hi + 1) if not _lying(model[k], oid, position)}
+    if lo == 0 and first is not None:
+        out.add(0)
+    return frozenset(out)
+
+
+def _misplaced(
+    model: Sequence[State], robot: str, k: int, oid: str, position: Sequence[float], first: Node | None
+) -> list[str]:
+    """Why `robot`'s pick of `oid` at instant `k` is not where the goods lie (``[]``: it is)."""
+    if _lying(model[k - 1], oid, position):
+        return []
+    where = "where they start" if first is None else f"where {first[0]} dropped them at instant {first[1]}"
+    planned = model[k - 1].objects.get(oid)
+    at = f" at {_point(planned.position)}" if planned is not None else ""
+    return [f"{robot} picks {oid}{at} at instant {k}, but {oid} lies at {_point(position)} then ({where})"]
 
 
 def occupancies(
@@ -291,11 +369,14 @@ def occupancies(
     settings = settings or ConflictSettings()
     grow = settings.clearance
     out: list[Occupancy] = []
+    models: dict[str, list[State]] = {}
+    moved = {s.object for plan in plans.values() for s in plan.steps if s.primitive == Primitive.PICKUP}
     for robot, plan in plans.items():
-        start = (starts or {}).get(robot) or initial_state(scene, robot)
+        start = (starts or {}).get(robot) or initial_state(scene, robot, plan, moved)
+        models[robot] = [start, *(step.state for step in plan.steps)]
         size, home = scene.robots[robot].size + grow, scene.robots[robot].pose
         out += _robot_occupancies(robot, plan, start, size, home, grow, settings.rest)
-    objects, problems = _object_occupancies(scene, plans, precedence, positions)
+    objects, problems = _object_occupancies(scene, plans, precedence, models, positions)
     return out + objects, problems
 
 
@@ -313,7 +394,7 @@ def conflicts(items: Sequence[Occupancy]) -> list[Conflict]:
     pairs, first, second = [], [], []
     for i, j in zip(left[keep].tolist(), right[keep].tolist(), strict=True):
         a, b = items[i], items[j]
-        if a.parties & b.parties:
+        if a.accounts_for(b):
             continue
         robots = a.what in a.parties and b.what in b.parties
         pairs.append((a, b))

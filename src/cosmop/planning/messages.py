@@ -197,10 +197,13 @@ def insert_steps(
         ]
         keyed += [((p + 0.5, rank, n), name) for n, (p, rank, name) in enumerate(sorted(inserts))]
         mission = [name for _, name in sorted(keyed)]
-    at: dict[int, list[tuple[int, str]]] = {}
+    # messages after one instant go in the mission's order (a wait the mission puts before a
+    # send stays before it, even when the event between them needs no step)
+    order = {name: i for i, name in enumerate(mission)}
+    at: dict[int, list[tuple[int, int, str]]] = {}
     for p, rank, name in inserts:
-        at.setdefault(p, []).append((rank, name))
-    state = start or initial_state(scene, robot)
+        at.setdefault(p, []).append((order.get(name, len(order)), rank, name))
+    state = start or initial_state(scene, robot, plan, scene.objects)
     steps: list[Step] = []
     moved: dict[int, int] = {0: 0}
     for k in range(plan.horizon + 1):
@@ -209,7 +212,7 @@ def insert_steps(
             steps.append(step)
             state = step.state
             moved[k] = len(steps)
-        for rank, name in sorted(at.get(k, ())):
+        for _, rank, name in sorted(at.get(k, ())):
             primitive = Primitive.RES if rank == 0 else Primitive.REQ
             steps.append(Step(primitive, None, state.robot, state.objects, name))
     return RobotPlan.from_steps(mission, steps), moved

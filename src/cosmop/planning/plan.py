@@ -57,7 +57,7 @@ import json
 import math
 import os
 import re
-from collections.abc import Iterable, Mapping
+from collections.abc import Collection, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from types import MappingProxyType
 from typing import Any
@@ -198,8 +198,18 @@ class State:
         object.__setattr__(self, "objects", _object_map(self.objects))
 
 
-def initial_state(scene: Scene, robot_id: str) -> State:
-    """Instant 0 of a robot's plan: the scenario.
+def initial_state(
+    scene: Scene,
+    robot_id: str,
+    plan: RobotPlan | Sequence[Step] | None = None,
+    moved: Collection[str] | None = None,
+) -> State:
+    """Instant 0 of a robot's plan: the scenario, with goods that robots move as the plan knows them.
+
+    Each robot is planned alone, against the objects as it knows them: goods another robot
+    hands over to it lie where the other puts them down, goods others drop in a dock it shares
+    lie in their slots (:mod:`cosmop.missions.handover`, :func:`cosmop.planning.aside.dock_slots`).
+    Its plan lists that model at every step; instant 0 is the model before the first step.
 
     Parameters
     ----------
@@ -207,12 +217,18 @@ def initial_state(scene: Scene, robot_id: str) -> State:
         The scene the plan is for.
     robot_id : str
         The robot whose plan it is.
+    plan : RobotPlan or sequence of Step, optional
+        The plan (or its steps).
+    moved : collection of str, optional
+        The goods whose place at instant 0 is the plan's own (as its first step lists them,
+        before that step's effect): goods the team moves, whose real places the team's checker
+        verifies (:mod:`cosmop.planning.joint`).  By default the goods the plan picks up.
 
     Returns
     -------
     State
-        The robot at its initial pose (mm, degrees); every object at its scenario position, not
-        carried and not away.
+        The robot at its initial pose (mm, degrees); every object at its scenario position
+        (or, the `moved` ones, as the plan lists them), not carried and not away.
 
     Raises
     ------
@@ -220,12 +236,16 @@ def initial_state(scene: Scene, robot_id: str) -> State:
         If the scene has no robot `robot_id`.
     """
     robot = scene.robots[robot_id]
-    return State(
-        robot=robot.pose,
-        objects={
-            oid: ObjectState(obj.position, carried=False, away=False) for oid, obj in scene.objects.items()
-        },
-    )
+    objects = {o: ObjectState(obj.position, carried=False, away=False) for o, obj in scene.objects.items()}
+    steps = plan.steps if isinstance(plan, RobotPlan) else tuple(plan or ())
+    if steps:
+        if moved is None:
+            moved = {s.object for s in steps if s.primitive == Primitive.PICKUP}
+        first = steps[0].objects
+        for oid in moved:
+            if oid in objects and oid in first:
+                objects[oid] = ObjectState(first[oid].position, carried=False, away=False)
+    return State(robot=robot.pose, objects=objects)
 
 
 Action = tuple[str, Any] | tuple[str]

@@ -100,7 +100,7 @@ def event_instants(
         realised after the previous one and every event after it.
     """
     events = plan.events if events is None else tuple(events)
-    states = [start or initial_state(scene, robot), *(s.state for s in plan.steps)]
+    states = [start or initial_state(scene, robot, plan, scene.objects), *(s.state for s in plan.steps)]
     out: list[int | None] = []
     last = None
     for event in events:

@@ -70,7 +70,7 @@ from cosmop.logic import (
 )
 from cosmop.planning.plan import State
 from cosmop.planning.regions import HalfPlane, square_sides, wall_regions
-from cosmop.scene import Scene
+from cosmop.scene import Scene, Workspace
 from cosmop.squares import docking_places
 
 NONE = 0
@@ -80,21 +80,22 @@ def _num(value: float) -> Fraction:
     return to_fraction(value)  # exact: a scenario's lengths lie on a micrometre grid
 
 
-def position_sort(scene: Scene, start: State | None = None) -> str:
+def position_sort(scene: Scene, start: State | None = None, spots: Iterable[tuple[float, float]] = ()) -> str:
     """The sort of the position variables: ``"int"`` (whole mm, the paper's) or ``"real"``.
 
     Walls and rectangular workspaces only bound positions (inequalities), so they never force
     a fractional pose; the poses a primitive forces are the start and home poses, the pick and
     drop poses (an object's position minus the two half-sides), point workspaces and, given a
-    `start` state, where the robot and the objects are in it.  When all of those are whole
-    millimetres, integers lose no plan; otherwise (an object of side 101 mm, a good at
-    x = 0.5 mm) positions are exact rationals, so that no plan is lost to rounding.
+    `start` state, where the robot and the objects are in it, and the `spots` drops are pinned
+    to.  When all of those are whole millimetres, integers lose no plan; otherwise (an object
+    of side 101 mm, a good at x = 0.5 mm) positions are exact rationals, so that no plan is lost to rounding.
     """
     numbers = [v for r in scene.robots.values() for v in (r.size / 2, *r.pose[:2])]
     numbers += [v for o in scene.objects.values() for v in (o.size / 2, *o.position)]
     numbers += [v for w in scene.workspaces.values() if w.is_point for v in w.point]
     if start is not None:  # a plan from a given state (mid-run) starts exactly there
         numbers += [*start.robot[:2], *(v for o in start.objects.values() for v in o.position)]
+    numbers += [v for spot in spots for v in spot]
     return "int" if all(_num(v).denominator == 1 for v in numbers) else "real"
 
 
@@ -222,6 +223,10 @@ class RobotProblem:
         is two, one to drives and one to picks and drops; :func:`past_its_ends` of either names
         the stronger GoTo part); every wall and object by default.
         Lazy geometry (:mod:`cosmop.planning.obstacles`) writes the parts it needs only.
+    spots : tuple of (Event, (float, float))
+        Drops pinned to one spot: the object's centre (mm) where the drop event must put it,
+        inside the event's workspace.  A robot that hands goods over to another drops them
+        where the receiver was planned to pick them (:mod:`cosmop.missions.handover`).
 
     Attributes
     ----------
@@ -249,6 +254,7 @@ class RobotProblem:
     automaton: DFA | None = None
     margin: Fraction = MOTION_MARGIN
     obstacles: frozenset[str] | None = None
+    spots: tuple[tuple[Event, tuple[float, float]], ...] = ()
     actions: tuple[Action, ...] = field(init=False)
     sort: str = field(init=False)
     objects: Mapping[str, ObjectVars] = field(init=False, repr=False, compare=False)
@@ -259,7 +265,7 @@ class RobotProblem:
         object.__setattr__(self, "primitives", MappingProxyType(dict(primitives)))
         acts = [(prim.name, obj) for prim in self.primitives.values() for obj in prim.targets(self)]
         object.__setattr__(self, "actions", tuple(Action(name, o, i + 1) for i, (name, o) in enumerate(acts)))
-        object.__setattr__(self, "sort", position_sort(self.scene, self.start))
+        object.__setattr__(self, "sort", position_sort(self.scene, self.start, (s for _, s in self.spots)))
         object.__setattr__(self, "objects", MappingProxyType(self._object_terms()))
 
     def _object_terms(self) -> dict[str, ObjectVars]:
@@ -348,6 +354,14 @@ class RobotProblem:
         if known is None:
             return self.scene.objects[obj].position, False, False
         return known.position, known.carried, known.away
+
+    def drop_centres(self, event: Event) -> Workspace:
+        """Where the drop `event` may put its object's centre: the workspace's
+        :meth:`~cosmop.scene.Workspace.centres`, or the one spot it is pinned to (:attr:`spots`)."""
+        for pinned, spot in self.spots:
+            if pinned == event:
+                return Workspace(event.workspace, point=spot)
+        return self.scene.workspaces[event.workspace].centres(self.scene.objects[event.obj].size)
 
     def obj(self, obj: str) -> ObjectVars:
         """The terms of `obj` (:class:`ObjectVars`; fixed fields are values)."""
@@ -504,7 +518,7 @@ def _drop_places(p: RobotProblem, obj: str) -> list | None:
     places = []
     for e in p.mission:
         if e.kind == "drop" and e.obj == obj:
-            ws = p.scene.workspaces[e.workspace].centres(p.scene.objects[obj].size)
+            ws = p.drop_centres(e)
             places += docking_places(*ws.ranges, d, p.scene.objects[obj].headings)
     return places or None
 
@@ -816,7 +830,7 @@ def _goal(p: RobotProblem, event: Event) -> tuple[Formula, Formula]:
     goal = p.is_action(primitive, obj)
     if event.kind == "drop":  # and the object inside the workspace
         v = p.obj(event.obj)
-        ws = p.scene.workspaces[event.workspace].centres(p.scene.objects[event.obj].size)
+        ws = p.drop_centres(event)
         if ws.point is not None:
             inside = v.x.eq(_num(ws.point[0])) & v.y.eq(_num(ws.point[1]))
         else:

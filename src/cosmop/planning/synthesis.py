@@ -29,6 +29,7 @@ quarter slower than in a local worker process.
 
 from __future__ import annotations
 
+import re
 import time
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
@@ -173,6 +174,7 @@ def synthesize(
     unrequestable: frozenset[str] = frozenset(),
     margin: float = MOTION_MARGIN,
     lazy: bool = True,
+    spots: tuple[tuple[Event, tuple[float, float]], ...] = (),
 ) -> Synthesis:
     """The shortest safe plan of motion primitives for one robot's local mission.
 
@@ -208,6 +210,8 @@ def synthesize(
         robot's route and adds those a plan breaks, until none does
         (:mod:`cosmop.planning.obstacles`); the same horizon and number of requests as the
         eager encoding (``False``: every obstacle from the start), proved there.
+    spots : tuple of (Event, (float, float))
+        Drops pinned to one spot (:attr:`~cosmop.planning.specification.RobotProblem.spots`).
 
     Returns
     -------
@@ -222,7 +226,16 @@ def synthesize(
     m = _local_mission(scene, robot, mission, start, max_horizon)
     if m.walled_off is not None:  # no horizon can do it: say so without the solver
         return Synthesis(robot, False, None, None, reason=m.walled_off, solve_s=time.perf_counter() - t0)
-    p = _problem(scene, robot, m, requests=requests, start=start, unrequestable=unrequestable, margin=margin)
+    p = _problem(
+        scene,
+        robot,
+        m,
+        requests=requests,
+        start=start,
+        unrequestable=unrequestable,
+        margin=margin,
+        spots=spots,
+    )
     found = _shortest_plan(p, m.lower, max_horizon, rlimit, incremental, lazy)
     if found.plan is not None:
         return found.synthesis(robot, t0, plan=_place_messages(p, found.plan, m.full))
@@ -303,6 +316,7 @@ def _problem(
     start: State | None,
     unrequestable: frozenset[str],
     margin: float,
+    spots: tuple[tuple[Event, tuple[float, float]], ...] = (),
 ) -> RobotProblem:
     """The solver's problem for the events of `m` (options as in :func:`synthesize`)."""
     return RobotProblem(
@@ -314,6 +328,7 @@ def _problem(
         unrequestable=frozenset(unrequestable),
         automaton=m.automaton,
         margin=to_fraction(margin),
+        spots=tuple(spots),
     )
 
 
@@ -588,7 +603,7 @@ def _explain_automaton(p: RobotProblem, K: int, rlimit: int) -> tuple[str, tuple
     """Why no word of a branching mission can be planned within ``K`` steps (a minimal core)."""
     blocking = _core(p, specification(p), K, rlimit)
     head = f"{p.robot} cannot complete any word of its mission within {K} steps"
-    return _because(head, blocking, K), blocking or ()
+    return _because(head, _as_written(p.scene, blocking), K), blocking or ()
 
 
 def _explain(p: RobotProblem, events: tuple[Event, ...], K: int, rlimit: int) -> tuple[str, tuple[str, ...]]:
@@ -601,11 +616,27 @@ def _explain(p: RobotProblem, events: tuple[Event, ...], K: int, rlimit: int) ->
     blocking = _core(p, specification(p, events[:i]), K, rlimit)
     event = events[i - 1]
     head = f"{p.robot} cannot reach {event.name} (event {i} of its mission) within {K} steps"
-    reason = _because(head, blocking, K)
+    reason = _because(head, _as_written(p.scene, blocking), K)
     if event.kind in ("pick", "drop") and blocking:
         sides = p.scene.objects[event.obj].sides
         reason += f" (sides of {event.obj} tried: {', '.join(sides)})"
     return reason, blocking or ()
+
+
+_WALL_PART = re.compile(r"\bwall (\d+)(?P<rest>( past its ends)?)(?: \[\[[^\]]*\], \[[^\]]*\]\])?")
+
+
+def _as_written(scene: Scene, blocking: tuple[str, ...] | None) -> tuple[str, ...] | None:
+    """`blocking` in the user's words: a wall the planner added is named by its label (what it
+    keeps the robot out of), and parts that name the same thing are said once."""
+    if not blocking:
+        return blocking
+
+    def name(match: re.Match) -> str:
+        label = scene.obstacles[int(match.group(1))].label
+        return match.group(0) if label is None else label + match.group("rest")
+
+    return tuple(dict.fromkeys(_WALL_PART.sub(name, part) for part in blocking))
 
 
 def _because(head: str, blocking: tuple[str, ...] | None, K: int) -> str:

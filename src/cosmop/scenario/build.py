@@ -19,6 +19,7 @@ from pydantic import ValidationError
 from cosmop.errors import EventSyntaxError, ScenarioError
 from cosmop.events import ID_PATTERN, Event, parse_event
 from cosmop.io import read_text
+from cosmop.missions.handover import handovers
 from cosmop.reading import FieldPath, Marks, format_path, load_yaml
 from cosmop.scenario.schema import (
     _EXPECTED,
@@ -328,7 +329,6 @@ class _Builder:
         if not tasks:
             self.fail(("mission", "tasks"), "expected a task list for at least one robot, got none")
         result = {}
-        mover: dict[str, FieldPath] = {}  # the first task that moves each object
         for robot, steps in tasks.items():
             if robot not in scene.robots:
                 self.fail(
@@ -351,18 +351,27 @@ class _Builder:
                         f"expected an event of robot {robot}, got {event.name}, which belongs to {owners}",
                     )
                 self.check_references(path, event, scene)
-                if event.kind in ("pick", "drop"):
-                    first = mover.setdefault(event.obj, path)
-                    if first[2] != robot:
-                        self.fail(
-                            path,
-                            f"{event.obj} is already moved by {first[2]} ({format_path(first)}); one robot "
-                            "moves each object in a task list (a relay between robots needs an order: "
-                            "write the mission as a dfa)",
-                        )
                 events.append(event)
             result[robot] = tuple(events)
+        self.check_relays(result)
         return result
+
+    def check_relays(self, tasks: Mapping[str, tuple[Event, ...]]) -> None:
+        """Goods in two robots' task lists are a relay: messages in the lists must order every
+        handling of them, and a robot meets them again only where it left them."""
+        relays = handovers(tasks)
+        for obj, (r1, i1), (r2, i2) in relays.unordered:
+            first, then = ("mission", "tasks", r1, i1), ("mission", "tasks", r2, i2)
+            self.fail(
+                then,
+                f"{obj} is moved by {r1} ({format_path(first)}) and by {r2} with no order between "
+                f"them; a relay needs a message: put msg({r1},{r2},TAG) in {r1}'s list after its drop "
+                f"and in {r2}'s list before its pick (or write the mission as a dfa)",
+            )
+        for why in relays.refused:
+            self.fail(
+                ("mission", "tasks"), f"expected each robot to meet goods only where it left them: {why}"
+            )
 
     def build_dfa(self, model: _DfaModel, scene: Scene) -> DfaSpec:
         base = ("mission", "dfa")

@@ -219,6 +219,10 @@ def _install(agent: Agent, plan: RobotPlan, done: list[Event], *, new: bool) -> 
 def _state_now(world: World, agent: Agent) -> State:
     """Where `agent`'s robot is (mm, degrees) and the objects as its plan sees them now."""
     k = agent.step_index
-    objects = agent.steps[k - 1].objects if k > 0 else initial_state(world.scenario.scene, agent.id).objects
+    scene = world.scenario.scene
+    if k > 0:
+        objects = agent.steps[k - 1].objects
+    else:
+        objects = initial_state(scene, agent.id, agent.steps, scene.objects).objects
     x, y, h = world.pose[agent.index]
     return State((float(x), float(y), math.degrees(float(h))), objects)

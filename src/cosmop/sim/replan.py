@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING
 from cosmop.control.geometry import box_gaps
 from cosmop.events import Event, Primitive
 from cosmop.planning.checker import check_robot_plan
-from cosmop.planning.plan import ObjectState, RobotPlan, State
+from cosmop.planning.plan import ObjectState, RobotPlan, State, initial_state
 from cosmop.scene import Scene, Wall
 from cosmop.sim.recoordinate import recoordinate_world
 
@@ -116,7 +116,7 @@ def replan_stalled(world: World, agent: Agent) -> None:
     remaining = [
         e for e in todo if e.name not in world.conflict_messages and e.name not in world.sent_messages
     ]
-    start = _start_state(world, agent)
+    start = _start_state(world, agent, {e.obj for e in remaining if e.kind == "pick"})
     # A replan should not be much longer than what is left of the plan: bound the search there
     # (an infeasible replan -- a blocked doorway -- would otherwise search every horizon).
     horizon = min(s.max_horizon, len(agent.steps) - agent.step_index + 4)
@@ -165,17 +165,28 @@ def _sensed(world: World, agent: Agent) -> list[tuple[float, float, float]]:
     ]
 
 
-def _start_state(world: World, agent: Agent) -> State:
+def _start_state(world: World, agent: Agent, picks: set[str | None] = frozenset()) -> State:
     """Where `agent` replans from: its pose and every object, rounded to integer mm and degrees.
 
     An object another robot carries, or one it has asked to be moved away (a ``Req`` step done),
-    is away: not in its way.
+    is away: not in its way.  Goods it still has to pick (`picks`) and does not carry are where
+    its plan expects them: a robot that another hands them over to waits for them where the
+    other puts them down (:mod:`cosmop.missions.handover`), wherever they are now.
     """
     i = agent.index
-    done_steps = agent.steps[: agent.step_index]
+    k = agent.step_index
+    done_steps = agent.steps[:k]
+    expected = (
+        agent.steps[k - 1].objects
+        if k > 0
+        else initial_state(world.scenario.scene, agent.id, agent.steps, world.object_ids).objects
+    )
     objects = {}
     for j, oid in enumerate(world.object_ids):
         carried = world.carried_by[j] == i
+        if oid in picks and not carried and oid in expected and not expected[oid].carried:
+            objects[oid] = ObjectState(expected[oid].position, carried=False, away=False)
+            continue
         away = world.carried_by[j] >= 0 and not carried
         away = away or any(st.primitive == Primitive.REQ and st.object == oid for st in done_steps)
         pos = world.object_xy[j]
