@@ -210,3 +210,22 @@ def test_makespan_first_then_total_then_the_first_found():
         keys = [(c1, c1), (max(1, c2), 1 + c2)]
         assert (choice.makespan, choice.total) == min(keys)
         assert choice.alternative is found.items[keys.index(min(keys))]  # ties: the first found
+
+
+def test_alternatives_that_cannot_win_are_never_planned():
+    # the mission may be left as it is (its first state is complete), or R1 or R2 moves O1:
+    # doing nothing costs nothing, so no word of the others is planned (branch and bound)
+    data = yaml.safe_load(EITHER.read_text())
+    data["mission"]["dfa"] = {
+        "initial": "s",
+        "marked": ["s", "done"],
+        "transitions": [
+            ["s", "pick(R1,O1)", "a"],
+            ["s", "pick(R2,O1)", "b"],
+            ["a", "drop(R1,O1,W1)", "done"],
+            ["b", "drop(R2,O1,W1)", "done"],
+        ],
+    }
+    team = plan_team(parse_scenario(data), workers=1)
+    assert team.plans.feasible and team.allocation.makespan == 0
+    assert team.allocation.considered == 1  # the others were never planned

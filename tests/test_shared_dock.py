@@ -71,5 +71,5 @@ def test_reasons_name_walls_the_planner_adds_by_what_they_keep_out():
     named = _as_written(
         scene, (f"wall {n} [[0.0, 0.0], [1.0, 0.0]]", f"gripper clear of wall {n}", "gripper clear of wall 1")
     )
-    assert named == ("the space of R2 standing at (0, 0)", "gripper clear of the space of R2 standing at (0, 0)",
-                     "gripper clear of wall 1")  # fmt: skip
+    space = "the space of R2 standing at (0, 0)"
+    assert named == (space, f"gripper clear of {space}", "gripper clear of wall 1")

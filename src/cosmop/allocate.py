@@ -34,6 +34,9 @@ from cosmop.scene import Scenario
 
 __all__ = ["allocate"]
 
+_EXPLAINED = 3  # unplannable words a failed allocation explains with the solver (each costs a core)
+_BATCH = 8  # alternatives planned together before the bound is looked at again
+
 
 def allocate(
     scenario: Scenario, mission: GlobalMission, planner
@@ -53,17 +56,7 @@ def allocate(
         return objects - {o for o, r in alt.movers(mission).items() if r != robot}
 
     found, costs, settled = _settle_own_choices(planner, found, mission, unanswerable)
-    pending: dict[str, list[tuple[tuple[str, ...], frozenset[str]]]] = {}
-    for alt in found.items:
-        for robot, word in alt.words.items():
-            job = (word, unanswerable(alt, robot))
-            if word and (robot, word, job[1]) not in costs and job not in pending.setdefault(robot, []):
-                pending[robot].append(job)
-    costs.update(
-        _plan_all(
-            planner, pending, lambda r, job: tuple(mission.events[e] for e in job[0]), lambda r, job: job[1]
-        )
-    )
+    found = _plan_bounded(planner, found, mission, unanswerable, costs)
     planner.forbidden = {}
 
     def synthesis(alt, robot: str) -> Synthesis:
@@ -78,6 +71,12 @@ def allocate(
         how = f"{', '.join(settled)}'s own choices planned as one branching mission each"
         choice = replace(choice, method=f"{choice.method}; {how}")
     if choice.alternative is None:
+        why = {}
+        for n, (robot, word) in enumerate(choice.unplannable):  # the first few, with the solver's why
+            forbidden = next((k[2] for k in costs if k[:2] == (robot, word)), frozenset())
+            if n < _EXPLAINED:
+                why[(robot, word)] = _explained(planner, robot, [mission.events[e] for e in word], forbidden)
+        choice = replace(choice, unplannable=MappingProxyType({**choice.unplannable, **why}))
         return {r: () for r in robots}, {}, [_no_alternative(choice, found.exhaustive)], choice
     words = dict(choice.alternative.words)
     # the loop starts from the plans costed here: same words, same requests ruled out
@@ -90,6 +89,59 @@ def allocate(
     }
     events = {r: tuple(parse_event(e) for e in placed.get(r, ())) for r in robots}
     return events, notes, [], choice
+
+
+def _plan_bounded(
+    planner, found: Alternatives, mission: GlobalMission, unanswerable, costs: dict
+) -> Alternatives:
+    """Plan the alternatives' words, cheapest lower bound first, until none left can win.
+
+    No plan is shorter than a step per event but ``return``, so an alternative whose bound
+    (makespan, then total) exceeds the best planned one's cost cannot be chosen
+    (:func:`~cosmop.missions.allocation.choose`); such alternatives are never planned
+    (branch and bound; the choice is the same as planning all).  `costs` gains the
+    syntheses; the alternatives planned are returned.
+    """
+
+    def bound(alt) -> tuple[int, int]:
+        steps = [sum(1 for e in w if mission.events[e].kind != "return") for w in alt.words.values()]
+        return max(steps, default=0), sum(steps)
+
+    def cost(alt) -> tuple[int, int] | None:
+        keys = [(r, w, unanswerable(alt, r)) for r, w in alt.words.items() if w]
+        if not all(k in costs and costs[k].feasible for k in keys):
+            return None
+        steps = [costs[k].horizon for k in keys]
+        return max(steps, default=0), sum(steps)
+
+    order = sorted(range(len(found.items)), key=lambda n: bound(found.items[n]))
+    planned: set[int] = set()
+    best = None
+    while order and (best is None or bound(found.items[order[0]]) <= best):
+        # the alternatives of the least bound left (a few at a time), planned together
+        level = bound(found.items[order[0]])
+        batch = [n for n in order[:_BATCH] if bound(found.items[n]) == level]
+        order = order[len(batch) :]
+        pending: dict[str, list[tuple[tuple[str, ...], frozenset[str]]]] = {}
+        for alt in (found.items[n] for n in batch):
+            for robot, word in alt.words.items():
+                job = (word, unanswerable(alt, robot))
+                if word and (robot, word, job[1]) not in costs and job not in pending.setdefault(robot, []):
+                    pending[robot].append(job)
+        costs.update(
+            _plan_all(
+                planner,
+                pending,
+                lambda r, job: tuple(mission.events[e] for e in job[0]),
+                lambda r, job: job[1],
+            )
+        )
+        planned.update(batch)
+        for n in batch:
+            c = cost(found.items[n])
+            best = c if c is not None and (best is None or c < best) else best
+    items = tuple(alt for n, alt in enumerate(found.items) if n in planned)
+    return Alternatives(items, found.exhaustive, found.explored)
 
 
 def _settle_own_choices(
@@ -171,6 +223,11 @@ def _allocate_deliveries(
     chosen = assign(options, steps, seconds=seconds)
     method = "branch and bound over (robot, workspace) per object, each delivery costed alone"
     if chosen.stuck:
+        failed = [(r, o, w) for o in chosen.stuck for r, w in options[o] if not costs[(r, o, w)].feasible]
+        for robot, obj, workspace in failed[:_EXPLAINED]:  # the solver's why (each costs a core)
+            word = _delivery_word(robot, obj, workspace, spec.returns)
+            why = _explained(planner, robot, word, nobody)
+            costs[(robot, obj, workspace)] = replace(costs[(robot, obj, workspace)], reason=why)
         why = "; ".join(_undeliverable(o, options[o], costs) for o in chosen.stuck)
         failed = Choice(None, None, None, chosen.nodes, method=method, costs=MappingProxyType(steps))
         return {r: () for r in robots}, {}, [why], failed
@@ -194,16 +251,28 @@ def _plan_all(planner, pending: dict[str, list[tuple]], word, forbid=None) -> di
     """Plan every robot's jobs, one job per robot at a time (the robots in parallel).
 
     ``word(robot, job)`` is the mission to plan; ``forbid(robot, job)``, if given, the objects
-    the robot may not request for it.  The results are keyed ``(robot, *job)``.
+    the robot may not request for it.  The results are keyed ``(robot, *job)``.  These are
+    trials: an infeasible one only says so (an explanation is an unsat core per event, which
+    cost minutes over many alternatives); :func:`_explained` explains those a reason names.
     """
     costs: dict[tuple, Synthesis] = {}
     for rank in range(max((len(jobs) for jobs in pending.values()), default=0)):
         batch = {r: jobs[rank] for r, jobs in pending.items() if rank < len(jobs)}
         if forbid is not None:
             planner.forbidden = {r: forbid(r, job) for r, job in batch.items()}
-        results = planner.run({r: word(r, job) for r, job in batch.items()})
+        results = planner.run({r: word(r, job) for r, job in batch.items()}, explain=False)
         costs.update({(r, *batch[r]): res for r, res in results.items()})
     return costs
+
+
+def _explained(planner, robot: str, events, forbidden: frozenset[str]) -> str:
+    """Why `robot` cannot plan `events` with `forbidden` requests ruled out (the solver's why)."""
+    saved = planner.forbidden
+    planner.forbidden = {robot: forbidden}
+    try:
+        return planner.run({robot: tuple(events)})[robot].reason or "no plan within the horizon"
+    finally:
+        planner.forbidden = saved
 
 
 def _delivery_word(robot: str, obj: str, workspace: str, returns: bool) -> tuple[Event, ...]:
