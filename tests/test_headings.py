@@ -125,6 +125,9 @@ def test_a_ros_heading_plans_writes_and_simulates_end_to_end(tmp_path):
     home = scenario.scene.robots["R1"].pose
     steps = team.plans.robots["R1"].steps
     assert steps[-1].robot == home
+    poses = [home, *(step.robot for step in steps)]
+    for k, step in enumerate(steps):  # a step that is no drive keeps the heading exactly (a Req first)
+        assert step.primitive == "GoTo" or step.robot == poses[k]
     assert check_plan(scenario, team.plans).ok
     team.plans.save(tmp_path / "plan.json")
     written = json.loads((tmp_path / "plan.json").read_text())["robots"]["R1"]["steps"]
