@@ -5,7 +5,8 @@ Section IV of the paper.  The state at instant ``k`` (Section IV-C) is the robot
 away) and the primitive :math:`\\pi` taken between ``k-1`` and ``k`` (``NONE`` at instant 0).
 Positions are integers in mm, headings integers in degrees, as in the paper, unless the scene
 needs finer poses (an odd side, a half-millimetre coordinate): then positions are exact
-rationals (:func:`position_sort`).
+rationals (:func:`position_sort`); so is the heading when a given heading is not whole degrees
+(:func:`heading_sort`).
 
 Each primitive is a small object with a name and an ``effect``: the constraint relating
 :math:`q` and :math:`\\bigcirc q` when :math:`\\bigcirc\\pi` is that primitive.  The
@@ -97,6 +98,22 @@ def position_sort(scene: Scene, start: State | None = None, spots: Iterable[tupl
         numbers += [*start.robot[:2], *(v for o in start.objects.values() for v in o.position)]
     numbers += [v for spot in spots for v in spot]
     return "int" if all(_num(v).denominator == 1 for v in numbers) else "real"
+
+
+def heading_sort(scene: Scene, robot: str, start: State | None = None) -> str:
+    """The sort of the robot's heading variable: ``"int"`` (whole degrees, the paper's) or ``"real"``.
+
+    A GoTo leaves the heading free (it ends turned to any heading), every other primitive keeps
+    it, and only three kinds of constraint fix it to a value: the heading at instant 0 (the
+    scenario's pose or, given a `start` state, the heading there), the home heading that
+    ``return`` comes back to (the scenario's pose), and the docking headings of picks and drops
+    (0, 90, 180 or 270 degrees).  When the robot's given headings are whole degrees, integers
+    lose no plan; otherwise (a ROS file's -1.5708 rad, which is -90.000210459 degrees, or
+    45.5 degrees) the heading is an exact rational, so that the plan starts and ends exactly
+    at the given headings.  Other robots' headings never enter this robot's problem.
+    """
+    headings = [scene.robots[robot].pose[2], *([start.robot[2]] if start is not None else [])]
+    return "int" if all(_num(h).denominator == 1 for h in headings) else "real"
 
 
 MOTION_MARGIN = Fraction(20)
@@ -208,8 +225,8 @@ class RobotProblem:
         it applies to (:meth:`Encoding.targets`), and the actions are all such pairs.
     start : State, optional
         Instant 0 when it is not the scenario: a robot that replans mid-mission starts where it
-        is (integer mm and degrees), with the objects as it knows them; ``return`` still means
-        the scenario's initial pose.
+        is (exact numbers: the sorts follow them), with the objects as it knows them; ``return``
+        still means the scenario's initial pose.
     unrequestable : frozenset of str
         Objects the robot may not ask for (nobody can move them, or asking deadlocks the team).
     automaton : DFA, optional
@@ -234,6 +251,8 @@ class RobotProblem:
         Every (primitive, object) the robot may take, with its code in :math:`\\pi`.
     sort : str
         The sort of positions (:func:`position_sort`).
+    heading_sort : str
+        The sort of the heading (:func:`heading_sort`).
     objects : Mapping[str, ObjectVars]
         Each object's terms: variables, or values for the fields no action changes.
 
@@ -257,6 +276,7 @@ class RobotProblem:
     spots: tuple[tuple[Event, tuple[float, float]], ...] = ()
     actions: tuple[Action, ...] = field(init=False)
     sort: str = field(init=False)
+    heading_sort: str = field(init=False)
     objects: Mapping[str, ObjectVars] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -266,6 +286,7 @@ class RobotProblem:
         acts = [(prim.name, obj) for prim in self.primitives.values() for obj in prim.targets(self)]
         object.__setattr__(self, "actions", tuple(Action(name, o, i + 1) for i, (name, o) in enumerate(acts)))
         object.__setattr__(self, "sort", position_sort(self.scene, self.start, (s for _, s in self.spots)))
+        object.__setattr__(self, "heading_sort", heading_sort(self.scene, self.robot, self.start))
         object.__setattr__(self, "objects", MappingProxyType(self._object_terms()))
 
     def _object_terms(self) -> dict[str, ObjectVars]:
@@ -319,7 +340,7 @@ class RobotProblem:
 
     @property
     def h(self) -> Var:
-        return Var("heading", "int")
+        return Var("heading", self.heading_sort)
 
     @property
     def pi(self) -> Var:

@@ -196,7 +196,7 @@ def synthesize(
         Search K with one solver whose unrolling grows (:class:`cosmop.logic.IncrementalUnrolling`,
         the default: 2.5x faster on the 10x10 example) instead of a fresh solver per K.
     start : State, optional
-        Instant 0 if not the scenario (replanning mid-mission; integer mm and degrees).
+        Instant 0 if not the scenario (replanning mid-mission; mm and degrees).
     explain : bool
         When infeasible, search for the first unreachable event and an unsat core (the
         ``reason``); a replan that only needs yes or no skips it.

@@ -139,6 +139,7 @@ class _Builder:
             self.fail(("version",), f"expected {_EXPECTED[('version',)]}, got {model.version}")
         scene = scene_to_internal(self.build_scene(model.scene), model.units or "mm")
         self.check_precision(scene)
+        self.check_headings(scene)
         self.check_bodies(scene)
         mission = self.build_mission(model.mission, scene)
         return Scenario(name=model.name, scene=scene, mission=mission, source=source)
@@ -216,6 +217,16 @@ class _Builder:
                 self.fail(
                     path,
                     f"expected a multiple of {grid} (plans are exact to a micrometre), got {shown_value}",
+                )
+
+    def check_headings(self, scene: Scene) -> None:
+        """Every heading is still a finite number of degrees (a huge one in radians overflows)."""
+        for rid, robot in scene.robots.items():
+            if not math.isfinite(robot.pose[2]):
+                given = _lookup(self.data, ("scene", "robots", rid, "pose", 2))[1]
+                self.fail(
+                    ("scene", "robots", rid, "pose", 2),
+                    f"expected a heading that stays finite in the planner's angle unit, got {given!r}",
                 )
 
     def check_bodies(self, scene: Scene) -> None:
