@@ -2,12 +2,12 @@
 
 :class:`Search` chooses one start edge per conflict (:mod:`cosmop.planning.conflict_order`) so
 that the team's order stays acyclic: unit propagation of the orders that are forced, choices
-that follow the robots' priorities, and conflict-directed backjumping.  Each dead end comes
-with the set of conflicts it follows from (:func:`_core`); one that follows from no choice is a
-*core*, a set of conflicts no order resolves together, found without a solver.  Of each core
-one conflict is set aside for re-planning (:class:`Culprits`).  What a dead end takes back is
-only what needs what goes (dependency-directed, as in Stallman and Sussman's reason
-maintenance): the rest of the order stays in place.
+that follow time (the robot expected first goes first), and conflict-directed backjumping.
+Each dead end comes with the set of conflicts it follows from (:func:`_core`); one that follows
+from no choice is a *core*, a set of conflicts no order resolves together, found without a
+solver.  Of each core one conflict is set aside for re-planning (:class:`Culprits`).  What a
+dead end takes back is only what needs what goes (dependency-directed, as in Stallman and
+Sussman's reason maintenance): the rest of the order stays in place.
 """
 
 from __future__ import annotations
@@ -33,7 +33,8 @@ class Search:
     * a conflict with a single way left takes it (*forced*); its reason is the cycle its other
       way would close (:func:`_core` follows it when needed);
     * otherwise the open conflict expected to start first is *chosen* a way (:func:`_options`:
-      the robot of higher priority first, then the lower makespan);
+      the occupancy expected to begin first goes first, so that the order follows the
+      itinerary, then the lower makespan);
     * a conflict with no way left gives a dead end and its set of conflicts (:func:`_core`):
       with the choices among them kept, no order of them is acyclic.  The search jumps back to
       the latest of those choices and takes its other way, forced now by that set.  A dead end
@@ -75,7 +76,6 @@ class Search:
         self.hidden = np.zeros(len(found), dtype=bool)
         self.every = self.live = np.arange(len(found))  # the conflicts not known to be ordered yet
         self._hide()
-        self.priority = _priorities(horizons, durations)
         self.cores: dict[int, list[Conflict]] = {}  # id of each conflict set aside -> its core
 
     @property
@@ -125,7 +125,7 @@ class Search:
             if not len(pool):
                 return kept
             i = int(pool[np.argmin(self.sides.expected_start(self.precedence, pool))])
-            self._take(i, _options(self.found[i], self.precedence, self.priority)[0], None)
+            self._take(i, _options(self.found[i], self.precedence)[0], None)
 
     def _dead_ends(self, stuck: list[int], back: int | None) -> str:
         """Settle this round's dead ends: ``"choice"`` when the first follows from a choice (the
@@ -629,7 +629,6 @@ def depth_first(found, horizons, links, starts, durations, max_backtracks, fixed
     """
     precedence = Precedence(horizons, links, starts, durations)
     sides = _Sides(found, precedence)
-    priority = _priorities(horizons, durations)
     chosen: list[tuple[tuple[Node, Node], Conflict, list]] = []
     stack: list[tuple[int, list[tuple[Node, Node]], Conflict]] = []  # (depth, untried, conflict)
     backtracks, deepest, culprit = 0, -1, None
@@ -659,28 +658,32 @@ def depth_first(found, horizons, links, starts, durations, max_backtracks, fixed
         if not len(pool):
             pool = np.flatnonzero(open_)
         conflict = found[pool[np.argmin(sides.expected_start(precedence, pool))]]
-        options = _options(conflict, precedence, priority)
+        options = _options(conflict, precedence)
         if len(options) > 1:
             stack.append((len(chosen), options[1:], conflict))
         chosen.append((options[0], conflict, precedence.add_start(options[0])))
 
 
-def _priorities(horizons, durations) -> dict[str, int]:
-    """Each robot's priority (0 first): the robot expected to finish first goes first, so that it
-    clears out early; one order for all robots keeps most choices consistent (no cycles)."""
-    alone = {r: sum(durations[r]) for r in horizons}
-    return {r: n for n, r in enumerate(sorted(horizons, key=lambda r: (alone[r], r)))}
-
-
-def _options(conflict: Conflict, precedence: Precedence, priority: Mapping[str, int]) -> list:
-    """The ways left to order `conflict`, best first: the robot of higher priority first, then
-    (between two of the same robot) the lower expected makespan."""
+def _options(conflict: Conflict, precedence: Precedence) -> list:
+    """The ways left to order `conflict`, best first: the occupancy expected to begin first goes
+    first (the robot that gets there first), and of two expected at once the way that keeps the
+    team's expected makespan lower."""
     options = _ways(conflict, precedence)
     if len(options) > 1:
-        options = sorted(options, key=lambda e: priority[e[0][0]])
-        if len({priority[e[0][0]] for e in options}) < len(options):
-            options = sorted(options, key=lambda e: (priority[e[0][0]], _makespan_with(precedence, e)))
+        starts = [_start(x, precedence) for x in _first_of(conflict, options)]
+        if abs(starts[0] - starts[1]) <= _AT_ONCE:
+            options = sorted(options, key=lambda e: _makespan_with(precedence, e))
     return options
+
+
+_AT_ONCE = 1e-6
+"""Seconds within which two occupancies count as expected to begin at once."""
+
+
+def _first_of(conflict: Conflict, options: list) -> list[Occupancy]:
+    """The occupancy that goes first in each of `options` (start edges of `conflict`)."""
+    a, b = conflict.a, conflict.b
+    return [a if (a.last, b.first) == edge else b for edge in options]
 
 
 def _start(x: Occupancy, precedence: Precedence) -> float:

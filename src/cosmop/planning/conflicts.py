@@ -71,11 +71,23 @@ class ConflictSettings:
     rest : float
         How far (mm) a standing robot may be off its planned pose (the simulator stops within
         its goal tolerance, 15 mm): goods another robot moves keep this from where it stands.
+    cut : bool
+        Cut every drive where it enters and leaves a place another robot uses, so that an
+        order holds only the piece inside (default true).
+    piece : float
+        The shortest piece such a cut leaves (mm, default 200).
+    passing : float
+        How far (mm) before a cut a robot that drives on through it may already count as there
+        (the simulator's pass tolerance, 150 mm): the cut where a drive leaves a shared place
+        lies this much beyond it, so that the message sent there is never early.
     """
 
     clearance: float = 100.0
     segment: float = math.inf
     rest: float = 20.0
+    cut: bool = True
+    piece: float = 200.0
+    passing: float = 150.0
 
 
 @dataclass(frozen=True)

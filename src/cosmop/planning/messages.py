@@ -16,6 +16,7 @@ steps realise it.  A sent message comes before a wait placed at the same point.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import replace
 
@@ -132,11 +133,54 @@ def split_drives(
             pieces *= 2
         for j in range(1, pieces):
             t = j / pieces
-            point = (start[0] + (pose[0] - start[0]) * t, start[1] + (pose[1] - start[1]) * t, pose[2])
+            point = (
+                start[0] + (pose[0] - start[0]) * t,
+                start[1] + (pose[1] - start[1]) * t,
+                _travel(start, pose),
+            )
             if roomy is None or roomy(point[0], point[1]):
                 out.append(replace(step, robot=point))
         out.append(step)
     return RobotPlan.from_steps(plan.mission, out)
+
+
+def cut_drives(
+    plan: RobotPlan,
+    start: Sequence[float],
+    cuts: Mapping[int, Sequence[float]],
+    roomy: Callable[[float, float], bool] | None = None,
+) -> RobotPlan:
+    """`plan` (from pose `start`) with its GoTo step *k* cut at the fractions ``cuts[k]`` of its way.
+
+    A piece sweeps part of what the whole drive sweeps, so the plan stays sound; at a cut the
+    robot faces the way it goes (no turn between pieces).  Each cut is
+    rounded to a multiple of :data:`CUT_GRAIN` of the way (an exact point of the segment for
+    coordinates on the micrometre grid), and a cut is made only where ``roomy(x, y)`` (a robot
+    may wait there for a message: not in a narrow passage).
+    """
+    out: list[Step] = []
+    pose = tuple(start)
+    for k, step in enumerate(plan.steps, 1):
+        begin, pose = pose, step.robot
+        if step.primitive == Primitive.GOTO:
+            for t in sorted({round(t * CUT_GRAIN) / CUT_GRAIN for t in cuts.get(k, ())}):
+                if 0.0 < t < 1.0:
+                    x, y = begin[0] + (pose[0] - begin[0]) * t, begin[1] + (pose[1] - begin[1]) * t
+                    point = (x, y, _travel(begin, pose))
+                    if roomy is None or roomy(point[0], point[1]):
+                        out.append(replace(step, robot=point))
+        out.append(step)
+    return RobotPlan.from_steps(plan.mission, out)
+
+
+def _travel(start: Sequence[float], end: Sequence[float]) -> float:
+    """The heading (degrees) of the way from `start` to `end`: a robot at a cut of the drive
+    faces where it goes, so it turns nowhere between the pieces."""
+    return round(math.degrees(math.atan2(end[1] - start[1], end[0] - start[0])), 9)
+
+
+CUT_GRAIN = 1024
+"""Cuts of a drive fall on multiples of ``1 / CUT_GRAIN`` of its way (dyadic: exact points)."""
 
 
 def merge_drives(plan: RobotPlan, waypoints: set[tuple[float, float]]) -> RobotPlan:

@@ -16,13 +16,14 @@ happen first and the team's makespan stays low.
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
 import shapely
 
-from cosmop.events import parse_event
+from cosmop.events import Primitive, parse_event
 from cosmop.io import collector_paused
 from cosmop.missions.precedence import Link, Node, Precedence
 from cosmop.planning.conflict_order import order_conflicts
@@ -35,11 +36,12 @@ from cosmop.planning.conflicts import (
     occupancies,
     ranked_detours,
 )
-from cosmop.planning.messages import merge_drives, place_edges, split_drives
+from cosmop.planning.messages import CUT_GRAIN, cut_drives, merge_drives, place_edges, split_drives
 from cosmop.planning.plan import PlanMessage, RobotPlan, State
 from cosmop.planning.realisation import message_links
 from cosmop.planning.timing import durations, start_pose
 from cosmop.scene import Scene
+from cosmop.squares import swept_square
 
 __all__ = ["TeamSafety", "make_team_safe"]
 
@@ -189,6 +191,8 @@ def make_team_safe(
         )
         for r, p in plans.items()
     }
+    if settings.cut:
+        plans = _cut_where_shared(scene, plans, settings, starts, positions, walls)
     horizons = {r: p.horizon for r, p in plans.items()}
     links = message_links(plans)
     times = durations(scene, plans, starts=starts)
@@ -225,6 +229,68 @@ def make_team_safe(
         time.perf_counter() - t0,
         fixed,
     )
+
+
+def _cut_where_shared(scene, plans, settings, starts, positions, walls) -> dict[str, RobotPlan]:
+    """Every drive cut where it enters and where it leaves a place another robot uses.
+
+    A conflict then holds only the piece of the drive inside the shared place, so the robot
+    waits just before it enters, not before its whole drive, and the other is told as soon as
+    it leaves (the temporal plan graph's grain: an order between the pieces of two drives that
+    share a region).  The plans stay sound: a piece sweeps part of what the drive swept.
+    """
+    precedence = Precedence({r: p.horizon for r, p in plans.items()}, message_links(plans))
+    items, _ = occupancies(scene, plans, precedence, settings, starts, positions)
+    tree = shapely.STRtree([item.region for item in items])
+    out = {}
+    for robot, plan in plans.items():
+        grown = scene.robots[robot].size + settings.clearance
+        poses = [start_pose(scene, robot, starts), *(step.robot for step in plan.steps)]
+        cuts: dict[int, list[float]] = {}
+        for k, step in enumerate(plan.steps, 1):
+            p, q = poses[k - 1], poses[k]
+            if step.primitive != Primitive.GOTO or math.dist(p[:2], q[:2]) < 2 * settings.piece:
+                continue
+            for j in tree.query(swept_square(p, q, grown), predicate="intersects"):
+                if robot not in items[j].parties:
+                    region = items[j].region
+                    cuts.setdefault(k, []).extend(_entry_exit(p, q, grown / 2.0, region, settings.passing))
+            cuts[k] = _spaced(cuts.get(k, []), settings.piece / math.dist(p[:2], q[:2]))
+        roomy = _roomy(walls, scene, robot, settings.clearance)
+        out[robot] = cut_drives(plan, poses[0], cuts, roomy) if cuts else plan
+    return out
+
+
+def _entry_exit(p, q, half: float, region, passing: float) -> tuple[float, ...]:
+    """Where a square of half side `half` moving from `p` to `q` starts and stops overlapping the
+    convex `region`: fractions of the way in (0, 1), rounded outwards to the cut grain; the
+    exit lies `passing` mm beyond (:attr:`~cosmop.planning.conflicts.ConflictSettings.passing`)."""
+    corners = [
+        (x + dx, y + dy) for x, y in region.exterior.coords for dx in (-half, half) for dy in (-half, half)
+    ]
+    reach = shapely.MultiPoint(corners).convex_hull  # the Minkowski sum: centres that overlap it
+    inside = shapely.LineString([p[:2], q[:2]]).intersection(reach)
+    if inside.is_empty:
+        return ()
+    dx, dy = q[0] - p[0], q[1] - p[1]
+    ts = [
+        ((x - p[0]) * dx + (y - p[1]) * dy) / (dx * dx + dy * dy) for x, y in shapely.get_coordinates(inside)
+    ]
+    beyond = passing / math.hypot(dx, dy)
+    low, high = (
+        math.floor(min(ts) * CUT_GRAIN) / CUT_GRAIN,
+        math.ceil((max(ts) + beyond) * CUT_GRAIN) / CUT_GRAIN,
+    )
+    return tuple(t for t in (low, high) if 0.0 < t < 1.0)
+
+
+def _spaced(cuts: list[float], gap: float) -> list[float]:
+    """`cuts` sorted, without those closer than `gap` to the one kept before them."""
+    out: list[float] = []
+    for t in sorted(set(cuts)):
+        if gap <= t <= 1.0 - gap and (not out or t - out[-1] >= gap):
+            out.append(t)
+    return out
 
 
 def _roomy(walls, scene: Scene, robot: str, room: float):

@@ -16,9 +16,10 @@ steps are expected to happen (and shared as itineraries):
 ``Req``, ``Res``
     no time of their own (a ``Req`` lasts until its message has been sent).
 
-Consecutive GoTo steps in one direction (a drive cut into pieces) are one drive, shared by the
-pieces in proportion to their lengths; a change of direction is estimated stop to stop (the
-controller passes intermediate waypoints without stopping, so real runs are usually faster).
+Consecutive GoTo steps in one direction (a drive cut into pieces, with messages sent or awaited
+between them) are one drive, shared by the pieces in proportion to their lengths; a change of
+direction is estimated stop to stop (the controller passes intermediate waypoints without
+stopping, so real runs are usually faster).
 The estimates order events; they are not a promise.
 """
 
@@ -124,11 +125,12 @@ def step_durations(
         out.append(0.0)
         if step.primitive == Primitive.GOTO:
             run.append((len(out) - 1, pose, step.robot))
-        else:
+        elif step.primitive in (Primitive.PICKUP, Primitive.DROPOFF):
             _close(run, out, dynamics)
             run = []
-            if step.primitive in (Primitive.PICKUP, Primitive.DROPOFF):
-                out[-1] = model.handling_time
+            out[-1] = model.handling_time
+        # a message between two pieces of one drive is sent or received on the way: a robot
+        # whose message has come drives on (waiting, when it must, is the order's, not the drive's)
         pose = step.robot
     _close(run, out, dynamics)
     return out

@@ -98,10 +98,12 @@ def go_to(world: World, agent: Agent, step: Step) -> Action | None:
     starts off touching something creeps out first (:func:`cosmop.sim.motion.creep_out`).
     """
     k = agent.step_index
-    last = k + 1 >= len(agent.steps) or agent.steps[k + 1].primitive != Primitive.GOTO
+    agent.through = False
+    after = _next_drive(world, agent, k)
+    last = after is None
     goal = step.robot
     stop = last or bool(
-        world.static_gaps(agent.steps[k + 1].robot[:2], world.robot_half[agent.index])[0]
+        world.static_gaps(agent.steps[after].robot[:2], world.robot_half[agent.index])[0]
         < world.settings.leave_gap
     )
     if agent.replan_start is not None and agent.replan_start[0] == k:  # a replan's first step
@@ -112,7 +114,25 @@ def go_to(world: World, agent: Agent, step: Step) -> Action | None:
         action = creep_out(world, agent, goal)
         if action is not None:
             return action
-    return drive(world, agent, goal, stop, heading=last, origin=origin)
+    action = drive(world, agent, goal, stop, heading=last, origin=origin)
+    agent.through = action is None and not stop
+    return action
+
+
+def _next_drive(world: World, agent: Agent, k: int) -> int | None:
+    """The index of the GoTo the robot drives on to from step `k`'s waypoint without stopping:
+    the next step, or the first after messages that hold nothing up (one it sends, one it
+    awaits that has come).  ``None`` when it stops at the waypoint."""
+    for n in range(k + 1, len(agent.steps)):
+        step = agent.steps[n]
+        if step.primitive == Primitive.GOTO:
+            return n
+        holds = step.primitive != Primitive.RES and not (
+            step.primitive == Primitive.REQ and step.message is not None and world.received(agent, step)
+        )
+        if holds:
+            return None
+    return None
 
 
 # -- PickUp and DropOff --------------------------------------------------------------------------
@@ -273,6 +293,8 @@ def wait_for_message(world: World, agent: Agent, step: Step) -> Action | None:
     """``Req``: stop and wait until the message is sent, and no robot that may move is within
     the standoff (a waiting robot is parked: :meth:`~cosmop.sim.world.World.crowded`)."""
     i = agent.index
+    if agent.through and step.message is not None and world.received(agent, step):
+        return None  # it has come: the robot drives on through the waypoint
     agent.waiting = True
     if world.v[i] > 0 or not world.received(agent, step) or world.crowded(i):
         return brake(world, i)
@@ -281,8 +303,10 @@ def wait_for_message(world: World, agent: Agent, step: Step) -> Action | None:
 
 
 def send_message(world: World, agent: Agent, step: Step) -> Action | None:
-    """``Res``: stop, then send the message (:meth:`~cosmop.sim.world.World.send`)."""
-    if world.v[agent.index] > 0:
+    """``Res``: stop, then send the message (:meth:`~cosmop.sim.world.World.send`); a robot
+    driving through the waypoint sends it on the way (a cut where a robot leaves a place it
+    shares lies a pass tolerance beyond the place: :class:`~cosmop.planning.conflicts.ConflictSettings`)."""
+    if world.v[agent.index] > 0 and not agent.through:
         return brake(world, agent.index)
     world.send(agent, step)
     return None

@@ -69,6 +69,7 @@ class Agent:
         self.detour_until = 0.0  # no new detour before this time, s
         self.last_progress_t = 0.0  # time of the last progress, s
         self.waiting = False  # standing for a message
+        self.through = False  # drove through its last waypoint: its messages there need no stop
         self.answers_sent: dict[str, int] = {}  # Res steps done per object
         # where it creeps out of touch before driving off: None not looked for yet, False none
         self.way_out: tuple[float, float] | bool | None = None
