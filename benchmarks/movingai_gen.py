@@ -52,13 +52,11 @@ def _centre(row: int, col: int) -> list[float]:
     return [col * CELL + CELL / 2, (ROWS - 1 - row) * CELL + CELL / 2]
 
 
-def movingai_warehouse(n: int, seed: int = 0) -> dict:
-    """The scenario (as the data of a YAML file) with ``n`` robots and ``n`` goods."""
+def _instance(n: int, seed: int, docks: str):
+    """The cells of a seeded instance: robots' parking cells, goods ``(aisle row, column, +1
+    when the block is below the good)`` and dock cells (docks ``"near"`` the good or on the
+    ``"far"`` side)."""
     rng = random.Random(seed)
-    with tempfile.TemporaryDirectory() as tmp:
-        path = Path(tmp) / "warehouse-10-20-10-2-1.map"
-        path.write_text(map_text())
-        walls = [[list(a), list(b)] for a, b in import_map(path, cell_size=CELL).walls]
     parking = [(r, c) for r in range(2, ROWS - 2, 2) for c in (3, 6, 9, COLS - 4, COLS - 7, COLS - 10)]
     rng.shuffle(parking)
     faces = []  # (aisle row, column, +1: the block is below the good, -1: above)
@@ -69,23 +67,45 @@ def movingai_warehouse(n: int, seed: int = 0) -> dict:
             faces += [(top - 1, left + dc, 1) for dc in range(1, BLOCK_W - 1)]
             faces += [(top + BLOCK_H, left + dc, -1) for dc in range(1, BLOCK_W - 1)]
     chosen = rng.sample(faces, n)
-    robots, objects, workspaces, tasks = {}, {}, {}, {}
     columns = {"left": 18, "right": COLS - 19}
-    docks = {side: [(r, c) for r in range(3, ROWS - 3, 3)] for side, c in columns.items()}
-    for places in docks.values():
-        rng.shuffle(places)
-    for i, (row, col, below) in enumerate(chosen):
+    places = {side: [(r, c) for r in range(3, ROWS - 3, 3)] for side, c in columns.items()}
+    for cells in places.values():
+        rng.shuffle(cells)
+    out = []
+    for row, col, below in chosen:
+        near, far = ("left", "right") if col < COLS // 2 else ("right", "left")
+        first, second = (near, far) if docks == "near" else (far, near)
+        out.append((row, col, below, (places[first] or places[second]).pop()))
+    return parking[:n], out
+
+
+def movingai_cells(n: int, seed: int = 0, docks: str = "near"):
+    """The grid version of :func:`movingai_warehouse`'s instance: per robot its parking cell, the
+    aisle cell of its good and its dock cell, ``(row, column)`` each."""
+    parking, goods = _instance(n, seed, docks)
+    return parking, [(row, col) for row, col, _, _ in goods], [dock for *_, dock in goods]
+
+
+def movingai_warehouse(n: int, seed: int = 0, docks: str = "near") -> dict:
+    """The scenario (as the data of a YAML file) with ``n`` robots and ``n`` goods; each good's
+    dock is in the dock area nearest it (``docks="near"``) or on the far side (``"far"``)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "warehouse-10-20-10-2-1.map"
+        path.write_text(map_text())
+        walls = [[list(a), list(b)] for a, b in import_map(path, cell_size=CELL).walls]
+    parking, goods = _instance(n, seed, docks)
+    robots, objects, workspaces, tasks = {}, {}, {}, {}
+    for i, (row, col, below, dock) in enumerate(goods):
         r, o, w = f"R{i + 1}", f"O{i + 1}", f"W{i + 1}"
         robots[r] = {"size": ROBOT, "pose": [*_centre(*parking[i]), 0]}
         x, y = _centre(row, col)
         objects[o] = {"size": GOOD, "position": [x, y - below * (CELL - GOOD) / 2]}  # against the face
-        near, far = ("left", "right") if col < COLS // 2 else ("right", "left")
-        dock = (docks[near] or docks[far]).pop()
         dx, dy = _centre(*dock)
         workspaces[w] = {"x": [dx - CELL / 2, dx + CELL / 2], "y": [dy - CELL / 2, dy + CELL / 2]}
         tasks[r] = [f"pick {o}", f"drop {o} at {w}", "return"]
+    far = "" if docks == "near" else "-far"
     return {
-        "name": f"movingai-warehouse-{n}-seed{seed}",
+        "name": f"movingai-warehouse-{n}-seed{seed}{far}",
         "scene": {"obstacles": walls, "robots": robots, "objects": objects, "workspaces": workspaces},
         "mission": {"tasks": tasks},
     }

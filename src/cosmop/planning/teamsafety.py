@@ -69,6 +69,12 @@ class TeamSafety:
         Seconds this took.
     fixed : Mapping[str, list]
         Every robot's places that re-planning cannot move (to choose detours).
+    chosen : int
+        Orders the search chose (one per conflict it ordered, before the implied ones are
+        dropped).
+    flipped : int
+        Of those, the orders that let go first the robot the itineraries expect there later:
+        where a cycle made the search depart from time (:mod:`cosmop.planning.conflict_search`).
     """
 
     plans: Mapping[str, RobotPlan]
@@ -80,6 +86,8 @@ class TeamSafety:
     makespan: float
     time_s: float
     fixed: Mapping[str, list] = field(default_factory=dict, repr=False)
+    chosen: int = 0
+    flipped: int = 0
 
     @property
     def safe(self) -> bool:
@@ -228,7 +236,20 @@ def make_team_safe(
         final.makespan,
         time.perf_counter() - t0,
         fixed,
+        len(chosen),
+        _flipped(chosen, precedence),
     )
+
+
+def _flipped(chosen, alone: Precedence) -> int:
+    """How many of the `chosen` orders let go first the occupancy the robots' own itineraries
+    (`alone`: no conflict ordered) expect to begin later: where the search departed from time."""
+    out = 0
+    for (first, _), conflict in chosen:
+        x, y = (conflict.a, conflict.b) if conflict.a.last == first else (conflict.b, conflict.a)
+        begins = [0.0 if o.first is None else alone.start_time(o.first) for o in (x, y)]
+        out += begins[0] > begins[1] + 1e-6
+    return out
 
 
 def _cut_where_shared(scene, plans, settings, starts, positions, walls) -> dict[str, RobotPlan]:
