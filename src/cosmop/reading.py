@@ -26,7 +26,7 @@ from __future__ import annotations
 import json
 import math
 import re
-from collections.abc import Callable
+from collections.abc import Iterator
 from typing import Any, NoReturn
 
 import yaml
@@ -42,8 +42,11 @@ __all__ = [
     "Marks",
     "check_printable",
     "format_path",
+    "json_position",
+    "json_problem",
     "load_json",
     "load_yaml",
+    "unprintable",
 ]
 
 MAX_DEPTH = 64
@@ -81,6 +84,23 @@ def format_path(path: FieldPath) -> str | None:
         else:
             text += f"[{part!r}]"
     return text or None
+
+
+def unprintable(text: str) -> str | None:
+    r"""Why a name or id `text` would not show as itself on a terminal, or ``None`` if it would.
+
+    Every character must be printable (:meth:`str.isprintable`): a control character such as
+    ESC (``"ware\e[31m"`` in YAML, ``"\u001b"`` in JSON) would reach the terminal and the files
+    written, and tabs, line breaks and invisible format characters would misalign or hide text.
+
+    >>> unprintable("warehouse"), unprintable("ware\x1b[31m")
+    (None, "expected printable text, got 'ware\\x1b[31m' (U+001B at character 5)")
+    """
+    if text.isprintable():
+        return None
+    index, char = next((i, c) for i, c in enumerate(text) if not c.isprintable())
+    shown = repr(text) if len(text) <= 80 else repr(text[:77]) + "..."
+    return f"expected printable text, got {shown} (U+{ord(char):04X} at character {index + 1})"
 
 
 def check_printable(text: str, error: type[CosmopInputError], file: str | None) -> None:
@@ -321,28 +341,26 @@ def _refuse_constant(name: str) -> Any:
 
 
 def load_json(
-    text: str,
-    file: str | None,
-    error: type[CosmopInputError],
-    *,
-    object_pairs_hook: Callable[[list[tuple[str, Any]]], Any] | None = None,
+    text: str, file: str | None, error: type[CosmopInputError], *, unique_keys: bool = False
 ) -> Any:
     """Parse untrusted JSON text within the bounds of this module.
 
-    `object_pairs_hook` may raise :class:`ValueError` to refuse an object (e.g. a repeated
-    key); its message becomes the error's.  ``NaN`` and ``Infinity`` are refused.
+    ``NaN``, ``Infinity`` and numbers beyond the floats' range (``1e999``) are refused, and with
+    `unique_keys` a key repeated within one object; such an error names the field path and
+    its line and column (:func:`json_problem`).
 
     Raises
     ------
     error
         For text that is not printable, not JSON (with the line and column), nested deeper than
-        :data:`MAX_DEPTH`, or with an integer of more than :data:`MAX_DIGITS` digits.
+        :data:`MAX_DEPTH`, with an integer of more than :data:`MAX_DIGITS` digits, a number
+        that is not finite, or (with `unique_keys`) a repeated key.
     """
     check_printable(text, error, file)
     try:
         data = json.loads(
             text,
-            object_pairs_hook=object_pairs_hook,
+            object_pairs_hook=_unique_keys if unique_keys else None,
             parse_int=_parse_int,
             parse_float=_parse_float,
             parse_constant=_refuse_constant,
@@ -351,11 +369,140 @@ def load_json(
         raise error(f"invalid JSON: {err.msg}", file=file, line=err.lineno, column=err.colno) from None
     except RecursionError:
         raise error(f"invalid JSON: values nest more than {MAX_DEPTH} levels deep", file=file) from None
-    except ValueError as err:  # _Refused, or the hook's refusal
-        raise error(f"invalid JSON: {err}", file=file) from None
+    except _Refused as err:
+        found = json_problem(text, unique_keys)
+        if found is None:  # cannot happen: the scan refuses what the parser refused
+            raise error(f"invalid JSON: {err}", file=file) from None
+        problem, path, (line, column) = found
+        raise error(
+            f"invalid JSON: {problem}", file=file, field=format_path(path), line=line, column=column
+        ) from None
     if _depth(data) > MAX_DEPTH:
         raise error(f"invalid JSON: values nest more than {MAX_DEPTH} levels deep", file=file)
     return data
+
+
+def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    result: dict[str, Any] = {}
+    for key, value in pairs:
+        if key in result:
+            raise _Refused(f"duplicate key {key!r}")
+        result[key] = value
+    return result
+
+
+# One token of JSON text: punctuation, a string's opening quote, or a bare word (a number, a
+# literal, or NaN/Infinity, which Python's parser also reads).
+_TOKEN = re.compile(r'\s*(?:([{}\[\]:,"])|(-?[A-Za-z0-9_.+-]+))')
+
+
+def _json_items(text: str, unique_keys: bool = False) -> Iterator[tuple[FieldPath, int, str | None]]:
+    """Every value of JSON `text` in document order: ``(field path, offset, problem)``.
+
+    `problem` is why the value (or, with `unique_keys`, its key) is refused, else ``None``.  The
+    scan is iterative (no recursion at any depth) and stops at text that is not JSON; the
+    parser reports that itself.
+    """
+    stack: list[list[Any]] = []  # [path part, keys seen (objects) or None (lists)]
+    expect_value, position = True, 0
+    while True:
+        match = _TOKEN.match(text, position)
+        if match is None:
+            return
+        punctuation, word = match.groups()
+        start, position = match.start(match.lastindex), match.end()
+        path = tuple(frame[0] for frame in stack)
+        if expect_value and punctuation in ("{", "["):
+            yield path, start, None
+            stack.append([None if punctuation == "{" else 0, {} if punctuation == "{" else None])
+            if punctuation == "[":
+                expect_value = True
+                follows = _TOKEN.match(text, position)
+                if follows is not None and follows.group(1) == "]":
+                    expect_value = False  # an empty list: no value to read
+            else:
+                expect_value = False  # a key or "}" comes next
+            continue
+        if stack and stack[-1][1] is not None and stack[-1][0] is None and punctuation == '"':
+            key, position = json.decoder.scanstring(text, position)  # an object's key
+            seen = stack[-1][1]
+            if unique_keys and key in seen:
+                first = _line_and_column(text, seen[key])[0]
+                yield (
+                    (*path[:-1], key),  # the object's own part of the path is its previous key
+                    start,
+                    f"duplicate key {key!r} (first on line {first}); every key appears once in its object",
+                )
+                return
+            seen[key] = start
+            stack[-1][0] = key
+            colon = _TOKEN.match(text, position)
+            if colon is None or colon.group(1) != ":":
+                return
+            position, expect_value = colon.end(), True
+            continue
+        if expect_value:
+            if punctuation == '"':
+                _, position = json.decoder.scanstring(text, position)
+                yield path, start, None
+            elif word is not None:
+                yield path, start, _refusal(word)
+            else:
+                return
+            expect_value = False
+            continue
+        if punctuation == "," and stack:
+            if stack[-1][1] is None:
+                stack[-1][0] += 1
+                expect_value = True
+            else:
+                stack[-1][0] = None  # a key comes next
+            continue
+        if punctuation in ("}", "]") and stack:
+            stack.pop()
+            continue
+        return
+
+
+def _refusal(word: str) -> str | None:
+    """Why the bare JSON word `word` (a number or literal) is refused, or ``None``."""
+    try:
+        if word in ("NaN", "Infinity", "-Infinity"):
+            _refuse_constant(word)
+        elif re.fullmatch(r"-?[0-9]+", word):
+            _parse_int(word)
+        elif word not in ("true", "false", "null"):
+            _parse_float(word)
+    except (_Refused, ValueError) as err:
+        return str(err)
+    return None
+
+
+def _line_and_column(text: str, offset: int) -> tuple[int, int]:
+    return text.count("\n", 0, offset) + 1, offset - (text.rfind("\n", 0, offset) + 1) + 1
+
+
+def json_problem(text: str, unique_keys: bool = False) -> tuple[str, FieldPath, tuple[int, int]] | None:
+    """The first value of JSON `text` that :func:`load_json` refuses: ``(why, field path, (line,
+    column))``, or ``None`` if there is none before the text stops being JSON."""
+    for path, offset, problem in _json_items(text, unique_keys):
+        if problem is not None:
+            return problem, path, _line_and_column(text, offset)
+    return None
+
+
+def json_position(text: str, path: FieldPath) -> tuple[int, int] | None:
+    """The ``(line, column)`` where the value at field `path` of JSON `text` starts, if it has one.
+
+    For error messages only (it scans the text up to that value).
+
+    >>> json_position('{"a": [1,\\n  2]}', ("a", 1))
+    (2, 3)
+    """
+    for found, offset, _ in _json_items(text):
+        if found == path:
+            return _line_and_column(text, offset)
+    return None
 
 
 def _depth(data: Any) -> int:

@@ -37,10 +37,11 @@ from shapely.geometry.base import BaseGeometry
 
 from cosmop.events import Primitive
 from cosmop.missions.precedence import Node, Precedence
-from cosmop.planning.plan import RobotPlan, State, _fmt, _point, initial_state
+from cosmop.planning.plan import RobotPlan, State, initial_state
 from cosmop.planning.realisation import at_pose
 from cosmop.scene import Scene
 from cosmop.squares import overlap_depths, square, swept_square
+from cosmop.units import UnitSystem, show_number, show_point
 
 __all__ = [
     "Conflict",
@@ -103,6 +104,8 @@ class Occupancy:
     body : shapely geometry, optional
         The region without the clearance robots keep from each other (a robot may pass goods
         as close as its plan allows); by default `region`.
+    units : {"mm", "m"}, optional
+        The units its words show lengths in: the scenario file's (``Scene.units``).
     """
 
     what: str
@@ -113,6 +116,7 @@ class Occupancy:
     label: str
     movable: bool = True
     body: BaseGeometry | None = field(default=None, repr=False)
+    units: UnitSystem = field(default="mm", repr=False, compare=False)
 
 
 @dataclass(frozen=True)
@@ -145,8 +149,9 @@ class Conflict:
         return f"{self.a.label} and {self.b.label} share the space {self.space()}"
 
     def space(self) -> str:
-        """The shared space's bounding box in words: ``x in [.., ..], y in [.., ..]`` (mm)."""
-        x0, y0, x1, y1 = (_fmt(round(v, 1)) for v in self.place)
+        """The shared space's bounding box in words: ``x in [.., ..], y in [.., ..]``, to 0.1 mm
+        in the scenario file's units."""
+        x0, y0, x1, y1 = (show_number(round(v, 1), self.a.units) for v in self.place)
         return f"x in [{x0}, {x1}], y in [{y0}, {y1}]"
 
 
@@ -158,10 +163,12 @@ def _robot_occupancies(
     home: Sequence[float],
     grow: float = 0.0,
     rest: float = 0.0,
+    units: UnitSystem = "mm",
 ) -> list[Occupancy]:
     """Where `robot` stands (merged over steps that keep its pose) and what its GoTo steps sweep.
 
-    A standing robot's body, which goods keep clear of, is its square grown by `rest`.
+    A standing robot's body, which goods keep clear of, is its square grown by `rest`; the
+    words show lengths in `units`.
     """
     K = plan.horizon
     poses = [start.robot, *(s.robot for s in plan.steps)]
@@ -188,9 +195,10 @@ def _robot_occupancies(
                 square(x, y, side),
                 first,
                 last,
-                f"{robot} standing at {_point((x, y))} {where}",
+                f"{robot} standing at {show_point((x, y), units)} {where}",
                 not fixed,
                 square(x, y, side - grow + 2 * rest),
+                units,
             )
         )
         k = end + 1
@@ -204,9 +212,11 @@ def _robot_occupancies(
                     swept_square(p, q, side),
                     (robot, k),
                     (robot, k),
-                    f"{robot}'s GoTo at instant {k} from {_point(p[:2])} to {_point(q[:2])}",
+                    f"{robot}'s GoTo at instant {k} from {show_point(p[:2], units)} to "
+                    f"{show_point(q[:2], units)}",
                     True,
                     swept_square(p, q, side - grow),
+                    units,
                 )
             )
     return out
@@ -252,8 +262,9 @@ def _object_occupancies(
                             square(*position, spec.size),
                             first,
                             (robot, k),
-                            f"{oid} resting at {_point(position)} {where}",
+                            f"{oid} resting at {show_point(position, scene.units)} {where}",
                             first is not None,
+                            units=scene.units,
                         )
                     )
                 position = None
@@ -268,8 +279,9 @@ def _object_occupancies(
                     square(*position, spec.size),
                     first,
                     None,
-                    f"{oid} resting at {_point(position)} {where}",
+                    f"{oid} resting at {show_point(position, scene.units)} {where}",
                     first is not None,
+                    units=scene.units,
                 )
             )
     return out, problems
@@ -294,7 +306,7 @@ def occupancies(
     for robot, plan in plans.items():
         start = (starts or {}).get(robot) or initial_state(scene, robot)
         size, home = scene.robots[robot].size + grow, scene.robots[robot].pose
-        out += _robot_occupancies(robot, plan, start, size, home, grow, settings.rest)
+        out += _robot_occupancies(robot, plan, start, size, home, grow, settings.rest, scene.units)
     objects, problems = _object_occupancies(scene, plans, precedence, positions)
     return out + objects, problems
 
