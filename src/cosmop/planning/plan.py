@@ -922,7 +922,8 @@ class _Reader:
         self.text = text
 
     def fail(self, path: FieldPath, expected: str) -> PlanError:
-        line, column = (None, None) if self.text is None else json_position(self.text, path) or (None, None)
+        found = json_position(self.text, path) if self.text is not None and path else None
+        line, column = found or (None, None)  # the whole file (path ()) has no line of its own
         return PlanError(expected, file=self.file, field=format_path(path), line=line, column=column)
 
     def mapping(self, value: Any, path: FieldPath, required: tuple[str, ...], optional: tuple[str, ...] = ()):

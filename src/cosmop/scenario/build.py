@@ -218,7 +218,15 @@ class _Builder:
         )
 
     def check_precision(self, scene: Scene) -> None:
-        """Every length the planner uses lies on the :data:`LENGTH_GRID` and within :data:`MAX_LENGTH`."""
+        """Every length the planner uses lies on the :data:`LENGTH_GRID` and within :data:`MAX_LENGTH`,
+        and every heading is a finite number of degrees (a metres file's 1e308 radians is not)."""
+        for rid, robot in scene.robots.items():
+            if not math.isfinite(robot.pose[2]):
+                path = ("scene", "robots", rid, "pose", 2)
+                written = _show(_lookup(self.data, path)[1])
+                self.fail(
+                    path, f"expected a finite heading (degrees), got {written}: beyond the range of numbers"
+                )
         grid = f"{shown(float(LENGTH_GRID), self.units):f}".rstrip("0") + (
             " m" if self.units == "m" else " mm"
         )
