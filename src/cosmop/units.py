@@ -38,6 +38,7 @@ __all__ = [
     "localize",
     "m_from_mm",
     "mm_from_m",
+    "plain",
     "rad_from_deg",
     "scene_to_internal",
     "show_angle",
@@ -96,6 +97,14 @@ def show_number(mm: float, units: UnitSystem) -> str:
     if value.is_integer():
         return str(int(value))
     return repr(value + 0.0)
+
+
+def plain(value: float) -> str:
+    """A number as people write it: whole ones in full (``800000``, never ``8e+05``), others to
+    six significant digits; huge and tiny ones in exponent form (``1e+300``)."""
+    if math.isfinite(value) and float(value).is_integer() and abs(value) < 1e15:
+        return str(int(value))
+    return f"{value:.6g}"
 
 
 def show_length(mm: float, units: UnitSystem) -> str:

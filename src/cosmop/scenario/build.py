@@ -56,7 +56,15 @@ from cosmop.scene import (
     Wall,
     Workspace,
 )
-from cosmop.units import SCENARIO_UNITS, default_dynamics, localize, scene_to_internal, show_length, shown
+from cosmop.units import (
+    SCENARIO_UNITS,
+    default_dynamics,
+    localize,
+    plain,
+    scene_to_internal,
+    show_length,
+    shown,
+)
 
 
 class _Builder:
@@ -223,7 +231,7 @@ class _Builder:
         for rid, robot in scene.robots.items():
             if not math.isfinite(robot.pose[2]):
                 path = ("scene", "robots", rid, "pose", 2)
-                written = _show(_lookup(self.data, path)[1])
+                written = _written(_lookup(self.data, path)[1])
                 self.fail(
                     path, f"expected a finite heading (degrees), got {written}: beyond the range of numbers"
                 )
@@ -232,7 +240,7 @@ class _Builder:
         )
         for path, value in _planned_lengths(scene):
             if not abs(value) <= MAX_LENGTH:  # inf too: a metres file's 1e308 overflows in mm
-                written = _show(_lookup(self.data, path)[1])  # as the file wrote it
+                written = _written(_lookup(self.data, path)[1])  # as the file wrote it
                 self.fail(
                     path, f"expected a length of at most {show_length(MAX_LENGTH, self.units)}, got {written}"
                 )
@@ -560,6 +568,13 @@ class _Builder:
                 f"workspace {workspace} is too small for {obj.id} ({size}): no drop position "
                 "in it keeps the object clear of the walls",
             )
+
+
+def _written(value: Any) -> str:
+    """A value as the file wrote it, for a message: numbers in full (``1e+308``, ``800000``)."""
+    if isinstance(value, int | float) and not isinstance(value, bool):
+        return plain(value)
+    return _show(value)
 
 
 def _known(group: str, ids: Mapping[str, Any]) -> str:

@@ -27,7 +27,7 @@ from typing import Literal
 
 from cosmop.reading import FieldPath
 from cosmop.scene import Dynamics, Scene
-from cosmop.units import UnitSystem
+from cosmop.units import UnitSystem, plain
 
 __all__ = ["QUANTITIES", "Quantity", "implausible", "out_of_range"]
 
@@ -98,7 +98,7 @@ class Quantity:
 
     def expected(self, bounds: tuple[float, float], units: UnitSystem) -> str:
         """The range `bounds` in words in the file's units: ``between 0.05 and 5 m``."""
-        lo, hi = (_number(self.in_file(bound, units)) for bound in bounds)
+        lo, hi = (plain(self.in_file(bound, units)) for bound in bounds)
         unit = self.unit(units)
         return f"at most {hi} {unit} either way" if self.signed else f"between {lo} and {hi} {unit}"
 
@@ -108,13 +108,6 @@ class Quantity:
             return None
         other: UnitSystem = "mm" if units == "m" else "m"
         return _SLIP[(self.kind in _ANGULAR, units)] if self.within(value, self.plausible, other) else None
-
-
-def _number(value: float) -> str:
-    """A number for people: whole ones in full (``800000``), others to six digits."""
-    if math.isfinite(value) and float(value).is_integer() and abs(value) < 1e15:
-        return str(int(value))
-    return f"{value:.6g}"
 
 
 _SIDE_OF_ROBOT = Quantity("a robot's side", "length", (50.0, 5000.0))
@@ -197,7 +190,7 @@ def out_of_range(scene: Scene, units: UnitSystem) -> tuple[FieldPath, str] | Non
         if quantity.valid is not None and not quantity.within(value, quantity.valid, units):
             slip = quantity.slip(value, units)
             return path, (
-                f"expected {quantity.what} {quantity.expected(quantity.valid, units)}, got {_number(value)}"
+                f"expected {quantity.what} {quantity.expected(quantity.valid, units)}, got {plain(value)}"
                 + (f"; {slip}" if slip else "")
             )
     return None
@@ -221,7 +214,7 @@ def implausible(scene: Scene, units: UnitSystem) -> list[tuple[FieldPath, str]]:
     for quantity, places in found.items():
         path, value = places[0]
         text = (
-            f"{quantity.what} of {_number(value)} {quantity.unit(units)} is implausible (expected "
+            f"{quantity.what} of {plain(value)} {quantity.unit(units)} is implausible (expected "
             f"{quantity.expected(quantity.plausible, units)})"
         )
         if (slip := quantity.slip(value, units)) is not None:
