@@ -513,8 +513,7 @@ class _Builder:
         sources = list(dict.fromkeys(source for source, _, _ in transitions))
         if initial in sources:
             return
-        named = len(sources) > 5
-        shown = ", ".join(sources[:5]) + (f" and {len(sources) - 5} more" if named else "")
+        shown = ", ".join(sources[:5]) + (f" and {len(sources) - 5} more" if len(sources) > 5 else "")
         if not listed and all(initial != target for _, _, target in transitions):
             problem = f"unknown initial state {initial!r}: no transition starts or ends there"
         else:
