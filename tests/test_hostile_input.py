@@ -29,7 +29,16 @@ from cosmop.pipeline import plan_team
 from cosmop.planning.checker import check_plan
 from cosmop.planning.plan import MAX_STEPS, PlanError, PlanSet, load_plan
 from cosmop.planning.synthesis import synthesize
-from cosmop.reading import MAX_DEPTH, MAX_DIGITS, MAX_NODES, MAX_TEXT, load_json, load_yaml
+from cosmop.reading import (
+    MAX_DEPTH,
+    MAX_DIGITS,
+    MAX_NODES,
+    MAX_TEXT,
+    json_position,
+    json_problem,
+    load_json,
+    load_yaml,
+)
 from cosmop.scenario import MAX_DFA_STATES, load_scenario, parse_scenario
 from cosmop.scene import MAX_TASK_EVENTS
 
@@ -449,3 +458,17 @@ def test_the_stored_plan_is_a_valid_plan_of_its_example():
     # their workspaces), so a mutation's violation could be the file's own
     report = check_plan(load_scenario(EXAMPLE), load_plan(PLAN))
     assert report.ok, report.violations
+
+
+def test_a_refused_json_value_is_found_by_its_field_and_line():
+    text = '{"why": "NaN, \\"1e999\\" and [", "a\\"b": [[], {"c": [1,\n 2, -Infinity]}]}'
+    assert json.loads(text.replace("-Infinity", "0"))  # JSON but for the one value
+    assert json_problem(text) == (
+        "-Infinity is not a number; numbers must be finite",
+        ('a"b', 1, "c", 2),  # words in strings are text, not numbers
+        (2, 5),
+    )
+    assert json_position(text, ('a"b', 1, "c", 1)) == (2, 2)
+    assert json_position(text, ("a", 0)) is None
+    assert json_problem('{"a": 1, "b": {"a": 2}, "a": 3}', unique_keys=True)[1] == ("a",)
+    assert json_problem('{"a": 1, "b": {"a": 2}, "a": 3}') is None  # repeats allowed unless asked

@@ -26,7 +26,7 @@ from __future__ import annotations
 import json
 import math
 import re
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from typing import Any, NoReturn
 
 import yaml
@@ -391,77 +391,66 @@ def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
     return result
 
 
-# One token of JSON text: punctuation, a string's opening quote, or a bare word (a number, a
-# literal, or NaN/Infinity, which Python's parser also reads).
-_TOKEN = re.compile(r'\s*(?:([{}\[\]:,"])|(-?[A-Za-z0-9_.+-]+))')
+_SPACE = re.compile(r"[ \t\n\r]*")
+_WORD = re.compile(r"-?[A-Za-z0-9_.+-]+")  # a number or a literal (NaN and Infinity too)
 
 
-def _json_items(text: str, unique_keys: bool = False) -> Iterator[tuple[FieldPath, int, str | None]]:
-    """Every value of JSON `text` in document order: ``(field path, offset, problem)``.
+def _decoder(unique_keys: bool) -> json.JSONDecoder:
+    """A decoder that refuses what :func:`load_json` refuses, raising :class:`_Refused`."""
+    return json.JSONDecoder(
+        object_pairs_hook=_unique_keys if unique_keys else None,
+        parse_int=_parse_int,
+        parse_float=_parse_float,
+        parse_constant=_refuse_constant,
+    )
 
-    `problem` is why the value (or, with `unique_keys`, its key) is refused, else ``None``.  The
-    scan is iterative (no recursion at any depth) and stops at text that is not JSON; the
-    parser reports that itself.
+
+def _members(text: str, at: int, skip: Callable[[int], int | None]) -> Iterator[tuple[str | int, int, int]]:
+    """The members of the object or list that starts at ``text[at]``, in order: ``(key or index,
+    where the member (its key) starts, where its value starts)``.
+
+    Between two members the value is skipped with ``skip(start)``, its end (the C parser's), so
+    finding a member costs a parse of the members before it, not a Python step per token.
+    Stops where `skip` says ``None`` and at text that is not JSON (the parser reports that).
     """
-    stack: list[list[Any]] = []  # [path part, keys seen (objects) or None (lists)]
-    expect_value, position = True, 0
-    while True:
-        match = _TOKEN.match(text, position)
-        if match is None:
-            return
-        punctuation, word = match.groups()
-        start, position = match.start(match.lastindex), match.end()
-        path = tuple(frame[0] for frame in stack)
-        if expect_value and punctuation in ("{", "["):
-            yield path, start, None
-            stack.append([None if punctuation == "{" else 0, {} if punctuation == "{" else None])
-            if punctuation == "[":
-                expect_value = True
-                follows = _TOKEN.match(text, position)
-                if follows is not None and follows.group(1) == "]":
-                    expect_value = False  # an empty list: no value to read
-            else:
-                expect_value = False  # a key or "}" comes next
-            continue
-        if stack and stack[-1][1] is not None and stack[-1][0] is None and punctuation == '"':
-            key, position = json.decoder.scanstring(text, position)  # an object's key
-            seen = stack[-1][1]
-            if unique_keys and key in seen:
-                first = _line_and_column(text, seen[key])[0]
-                yield (
-                    (*path[:-1], key),  # the object's own part of the path is its previous key
-                    start,
-                    f"duplicate key {key!r} (first on line {first}); every key appears once in its object",
-                )
-                return
-            seen[key] = start
-            stack[-1][0] = key
-            colon = _TOKEN.match(text, position)
-            if colon is None or colon.group(1) != ":":
-                return
-            position, expect_value = colon.end(), True
-            continue
-        if expect_value:
-            if punctuation == '"':
-                _, position = json.decoder.scanstring(text, position)
-                yield path, start, None
-            elif word is not None:
-                yield path, start, _refusal(word)
-            else:
-                return
-            expect_value = False
-            continue
-        if punctuation == "," and stack:
-            if stack[-1][1] is None:
-                stack[-1][0] += 1
-                expect_value = True
-            else:
-                stack[-1][0] = None  # a key comes next
-            continue
-        if punctuation in ("}", "]") and stack:
-            stack.pop()
-            continue
+    close = "}" if text[at] == "{" else "]"
+    position, index = _SPACE.match(text, at + 1).end(), 0
+    if text.startswith(close, position):
         return
+    while True:
+        first, part = position, index
+        if close == "}":
+            if not text.startswith('"', position):
+                return
+            part, position = json.decoder.scanstring(text, position + 1)
+            position = _SPACE.match(text, position).end()
+            if not text.startswith(":", position):
+                return
+            position = _SPACE.match(text, position + 1).end()
+        yield part, first, position
+        end = skip(position)
+        if end is None:
+            return
+        position = _SPACE.match(text, end).end()
+        if not text.startswith(",", position):
+            return
+        position, index = _SPACE.match(text, position + 1).end(), index + 1
+
+
+def _skipper(text: str, decoder: json.JSONDecoder, refused: list[int]) -> Callable[[int], int | None]:
+    """A `skip` for :func:`_members`: the end of the value at a position of `text`, or ``None``
+    when `decoder` refuses it (its position is then added to `refused`) or it is not JSON."""
+
+    def skip(start: int) -> int | None:
+        try:
+            return decoder.scan_once(text, start)[1]
+        except _Refused:
+            refused.append(start)
+        except (StopIteration, ValueError, RecursionError):
+            pass
+        return None
+
+    return skip
 
 
 def _refusal(word: str) -> str | None:
@@ -484,25 +473,49 @@ def _line_and_column(text: str, offset: int) -> tuple[int, int]:
 
 def json_problem(text: str, unique_keys: bool = False) -> tuple[str, FieldPath, tuple[int, int]] | None:
     """The first value of JSON `text` that :func:`load_json` refuses: ``(why, field path, (line,
-    column))``, or ``None`` if there is none before the text stops being JSON."""
-    for path, offset, problem in _json_items(text, unique_keys):
-        if problem is not None:
-            return problem, path, _line_and_column(text, offset)
-    return None
+    column))``, or ``None`` if there is none.
+
+    It descends from the top into the member whose value the parser refuses: a parse (in C) of
+    the text before the refusal per level of nesting.
+    """
+    refused: list[int] = []
+    skip, path = _skipper(text, _decoder(unique_keys), refused), []
+    at = _SPACE.match(text).end()
+    while text.startswith(("{", "["), at):
+        keys: dict[str | int, int] = {}
+        for part, first, _ in _members(text, at, skip):  # stops after a refused member
+            if unique_keys and part in keys:  # a list's indices never repeat
+                line = _line_and_column(text, keys[part])[0]
+                problem = (
+                    f"duplicate key {part!r} (first on line {line}); every key appears once in its object"
+                )
+                return problem, (*path, part), _line_and_column(text, first)
+            keys[part] = first
+        if not refused:
+            return None
+        at = refused.pop()  # the last member's value: descend into it
+        path.append(part)
+    word = _WORD.match(text, at)
+    problem = None if word is None else _refusal(word.group())
+    return None if problem is None else (problem, tuple(path), _line_and_column(text, at))
 
 
 def json_position(text: str, path: FieldPath) -> tuple[int, int] | None:
     """The ``(line, column)`` where the value at field `path` of JSON `text` starts, if it has one.
 
-    For error messages only (it scans the text up to that value).
+    For error messages: it parses (in C) the members before each part of the path.
 
     >>> json_position('{"a": [1,\\n  2]}', ("a", 1))
     (2, 3)
     """
-    for found, offset, _ in _json_items(text):
-        if found == path:
-            return _line_and_column(text, offset)
-    return None
+    skip, at = _skipper(text, json.JSONDecoder(), []), _SPACE.match(text).end()
+    for part in path:
+        if not text.startswith(("{", "["), at):
+            return None
+        at = next((start for key, _, start in _members(text, at, skip) if key == part), None)
+        if at is None:
+            return None
+    return _line_and_column(text, at)
 
 
 def _depth(data: Any) -> int:
