@@ -142,7 +142,10 @@ def _repeated(plan: dict, robot: str, primitive: str) -> dict:
     data = copy.deepcopy(plan)
     steps = data["robots"][robot]["steps"]
     k = next(i for i, s in enumerate(steps) if s["primitive"] == primitive and s.get("message"))
-    steps.insert(k + 1, copy.deepcopy(steps[k]))
+    again = copy.deepcopy(steps[k])
+    if "end" in again:  # the itinerary: the repeat starts when the step ends
+        again["start"] = again["end"]
+    steps.insert(k + 1, again)
     data["robots"][robot]["horizon"] += 1
     return data
 

@@ -181,3 +181,24 @@ def test_show_writes_lengths_points_poses_and_speeds_in_the_files_units():
     assert show_pose((0.0, 500.0, 90.0), "m") == "(0, 0.5, 1.5708 rad)"
     assert show_pose((0.0, 500.0, 90.0), "mm") == "(0, 500, 90°)"
     assert show_speed(750.0, "m") == "0.75 m/s" and show_speed(750.0, "mm") == "750 mm/s"
+
+
+def test_simulates_table_shows_poses_and_distances_in_the_files_units(tmp_path):
+    from types import SimpleNamespace
+
+    from rich.console import Console
+
+    from cosmop.cli.simulate import _robots_table
+
+    run = SimpleNamespace(robots={"R1": ((-2000.0, -1000.0, 90.0), 12345.0)}, finished={"R1": True}, steps={})
+    si = tmp_path / "si.yaml"
+    si.write_text(SI_TEXT)
+    for scenario, pose, distance in (
+        (load_scenario(si), "-2.000, -1.000, 1.57", "12.35 m"),
+        (load_scenario(MM_FILE), "-2000, -1000, 90", "12345 mm"),
+    ):
+        console = Console(width=200, record=True)
+        console.print(_robots_table(scenario, run, 0))
+        text = console.export_text()
+        assert pose in text and distance in text
+        assert ("pose [m, rad]" if scenario.units == "m" else "pose [mm, deg]") in text

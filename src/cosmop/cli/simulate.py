@@ -191,7 +191,7 @@ def _robots_table(loaded: Scenario, result: Any, seed: int) -> Table:
     metres = loaded.units == "m"  # the scenario file's units: metres and radians, or mm and degrees
     pose_column = "pose [m, rad]" if metres else "pose [mm, deg]"
     for column in ("robot", pose_column, "distance", "finished", "done at (planned)"):
-        table.add_column(column)
+        table.add_column(Text(column))  # Text: "[mm, deg]" is not markup
     finished = result.finished
     for rid, (pose, dist) in result.robots.items():
         x, y, heading = pose

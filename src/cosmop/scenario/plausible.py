@@ -64,7 +64,7 @@ class Quantity:
         ``(lo, hi)`` in mm, degrees and seconds: outside, the value is probably a mistake.
     valid : tuple of float, optional
         ``(lo, hi)``: outside, the value is refused; ``None`` when other checks bound it.
-    signed : bool, optional
+    magnitude : bool, optional
         Whether the bounds are on the value's magnitude (coordinates, headings), ``lo`` then 0.
     """
 
@@ -72,7 +72,7 @@ class Quantity:
     kind: Kind
     plausible: tuple[float, float]
     valid: tuple[float, float] | None = None
-    signed: bool = False
+    magnitude: bool = False
 
     def unit(self, units: UnitSystem) -> str:
         """The quantity's unit in a file in `units`: ``"m/s"``."""
@@ -94,13 +94,13 @@ class Quantity:
         """Whether `value`, as written in a file in `units`, lies within `bounds` (internal units)."""
         inside = self.internal(value, units)  # a metres file's 1e308 is inf here, out of every range
         lo, hi = bounds
-        return lo <= (abs(inside) if self.signed else inside) <= hi
+        return lo <= (abs(inside) if self.magnitude else inside) <= hi
 
     def expected(self, bounds: tuple[float, float], units: UnitSystem) -> str:
         """The range `bounds` in words in the file's units: ``between 0.05 and 5 m``."""
         lo, hi = (plain(self.in_file(bound, units)) for bound in bounds)
         unit = self.unit(units)
-        return f"at most {hi} {unit} either way" if self.signed else f"between {lo} and {hi} {unit}"
+        return f"at most {hi} {unit} either way" if self.magnitude else f"between {lo} and {hi} {unit}"
 
     def slip(self, value: float, units: UnitSystem) -> str | None:
         """The likely slip of units when `value` would be plausible in the other units, else None."""
@@ -113,8 +113,8 @@ class Quantity:
 _SIDE_OF_ROBOT = Quantity("a robot's side", "length", (50.0, 5000.0))
 _SIDE_OF_OBJECT = Quantity("an object's side", "length", (10.0, 5000.0))
 _SIDE_OF_PERSON = Quantity("a person's side", "length", (100.0, 3000.0))
-_COORDINATE = Quantity("a coordinate", "length", (0.0, 1e7), signed=True)
-_HEADING = Quantity("a heading", "angle", (0.0, 360.0), signed=True)
+_COORDINATE = Quantity("a coordinate", "length", (0.0, 1e7), magnitude=True)
+_HEADING = Quantity("a heading", "angle", (0.0, 360.0), magnitude=True)
 _WALKING = Quantity("a walking speed", "speed", (20.0, 5000.0), valid=(1.0, 1e5))
 _DYNAMICS = {
     "max_speed": Quantity("a top speed", "speed", (20.0, 10_000.0), valid=(1.0, 1e5)),
