@@ -94,6 +94,20 @@ def catalogue(base: str, plan: dict) -> dict[str, str]:
     )
     head = base.split("mission:")[0].rstrip("\n")
     files["dfa_20000_states.yaml"] = head + "\nmission:\n  dfa:\n    initial: s0\n    transitions:\n" + chain
+
+    # issue 39's findings: each passed validate and then failed, hung or misled
+    def dfa(initial: str, transitions: str) -> str:
+        return head + f"\nmission:\n  dfa:\n    initial: {initial}\n    transitions: {transitions}\n"
+
+    files |= {
+        "msg_not_awaited.yaml": base.replace("R1: [pick O1,", 'R1: [pick O1, "msg(R1,R2,t)",'),
+        "name_escape.yaml": base.replace("name: warehouse-2x2", 'name: "ware\\e[31mhouse"'),
+        "dfa_initial_typo.yaml": dfa("q9", '[[q0, "return(R1)", q1]]'),
+        "dfa_no_transitions.yaml": dfa("q0", "[]"),
+        "cycle_1e-9.yaml": base.replace("  robots:", "  dynamics: {cycle: 1e-9}\n  robots:", 1),
+        "max_speed_1e-300.yaml": base.replace("  robots:", "  dynamics: {max_speed: 1e-300}\n  robots:", 1),
+        "millimetres_in_metres.yaml": base.replace("name: warehouse-2x2", "name: warehouse-2x2\nunits: m"),
+    }
     steps = plan["robots"]["R1"]["steps"]
     text = json.dumps(plan)
     long = copy.deepcopy(plan)
@@ -114,8 +128,26 @@ def catalogue(base: str, plan: dict) -> dict[str, str]:
         "plan_40000_steps_8MB.json": json.dumps(long),
         "plan_marked_infeasible.json": json.dumps(infeasible),
         "plan_nan.json": text.replace("[1750, -1000, 0]", "[NaN, -1000, 0]", 1),
+        "plan_infinity.json": text.replace("[1750, -1000, 0]", "[Infinity, -1000, 0]", 1),
+        "plan_duplicate_key.json": text.replace('"horizon": ', '"horizon": 9, "horizon": ', 1),
+        "plan_escape_in_reason.json": json.dumps(infeasible | {"reason": "ok\u001b[2J"}),
+        "plan_msg_awaited_twice.json": json.dumps(_repeated(plan, "R1", "Req")),
+        "plan_msg_sent_twice.json": json.dumps(_repeated(plan, "R2", "Res")),
     }
     return files
+
+
+def _repeated(plan: dict, robot: str, primitive: str) -> dict:
+    """`plan` with `robot`'s first `msg` step of `primitive` repeated right after itself."""
+    data = copy.deepcopy(plan)
+    steps = data["robots"][robot]["steps"]
+    k = next(i for i, s in enumerate(steps) if s["primitive"] == primitive and s.get("message"))
+    again = copy.deepcopy(steps[k])
+    if "end" in again:  # the itinerary: the repeat starts when the step ends
+        again["start"] = again["end"]
+    steps.insert(k + 1, again)
+    data["robots"][robot]["horizon"] += 1
+    return data
 
 
 def mutate_text(text: str, rng: random.Random) -> str:

@@ -39,7 +39,7 @@ def room(seed: int) -> dict:
             "objects": {"O1": {"size": 100, "position": a}, "O2": {"size": 100, "position": b}},
             "workspaces": docks,
         },
-        "mission": {"tasks": {"R1": []}},
+        "mission": {"tasks": {"R1": ["return"]}},  # a scene to plan in: the tests give the missions
     }
 
 

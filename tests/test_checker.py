@@ -189,7 +189,11 @@ def test_messages_that_wait_on_each_other_deadlock() -> None:
             "scene": {
                 "robots": {"R1": {"size": 400, "pose": [0, 0, 0]}, "R2": {"size": 400, "pose": [2000, 0, 0]}}
             },
-            "mission": {"tasks": {"R1": [], "R2": []}},
+            # the plans' own missions: an empty mission is refused, and each message is listed
+            # by both its sender and its receiver
+            "mission": {
+                "tasks": {"R1": ["msg(R2,R1,a)", "msg(R1,R2,b)"], "R2": ["msg(R1,R2,b)", "msg(R2,R1,a)"]}
+            },
         }
     )
     report = check_plan(scenario, PlanSet("two", True, {"R1": r1, "R2": r2}, messages=messages))
@@ -253,7 +257,7 @@ def test_goto_clipping_a_resting_object() -> None:
     assert [(v.instant, v.rule) for v in violations] == [(1, "object-collision"), (3, "object-collision")]
     assert violations[0].message == (
         "R1 at instant 1: GoTo from (-2000, -1000) to (1750, -1000) sweeps over O2, resting at "
-        "(1900, -1000) (size 100); go around it or request it away with Req(O2)"
+        "(1900, -1000) (size 100 mm); go around it or request it away with Req(O2)"
     )
 
 
@@ -423,7 +427,7 @@ def test_dropping_outside_the_workspace() -> None:
     assert v.message == (
         "R2: mission event drop(R2,O2,W2) (2nd of 3) is not realised: there is no DropOff(O2) that "
         "leaves O2 in W2 after instant 2 (pick(R2,O2)); DropOff(O2) at instant 4 leaves it at "
-        "(1500, 2050), not wholly inside W2 (x in [1000, 1500], y in [2000, 2500]) (size 100) "
+        "(1500, 2050), not wholly inside W2 (x in [1000, 1500], y in [2000, 2500]) (size 100 mm) "
         "(so return(R2) cannot be matched either)"
     )
 

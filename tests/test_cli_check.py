@@ -127,7 +127,7 @@ def test_wrong_format_exits_2(tmp_path: Path) -> None:
     result = runner.invoke(app, ["check", str(EXAMPLE), str(path)])
     assert result.exit_code == 2
     assert result.stderr.strip() == (
-        f"error: {path}: format: unknown format 'cosmop.plan/0'; expected 'cosmop.plan/1'"
+        f"error: {path}: format: unknown format 'cosmop.plan/0'; expected 'cosmop.plan/1' (line 1, column 12)"
     )
 
 

@@ -21,12 +21,24 @@ import pytest
 import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from typer.testing import CliRunner
 
+from cosmop.cli import app
 from cosmop.errors import CosmopInputError, ScenarioError
+from cosmop.pipeline import plan_team
 from cosmop.planning.checker import check_plan
 from cosmop.planning.plan import MAX_STEPS, PlanError, PlanSet, load_plan
 from cosmop.planning.synthesis import synthesize
-from cosmop.reading import MAX_DEPTH, MAX_DIGITS, MAX_NODES, MAX_TEXT, load_json, load_yaml
+from cosmop.reading import (
+    MAX_DEPTH,
+    MAX_DIGITS,
+    MAX_NODES,
+    MAX_TEXT,
+    json_position,
+    json_problem,
+    load_json,
+    load_yaml,
+)
 from cosmop.scenario import MAX_DFA_STATES, load_scenario, parse_scenario
 from cosmop.scene import MAX_TASK_EVENTS
 
@@ -269,3 +281,194 @@ def test_hostile_scenarios_exit_2_with_one_line(tmp_path, name, text):
     assert "Traceback" not in run.stderr + run.stdout
     assert run.stderr.strip().count("\n") == 0 and str(path) in run.stderr
     assert not (tmp_path / "p.json").exists()
+
+
+# -- the fuzzer's findings (issue 39), one regression test each ----------------------------------
+
+runner = CliRunner()
+
+
+def _scenario_error(text: str) -> ScenarioError:
+    with pytest.raises(ScenarioError) as info:
+        parse_scenario(yaml.safe_load(text))
+    return info.value
+
+
+def test_a_message_nobody_awaits_is_refused_at_validate_naming_its_field(tmp_path):
+    # it passed validate, then plan died on an AssertionError of the exact checker
+    text = SCENARIO_TEXT.replace("R1: [pick O1,", 'R1: [pick O1, "msg(R1,R2,t)",')
+    path = tmp_path / "msg.yaml"
+    path.write_text(text)
+    result = runner.invoke(app, ["validate", str(path)])
+    assert result.exit_code == 2
+    assert result.stderr.strip() == (
+        f"error: {path}: mission.tasks.R1[1]: msg(R1,R2,t) is sent by R1, but R2's task list never awaits "
+        "it; a message is listed by both its sender and its receiver, once each (line 26, column 19)"
+    )
+    twice = text.replace("R2: [pick O2,", 'R2: ["msg(R1,R2,t)", pick O2, "msg(R1,R2,t)",')
+    err = _scenario_error(twice)
+    assert err.field == "mission.tasks.R2[2]" and "already in R2's task list (mission.tasks.R2[0])" in str(
+        err
+    )
+    matched = text.replace("R2: [pick O2,", 'R2: ["msg(R1,R2,t)", pick O2,')
+    assert parse_scenario(yaml.safe_load(matched)).mission.tasks["R2"][0].name == "msg(R1,R2,t)"
+
+
+def test_a_message_listed_by_both_robots_is_planned():
+    scenario = parse_scenario(
+        {
+            "name": "told",
+            "scene": {
+                "robots": {"R1": {"size": 400, "pose": [0, 0, 0]}, "R2": {"size": 400, "pose": [2000, 0, 0]}},
+                "objects": {"O1": {"size": 100, "position": [1000, 1000]}},
+                "workspaces": {"W1": {"point": [-1000, 1000]}},
+            },
+            "mission": {
+                "tasks": {"R1": ["pick O1", "msg(R1,R2,t)", "drop O1 at W1"], "R2": ["msg(R1,R2,t)"]}
+            },
+        }
+    )
+    result = plan_team(scenario, workers=1)
+    assert result.plans.feasible and result.report.ok
+    sent = [k for k, s in enumerate(result.plans.robots["R1"].steps, 1) if s.message == "msg(R1,R2,t)"]
+    awaited = [k for k, s in enumerate(result.plans.robots["R2"].steps, 1) if s.message == "msg(R1,R2,t)"]
+    assert len(sent) == len(awaited) == 1
+
+
+def _repeat_step(data: dict, robot: str, index: int) -> None:
+    """Repeat step `index` of `robot`'s plan right after itself (the same state, a moment later)."""
+    plan = data["robots"][robot]
+    step = copy.deepcopy(plan["steps"][index])
+    if "end" in step:  # a plan with an itinerary: the repeat starts when the step ends
+        step["start"] = step["end"]
+    plan["steps"].insert(index + 1, step)
+    plan["horizon"] += 1
+
+
+@pytest.mark.parametrize(
+    ("robot", "index", "words"),
+    [
+        ("R1", 1, "R1 awaits msg(R2,R1,clear1) again at instant 3 (first at instant 2)"),
+        ("R2", 4, "R2 sends msg(R2,R1,clear1) again at instant 6 (first at instant 5)"),
+        ("R2", 2, "R2 answers Res(O2) at instant 4, but its mission has no away(O2,...,R2) event left"),
+    ],
+)
+def test_a_repeated_req_or_res_is_a_violation_and_simulate_refuses_it(tmp_path, robot, index, words):
+    # messages match one to one: the checker said "plan valid" and simulate ran it
+    data = json.loads(PLAN.read_text())
+    _repeat_step(data, robot, index)
+    path = tmp_path / "plan.json"
+    path.write_text(json.dumps(data))
+    report = check_plan(load_scenario(EXAMPLE), load_plan(path))
+    assert [(v.robot, v.rule) for v in report.violations] == [(robot, "message")]
+    assert words in report.violations[0].message
+    assert runner.invoke(app, ["check", str(EXAMPLE), str(path)]).exit_code == 1
+    result = runner.invoke(app, ["simulate", str(EXAMPLE), "--plan", str(path)])
+    assert result.exit_code == 2 and words in result.stderr
+
+
+def test_the_task_limit_counts_the_users_tasks_not_the_hand_overs_the_planner_adds(tmp_path):
+    # example 01 with R1's list at the limit passed validate, then plan refused "101 events"
+    at_limit = ", ".join(["pick O1, drop O1 at W1"] * (MAX_TASK_EVENTS // 2))
+    path = tmp_path / "full.yaml"
+    path.write_text(SCENARIO_TEXT.replace("R1: [pick O1, drop O1 at W1, return]", f"R1: [{at_limit}]"))
+    word = ["away(O2,R1,R2)", *(e.name for e in load_scenario(path).mission.tasks["R1"])]
+    result = synthesize(load_scenario(path).scene, "R1", word, max_horizon=50)
+    assert not result.feasible and "needs at least 101 steps" in result.reason  # not "101 events"
+    result = synthesize(load_scenario(path).scene, "R1", [*word, "return(R1)"], max_horizon=MAX_STEPS)
+    assert f"101 tasks (pick, drop, return); at most {MAX_TASK_EVENTS} are planned" in result.reason
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "field"),
+    [
+        ("name: warehouse-2x2", 'name: "ware\\e[31mhouse"', "name"),
+        ("    R2: {size: 400,", '    "R\\e2": {size: 400,', "scene.robots['R\\x1b2']"),
+        ("W2: {x:", '"W\\u202e2": {x:', "scene.workspaces['W\\u202e2']"),
+        ("R2: [pick O2,", 'R2: ["pick O2\\t",', "mission.tasks.R2[0]"),
+    ],
+)
+def test_control_characters_in_names_and_ids_exit_2_with_one_line(tmp_path, old, new, field):
+    # YAML escapes put terminal control sequences into a name, which reached the terminal and the plan
+    path = tmp_path / "escape.yaml"
+    path.write_text(SCENARIO_TEXT.replace(old, new, 1))
+    result = runner.invoke(app, ["validate", str(path)])
+    assert result.exit_code == 2 and result.stdout == ""
+    (line,) = result.stderr.splitlines()
+    assert line.startswith(f"error: {path}: {field}: expected printable text, got ")
+    assert line.isprintable()
+
+
+def test_a_plan_file_with_a_control_character_in_its_text_is_refused(tmp_path):
+    data = json.loads(PLAN.read_text())
+    data["reason"] = "ok\u001b[2J"
+    path = tmp_path / "plan.json"
+    path.write_text(json.dumps(data))
+    with pytest.raises(PlanError) as info:
+        load_plan(path)
+    assert info.value.field == "reason" and "U+001B at character 3" in str(info.value)
+
+
+@pytest.mark.parametrize(
+    ("mission", "field", "words"),
+    [
+        # a typo in the initial state validated and planned as an empty mission ("0 steps checked")
+        (
+            {"dfa": {"initial": "q9", "transitions": [["q0", "return(R1)", "q1"]]}},
+            "mission.dfa.initial",
+            "unknown initial state 'q9': no transition starts or ends there; expected a state that a "
+            "transition leaves (q0)",
+        ),
+        (
+            {"dfa": {"initial": "q1", "states": ["q0", "q1"], "transitions": [["q0", "return(R1)", "q1"]]}},
+            "mission.dfa.initial",
+            "no transition leaves the initial state 'q1': the mission is empty",
+        ),
+        ({"dfa": {"initial": "q0", "transitions": []}}, "mission.dfa.transitions", "the mission is empty"),
+        ({"tasks": {"R1": [], "R2": []}}, "mission.tasks", "the mission is empty"),
+        ({"tasks": {}}, "mission.tasks", "at least one robot"),
+    ],
+)
+def test_an_empty_mission_is_refused_whatever_its_form(mission, field, words):
+    data = yaml.safe_load(SCENARIO_TEXT)
+    data["mission"] = mission
+    with pytest.raises(ScenarioError) as info:
+        parse_scenario(data)
+    assert info.value.field == field and words in info.value.expected
+
+
+def test_a_scene_without_walls_plans():
+    # lazy geometry built an empty table of sides of the wrong shape and crashed
+    scene = parse_scenario(
+        {
+            "name": "open",
+            "scene": {
+                "robots": {"R1": {"size": 400, "pose": [0, 0, 0]}},
+                "objects": {"O1": {"size": 100, "position": [1000, 1000]}},
+                "workspaces": {"W1": {"point": [-1000, 1000]}},
+            },
+            "mission": {"tasks": {"R1": ["pick O1", "drop O1 at W1"]}},
+        }
+    ).scene
+    assert synthesize(scene, "R1", ["pick(R1,O1)", "drop(R1,O1,W1)"]).feasible
+
+
+def test_the_stored_plan_is_a_valid_plan_of_its_example():
+    # the mutations start from it; it had gone stale (its drops no longer left the goods in
+    # their workspaces), so a mutation's violation could be the file's own
+    report = check_plan(load_scenario(EXAMPLE), load_plan(PLAN))
+    assert report.ok, report.violations
+
+
+def test_a_refused_json_value_is_found_by_its_field_and_line():
+    text = '{"why": "NaN, \\"1e999\\" and [", "a\\"b": [[], {"c": [1,\n 2, -Infinity]}]}'
+    assert json.loads(text.replace("-Infinity", "0"))  # JSON but for the one value
+    assert json_problem(text) == (
+        "-Infinity is not a number; numbers must be finite",
+        ('a"b', 1, "c", 2),  # words in strings are text, not numbers
+        (2, 5),
+    )
+    assert json_position(text, ('a"b', 1, "c", 1)) == (2, 2)
+    assert json_position(text, ("a", 0)) is None
+    assert json_problem('{"a": 1, "b": {"a": 2}, "a": 3}', unique_keys=True)[1] == ("a",)
+    assert json_problem('{"a": 1, "b": {"a": 2}, "a": 3}') is None  # repeats allowed unless asked

@@ -335,8 +335,10 @@ def test_from_dict_without_a_file() -> None:
         ('{"format": "cosmop.plan/1",\n "scenario": }', "invalid JSON: Expecting value", 2),
         ("", "the file is empty", None),
         ("[1, 2]", "expected a JSON object, got a list", None),
-        ('{"format": "cosmop.plan/1", "format": "x"}', "duplicate key 'format'", None),
-        ('{"a": NaN}', "NaN is not a number", None),
+        # a value the parser refuses: the field and its line are named
+        ('{"format": "cosmop.plan/1",\n "format": "x"}', "format: invalid JSON: duplicate key 'format'", 2),
+        ('{"a": NaN}', "a: invalid JSON: NaN is not a number", 1),
+        ('{"robots": {"R1": {"steps": [{},\n {"robot": [1e999, 0, 0]}]}}}', "robots.R1.steps[1].robot[0]", 2),
     ],
 )
 def test_unreadable_plan_files(tmp_path: Path, content: str, fragment: str, line: int | None) -> None:

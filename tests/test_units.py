@@ -12,9 +12,10 @@ from typer.testing import CliRunner
 
 from cosmop.cli import app
 from cosmop.errors import ScenarioError
+from cosmop.planning.checker import check_plan
 from cosmop.planning.plan import Coordination, PlanError, PlanSet, load_plan, plan_from_actions
 from cosmop.scenario import load_scenario
-from cosmop.units import INTERNAL_UNITS, localize, mm_from_m
+from cosmop.units import INTERNAL_UNITS, localize, mm_from_m, show_length, show_point, show_pose, show_speed
 from handmade_plans import R1_ACTIONS, R1_MISSION, R2_RES_ACTIONS, R2_RES_MISSION
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -118,3 +119,86 @@ def test_plan_files_say_their_units_and_old_ones_still_load(tmp_path):
     with pytest.raises(PlanError) as info:
         load_plan(tmp_path / "si.json")
     assert info.value.field == "units" and "mm" in info.value.expected
+
+
+# -- every message in the file's units ---------------------------------------------------------
+
+WALLED_IN = """
+name: walled-in
+units: m
+scene:
+  obstacles:                    # a box around R1, far from its goods
+    - [[799, 999], [801, 999]]
+    - [[801, 999], [801, 1001]]
+    - [[801, 1001], [799, 1001]]
+    - [[799, 1001], [799, 999]]
+  robots:
+    R1: {size: 0.4, pose: [800, 1000, 0]}
+  objects:
+    O1: {size: 0.1, position: [805, 1000]}
+  workspaces:
+    W1: {point: [807, 1000]}
+mission:
+  tasks:
+    R1: [pick O1, drop O1 at W1]
+"""
+
+
+def test_a_metres_file_is_answered_in_metres_by_validate_and_plan(tmp_path):
+    path = tmp_path / "walled.yaml"
+    path.write_text(WALLED_IN)
+    result = runner.invoke(app, ["validate", str(path)])
+    assert result.exit_code == 0 and "R1 (size 0.4 m)" in result.stdout
+    out = tmp_path / "plan.json"
+    result = runner.invoke(app, ["plan", str(path), "-o", str(out)])
+    assert result.exit_code == 1
+    reason = load_plan(out).reason
+    # it said "start (800000, 1e+06)": millimetres, and not even in full
+    assert "walls separate its start (800, 1000) from its pick poses" in reason
+    assert "west (804.75, 1000)" in reason
+    assert "800000" not in reason and "e+" not in reason
+
+
+def test_the_checker_speaks_metres_for_a_metres_file(tmp_path):
+    si = tmp_path / "si.yaml"
+    si.write_text(SI_TEXT)
+    scenario = load_scenario(si)
+    assert scenario.units == "m" and load_scenario(MM_FILE).units == "mm"
+    through = plan_from_actions(scenario.scene, "R1", ["return(R1)"], [("GoTo", (1000, 1000, 0))])
+    report = check_plan(scenario, PlanSet("warehouse-2x2", True, {"R1": through}))
+    messages = " ".join(v.message for v in report.violations)
+    assert "GoTo from (-2, -1) to (1, 1) crosses wall [[-1,0],[1,0]]" in messages
+    mm = check_plan(load_scenario(MM_FILE), PlanSet("warehouse-2x2", True, {"R1": through}))
+    assert "GoTo from (-2000, -1000) to (1000, 1000) crosses wall [[-1000,0],[1000,0]]" in " ".join(
+        v.message for v in mm.violations
+    )
+
+
+def test_show_writes_lengths_points_poses_and_speeds_in_the_files_units():
+    assert show_point((800000.0, 1e6), "m") == "(800, 1000)"
+    assert show_point((1433.5, -2000.0), "mm") == "(1433.5, -2000)"
+    assert show_length(2300.0, "m") == "2.3 m" and show_length(1e9, "mm") == "1000000000 mm"
+    assert show_pose((0.0, 500.0, 90.0), "m") == "(0, 0.5, 1.5708 rad)"
+    assert show_pose((0.0, 500.0, 90.0), "mm") == "(0, 500, 90°)"
+    assert show_speed(750.0, "m") == "0.75 m/s" and show_speed(750.0, "mm") == "750 mm/s"
+
+
+def test_simulates_table_shows_poses_and_distances_in_the_files_units(tmp_path):
+    from types import SimpleNamespace
+
+    from rich.console import Console
+
+    from cosmop.cli.simulate import _robots_table
+
+    run = SimpleNamespace(robots={"R1": ((-2000.0, -1000.0, 90.0), 12345.0)}, finished={"R1": True}, steps={})
+    si = tmp_path / "si.yaml"
+    si.write_text(SI_TEXT)
+    for scenario, pose, distance in (
+        (load_scenario(si), "-2.000, -1.000, 1.57", "12.35 m"),
+        (load_scenario(MM_FILE), "-2000, -1000, 90", "12345 mm"),
+    ):
+        console = Console(width=200, record=True)
+        console.print(_robots_table(scenario, run, 0))
+        text = console.export_text()
+        assert pose in text and distance in text
+        assert ("pose [m, rad]" if scenario.units == "m" else "pose [mm, deg]") in text

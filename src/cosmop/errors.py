@@ -8,8 +8,16 @@ The command line prints such errors as one line and exits with status 2.
 from __future__ import annotations
 
 import os
+from dataclasses import dataclass
 
-__all__ = ["CosmopInputError", "EventSyntaxError", "MissionTooLargeError", "OutputPathError", "ScenarioError"]
+__all__ = [
+    "CosmopInputError",
+    "EventSyntaxError",
+    "InputWarning",
+    "MissionTooLargeError",
+    "OutputPathError",
+    "ScenarioError",
+]
 
 
 class CosmopInputError(Exception):
@@ -52,11 +60,7 @@ class CosmopInputError(Exception):
         super().__init__(self._message())
 
     def _message(self) -> str:
-        text = ": ".join(part for part in (self.file, self.field, self.expected) if part is not None)
-        if self.line is not None:
-            where = f"line {self.line}" if self.column is None else f"line {self.line}, column {self.column}"
-            text = f"{text} ({where})"
-        return text
+        return _located(self.file, self.field, self.expected, self.line, self.column)
 
     def __str__(self) -> str:
         return self._message()
@@ -70,6 +74,50 @@ class CosmopInputError(Exception):
 
 def _rebuild(cls, expected, file, field, line, column):
     return cls(expected, file=file, field=field, line=line, column=column)
+
+
+@dataclass(frozen=True)
+class InputWarning:
+    """Input that loads but is probably a mistake: a file, a field inside it, and why.
+
+    The library never prints these; a loader returns them as values (e.g.
+    ``Scenario.warnings``) and the command line prints each as one line, ``warning: ...``,
+    leaving the exit status alone.
+
+    Parameters
+    ----------
+    problem : str
+        What looks wrong and the likely mistake, e.g. "looks like millimetres in a metres file".
+    file : str, optional
+        The file the input came from.
+    field : str, optional
+        The dotted and indexed path of the field, e.g. ``scene.robots.R1.size``.
+    line, column : int, optional
+        The 1-based position of the field in `file`, when known.
+
+    Notes
+    -----
+    ``str(warning)`` is written as :class:`CosmopInputError`'s: ``"{file}: {field}: {problem}"``
+    with the parts that are ``None`` left out, then ``" (line L, column C)"``.
+    """
+
+    problem: str
+    file: str | None = None
+    field: str | None = None
+    line: int | None = None
+    column: int | None = None
+
+    def __str__(self) -> str:
+        return _located(self.file, self.field, self.problem, self.line, self.column)
+
+
+def _located(file: str | None, field: str | None, text: str, line: int | None, column: int | None) -> str:
+    """``"{file}: {field}: {text} (line L, column C)"``, leaving out the parts not known."""
+    text = ": ".join(part for part in (file, field, text) if part is not None)
+    if line is not None:
+        where = f"line {line}" if column is None else f"line {line}, column {column}"
+        text = f"{text} ({where})"
+    return text
 
 
 class ScenarioError(CosmopInputError):

@@ -53,6 +53,7 @@ from cosmop.planning.teamsafety import TeamSafety, make_team_safe
 from cosmop.planning.timing import itinerary
 from cosmop.scene import Scenario, Scene, Wall
 from cosmop.squares import square
+from cosmop.units import show_point
 
 __all__ = ["TeamResult", "plan_team"]
 
@@ -696,7 +697,8 @@ def _move_aside(
             for other in base:
                 if other != helper:
                     planner.obstacles[other] = planner.obstacles.get(other, ()) + walls
-            replans.append(f"{helper} sets {obj} down at ({task.point[0]:g}, {task.point[1]:g}): {task.why}")
+            place = show_point(task.point, planner.scenario.scene.units)
+            replans.append(f"{helper} sets {obj} down at {place}: {task.why}")
             break
         else:
             tried = [

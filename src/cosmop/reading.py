@@ -26,7 +26,7 @@ from __future__ import annotations
 import json
 import math
 import re
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from typing import Any, NoReturn
 
 import yaml
@@ -42,8 +42,11 @@ __all__ = [
     "Marks",
     "check_printable",
     "format_path",
+    "json_position",
+    "json_problem",
     "load_json",
     "load_yaml",
+    "unprintable",
 ]
 
 MAX_DEPTH = 64
@@ -81,6 +84,23 @@ def format_path(path: FieldPath) -> str | None:
         else:
             text += f"[{part!r}]"
     return text or None
+
+
+def unprintable(text: str) -> str | None:
+    r"""Why a name or id `text` would not show as itself on a terminal, or ``None`` if it would.
+
+    Every character must be printable (:meth:`str.isprintable`): a control character such as
+    ESC (``"ware\e[31m"`` in YAML, ``"\u001b"`` in JSON) would reach the terminal and the files
+    written, and tabs, line breaks and invisible format characters would misalign or hide text.
+
+    >>> unprintable("warehouse"), unprintable("ware\x1b[31m")
+    (None, "expected printable text, got 'ware\\x1b[31m' (U+001B at character 5)")
+    """
+    if text.isprintable():
+        return None
+    index, char = next((i, c) for i, c in enumerate(text) if not c.isprintable())
+    shown = repr(text) if len(text) <= 80 else repr(text[:77]) + "..."
+    return f"expected printable text, got {shown} (U+{ord(char):04X} at character {index + 1})"
 
 
 def check_printable(text: str, error: type[CosmopInputError], file: str | None) -> None:
@@ -321,28 +341,26 @@ def _refuse_constant(name: str) -> Any:
 
 
 def load_json(
-    text: str,
-    file: str | None,
-    error: type[CosmopInputError],
-    *,
-    object_pairs_hook: Callable[[list[tuple[str, Any]]], Any] | None = None,
+    text: str, file: str | None, error: type[CosmopInputError], *, unique_keys: bool = False
 ) -> Any:
     """Parse untrusted JSON text within the bounds of this module.
 
-    `object_pairs_hook` may raise :class:`ValueError` to refuse an object (e.g. a repeated
-    key); its message becomes the error's.  ``NaN`` and ``Infinity`` are refused.
+    ``NaN``, ``Infinity`` and numbers beyond the floats' range (``1e999``) are refused, and with
+    `unique_keys` a key repeated within one object; such an error names the field path and
+    its line and column (:func:`json_problem`).
 
     Raises
     ------
     error
         For text that is not printable, not JSON (with the line and column), nested deeper than
-        :data:`MAX_DEPTH`, or with an integer of more than :data:`MAX_DIGITS` digits.
+        :data:`MAX_DEPTH`, with an integer of more than :data:`MAX_DIGITS` digits, a number
+        that is not finite, or (with `unique_keys`) a repeated key.
     """
     check_printable(text, error, file)
     try:
         data = json.loads(
             text,
-            object_pairs_hook=object_pairs_hook,
+            object_pairs_hook=_unique_keys if unique_keys else None,
             parse_int=_parse_int,
             parse_float=_parse_float,
             parse_constant=_refuse_constant,
@@ -351,11 +369,153 @@ def load_json(
         raise error(f"invalid JSON: {err.msg}", file=file, line=err.lineno, column=err.colno) from None
     except RecursionError:
         raise error(f"invalid JSON: values nest more than {MAX_DEPTH} levels deep", file=file) from None
-    except ValueError as err:  # _Refused, or the hook's refusal
-        raise error(f"invalid JSON: {err}", file=file) from None
+    except _Refused as err:
+        found = json_problem(text, unique_keys)
+        if found is None:  # cannot happen: the scan refuses what the parser refused
+            raise error(f"invalid JSON: {err}", file=file) from None
+        problem, path, (line, column) = found
+        raise error(
+            f"invalid JSON: {problem}", file=file, field=format_path(path), line=line, column=column
+        ) from None
     if _depth(data) > MAX_DEPTH:
         raise error(f"invalid JSON: values nest more than {MAX_DEPTH} levels deep", file=file)
     return data
+
+
+def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    result: dict[str, Any] = {}
+    for key, value in pairs:
+        if key in result:
+            raise _Refused(f"duplicate key {key!r}")
+        result[key] = value
+    return result
+
+
+_SPACE = re.compile(r"[ \t\n\r]*")
+_WORD = re.compile(r"-?[A-Za-z0-9_.+-]+")  # a number or a literal (NaN and Infinity too)
+
+
+def _decoder(unique_keys: bool) -> json.JSONDecoder:
+    """A decoder that refuses what :func:`load_json` refuses, raising :class:`_Refused`."""
+    return json.JSONDecoder(
+        object_pairs_hook=_unique_keys if unique_keys else None,
+        parse_int=_parse_int,
+        parse_float=_parse_float,
+        parse_constant=_refuse_constant,
+    )
+
+
+def _members(text: str, at: int, skip: Callable[[int], int | None]) -> Iterator[tuple[str | int, int, int]]:
+    """The members of the object or list that starts at ``text[at]``, in order: ``(key or index,
+    where the member (its key) starts, where its value starts)``.
+
+    Between two members the value is skipped with ``skip(start)``, its end (the C parser's), so
+    finding a member costs a parse of the members before it, not a Python step per token.
+    Stops where `skip` says ``None`` and at text that is not JSON (the parser reports that).
+    """
+    close = "}" if text[at] == "{" else "]"
+    position, index = _SPACE.match(text, at + 1).end(), 0
+    if text.startswith(close, position):
+        return
+    while True:
+        first, part = position, index
+        if close == "}":
+            if not text.startswith('"', position):
+                return
+            part, position = json.decoder.scanstring(text, position + 1)
+            position = _SPACE.match(text, position).end()
+            if not text.startswith(":", position):
+                return
+            position = _SPACE.match(text, position + 1).end()
+        yield part, first, position
+        end = skip(position)
+        if end is None:
+            return
+        position = _SPACE.match(text, end).end()
+        if not text.startswith(",", position):
+            return
+        position, index = _SPACE.match(text, position + 1).end(), index + 1
+
+
+def _skipper(text: str, decoder: json.JSONDecoder, refused: list[int]) -> Callable[[int], int | None]:
+    """A `skip` for :func:`_members`: the end of the value at a position of `text`, or ``None``
+    when `decoder` refuses it (its position is then added to `refused`) or it is not JSON."""
+
+    def skip(start: int) -> int | None:
+        try:
+            return decoder.scan_once(text, start)[1]
+        except _Refused:
+            refused.append(start)
+        except (StopIteration, ValueError, RecursionError):
+            pass
+        return None
+
+    return skip
+
+
+def _refusal(word: str) -> str | None:
+    """Why the bare JSON word `word` (a number or literal) is refused, or ``None``."""
+    try:
+        if word in ("NaN", "Infinity", "-Infinity"):
+            _refuse_constant(word)
+        elif re.fullmatch(r"-?[0-9]+", word):
+            _parse_int(word)
+        elif word not in ("true", "false", "null"):
+            _parse_float(word)
+    except (_Refused, ValueError) as err:
+        return str(err)
+    return None
+
+
+def _line_and_column(text: str, offset: int) -> tuple[int, int]:
+    return text.count("\n", 0, offset) + 1, offset - (text.rfind("\n", 0, offset) + 1) + 1
+
+
+def json_problem(text: str, unique_keys: bool = False) -> tuple[str, FieldPath, tuple[int, int]] | None:
+    """The first value of JSON `text` that :func:`load_json` refuses: ``(why, field path, (line,
+    column))``, or ``None`` if there is none.
+
+    It descends from the top into the member whose value the parser refuses: a parse (in C) of
+    the text before the refusal per level of nesting.
+    """
+    refused: list[int] = []
+    skip, path = _skipper(text, _decoder(unique_keys), refused), []
+    at = _SPACE.match(text).end()
+    while text.startswith(("{", "["), at):
+        keys: dict[str | int, int] = {}
+        for part, first, _ in _members(text, at, skip):  # stops after a refused member
+            if unique_keys and part in keys:  # a list's indices never repeat
+                line = _line_and_column(text, keys[part])[0]
+                problem = (
+                    f"duplicate key {part!r} (first on line {line}); every key appears once in its object"
+                )
+                return problem, (*path, part), _line_and_column(text, first)
+            keys[part] = first
+        if not refused:
+            return None
+        at = refused.pop()  # the last member's value: descend into it
+        path.append(part)
+    word = _WORD.match(text, at)
+    problem = None if word is None else _refusal(word.group())
+    return None if problem is None else (problem, tuple(path), _line_and_column(text, at))
+
+
+def json_position(text: str, path: FieldPath) -> tuple[int, int] | None:
+    """The ``(line, column)`` where the value at field `path` of JSON `text` starts, if it has one.
+
+    For error messages: it parses (in C) the members before each part of the path.
+
+    >>> json_position('{"a": [1,\\n  2]}', ("a", 1))
+    (2, 3)
+    """
+    skip, at = _skipper(text, json.JSONDecoder(), []), _SPACE.match(text).end()
+    for part in path:
+        if not text.startswith(("{", "["), at):
+            return None
+        at = next((start for key, _, start in _members(text, at, skip) if key == part), None)
+        if at is None:
+            return None
+    return _line_and_column(text, at)
 
 
 def _depth(data: Any) -> int:

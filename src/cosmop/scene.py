@@ -21,6 +21,7 @@ from typing import Any, Literal
 
 from cosmop._frozen import reduce_frozen
 from cosmop.docking import SIDES
+from cosmop.errors import InputWarning
 from cosmop.events import Event
 
 __all__ = [
@@ -48,7 +49,9 @@ MAX_LENGTH = 1e9
 """The largest length or coordinate, in mm (1000 km)."""
 
 MAX_TASK_EVENTS = 100
-"""Most events one robot's task list may hold (its shortest plan is searched up to 3 per event)."""
+"""Most tasks (pick, drop and return events) one robot's mission may hold; its shortest plan is
+searched up to 3 steps per event.  Messages (``msg``, ``away``) do not count: the planner adds
+them itself when it coordinates the team, and the scenario and the planner count the same."""
 
 
 Point = tuple[float, float]
@@ -376,6 +379,12 @@ class Scene:
     dynamics : Dynamics, optional
         The scene-wide robot limits as given in the file (:class:`Dynamics`' defaults
         overridden by ``scene.dynamics``); each robot's own are in ``Robot.dynamics``.
+    units : {"mm", "m"}, optional
+        The units the scenario file was written in (``"mm"``: millimetres and degrees, the
+        default; ``"m"``: metres and radians).  Every number of the scene is in millimetres and
+        degrees either way; this only says how messages show lengths, speeds and angles to the
+        person who wrote the file (:mod:`cosmop.units`), so two scenes that differ only here
+        are equal.
     """
 
     __reduce__ = reduce_frozen  # picklable for worker processes
@@ -386,6 +395,7 @@ class Scene:
     workspaces: Mapping[str, Workspace] = field(default_factory=dict)
     humans: Mapping[str, Human] = field(default_factory=dict)
     dynamics: Dynamics = Dynamics()
+    units: Literal["mm", "m"] = field(default="mm", compare=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "obstacles", tuple(self.obstacles))
@@ -557,9 +567,19 @@ class Scenario:
         The global mission.
     source : pathlib.Path, optional
         The file it was loaded from, as given to :func:`cosmop.scenario.load_scenario`.
+    warnings : tuple of InputWarning, optional
+        What the loader found implausible but not wrong (a robot 400 m wide in a metres
+        file, ...), one record per finding; the library never prints them.  They describe the
+        file, not the scenario, so two scenarios that differ only here are equal.
     """
 
     name: str
     scene: Scene
     mission: Mission
     source: Path | None = None
+    warnings: tuple[InputWarning, ...] = field(default=(), compare=False)
+
+    @property
+    def units(self) -> Literal["mm", "m"]:
+        """The units the file was written in, which messages show lengths in (``Scene.units``)."""
+        return self.scene.units

@@ -12,12 +12,17 @@ same units.
 
 Conversions round to 1e-6 mm and 1e-9 degrees, so that ``2.3`` m is exactly ``2300`` mm and
 walls meant to meet still meet.
+
+Nothing downstream knows the difference but the words: the converted scene remembers its file's
+units (``Scene.units``), and every message that shows a length, point, pose or speed writes it
+with :func:`show_length`, :func:`show_point`, :func:`show_pose` or :func:`show_speed`, so that a
+metres file is answered in metres.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import replace
 from typing import Any, Literal
 
@@ -29,11 +34,20 @@ __all__ = [
     "UnitSystem",
     "check_units_field",
     "default_dynamics",
+    "length_unit",
     "localize",
     "m_from_mm",
     "mm_from_m",
+    "plain",
     "rad_from_deg",
     "scene_to_internal",
+    "show_angle",
+    "show_length",
+    "show_number",
+    "show_point",
+    "show_pose",
+    "show_speed",
+    "shown",
 ]
 
 UnitSystem = Literal["mm", "m"]
@@ -63,9 +77,62 @@ def shown(mm: float, units: UnitSystem) -> float:
     return m_from_mm(mm) if units == "m" else mm
 
 
+def length_unit(units: UnitSystem) -> str:
+    """The unit lengths are written in: ``"m"`` or ``"mm"``."""
+    return "m" if units == "m" else "mm"
+
+
+def show_number(mm: float, units: UnitSystem) -> str:
+    """A length or coordinate of the internal scene (mm) as the file would write it, without a unit.
+
+    Whole numbers without a point and in full (``800000``, never ``8e+05``), others exactly in
+    mm and to 1e-9 m (a micrometre's thousandth, below the planner's grid) in metres.
+
+    >>> show_number(800000.0, "m"), show_number(1433.5, "mm"), show_number(-2000.0, "mm")
+    ('800', '1433.5', '-2000')
+    """
+    value = round(float(mm) / _MM_PER_M, 9) if units == "m" else float(mm)
+    if not math.isfinite(value):
+        return str(value)
+    if value.is_integer():
+        return str(int(value))
+    return repr(value + 0.0)
+
+
+def plain(value: float) -> str:
+    """A number as people write it: whole ones in full (``800000``, never ``8e+05``), others to
+    six significant digits; huge and tiny ones in exponent form (``1e+300``)."""
+    if math.isfinite(value) and float(value).is_integer() and abs(value) < 1e15:
+        return str(int(value))
+    return f"{value:.6g}"
+
+
 def show_length(mm: float, units: UnitSystem) -> str:
     """A length of the internal scene (mm) in the file's units, with the unit (``"0.4 m"``)."""
-    return f"{shown(mm, units):g} {'m' if units == 'm' else 'mm'}"
+    return f"{show_number(mm, units)} {length_unit(units)}"
+
+
+def show_point(point: Iterable[float], units: UnitSystem) -> str:
+    """A point of the internal scene (mm) in the file's units: ``(0.8, 1)`` for ``(800, 1000)`` in m."""
+    return "(" + ", ".join(show_number(v, units) for v in point) + ")"
+
+
+def show_angle(degrees: float, units: UnitSystem) -> str:
+    """A heading of the internal scene (degrees) in the file's units: ``90°`` or ``1.5708 rad``."""
+    if units == "m":
+        return f"{math.radians(degrees):.6g} rad"
+    return f"{show_number(degrees, 'mm')}°"
+
+
+def show_pose(pose: Sequence[float], units: UnitSystem) -> str:
+    """A pose ``(x, y, heading)`` of the internal scene in the file's units: ``(0.8, 1, 1.5708 rad)``."""
+    x, y, heading = pose
+    return f"({show_number(x, units)}, {show_number(y, units)}, {show_angle(heading, units)})"
+
+
+def show_speed(mm_per_s: float, units: UnitSystem) -> str:
+    """A speed of the internal scene (mm/s) in the file's units, with the unit (``"0.75 m/s"``)."""
+    return f"{show_number(mm_per_s, units)} {length_unit(units)}/s"
 
 
 def _deg_from_rad(value: float) -> float:
@@ -170,6 +237,7 @@ def scene_to_internal(scene: Scene, units: UnitSystem) -> Scene:
         workspaces=workspaces,
         humans=humans,
         dynamics=_dynamics(scene.dynamics),
+        units="m",  # messages show its lengths in metres again
     )
 
 

@@ -85,8 +85,15 @@ def stdout() -> Console:
 
 
 def load(path: Path) -> Scenario:
-    """Load a scenario for a command; a bad file raises ScenarioError, reported by the group."""
-    return load_scenario(path)
+    """Load a scenario for a command; a bad file raises ScenarioError, reported by the group.
+
+    What the loader found implausible (``Scenario.warnings``) is printed on standard error, one
+    line each, ``warning: ...``; it changes nothing else.
+    """
+    scenario = load_scenario(path)
+    for warning in scenario.warnings:
+        typer.echo(f"warning: {warning}", err=True)  # plain echo: field paths are not markup
+    return scenario
 
 
 ScenarioArgument = Annotated[

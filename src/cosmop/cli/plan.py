@@ -124,7 +124,7 @@ def plan(
     console = stdout()
     console.print(_plan_table(loaded, result))
     if result.plans.feasible:
-        console.print(Text(plan_verdict(result.plans, result.verification), style="green"))
+        console.print(Text(plan_verdict(result.plans, result.verification, loaded.units), style="green"))
     if result.verification is not None:
         _print_coordination(console, result)
     if result.allocation is not None and result.allocation.alternative is not None:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
@@ -187,14 +188,19 @@ def _animate(
 def _robots_table(loaded: Scenario, result: Any, seed: int) -> Table:
     """One row per robot: where it ended, how far it drove, whether and when it finished."""
     table = Table(title=Text(f"simulation of {loaded.name} (seed {seed})"), header_style="bold")
-    for column in ("robot", "pose [mm, deg]", "distance", "finished", "done at (planned)"):
-        table.add_column(column)
+    metres = loaded.units == "m"  # the scenario file's units: metres and radians, or mm and degrees
+    pose_column = "pose [m, rad]" if metres else "pose [mm, deg]"
+    for column in ("robot", pose_column, "distance", "finished", "done at (planned)"):
+        table.add_column(Text(column))  # Text: "[mm, deg]" is not markup
     finished = result.finished
     for rid, (pose, dist) in result.robots.items():
+        x, y, heading = pose
         table.add_row(
             rid,
-            f"{pose[0]:.0f}, {pose[1]:.0f}, {pose[2]:.0f}",
-            f"{dist / 1000:.1f} m",
+            f"{x / 1000:.3f}, {y / 1000:.3f}, {math.radians(heading):.2f}"
+            if metres
+            else f"{x:.0f}, {y:.0f}, {heading:.0f}",
+            f"{dist / 1000:.2f} m" if metres else f"{dist:.0f} mm",
             "yes" if finished[rid] else Text("no", style="red"),
             _done_at(result.steps.get(rid, ()), finished[rid]),
         )

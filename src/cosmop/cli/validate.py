@@ -7,6 +7,7 @@ from rich.text import Text
 
 from cosmop.cli._app import ScenarioArgument, load, stdout
 from cosmop.scene import Scenario
+from cosmop.units import show_length
 
 __all__ = ["validate"]
 
@@ -30,7 +31,8 @@ def _summary_table(scenario: Scenario) -> Table:
     def row(part: str, count: int, details: str) -> None:
         table.add_row(part, str(count), Text(details))  # Text: ids are data, never markup
 
-    row("robots", len(scene.robots), ", ".join(f"{r.id} (size {r.size:g} mm)" for r in scene.robots.values()))
+    sizes = (f"{r.id} (size {show_length(r.size, scenario.units)})" for r in scene.robots.values())
+    row("robots", len(scene.robots), ", ".join(sizes))
     row("objects", len(scene.objects), ", ".join(scene.objects) or "-")
     row(
         "workspaces",

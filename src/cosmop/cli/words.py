@@ -8,6 +8,8 @@ from __future__ import annotations
 
 from typing import Any
 
+from cosmop.units import UnitSystem, show_point
+
 __all__ = ["decompose_verdict", "plan_verdict"]
 
 
@@ -57,8 +59,9 @@ def decompose_verdict(result: Any, verification: Any, holds: bool | None = None)
     )
 
 
-def plan_verdict(plans: Any, verification: Any) -> str:
-    """One sentence on what ``cosmop plan`` found (feasible plan sets only)."""
+def plan_verdict(plans: Any, verification: Any, units: UnitSystem = "mm") -> str:
+    """One sentence on what ``cosmop plan`` found (feasible plan sets only); places in `units`,
+    the scenario file's."""
     pairs = len(plans.coordination)
     messages = len(getattr(plans, "messages", ()))
     order = (
@@ -73,8 +76,8 @@ def plan_verdict(plans: Any, verification: Any) -> str:
             "or the mission's order need it"
         )
     for task in getattr(plans, "added", ()):
-        x, y = task.point
-        order += f"; {task.robot} sets {task.object} down at ({x:g}, {y:g}), a task no mission names"
+        place = show_point(task.point, units)
+        order += f"; {task.robot} sets {task.object} down at {place}, a task no mission names"
     proven = (
         "and together they do exactly the team mission (proven)"
         if verification is not None and verification.holds

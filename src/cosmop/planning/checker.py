@@ -64,11 +64,12 @@ from cosmop.docking import DOCKING_HEADINGS, docking_pose, in_front
 from cosmop.errors import EventSyntaxError
 from cosmop.events import Event, Primitive, parse_event, realising_step
 from cosmop.planning.joint import check_team
-from cosmop.planning.plan import PlanSet, RobotPlan, State, Step, _fmt, _point, initial_state
+from cosmop.planning.plan import PlanSet, RobotPlan, State, Step, initial_state
 from cosmop.planning.realisation import TOLERANCE, angles_equal, at_pose, event_instants, holds_at
 from cosmop.planning.report import RULES, CheckReport, Violation
 from cosmop.scene import Scenario, Scene, Wall
 from cosmop.squares import square, swept_square
+from cosmop.units import UnitSystem, show_angle, show_length, show_number, show_point, show_pose
 
 __all__ = [
     "RULES",
@@ -100,9 +101,10 @@ def _wall_line(wall: Wall) -> LineString:
     return LineString([wall.start, wall.end])
 
 
-def _wall_text(wall: Wall) -> str:
-    (x1, y1), (x2, y2) = wall.start, wall.end
-    return f"[[{_fmt(x1)},{_fmt(y1)}],[{_fmt(x2)},{_fmt(y2)}]]"
+def _wall_text(wall: Wall, units: UnitSystem) -> str:
+    """A wall as the scenario file writes it, in its units: ``[[-2.5,0],[2.5,0]]``."""
+    (x1, y1), (x2, y2) = ((show_number(v, units) for v in end) for end in (wall.start, wall.end))
+    return f"[[{x1},{y1}],[{x2},{y2}]]"
 
 
 # ----------------------------------------------------------------------------------------------
@@ -127,11 +129,6 @@ def _or(words: Iterable[str]) -> str:
 def _docking_heading(heading: float) -> int | None:
     """The docking heading (:data:`~cosmop.docking.DOCKING_HEADINGS`) `heading` equals, or ``None``."""
     return next((h for h in DOCKING_HEADINGS if angles_equal(heading, h)), None)
-
-
-def _pose(pose: Iterable[float]) -> str:
-    x, y, heading = pose
-    return f"({_fmt(x)}, {_fmt(y)}, {_fmt(heading)}°)"
 
 
 def _yes(flag: bool) -> str:
@@ -183,6 +180,20 @@ class _RobotChecker:
         else:
             prefix = f"{self.robot_id} at instant {k}, {self.plan.steps[k - 1].label}: "
         self.violations.append(Violation(self.robot_id, k, rule, prefix + message))
+
+    # -- words, in the units of the scenario file ----------------------------------------------
+
+    def point(self, point: Iterable[float]) -> str:
+        return show_point(point, self.scene.units)
+
+    def pose(self, pose: Iterable[float]) -> str:
+        return show_pose(tuple(pose), self.scene.units)
+
+    def length(self, mm: float) -> str:
+        return show_length(mm, self.scene.units)
+
+    def angle(self, degrees: float) -> str:
+        return show_angle(degrees, self.scene.units)
 
     def gap(self, oid: str) -> float:
         """d = (l + b)/2 for this robot and object `oid`."""
@@ -248,7 +259,7 @@ class _RobotChecker:
             self.add(
                 k,
                 "robot-static",
-                f"the robot moves from {_pose(prev.robot)} to {_pose(cur.robot)}; "
+                f"the robot moves from {self.pose(prev.robot)} to {self.pose(cur.robot)}; "
                 f"only GoTo moves the robot, so keep the pose of instant {k - 1}",
             )
 
@@ -262,7 +273,7 @@ class _RobotChecker:
                 self.add(
                     k,
                     "position",
-                    f"{oid} moves from {_point(before.position)} to {_point(after)}; "
+                    f"{oid} moves from {self.point(before.position)} to {self.point(after)}; "
                     f"objects move only when dropped off{carried}",
                 )
 
@@ -288,8 +299,8 @@ class _RobotChecker:
             self.add(
                 k,
                 rule,
-                f"the robot's heading is {_fmt(cur.robot[2])}°, but {oid} is {verb} facing one of its "
-                f"sides {', '.join(sides)}: at heading {_or(f'{h}°' for h in allowed)}",
+                f"the robot's heading is {self.angle(cur.robot[2])}, but {oid} is {verb} facing one of its "
+                f"sides {', '.join(sides)}: at heading {_or(self.angle(h) for h in allowed)}",
             )
             return None
         return heading
@@ -310,10 +321,10 @@ class _RobotChecker:
         area = swept_square(prev.robot, cur.robot, self.side)
         (x0, y0, _), (x1, y1, _) = prev.robot, cur.robot
         if _eq(x0, x1) and _eq(y0, y1):
-            motion, verb_wall, verb_obj = f"GoTo staying at {_point((x0, y0))}", "overlaps", "overlaps"
+            motion, verb_wall, verb_obj = f"GoTo staying at {self.point((x0, y0))}", "overlaps", "overlaps"
         else:
             motion, verb_wall, verb_obj = (
-                f"GoTo from {_point((x0, y0))} to {_point((x1, y1))}",
+                f"GoTo from {self.point((x0, y0))} to {self.point((x1, y1))}",
                 "crosses",
                 "sweeps over",
             )
@@ -322,7 +333,7 @@ class _RobotChecker:
                 self.add(
                     k,
                     "wall",
-                    f"{motion} {verb_wall} wall {_wall_text(wall)}; "
+                    f"{motion} {verb_wall} wall {_wall_text(wall, self.scene.units)}; "
                     "add a waypoint (another GoTo) to go around it",
                     labelled=True,
                 )
@@ -332,8 +343,8 @@ class _RobotChecker:
                 self.add(
                     k,
                     "object-collision",
-                    f"{motion} {verb_obj} {oid}, resting at {_point(position)} "
-                    f"(size {_fmt(self.scene.objects[oid].size)}); go around it or request it away "
+                    f"{motion} {verb_obj} {oid}, resting at {self.point(position)} "
+                    f"(size {self.length(self.scene.objects[oid].size)}); go around it or request it away "
                     f"with Req({oid})",
                     labelled=True,
                 )
@@ -350,8 +361,9 @@ class _RobotChecker:
                 self.add(
                     k,
                     "wall",
-                    f"the robot at {_point((x, y))} and {oid} at {_point(where)} are on the two sides of "
-                    f"wall {_wall_text(wall)}; the gripper cannot reach through it",
+                    f"the robot at {self.point((x, y))} and {oid} at {self.point(where)} are on the two "
+                    f"sides of wall {_wall_text(wall, self.scene.units)}; "
+                    "the gripper cannot reach through it",
                 )
 
     def pickup(self, k: int, step: Step, prev: State, cur: State) -> None:
@@ -366,8 +378,9 @@ class _RobotChecker:
             self.add(
                 k,
                 "pick-pose",
-                f"the robot is at {_point((x, y))}, but picking {oid} at {_point((ox, oy))} at heading "
-                f"{heading}° requires standing in front of it at {_point(pose)} (d = {_fmt(d)} mm)",
+                f"the robot is at {self.point((x, y))}, but picking {oid} at {self.point((ox, oy))} at "
+                f"heading {self.angle(heading)} requires standing in front of it at {self.point(pose)} "
+                f"(d = {self.length(d)})",
             )
         elif pose is not None:
             self.reach(k, oid, cur, (ox, oy))
@@ -420,8 +433,9 @@ class _RobotChecker:
             self.add(
                 k,
                 "drop-pose",
-                f"{oid} is put at {_point(where)}, but a robot at {_point((x, y))} facing {heading}° puts "
-                f"it in front of itself at {_point(front)} (d = {_fmt(d)} mm)",
+                f"{oid} is put at {self.point(where)}, but a robot at {self.point((x, y))} facing "
+                f"{self.angle(heading)} puts it in front of itself at {self.point(front)} "
+                f"(d = {self.length(d)})",
             )
         self.positions_static(k, prev, cur, moved=oid)
         self.flags_static(k, prev, cur, "away")
@@ -433,7 +447,8 @@ class _RobotChecker:
                 self.add(
                     k,
                     "wall",
-                    f"{oid} dropped at {_point(where)} overlaps wall {_wall_text(wall)}; drop it elsewhere",
+                    f"{oid} dropped at {self.point(where)} overlaps wall "
+                    f"{_wall_text(wall, self.scene.units)}; drop it elsewhere",
                 )
         if placed:
             self.reach(k, oid, cur, where, skip=crossed)
@@ -442,8 +457,8 @@ class _RobotChecker:
                 self.add(
                     k,
                     "object-collision",
-                    f"{oid} dropped at {_point(where)} overlaps {other}, resting at "
-                    f"{_point(cur.objects[other].position)}; drop it elsewhere",
+                    f"{oid} dropped at {self.point(where)} overlaps {other}, resting at "
+                    f"{self.point(cur.objects[other].position)}; drop it elsewhere",
                 )
 
     def req(self, k: int, step: Step, prev: State, cur: State) -> None:
@@ -462,11 +477,11 @@ class _RobotChecker:
         poses = [(h, docking_pose((ox, oy), d, h)) for h in self.scene.objects[oid].headings]
         blocked = [(h, p) for h, p in poses if overlaps(square(x, y, self.side), square(*p, self.side))]
         if blocked:
-            where = ", ".join(f"{_point(p)} (heading {h}°)" for h, p in blocked)
+            where = ", ".join(f"{self.point(p)} (heading {self.angle(h)})" for h, p in blocked)
             self.add(
                 k,
                 "req-room",
-                f"the requester at {_point((x, y))} stands in the way of a robot picking {oid} from "
+                f"the requester at {self.point((x, y))} stands in the way of a robot picking {oid} from "
                 f"{where}; request from a pose that leaves the pick pose on each of its sides free",
             )
 
@@ -551,7 +566,7 @@ class _RobotChecker:
         after = "anywhere in the plan" if last is None else f"after instant {last} ({events[n - 2].name})"
         head = f"mission event {event.name} ({_nth(n)} of {total}) is not realised"
         if event.kind == "return":
-            text = f"{head}: the robot is never at its initial pose {_pose(self.home)} {after}"
+            text = f"{head}: the robot is never at its initial pose {self.pose(self.home)} {after}"
         else:
             text = f"{head}: there is no {self.expectation(event)} {after}"
         earlier = []
@@ -572,11 +587,12 @@ class _RobotChecker:
                 ):
                     text += (
                         f"; DropOff({event.obj}) at instant {i} leaves it at "
-                        f"{_point(step.objects[event.obj].position)}, "
+                        f"{self.point(step.objects[event.obj].position)}, "
                         f"{_outside(self.scene, event.obj, event.workspace)}"
                     )
         elif event.kind == "return" and self.plan.horizon:
-            text += f"; the last pose is {_pose(self.states[-1].robot)}: add a GoTo back to the initial pose"
+            last = self.pose(self.states[-1].robot)
+            text += f"; the last pose is {last}: add a GoTo back to the initial pose"
         remaining = [e.name for e in events[n:]]
         if remaining:
             text += f" (so {', '.join(remaining)} cannot be matched either)"
@@ -587,14 +603,16 @@ def _outside(scene: Scene, oid: str, wid: str) -> str:
     """Words for an object left where the drop's workspace does not hold it."""
     if scene.workspaces[wid].is_point:
         return f"not on {_workspace_text(scene, wid)}"
-    return f"not wholly inside {_workspace_text(scene, wid)} (size {_fmt(scene.objects[oid].size)})"
+    size = show_length(scene.objects[oid].size, scene.units)
+    return f"not wholly inside {_workspace_text(scene, wid)} (size {size})"
 
 
 def _workspace_text(scene: Scene, wid: str) -> str:
     ws = scene.workspaces[wid]
     if ws.point is not None:
-        return f"{wid} (the point {_point(ws.point)})"
-    return f"{wid} (x in [{_fmt(ws.x[0])}, {_fmt(ws.x[1])}], y in [{_fmt(ws.y[0])}, {_fmt(ws.y[1])}])"
+        return f"{wid} (the point {show_point(ws.point, scene.units)})"
+    (x0, x1), (y0, y1) = ((show_number(v, scene.units) for v in axis) for axis in (ws.x, ws.y))
+    return f"{wid} (x in [{x0}, {x1}], y in [{y0}, {y1}])"
 
 
 def check_robot_plan(

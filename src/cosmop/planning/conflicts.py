@@ -37,10 +37,11 @@ from shapely.geometry.base import BaseGeometry
 
 from cosmop.events import Primitive
 from cosmop.missions.precedence import Node, Precedence
-from cosmop.planning.plan import RobotPlan, State, _fmt, _point, initial_state
+from cosmop.planning.plan import RobotPlan, State, initial_state
 from cosmop.planning.realisation import TOLERANCE, at_pose
 from cosmop.scene import Scene
 from cosmop.squares import overlap_depths, square, swept_square
+from cosmop.units import UnitSystem, show_number, show_point
 
 __all__ = [
     "Conflict",
@@ -121,6 +122,8 @@ class Occupancy:
         Goods at rest: per robot that moves them, the instants of its plan at which its model
         does not have them lying here although they may be (see :func:`_unseen`).  Only at
         those instants is the robot's plan not already checked against them.
+    units : {"mm", "m"}, optional
+        The units its words show lengths in: the scenario file's (``Scene.units``).
     """
 
     what: str
@@ -131,6 +134,7 @@ class Occupancy:
     label: str
     movable: bool = True
     body: BaseGeometry | None = field(default=None, repr=False)
+    units: UnitSystem = field(default="mm", repr=False, compare=False)
     states: tuple[int, int] | None = None
     unseen: tuple[tuple[str, frozenset[int]], ...] = ()
 
@@ -178,8 +182,9 @@ class Conflict:
         return f"{self.a.label} and {self.b.label} share the space {self.space()}"
 
     def space(self) -> str:
-        """The shared space's bounding box in words: ``x in [.., ..], y in [.., ..]`` (mm)."""
-        x0, y0, x1, y1 = (_fmt(round(v, 1)) for v in self.place)
+        """The shared space's bounding box in words: ``x in [.., ..], y in [.., ..]``, to 0.1 mm
+        in the scenario file's units."""
+        x0, y0, x1, y1 = (show_number(round(v, 1), self.a.units) for v in self.place)
         return f"x in [{x0}, {x1}], y in [{y0}, {y1}]"
 
 
@@ -191,10 +196,12 @@ def _robot_occupancies(
     home: Sequence[float],
     grow: float = 0.0,
     rest: float = 0.0,
+    units: UnitSystem = "mm",
 ) -> list[Occupancy]:
     """Where `robot` stands (merged over steps that keep its pose) and what its GoTo steps sweep.
 
-    A standing robot's body, which goods keep clear of, is its square grown by `rest`.
+    A standing robot's body, which goods keep clear of, is its square grown by `rest`; the
+    words show lengths in `units`.
     """
     K = plan.horizon
     poses = [start.robot, *(s.robot for s in plan.steps)]
@@ -221,9 +228,10 @@ def _robot_occupancies(
                 square(x, y, side),
                 first,
                 last,
-                f"{robot} standing at {_point((x, y))} {where}",
+                f"{robot} standing at {show_point((x, y), units)} {where}",
                 not fixed,
                 square(x, y, side - grow + 2 * rest),
+                units,
                 (k, end),
             )
         )
@@ -238,9 +246,11 @@ def _robot_occupancies(
                     swept_square(p, q, side),
                     (robot, k),
                     (robot, k),
-                    f"{robot}'s GoTo at instant {k} from {_point(p[:2])} to {_point(q[:2])}",
+                    f"{robot}'s GoTo at instant {k} from {show_point(p[:2], units)} to "
+                    f"{show_point(q[:2], units)}",
                     True,
                     swept_square(p, q, side - grow),
+                    units,
                     (k - 1, k),
                 )
             )
@@ -283,13 +293,15 @@ def _object_occupancies(
         for robot, k, primitive in handling:
             if primitive == Primitive.PICKUP:
                 if position is not None:
-                    out.append(_resting(oid, spec.size, parties, position, first, (robot, k), models))
-                    problems += _misplaced(models[robot], robot, k, oid, position, first)
+                    out.append(
+                        _resting(oid, spec.size, parties, position, first, (robot, k), models, scene.units)
+                    )
+                    problems += _misplaced(models[robot], robot, k, oid, position, first, scene.units)
                 position = None
             else:
                 position, first = plans[robot].steps[k - 1].objects[oid].position, (robot, k)
         if position is not None:
-            out.append(_resting(oid, spec.size, parties, position, first, None, models))
+            out.append(_resting(oid, spec.size, parties, position, first, None, models, scene.units))
     return out, problems
 
 
@@ -301,6 +313,7 @@ def _resting(
     first: Node | None,
     last: Node | None,
     models: Mapping[str, Sequence[State]],
+    units: UnitSystem = "mm",
 ) -> Occupancy:
     """Goods `oid` at rest at `position` from the start of step `first` (``None``: from the
     beginning) to the completion of step `last` (``None``: for good), moved by `parties`."""
@@ -312,8 +325,9 @@ def _resting(
         square(*position, size),
         first,
         last,
-        f"{oid} resting at {_point(position)} {where}",
+        f"{oid} resting at {show_point(position, units)} {where}",
         first is not None,
+        units=units,
         unseen=tuple((r, k) for r, k in unseen if k),
     )
 
@@ -354,15 +368,22 @@ def _unseen(
 
 
 def _misplaced(
-    model: Sequence[State], robot: str, k: int, oid: str, position: Sequence[float], first: Node | None
+    model: Sequence[State],
+    robot: str,
+    k: int,
+    oid: str,
+    position: Sequence[float],
+    first: Node | None,
+    units: UnitSystem = "mm",
 ) -> list[str]:
     """Why `robot`'s pick of `oid` at instant `k` is not where the goods lie (``[]``: it is)."""
     if _lying(model[k - 1], oid, position):
         return []
     where = "where they start" if first is None else f"where {first[0]} dropped them at instant {first[1]}"
     planned = model[k - 1].objects.get(oid)
-    at = f" at {_point(planned.position)}" if planned is not None else ""
-    return [f"{robot} picks {oid}{at} at instant {k}, but {oid} lies at {_point(position)} then ({where})"]
+    at = f" at {show_point(planned.position, units)}" if planned is not None else ""
+    lies = show_point(position, units)
+    return [f"{robot} picks {oid}{at} at instant {k}, but {oid} lies at {lies} then ({where})"]
 
 
 def occupancies(
@@ -387,7 +408,7 @@ def occupancies(
         start = (starts or {}).get(robot) or initial_state(scene, robot, plan, moved)
         models[robot] = [start, *(step.state for step in plan.steps)]
         size, home = scene.robots[robot].size + grow, scene.robots[robot].pose
-        out += _robot_occupancies(robot, plan, start, size, home, grow, settings.rest)
+        out += _robot_occupancies(robot, plan, start, size, home, grow, settings.rest, scene.units)
     objects, problems = _object_occupancies(scene, plans, precedence, models, positions)
     return out + objects, problems
 

@@ -2,9 +2,10 @@
 
 A plan set is sound for the team, beyond each robot's plan being sound alone, when
 
-* every message is sent by exactly its sender's plan and awaited by exactly its receiver's
-  (``message``), and the plan file's ``messages`` list names exactly the ``msg`` events the
-  plans use;
+* every message is sent by exactly its sender's plan and awaited by exactly its receiver's,
+  once each (``message``: a second ``Req`` or ``Res`` of one message, or an answer no
+  request is left for, is one too many), and the plan file's ``messages`` list names exactly
+  the ``msg`` events the plans use;
 * the messages cannot deadlock the team (``deadlock``): the partial order they impose on the
   steps has no cycle (:mod:`cosmop.missions.precedence`); the shortest blocking word is given;
 * every conflict between two robots' plans is ordered by the messages (``conflict``,
@@ -20,12 +21,13 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 
+from cosmop.events import parse_event
 from cosmop.missions.mission import GlobalMission
 from cosmop.missions.precedence import Link, Precedence
 from cosmop.missions.team import check_words
 from cosmop.planning.conflicts import ConflictSettings, conflicts, is_ordered, occupancies
 from cosmop.planning.plan import PlanSet, RobotPlan
-from cosmop.planning.realisation import message_links, unanswered_requests
+from cosmop.planning.realisation import message_links, repeated_messages, unanswered_requests, unsent_answers
 from cosmop.planning.report import Violation
 from cosmop.scene import Scenario
 
@@ -68,6 +70,28 @@ def _messages(plan: PlanSet, plans: Mapping[str, RobotPlan]) -> list[Violation]:
                 "message",
                 f"{robot} waits at instant {instant} for {obj} to be moved away, but its mission has "
                 f"no away({obj},{robot},...) event left: no robot answers, it would wait forever",
+            )
+        )
+    for robot, instant, obj in unsent_answers(plans):
+        out.append(
+            _violation(
+                robot,
+                instant,
+                "message",
+                f"{robot} answers Res({obj}) at instant {instant}, but its mission has no "
+                f"away({obj},...,{robot}) event left: every request is answered once, so this answer "
+                "is one too many",
+            )
+        )
+    for robot, instant, name, first in repeated_messages(plans):
+        does = "sends" if parse_event(name).sender == robot else "awaits"
+        out.append(
+            _violation(
+                robot,
+                instant,
+                "message",
+                f"{robot} {does} {name} again at instant {instant} (first at instant {first}); every message "
+                "is sent once and awaited once",
             )
         )
     used = {link.event for link in links if link.event.startswith("msg(")}

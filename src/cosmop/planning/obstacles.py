@@ -220,6 +220,8 @@ class _Sides:
         for key in list(self._keys):  # the stronger GoTo part: kept clear by the same sides
             self._row[past_its_ends(key)], self._roles[past_its_ends(key)] = self._row[key], 0
         table = np.array([planes[k] for k in self._keys], dtype=float)  # (obstacles, bodies, 4 sides, abc)
+        # no wall and no other robot's goods (only the robot's own, always held): keep the shape
+        table = table.reshape(len(self._keys), 1 + len(goods), 4, 3)
         table /= np.abs(table[..., :2]).sum(axis=-1, keepdims=True)
         self._table = table
         grown = np.array([float(margin if self._roles[k] == 0 else robot_gap) for k in self._keys])

@@ -67,7 +67,7 @@ from cosmop.docking import in_front
 from cosmop.errors import CosmopInputError, EventSyntaxError
 from cosmop.events import ID_PATTERN, Event, Primitive, parse_event
 from cosmop.io import read_text, write_atomic
-from cosmop.reading import FieldPath, format_path, load_json
+from cosmop.reading import FieldPath, format_path, json_position, load_json, unprintable
 from cosmop.scene import Scenario, Scene, Workspace
 from cosmop.units import INTERNAL_UNITS, check_units_field
 
@@ -914,22 +914,13 @@ def load_plan(path: str | os.PathLike[str]) -> PlanSet:
     text = read_text(path, PlanError, "a plan file")
     if not text.strip():
         raise PlanError("the file is empty; expected a cosmop.plan/1 JSON object", file=file)
-    data = load_json(text, file, PlanError, object_pairs_hook=_no_duplicates)
-    return PlanSet.from_dict(data, file=file)
+    data = load_json(text, file, PlanError, unique_keys=True)
+    return _Reader(file, text).plan_set(data)  # the text: errors say the field's line
 
 
 # ----------------------------------------------------------------------------------------------
 # Reading: shape validation with field paths
 # ----------------------------------------------------------------------------------------------
-
-
-def _no_duplicates(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
-    result: dict[str, Any] = {}
-    for key, value in pairs:
-        if key in result:
-            raise ValueError(f"duplicate key {key!r}; every key and id must appear once in its object")
-        result[key] = value
-    return result
 
 
 def _describe(value: Any) -> str:
@@ -943,13 +934,17 @@ def _describe(value: Any) -> str:
 
 
 class _Reader:
-    """Builds a PlanSet from parsed JSON, raising PlanError with the file and field path."""
+    """Builds a PlanSet from parsed JSON, raising PlanError with the file and field path (and
+    its line and column, given the file's `text`)."""
 
-    def __init__(self, file: str | None) -> None:
+    def __init__(self, file: str | None, text: str | None = None) -> None:
         self.file = file
+        self.text = text
 
     def fail(self, path: FieldPath, expected: str) -> PlanError:
-        return PlanError(expected, file=self.file, field=format_path(path))
+        found = json_position(self.text, path) if self.text is not None and path else None
+        line, column = found or (None, None)  # the whole file (path ()) has no line of its own
+        return PlanError(expected, file=self.file, field=format_path(path), line=line, column=column)
 
     def mapping(self, value: Any, path: FieldPath, required: tuple[str, ...], optional: tuple[str, ...] = ()):
         if not isinstance(value, dict):
@@ -968,6 +963,8 @@ class _Reader:
     def string(self, value: Any, path: FieldPath, what: str = "text") -> str:
         if not isinstance(value, str):
             raise self.fail(path, f"expected {what}, got {_describe(value)}")
+        if (problem := unprintable(value)) is not None:  # it is printed and written on
+            raise self.fail(path, problem)
         return value
 
     def ident(self, value: Any, path: FieldPath, what: str) -> str:

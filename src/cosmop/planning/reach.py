@@ -28,6 +28,7 @@ from cosmop.docking import docking_pose
 from cosmop.events import Event
 from cosmop.scene import Scene
 from cosmop.squares import docking_places
+from cosmop.units import show_point
 
 __all__ = ["free_component", "unreachable"]
 
@@ -69,7 +70,9 @@ def unreachable(
             obj = scene.objects[event.obj]
             poses = [docking_pose(obj.position, d, h) for h in obj.headings]
             where = shapely.MultiPoint(poses)
-            sides = ", ".join(f"{side} ({x:g}, {y:g})" for side, (x, y) in zip(obj.sides, poses, strict=True))
+            sides = ", ".join(
+                f"{side} {show_point(pose, scene.units)}" for side, pose in zip(obj.sides, poses, strict=True)
+            )
             what = f"its pick poses on the sides tried: {sides}"
         else:
             obj = scene.objects[event.obj]
@@ -80,7 +83,7 @@ def unreachable(
         if not component.intersects(where):
             return (
                 f"{robot} cannot reach {event.name} (event {i} of its mission) at any horizon: "
-                f"walls separate its start ({x0:g}, {y0:g}) from {what}"
+                f"walls separate its start {show_point((x0, y0), scene.units)} from {what}"
             )
     return None
 

@@ -159,6 +159,39 @@ def unanswered_requests(plans: Mapping[str, RobotPlan]) -> list[tuple[str, int, 
     ]
 
 
+def unsent_answers(plans: Mapping[str, RobotPlan]) -> list[tuple[str, int, str]]:
+    """``(robot, instant, object)`` of every ``Res(O)`` whose mission has no ``away`` left for it.
+
+    Such an answer tells nobody anything: every request it could answer is answered already
+    (messages match one to one), so the plan does something its mission does not ask for.
+    """
+    return [
+        (robot, k, str(step.object))
+        for robot, plan in plans.items()
+        for k, step, event in _message_steps(robot, plan)
+        if event is None and step.primitive == Primitive.RES
+    ]
+
+
+def repeated_messages(plans: Mapping[str, RobotPlan]) -> list[tuple[str, int, str, int]]:
+    """``(robot, instant, message, first instant)`` of every ``Req`` or ``Res`` step that awaits
+    or sends a ``msg`` an earlier step of the same plan already awaits or sends.
+
+    A message is sent once and awaited once; :func:`message_links` matches the first of each.
+    """
+    out = []
+    for robot, plan in plans.items():
+        first: dict[tuple[str, Primitive], int] = {}
+        for k, step, event in _message_steps(robot, plan):
+            if event is None or step.message is None:
+                continue  # an away: a second Req(O) or Res(O) finds no away left (above)
+            key = (event.name, step.primitive)
+            if key in first:
+                out.append((robot, k, event.name, first[key]))
+            first.setdefault(key, k)
+    return out
+
+
 def message_links(plans: Mapping[str, RobotPlan]) -> list[Link]:
     """Every message of the plans with the steps that send and await it.
 

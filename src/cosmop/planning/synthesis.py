@@ -40,7 +40,7 @@ import z3
 
 from cosmop.automata import DFA
 from cosmop.automata.operations import project, trim
-from cosmop.events import Event, Primitive, parse_event
+from cosmop.events import MESSAGE_KINDS, Event, Primitive, parse_event
 from cosmop.io import collector_paused
 from cosmop.logic import IncrementalUnrolling, Signature, Unrolling, assert_all, conj, to_fraction
 from cosmop.planning.messages import answer_early, place_mission_messages, strip_messages, wait_early
@@ -276,8 +276,9 @@ def _local_mission(
 ) -> _Mission:
     """The events to plan, the least horizon, and what rules the mission out before solving.
 
-    Walls (:func:`~cosmop.planning.reach.unreachable`), the number of events planned at once
-    (:data:`~cosmop.scene.MAX_TASK_EVENTS`, sequences only) and a least horizon beyond
+    Walls (:func:`~cosmop.planning.reach.unreachable`), the number of tasks planned at once
+    (:data:`~cosmop.scene.MAX_TASK_EVENTS`, sequences only; the messages coordination adds do
+    not count) and a least horizon beyond
     `max_horizon` each make ``walled_off`` say why no plan is searched.
     """
     origin = start.robot[:2] if start is not None else None
@@ -290,9 +291,11 @@ def _local_mission(
         events = strip_messages(full)
         walled_off = unreachable(scene, robot, events, origin)
         lower = _least_steps(events)
-    if walled_off is None and automaton is None and len(events) > MAX_TASK_EVENTS:
+    tasks = sum(1 for e in events if e.kind not in MESSAGE_KINDS)  # what the scenario bounds too
+    if walled_off is None and automaton is None and tasks > MAX_TASK_EVENTS:
         walled_off = (
-            f"{robot}'s mission has {len(events)} events; at most {MAX_TASK_EVENTS} are planned at once"
+            f"{robot}'s mission has {tasks} tasks (pick, drop, return); at most {MAX_TASK_EVENTS} are "
+            "planned at once"
         )
     if walled_off is None and lower > max_horizon:
         walled_off = (

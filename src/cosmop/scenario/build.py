@@ -16,16 +16,18 @@ from typing import Any, NoReturn
 
 from pydantic import ValidationError
 
-from cosmop.errors import EventSyntaxError, ScenarioError
-from cosmop.events import ID_PATTERN, Event, parse_event
+from cosmop.errors import EventSyntaxError, InputWarning, ScenarioError
+from cosmop.events import ID_PATTERN, MESSAGE_KINDS, Event, parse_event
 from cosmop.io import read_text
 from cosmop.missions.handover import handovers
 from cosmop.reading import FieldPath, Marks, format_path, load_yaml
+from cosmop.scenario.plausible import implausible, out_of_range
 from cosmop.scenario.schema import (
     _EXPECTED,
     _RANGE,
     MAX_DFA_STATES,
     SCENARIO_VERSION,
+    UNPRINTABLE,
     _DeliveryModel,
     _DfaModel,
     _expected_at,
@@ -55,7 +57,15 @@ from cosmop.scene import (
     Wall,
     Workspace,
 )
-from cosmop.units import SCENARIO_UNITS, default_dynamics, localize, scene_to_internal, show_length, shown
+from cosmop.units import (
+    SCENARIO_UNITS,
+    default_dynamics,
+    localize,
+    plain,
+    scene_to_internal,
+    show_length,
+    shown,
+)
 
 
 class _Builder:
@@ -68,19 +78,28 @@ class _Builder:
         units = data.get("units") if isinstance(data, Mapping) else None
         self.units = units if units in SCENARIO_UNITS else "mm"  # the words of its messages
 
-    def fail(self, path: FieldPath, expected: str) -> NoReturn:
-        line = column = None
+    def position(self, path: FieldPath) -> tuple[int | None, int | None]:
+        """The line and column of `path` in the file (of its nearest written parent), if known."""
         for length in range(len(path), 0, -1):
             if path[:length] in self.marks:
-                line, column = self.marks[path[:length]]
-                break
+                return self.marks[path[:length]]
+        return None, None
+
+    def fail(self, path: FieldPath, expected: str, *, in_file_units: bool = False) -> NoReturn:
+        """Raise the error at `path`; `expected` names units the internal way (mm, degrees)
+        unless `in_file_units` says it is written in the file's units already."""
+        line, column = self.position(path)
         raise ScenarioError(
-            localize(expected, self.units),
+            expected if in_file_units else localize(expected, self.units),
             file=self.file,
             field=format_path(path) if path else None,
             line=line,
             column=column,
         )
+
+    def warning(self, path: FieldPath, problem: str) -> InputWarning:
+        line, column = self.position(path)
+        return InputWarning(problem, file=self.file, field=format_path(path), line=line, column=column)
 
     # -- structure ----------------------------------------------------------------------------
 
@@ -111,6 +130,8 @@ class _Builder:
     def _structure_error(self, error: Mapping[str, Any]) -> NoReturn:
         loc: FieldPath = tuple(error["loc"])
         kind = error["type"]
+        if kind == UNPRINTABLE:  # a name, id, state or event: the message says what and where
+            self.fail(loc[: loc.index("[key]")] if "[key]" in loc else loc, error["msg"])
         if "[key]" in loc:
             cut = loc.index("[key]")
             key = loc[cut - 1]
@@ -137,12 +158,16 @@ class _Builder:
         model = self.validate_structure()
         if model.version is not None and model.version != SCENARIO_VERSION:
             self.fail(("version",), f"expected {_EXPECTED[('version',)]}, got {model.version}")
-        scene = scene_to_internal(self.build_scene(model.scene), model.units or "mm")
+        written = self.build_scene(model.scene)  # in the file's units
+        if (problem := out_of_range(written, self.units)) is not None:
+            self.fail(*problem, in_file_units=True)
+        scene = scene_to_internal(written, self.units)
         self.check_precision(scene)
         self.check_headings(scene)
         self.check_bodies(scene)
         mission = self.build_mission(model.mission, scene)
-        return Scenario(name=model.name, scene=scene, mission=mission, source=source)
+        warnings = tuple(self.warning(path, problem) for path, problem in implausible(written, self.units))
+        return Scenario(name=model.name, scene=scene, mission=mission, source=source, warnings=warnings)
 
     def build_scene(self, model: _SceneModel) -> Scene:
         owner_of_id: dict[str, FieldPath] = {}
@@ -203,14 +228,23 @@ class _Builder:
         )
 
     def check_precision(self, scene: Scene) -> None:
-        """Every length the planner uses lies on the :data:`LENGTH_GRID` and within :data:`MAX_LENGTH`."""
+        """Every length the planner uses lies on the :data:`LENGTH_GRID` and within :data:`MAX_LENGTH`,
+        and every heading is a finite number of degrees (a metres file's 1e308 radians is not)."""
+        for rid, robot in scene.robots.items():
+            if not math.isfinite(robot.pose[2]):
+                path = ("scene", "robots", rid, "pose", 2)
+                written = _written(_lookup(self.data, path)[1])
+                self.fail(
+                    path, f"expected a finite heading (degrees), got {written}: beyond the range of numbers"
+                )
         grid = f"{shown(float(LENGTH_GRID), self.units):f}".rstrip("0") + (
             " m" if self.units == "m" else " mm"
         )
         for path, value in _planned_lengths(scene):
-            if abs(value) > MAX_LENGTH:
+            if not abs(value) <= MAX_LENGTH:  # inf too: a metres file's 1e308 overflows in mm
+                written = _written(_lookup(self.data, path)[1])  # as the file wrote it
                 self.fail(
-                    path, f"expected a length of at most {show_length(MAX_LENGTH, self.units)}, got {value:g}"
+                    path, f"expected a length of at most {show_length(MAX_LENGTH, self.units)}, got {written}"
                 )
             if (Fraction(repr(float(value))) / LENGTH_GRID).denominator != 1:
                 shown_value = f"{shown(value, self.units):.12g}"
@@ -345,12 +379,6 @@ class _Builder:
                 self.fail(
                     ("mission", "tasks", robot), f"unknown robot {robot!r}; {_known('robots', scene.robots)}"
                 )
-            if len(steps) > MAX_TASK_EVENTS:
-                self.fail(
-                    ("mission", "tasks", robot),
-                    f"a task list of {len(steps)} events; at most {MAX_TASK_EVENTS} per robot are planned "
-                    "(split the mission into several runs)",
-                )
             events = []
             for index, text in enumerate(steps):
                 path = ("mission", "tasks", robot, index)
@@ -363,9 +391,50 @@ class _Builder:
                     )
                 self.check_references(path, event, scene)
                 events.append(event)
+            tasks_given = sum(1 for event in events if event.kind not in MESSAGE_KINDS)
+            if tasks_given > MAX_TASK_EVENTS:
+                self.fail(
+                    ("mission", "tasks", robot),
+                    f"a task list of {tasks_given} tasks (pick, drop, return); at most {MAX_TASK_EVENTS} "
+                    "per robot are planned (split the mission into several runs)",
+                )
             result[robot] = tuple(events)
+        if not any(result.values()):
+            self.fail(
+                ("mission", "tasks"),
+                "expected at least one task, got only empty task lists: the mission is empty",
+            )
+        self.check_messages(result)
         self.check_relays(result)
         return result
+
+    def check_messages(self, tasks: Mapping[str, tuple[Event, ...]]) -> None:
+        """Every message of the task lists is in its sender's list and its receiver's, once each:
+        a message sent that nobody awaits (or awaited that nobody sends) matches nothing."""
+        where: dict[Event, dict[str, list[int]]] = {}
+        for robot, events in tasks.items():
+            for index, event in enumerate(events):
+                if event.kind in MESSAGE_KINDS:
+                    where.setdefault(event, {}).setdefault(robot, []).append(index)
+        for event, places in where.items():
+            for robot, indices in places.items():
+                if len(indices) > 1:
+                    first = format_path(("mission", "tasks", robot, indices[0]))
+                    self.fail(
+                        ("mission", "tasks", robot, indices[1]),
+                        f"{event.name} is already in {robot}'s task list ({first}); every message is sent "
+                        "once and awaited once",
+                    )
+            for robot in (event.sender, event.receiver):
+                if robot not in places:
+                    other = next(iter(places))
+                    role = "sent" if other == event.sender else "awaited"
+                    does = "awaits" if robot == event.receiver else "sends"
+                    self.fail(
+                        ("mission", "tasks", other, places[other][0]),
+                        f"{event.name} is {role} by {other}, but {robot}'s task list never {does} it; a "
+                        "message is listed by both its sender and its receiver, once each",
+                    )
 
     def check_relays(self, tasks: Mapping[str, tuple[Event, ...]]) -> None:
         """Goods in two robots' task lists are a relay: messages in the lists must order every
@@ -417,6 +486,7 @@ class _Builder:
             order.setdefault(target)
             transitions.append((source, event, target))
         states = tuple(order)
+        self.check_start(model.initial, transitions, listed is not None)
         if len(states) > MAX_DFA_STATES:
             self.fail(
                 base,
@@ -451,6 +521,24 @@ class _Builder:
                 f"can be reached from the initial state {model.initial!r}; expected at least one",
             )
         return spec
+
+    def check_start(self, initial: str, transitions: list[tuple[str, Event, str]], listed: bool) -> None:
+        """Some event can happen from the initial state: else the mission is empty (nothing to
+        plan), most often because the initial state's name has a typo."""
+        base = ("mission", "dfa")
+        if not transitions:
+            self.fail(
+                (*base, "transitions"), "expected at least one transition, got none: the mission is empty"
+            )
+        sources = list(dict.fromkeys(source for source, _, _ in transitions))
+        if initial in sources:
+            return
+        shown = ", ".join(sources[:5]) + (f" and {len(sources) - 5} more" if len(sources) > 5 else "")
+        if not listed and all(initial != target for _, _, target in transitions):
+            problem = f"unknown initial state {initial!r}: no transition starts or ends there"
+        else:
+            problem = f"no transition leaves the initial state {initial!r}: the mission is empty"
+        self.fail((*base, "initial"), f"{problem}; expected a state that a transition leaves ({shown})")
 
     def unique_states(self, path: FieldPath, states: list[str]) -> tuple[str, ...]:
         seen: dict[str, int] = {}
@@ -499,6 +587,13 @@ class _Builder:
                 f"workspace {workspace} is too small for {obj.id} ({size}): no drop position "
                 "in it keeps the object clear of the walls",
             )
+
+
+def _written(value: Any) -> str:
+    """A value as the file wrote it, for a message: numbers in full (``1e+308``, ``800000``)."""
+    if isinstance(value, int | float) and not isinstance(value, bool):
+        return plain(value)
+    return _show(value)
 
 
 def _known(group: str, ids: Mapping[str, Any]) -> str:

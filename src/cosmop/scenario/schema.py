@@ -7,10 +7,11 @@ from collections.abc import Mapping
 from types import NoneType, UnionType
 from typing import Annotated, Any, Literal, Union, get_args, get_origin
 
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, field_validator
+from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field, field_validator
+from pydantic_core import PydanticCustomError
 
 from cosmop.docking import SIDES
-from cosmop.reading import FieldPath
+from cosmop.reading import FieldPath, unprintable
 from cosmop.units import SCENARIO_UNITS
 
 MAX_DFA_STATES = 2000
@@ -32,10 +33,23 @@ def _int_state_to_str(value: Any) -> Any:
     return str(value) if isinstance(value, int) and not isinstance(value, bool) else value
 
 
+def _printable(value: str) -> str:
+    """Names, ids, states and events are shown on terminals and written into files: a YAML
+    escape such as ``"\\e[31m"`` must not smuggle a control sequence through them."""
+    if (problem := unprintable(value)) is not None:
+        raise PydanticCustomError(UNPRINTABLE, problem)
+    return value
+
+
+UNPRINTABLE = "unprintable"
+"""The pydantic error type of text that is not printable (its message says where and why)."""
+
 _Number = Annotated[float, Field(strict=True, allow_inf_nan=False)]
 _Positive = Annotated[float, Field(strict=True, allow_inf_nan=False, gt=0)]
-_Text = Annotated[str, Field(strict=True)]
-_StateName = Annotated[str, BeforeValidator(_int_state_to_str), Field(strict=True, min_length=1)]
+_Text = Annotated[str, Field(strict=True), AfterValidator(_printable)]
+_StateName = Annotated[
+    str, BeforeValidator(_int_state_to_str), Field(strict=True, min_length=1), AfterValidator(_printable)
+]
 _Pair = tuple[_Number, _Number]
 
 
@@ -133,7 +147,7 @@ class _MissionModel(_Model):
 
 class _ScenarioModel(_Model):
     version: Annotated[int, Field(strict=True)] | None = None
-    name: Annotated[str, Field(strict=True, min_length=1)]
+    name: Annotated[str, Field(strict=True, min_length=1), AfterValidator(_printable)]
     scene: _SceneModel
     mission: _MissionModel
     units: Literal[SCENARIO_UNITS] | None = None  # type: ignore[valid-type]
