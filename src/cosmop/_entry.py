@@ -15,6 +15,11 @@ expect), no traceback, no process left and nothing half-written, in one of two w
   unwinds; or one when the command is done) ends it on the spot: its child processes killed,
   the staging folders removed, ``interrupted``, 130.
 
+A command that is done ends the program the same way, at once (:func:`os._exit` with the
+command's status, its output flushed): the interpreter's teardown would wait for any thread
+left, and in its last part Python gives Ctrl-C back to the system, which would kill the
+program with no word.
+
 This module imports nothing heavy: the handler is in place before the command line loads
 numpy, shapely, Z3 and pydantic (about a second).  Before it, while Python itself starts (its
 first 50 ms or so), Ctrl-C is Python's: the process ends by the signal, or, in a narrow part of
@@ -23,7 +28,6 @@ that time, with Python's own KeyboardInterrupt traceback.
 
 from __future__ import annotations
 
-import contextlib
 import os
 import signal
 import sys
@@ -48,8 +52,8 @@ class _CtrlC:
 
 
 def _end() -> None:
-    """End the interrupted program now: child processes killed, staging folders removed,
-    output flushed, ``interrupted``, status 130."""
+    """End the interrupted program now (no return): child processes killed, staging folders
+    removed, ``interrupted``, status 130."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # ending: a further Ctrl-C has nothing to add
     # modules looked up, not imported: one not loaded yet has started nothing to clean up
     processes = sys.modules.get("multiprocessing")
@@ -62,17 +66,38 @@ def _end() -> None:
     io = sys.modules.get("cosmop.io")
     if io is not None:
         io.abandon_staging()
-    for stream in (sys.stdout, sys.stderr):
-        with contextlib.suppress(OSError, ValueError):  # a closed pipe or stream: nothing to say there
-            stream.flush()
-    with contextlib.suppress(OSError):
-        # on a terminal, a progress display may be cut short: clear its line, show the cursor
-        os.write(2, (b"\r\x1b[2K\x1b[?25h" if os.isatty(2) else b"") + b"interrupted\n")
+    _flush()
+    # on a terminal, a progress display may be cut short: clear its line, show the cursor
+    _quietly(os.write, 2, (b"\r\x1b[2K\x1b[?25h" if os.isatty(2) else b"") + b"interrupted\n")
     os._exit(EXIT_INTERRUPTED)
 
 
+def _finish(code: object) -> None:
+    """End the program whose command is done (no return), with the command's exit status
+    (`code` as :class:`SystemExit` holds it), at once: the interpreter's teardown is skipped."""
+    if code is not None and not isinstance(code, int):
+        print(code, file=sys.stderr)
+    _flush()
+    os._exit(0 if code is None else code if isinstance(code, int) else 1)
+
+
+def _flush() -> None:
+    for stream in (sys.stdout, sys.stderr):
+        _quietly(stream.flush)
+
+
+def _quietly(action, *args) -> None:
+    """``action(*args)``, where a closed pipe or stream has nothing more to take (contextlib's
+    ``suppress`` would load a module before the handler is in place)."""
+    try:
+        action(*args)
+    except (OSError, ValueError):
+        return
+
+
 def run() -> None:
-    """Run :func:`cosmop.cli.main` and answer Ctrl-C as the module docstring says."""
+    """Run :func:`cosmop.cli.main` and answer Ctrl-C as the module docstring says; the program
+    ends here (no return)."""
     ctrl_c = _CtrlC()
     if signal.getsignal(signal.SIGINT) is signal.default_int_handler:  # not ignored by the caller
         signal.signal(signal.SIGINT, ctrl_c)
@@ -82,14 +107,18 @@ def run() -> None:
         main()
     except KeyboardInterrupt:
         pass
-    except BaseException:  # the command's exit status, or an error
+    except SystemExit as done:  # how the command line ends, with its status
+        ctrl_c.ending = True
+        if not ctrl_c.taken:
+            _finish(done.code)
+    except BaseException:  # a bug: Python prints its traceback
         ctrl_c.ending = True
         if not ctrl_c.taken:
             raise
-        # after a Ctrl-C, whatever ends the command is the interrupt's doing: a library may
-        # have turned it into another exception (ctypes, inside a call to Z3, makes it an
-        # ArgumentError) and the command line into exit status 130
     else:
         ctrl_c.ending = True
-        return
+        _finish(0)
+    # after a Ctrl-C, whatever ends the command is the interrupt's doing: a library may have
+    # turned it into another exception (ctypes, inside a call to Z3, makes it an ArgumentError)
+    # and the command line into exit status 130
     _end()
