@@ -165,8 +165,8 @@ class _Workers(ProcessPoolExecutor):
         pool is told to shut down and cancel the work not started (its manager thread drops
         that work first), the workers are killed and reaped, and the manager thread, which then
         finds them gone, is joined.  The writing end of the results' pipe that this process
-        holds is closed first: should the manager be reading a result that a killed worker had
-        half sent, it reads the end of the pipe instead of waiting forever.  Ctrl-C is held back
+        holds is closed before: should the manager be reading a result that a killed worker
+        had half sent, it reads the end of the pipe instead of waiting forever.  Ctrl-C is held back
         meanwhile (a second one must not leave the pool half stopped); it arrives right after.
         (Python 3.14 has ``kill_workers``; before it, the processes are private.)
         """
