@@ -17,8 +17,9 @@ Usage::
 
 ``--scene movingai`` (default) is the MovingAI warehouse of ``movingai_gen.py`` with 12 robots
 fetching 12 goods; ``--simulate`` interrupts ``cosmop simulate --gif`` instead of ``cosmop plan
---png``.  Writes ``results/sweep_sigint.json``; prints one row per interrupt and the count of
-clean ones.  :func:`interrupt` is also what ``tests/test_interrupts.py`` runs.
+--png``.  Writes ``results/sweep_sigint.json`` (``_simulate``, ``_double`` added to the name
+with those options); prints one row per interrupt and the count of clean ones.
+:func:`interrupt` is also what ``tests/test_interrupts.py`` runs.
 """
 
 from __future__ import annotations
@@ -222,7 +223,8 @@ def main(argv: list[str] | None = None) -> int:
             print(json.dumps({key: v for key, v in row.items() if key != "stderr"}), flush=True)
     from _harness import save_results
 
-    save_results("sweep_sigint", rows)
+    name = "sweep_sigint" + ("_simulate" if args.simulate else "") + ("_double" if args.second else "")
+    save_results(name, rows)
     interrupted = [r for r in rows if not r["finished"]]
     clean = sum(1 for r in interrupted if not r["problems"])
     latencies = sorted(r["latency_s"] for r in interrupted)
