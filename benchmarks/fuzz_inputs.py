@@ -3,7 +3,8 @@
 Two sets of files, each run as a fresh ``cosmop`` process with a time limit:
 
 * a catalogue of hostile files (the issue's list and 10 MB files of several shapes), each
-  through ``validate`` and ``plan`` (scenarios) or ``check`` and ``simulate --plan`` (plans);
+  through ``validate`` and ``plan`` (scenarios) or ``check`` and ``simulate --plan`` (plans),
+  and ``/dev/zero`` (an endless stream) through ``validate`` and ``check``;
 * seeded random mutations of the examples' scenario files (text edits) through ``validate``,
   and of a real plan file (a leaf replaced, a byte spliced) through ``check``.
 
@@ -203,6 +204,10 @@ def main(argv: list[str] | None = None) -> int:
                     {"set": "hostile", "file": name, "bytes": len(content.encode())}
                     | run(command, args.limit)
                 )
+                print(json.dumps(rows[-1]), flush=True)
+        if Path("/dev/zero").exists():  # an endless stream: refused once past the size bound
+            for command in (["validate", "/dev/zero"], ["check", str(EXAMPLE), "/dev/zero"]):
+                rows.append({"set": "hostile", "file": "/dev/zero", "bytes": None} | run(command, args.limit))
                 print(json.dumps(rows[-1]), flush=True)
         texts = [p.read_text() for p in SCENARIOS]
         for k in range(args.mutations):

@@ -10,7 +10,9 @@ from __future__ import annotations
 import itertools
 import math
 import os
+import subprocess
 import sys
+import time
 import types
 
 import pytest
@@ -209,6 +211,30 @@ def test_failure_midway_leaves_no_file_and_keeps_the_old_one(tmp_path, monkeypat
         save_animation(SCENE, make_trace(), old, dpi=DPI)
     assert os.listdir(tmp_path) == ["old.gif"]
     assert old.read_bytes() == b"previous animation"
+
+
+def test_an_interrupted_animation_is_abandoned_not_finished(tmp_path, monkeypatch):
+    # issue 39: Ctrl-C while drawing had Pillow write every frame drawn so far (seconds) only to
+    # throw the file away; an MP4's ffmpeg is killed, not waited for
+    import matplotlib.animation
+
+    finished = []
+    monkeypatch.setattr(matplotlib.animation.PillowWriter, "finish", lambda self: finished.append(self))
+    update = animation_module._Animator.update
+
+    def interrupted(self, index):
+        if index == 2:
+            raise KeyboardInterrupt
+        update(self, index)
+
+    monkeypatch.setattr(animation_module._Animator, "update", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        save_animation(SCENE, make_trace(), tmp_path / "run.gif", dpi=DPI)
+    assert finished == [] and os.listdir(tmp_path) == []
+    ffmpeg = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"], stdin=subprocess.PIPE)
+    start = time.perf_counter()
+    animation_module._abandon(types.SimpleNamespace(_proc=ffmpeg))
+    assert ffmpeg.returncode is not None and time.perf_counter() - start < 10
 
 
 def test_frames_are_still_written_when_the_canvas_cannot_be_taken_as_is(tmp_path, monkeypatch):

@@ -3,6 +3,10 @@ named as a folder are exit 2 with one line naming the option, and nothing is wri
 
 from __future__ import annotations
 
+import os
+import socket
+import stat
+import threading
 from pathlib import Path
 
 import pytest
@@ -44,6 +48,60 @@ def test_a_folder_is_not_a_file_and_a_file_is_not_a_folder(tmp_path):
     result = runner.invoke(app, ["decompose", SCENARIO, "--dot", str(file)])
     assert result.exit_code == 2 and "--dot: is a file; expected a folder" in result.stderr
     assert file.read_text() == "x"
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="named pipes are POSIX's")
+def test_an_output_through_a_named_pipe_is_written_through_and_the_pipe_kept(tmp_path):
+    # issue 39: -o naming a FIFO (or /dev/null, as root) replaced it with a plain file
+    fifo = tmp_path / "view.html"
+    os.mkfifo(fifo)
+    received = []
+    reader = threading.Thread(target=lambda: received.append(fifo.read_bytes()), daemon=True)
+    reader.start()
+    result = runner.invoke(app, ["view", SCENARIO, "-o", str(fifo)])
+    reader.join(timeout=60)
+    assert result.exit_code == 0, result.output
+    assert stat.S_ISFIFO(fifo.lstat().st_mode)  # still the pipe
+    assert received and received[0].rstrip().endswith(b"</html>")
+    assert [p.name for p in tmp_path.iterdir()] == ["view.html"]  # no staging folder
+
+
+def test_a_device_is_written_through_never_replaced(monkeypatch):
+    import tempfile
+
+    from cosmop.io import check_writable, write_atomic
+
+    def replaced(*args, **kwargs):
+        raise AssertionError("a device node must never be replaced")
+
+    # nothing may be staged or moved: /dev/null is only ever opened and written
+    monkeypatch.setattr(os, "replace", replaced)
+    monkeypatch.setattr(tempfile, "mkdtemp", replaced)
+    check_writable("/dev/null", "-o")
+    write_atomic("/dev/null", "nothing")
+    assert stat.S_ISCHR(os.stat("/dev/null").st_mode)
+
+
+def test_a_link_is_kept_and_the_file_it_names_replaced(tmp_path):
+    from cosmop.io import write_atomic
+
+    (tmp_path / "real.json").write_text("old")
+    link = tmp_path / "link.json"
+    link.symlink_to("real.json")
+    write_atomic(link, "new")
+    assert link.is_symlink() and (tmp_path / "real.json").read_text() == "new"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["link.json", "real.json"]
+
+
+@pytest.mark.skipif(not hasattr(socket, "AF_UNIX"), reason="needs Unix sockets")
+def test_a_socket_is_no_output(tmp_path):
+    with socket.socket(socket.AF_UNIX) as server:
+        server.bind(str(tmp_path / "s"))
+        result = runner.invoke(app, ["view", SCENARIO, "-o", str(tmp_path / "s")])
+    assert result.exit_code == 2
+    assert (
+        result.stderr == f"error: {tmp_path / 's'}: -o: is a socket; expected the path of a file to write\n"
+    )
 
 
 def test_an_interrupt_waits_for_outputs_that_belong_together():

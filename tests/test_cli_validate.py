@@ -143,6 +143,43 @@ def test_usage_errors_exit_2() -> None:
     assert "Traceback" not in missing_argument.output + unknown_command.output
 
 
+@pytest.mark.parametrize(
+    ("args", "named"),
+    [
+        (
+            ["plan", str(TASKS_FILE), "-o", "p.json", "--workers", "0"],
+            "cosmop plan: Invalid value for '--workers'",
+        ),
+        (
+            ["simulate", str(TASKS_FILE), "--max-time", "-1"],
+            "cosmop simulate: Invalid value for '--max-time'",
+        ),
+        (["simulate", str(TASKS_FILE), "--seed", "-1"], "cosmop simulate: Invalid value for '--seed'"),
+        (["plan", str(TASKS_FILE), "-o", "p.json", "--wrkers", "2"], "cosmop plan: No such option: --wrkers"),
+        (["plan", str(TASKS_FILE)], "cosmop plan: Missing option '-o'"),
+        (["validate"], "cosmop validate: Missing argument 'SCENARIO'"),
+        (["frobnicate"], "cosmop: No such command 'frobnicate'"),
+        (["--bogus"], "cosmop: No such option: --bogus"),
+    ],
+    ids=[
+        "workers-0",
+        "max-time-negative",
+        "seed-negative",
+        "unknown-option",
+        "missing-option",
+        "missing-argument",
+        "unknown-command",
+        "unknown-group-option",
+    ],
+)
+def test_a_usage_error_is_one_line_naming_the_option(args, named) -> None:
+    # issue 39: usage errors printed a five-line box; --seed -1 died in numpy
+    result = runner.invoke(app, args)
+    assert result.exit_code == 2
+    assert result.stdout == ""
+    assert result.stderr.startswith(f"error: {named}") and result.stderr.count("\n") == 1, result.stderr
+
+
 def test_version() -> None:
     result = runner.invoke(app, ["--version"])
     assert result.exit_code == 0

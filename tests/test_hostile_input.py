@@ -93,6 +93,37 @@ def test_control_characters_are_refused_with_their_position(char):
     assert (err.line, err.column) == (2, 9)
 
 
+def test_a_file_past_the_size_bound_is_refused_after_reading_that_much(tmp_path, monkeypatch):
+    import cosmop.io
+
+    path = tmp_path / "big.yaml"
+    path.write_bytes(b"#" * 1001)
+    assert len(cosmop.io.read_bytes(path, ScenarioError, "a scenario file", limit=1001)) == 1001
+    with pytest.raises(ScenarioError, match="more than 1,000 bytes; expected a scenario file of at most"):
+        cosmop.io.read_bytes(path, ScenarioError, "a scenario file", limit=1000)
+    # an endless stream: at most the bound and a byte are read, not the stream into memory
+    monkeypatch.setattr(cosmop.io, "MAX_FILE_BYTES", 2**20)
+    with pytest.raises(ScenarioError, match="/dev/zero: more than 1,048,576 bytes"):
+        load_scenario("/dev/zero")
+
+
+def test_validate_dev_zero_is_one_line_and_exit_2(monkeypatch):
+    # issue 39: validate /dev/zero read the whole stream (MemoryError); the bound is lowered
+    # here to keep the test small, the reading is the same
+    from typer.testing import CliRunner
+
+    import cosmop.io
+    from cosmop.cli import app
+
+    monkeypatch.setattr(cosmop.io, "MAX_FILE_BYTES", 2**20)
+    result = CliRunner().invoke(app, ["validate", "/dev/zero"])
+    assert result.exit_code == 2
+    assert (
+        result.stderr
+        == "error: /dev/zero: more than 1,048,576 bytes; expected a scenario file of at most that size\n"
+    )
+
+
 def test_json_bounds(tmp_path):
     for text, words in [
         ("[" * (MAX_DEPTH + 1) + "]" * (MAX_DEPTH + 1), "levels deep"),

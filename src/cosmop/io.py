@@ -6,13 +6,24 @@ import contextlib
 import gc
 import os
 import shutil
+import stat
 import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
 from cosmop.errors import CosmopInputError, OutputPathError
 
-__all__ = ["atomic_path", "check_writable", "collector_paused", "uninterrupted", "write_atomic"]
+__all__ = [
+    "MAX_FILE_BYTES",
+    "abandon_staging",
+    "atomic_path",
+    "check_writable",
+    "collector_paused",
+    "read_bytes",
+    "read_text",
+    "uninterrupted",
+    "write_atomic",
+]
 
 
 @contextlib.contextmanager
@@ -56,10 +67,24 @@ def check_writable(path: str | os.PathLike[str] | None, option: str, *, folder: 
         The command-line option that named it (``-o``, ``--png``), for the message.
     folder : bool
         Whether the output is a folder to create (then it must not exist yet as a file).
+
+    Notes
+    -----
+    A character device or a named pipe (``/dev/null``, a FIFO) is a writable file output when
+    it may be written (:func:`atomic_path` writes through it); a block device or a socket never is.
     """
     if path is None:
         return
     target = Path(path)
+    if not folder and _stream(target):  # written through (atomic_path): its folder is not touched
+        if not os.access(target, os.W_OK):
+            raise OutputPathError("is not writable", file=target, field=option)
+        return
+    kind = _special(target)
+    if kind is not None:
+        expected = "a folder to write into" if folder else "the path of a file to write"
+        raise OutputPathError(f"is {kind}; expected {expected}", file=target, field=option)
+    target = _followed(target)
     parent = target.parent
     if not folder and target.is_dir():
         raise OutputPathError("is a folder; expected the path of a file to write", file=target, field=option)
@@ -100,7 +125,8 @@ def write_atomic(path: str | os.PathLike[str], data: str | bytes) -> None:
     staging folder beside `path`, flushed to disk with ``fsync`` and moved over `path` with
     :func:`os.replace`, which is atomic on POSIX and Windows. Readers therefore see either the
     old file or the complete new one, never a half-written file; if anything fails the staging
-    folder is removed and `path` is untouched.
+    folder is removed and `path` is untouched.  (A character device or a named pipe, such as
+    ``/dev/null``, is written through instead, never replaced: see :func:`atomic_path`.)
 
     Parameters
     ----------
@@ -138,6 +164,12 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
     POSIX, an empty folder). The staging folder is always removed, so a failure, inside the
     block or in the move, leaves `path` untouched and nothing behind.
 
+    Two kinds of `path` are not replaced.  A character device or a named pipe (``/dev/null``,
+    a FIFO; a link to one) is yielded itself and written through, as a shell's ``>`` does:
+    moving a file onto it would replace the device node or the pipe with a plain file (and
+    nothing in a stream can be written atomically).  A symbolic link is kept, and the file it
+    names is replaced.
+
     Parameters
     ----------
     path : str or os.PathLike
@@ -146,7 +178,8 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
     Yields
     ------
     pathlib.Path
-        ``<staging folder>/<name of path>``; nothing exists there yet.
+        ``<staging folder>/<name of path>``, where nothing exists yet; or `path` itself, for
+        a character device or a named pipe.
 
     Raises
     ------
@@ -164,7 +197,14 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
     >>> shutil.rmtree(folder)
     """
     target = Path(path)
+    if _stream(target):
+        # a device (/dev/null) or a named pipe: written through, as a shell's > does; a file
+        # moved onto it would replace it (the device node, the pipe) with a plain file
+        yield target
+        return
+    target = _followed(target)  # a symbolic link stays, and the file it names is replaced
     staging = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent))
+    _STAGING.add(staging)
     try:
         tmp = staging / target.name
         yield tmp
@@ -176,7 +216,51 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
         os.replace(tmp, target)
     finally:
         shutil.rmtree(staging, ignore_errors=True)
+        _STAGING.discard(staging)
     _fsync_directory(target.parent)
+
+
+def _stream(path: Path) -> bool:
+    """Whether `path` names a character device or a named pipe (a link followed): outputs
+    written through, never replaced."""
+    try:
+        mode = os.stat(path).st_mode
+    except (OSError, ValueError):
+        return False
+    return stat.S_ISCHR(mode) or stat.S_ISFIFO(mode)
+
+
+def _special(path: Path) -> str | None:
+    """What `path` is when it is neither a file, a folder, a character device nor a named pipe
+    (``"a block device"``, ``"a socket"``): no output may go there."""
+    try:
+        mode = os.stat(path).st_mode
+    except (OSError, ValueError):
+        return None
+    if stat.S_ISREG(mode) or stat.S_ISDIR(mode) or stat.S_ISCHR(mode) or stat.S_ISFIFO(mode):
+        return None
+    return "a block device" if stat.S_ISBLK(mode) else "a socket" if stat.S_ISSOCK(mode) else "a special file"
+
+
+def _followed(path: Path) -> Path:
+    """`path`, or the path a symbolic link there names (the link is kept, its file replaced)."""
+    return Path(os.path.realpath(path)) if path.is_symlink() else path
+
+
+_STAGING: set[Path] = set()
+"""The staging folders of :func:`atomic_path` blocks that have not ended yet."""
+
+
+def abandon_staging() -> None:
+    """Remove the staging folders of the outputs being written, which will never be finished.
+
+    For a program that must end on the spot (:func:`os._exit`, a second Ctrl-C), where the
+    blocks' own clean-up will not run: the outputs stay as they were, and nothing is left
+    beside them.
+    """
+    for staging in list(_STAGING):
+        shutil.rmtree(staging, ignore_errors=True)
+        _STAGING.discard(staging)
 
 
 def _fsync_file(path: Path) -> None:
@@ -205,8 +289,50 @@ def _fsync_directory(directory: Path) -> None:
         os.close(fd)
 
 
+MAX_FILE_BYTES = 256 * 2**20
+"""Most bytes an input file may have: 256 MiB (a trace of the 10×10 example's 218 s run is 7 MB)."""
+
+
+def read_bytes(
+    path: str | os.PathLike[str], error: type[CosmopInputError], kind: str, limit: int | None = None
+) -> bytes:
+    """Read an input file, at most `limit` bytes; every failure raises ``error`` naming the file.
+
+    At most ``limit + 1`` bytes are read, so an endless stream (``/dev/zero``) or a file past
+    the bound is refused after that much, not read into memory whole.  Pipes and devices are
+    read like files (``cosmop validate <(generate)`` works).
+
+    Parameters
+    ----------
+    path : path-like
+    error : type of CosmopInputError
+        The error to raise (e.g. ``ScenarioError``), constructed as ``error(message, file=...)``.
+    kind : str
+        What the file should be (``"a scenario file"``), for the messages.
+    limit : int, optional
+        The most bytes the file may have (default :data:`MAX_FILE_BYTES`).
+    """
+    file = os.fspath(path)
+    limit = MAX_FILE_BYTES if limit is None else limit
+    try:
+        with open(path, "rb") as handle:
+            raw = handle.read(limit + 1)
+    except FileNotFoundError:
+        raise error("file not found", file=file) from None
+    except IsADirectoryError:
+        raise error(f"is a directory, expected {kind}", file=file) from None
+    except PermissionError:
+        raise error("permission denied: cannot read the file", file=file) from None
+    except OSError as err:
+        raise error(f"cannot read the file: {err.strerror or err}", file=file) from None
+    if len(raw) > limit:
+        raise error(f"more than {limit:,} bytes; expected {kind} of at most that size", file=file)
+    return raw
+
+
 def read_text(path: str | os.PathLike[str], error: type[CosmopInputError], kind: str) -> str:
-    """Read a UTF-8 input file; every failure raises ``error`` naming the file.
+    """Read a UTF-8 input file (within :data:`MAX_FILE_BYTES`, :func:`read_bytes`); every
+    failure raises ``error`` naming the file.
 
     Parameters
     ----------
@@ -221,18 +347,9 @@ def read_text(path: str | os.PathLike[str], error: type[CosmopInputError], kind:
     str
         The text, without a UTF-8 byte-order mark.
     """
-    file = os.fspath(path)
-    try:
-        raw = Path(path).read_bytes()
-    except FileNotFoundError:
-        raise error("file not found", file=file) from None
-    except IsADirectoryError:
-        raise error(f"is a directory, expected {kind}", file=file) from None
-    except PermissionError:
-        raise error("permission denied: cannot read the file", file=file) from None
-    except OSError as err:
-        raise error(f"cannot read the file: {err.strerror or err}", file=file) from None
+    raw = read_bytes(path, error, kind)
     try:
         return raw.decode("utf-8-sig")
     except UnicodeDecodeError as err:
-        raise error(f"expected UTF-8 text, found an invalid byte at offset {err.start}", file=file) from None
+        message = f"expected UTF-8 text, found an invalid byte at offset {err.start}"
+        raise error(message, file=os.fspath(path)) from None

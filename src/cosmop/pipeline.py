@@ -37,6 +37,7 @@ from cosmop.allocate import allocate
 from cosmop.automata import DFA
 from cosmop.errors import MissionTooLargeError
 from cosmop.events import Event, Primitive, parse_event
+from cosmop.io import uninterrupted
 from cosmop.missions.allocation import Choice
 from cosmop.missions.coordination import Coordinated, coordinate
 from cosmop.missions.decomposition import decompose
@@ -140,11 +141,54 @@ def _synthesize(job: _Job) -> Synthesis:
     )
 
 
-def _pool(workers: int) -> ProcessPoolExecutor:
-    """Worker processes (forked where the platform allows: no re-import of the package)."""
-    methods = multiprocessing.get_all_start_methods()
-    context = multiprocessing.get_context("fork" if "fork" in methods else "spawn")
-    return ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=_leave_interrupts)
+class _Workers(ProcessPoolExecutor):
+    """The pipeline's worker processes: Ctrl-C is the parent's, and an interrupt ends them at once.
+
+    A terminal sends Ctrl-C (SIGINT) to every process of its foreground job, these workers too.
+    A worker ignores it (its initializer, :func:`_leave_interrupts`); the parent answers it, and
+    :meth:`stop` ends the workers.  Workers are forked where the platform allows (no re-import of
+    the package), inside :meth:`submit`: the parent holds Ctrl-C back while it submits
+    (:func:`cosmop.io.uninterrupted`), so that an interrupt can neither stop it between starting
+    a worker and recording it (a worker nobody would end) nor reach a worker before its
+    initializer runs (the worker is born with the parent's noting handler, which only notes it).
+    """
+
+    def __init__(self, workers: int) -> None:
+        methods = multiprocessing.get_all_start_methods()
+        context = multiprocessing.get_context("fork" if "fork" in methods else "spawn")
+        super().__init__(max_workers=workers, mp_context=context, initializer=_leave_interrupts)
+
+    def submit(self, fn, /, *args, **kwargs):
+        with uninterrupted():
+            return super().submit(fn, *args, **kwargs)
+
+    def stop(self) -> None:
+        """End the workers now, then the pool, leaving no process and no thread behind.
+
+        A synthesis can run for minutes and a worker ignores Ctrl-C: waiting for it, as
+        ``shutdown`` and the interpreter's exit after it do, would hang the program.  So the
+        pool is told to shut down and cancel the work not started (its manager thread drops
+        that work first), the workers are killed and reaped, and the manager thread, which then
+        finds them gone, is joined.  The writing end of the results' pipe that this process
+        holds is closed before: should the manager be reading a result that a killed worker
+        had half sent, it reads the end of the pipe instead of waiting forever.  Ctrl-C is held back
+        meanwhile (a second one must not leave the pool half stopped); it arrives right after.
+        (Python 3.14 has ``kill_workers``; before it, the processes are private.)
+        """
+        with uninterrupted():
+            processes = list((self._processes or {}).values())
+            manager, results = self._executor_manager_thread, self._result_queue
+            self.shutdown(wait=False, cancel_futures=True)
+            for process in processes:
+                process.kill()
+            for process in processes:
+                process.join()
+            if results is not None:
+                results._writer.close()
+            if manager is not None:
+                manager.join()
+            if results is not None:
+                results.close()
 
 
 def _leave_interrupts() -> None:
@@ -244,8 +288,11 @@ class _Planner:
                     if self.on_robot is not None:
                         self.on_robot(robot, out[robot])
             except BaseException:  # an interrupt or a failed synthesis: leave no work queued
-                for future in futures.values():
-                    future.cancel()
+                # (the pipeline's own pool cancels its work as plan_team stops it: a future
+                # cancelled behind its back breaks its manager thread before Python 3.12)
+                if not isinstance(self.executor, _Workers):
+                    for future in futures.values():
+                        future.cancel()
                 raise
         for robot, events in jobs.items():
             self.cache[self.key(robot, events, explain=explain or out[robot].feasible)] = out[robot]
@@ -303,7 +350,7 @@ def plan_team(
     if executor is None:
         team = len(scenario.scene.robots)
         n_workers = min(os.cpu_count() or 1, team) if workers is None else max(1, workers)
-        pool = _pool(n_workers) if n_workers > 1 else None
+        pool = _Workers(n_workers) if n_workers > 1 else None
     planner = _Planner(scenario, executor or pool, on_robot, max_horizon, rlimit, phases)
     try:
         choice = None
@@ -318,10 +365,7 @@ def plan_team(
         return _loop(scenario, mission, words, notes, reasons, planner, max_iterations, conflicts, choice)
     except BaseException:  # an interrupt or an error: do not wait for the workers' syntheses
         if pool is not None:
-            pool.shutdown(wait=False, cancel_futures=True)
-            # a synthesis can run for minutes: end the workers now (no public call before 3.14)
-            for process in list((getattr(pool, "_processes", None) or {}).values()):
-                process.terminate()
+            pool.stop()
             pool = None
         raise
     finally:

@@ -2,9 +2,10 @@
 
 The library is silent; this package is the friendly layer. Errors in the user's input
 (:class:`~cosmop.errors.CosmopInputError`) are printed as one line, ``error: <message>``, on
-standard error, and the command exits with status 2 -- the same status as a usage error. Other
-exit statuses: 0 for success, 1 for a well-formed problem without a solution (e.g. an infeasible
-scenario).
+standard error, and the command exits with status 2 -- as does a usage error (an option out of
+its range, a missing argument), also one line. Other exit statuses: 0 for success, 1 for a
+well-formed problem without a solution (e.g. an infeasible scenario), 130 after Ctrl-C, which
+the program answers (:mod:`cosmop._entry`, the ``cosmop`` command).
 
 One module per command (or family of commands), registered here, in order, on the one
 :data:`~cosmop.cli._app.app`: ``validate``, ``decompose``, ``plan`` and ``check``, ``simulate``, and the
@@ -34,5 +35,6 @@ for _name, _command in (
 
 
 def main() -> None:
-    """Run the command line (``python -m cosmop``), with the program name ``cosmop``."""
+    """Run the command line, with the program name ``cosmop`` (the program, ``cosmop`` and
+    ``python -m cosmop``, is :func:`cosmop._entry.run`, which also answers Ctrl-C)."""
     app(prog_name="cosmop")

@@ -1,15 +1,16 @@
 """The command group every ``cosmop`` command registers on, and what the commands share.
 
 Input errors (:class:`~cosmop.errors.CosmopInputError`, an event typed on the command line, a file
-the system refuses to write) become one line on standard error and exit status 2; Ctrl-C ends
-with status 130.  Commands load their scenario with :func:`load` and print with :func:`stdout`.
+the system refuses to write) and usage errors become one line on standard error and exit
+status 2; Ctrl-C is the program's (:mod:`cosmop._entry`).  Commands load their scenario with
+:func:`load` and print with :func:`stdout`.
 """
 
 from __future__ import annotations
 
 import sys
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated, Any, NoReturn
 
 import typer
 from rich.console import Console
@@ -26,18 +27,45 @@ EXIT_INPUT_ERROR = 2
 """Exit status for bad input (also the status of command-line usage errors)."""
 
 
-class _Group(TyperGroup):
-    """Command group that turns input errors into one line on stderr and exit status 2.
+# click's error base class, from typer's own BadParameter (typer may bundle its own click)
+_ClickException = next(c for c in typer.BadParameter.__mro__ if c.__name__ == "ClickException")
 
-    Input errors are :class:`~cosmop.errors.CosmopInputError` (bad files) and
+
+def _usage_error(err: Exception) -> NoReturn:
+    """A command-line usage error (an option out of range, a missing argument, an unknown
+    command) as one line naming the command and the option, with click's exit status (2).
+
+    The help that ``cosmop`` with no arguments prints is shown as it is."""
+    if type(err).__name__ == "NoArgsIsHelpError":
+        raise err
+    ctx = getattr(err, "ctx", None)
+    where = f"{ctx.command_path}: " if ctx is not None else ""
+    message = " ".join(err.format_message().split())  # one line, whatever click wrapped
+    typer.echo(f"error: {where}{message}", err=True)
+    raise typer.Exit(err.exit_code) from None
+
+
+class _Group(TyperGroup):
+    """Command group that turns usage and input errors into one line on stderr and exit status 2.
+
+    Usage errors are click's (an option out of its range, an unknown option or command); input
+    errors are :class:`~cosmop.errors.CosmopInputError` (bad files) and
     :class:`~cosmop.errors.EventSyntaxError` (an event typed on the command line); a file the
     system refuses to write (:class:`OSError`, e.g. a full disk) is reported the same way.
-    Ctrl-C ends with one line and status 130 (128 + SIGINT), as shells expect.
+    Ctrl-C is the program's (:mod:`cosmop._entry`): KeyboardInterrupt passes through.
     """
+
+    def make_context(self, info_name, args, parent=None, **extra) -> Any:
+        try:  # the group's own options and arguments
+            return super().make_context(info_name, args, parent=parent, **extra)
+        except _ClickException as err:
+            _usage_error(err)
 
     def invoke(self, ctx: typer.Context) -> Any:
         try:
             return super().invoke(ctx)
+        except _ClickException as err:  # a command's options and arguments, or its own checks
+            _usage_error(err)
         except (CosmopInputError, EventSyntaxError) as err:
             # plain echo, not rich: field paths such as tasks.R1[0] must not be read as markup
             typer.echo(f"error: {err}", err=True)
@@ -46,9 +74,6 @@ class _Group(TyperGroup):
             where = f"{err.filename}: " if err.filename else ""
             typer.echo(f"error: {where}{err.strerror or err}", err=True)
             raise typer.Exit(EXIT_INPUT_ERROR) from None
-        except KeyboardInterrupt:
-            typer.echo("interrupted", err=True)
-            raise typer.Exit(130) from None
 
 
 app = typer.Typer(

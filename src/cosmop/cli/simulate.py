@@ -34,7 +34,7 @@ def simulate(
             show_default=False,
         ),
     ] = None,
-    seed: Annotated[int, typer.Option(help="Seed of the people's random walks.")] = 0,
+    seed: Annotated[int, typer.Option(help="Seed of the people's random walks (0 or more).", min=0)] = 0,
     summary: Annotated[
         Path | None, typer.Option(help="Write the summary (cosmop.sim/1 JSON) here.", show_default=False)
     ] = None,

@@ -27,20 +27,11 @@ from typing import Any, Literal
 
 import numpy as np
 
-from cosmop.io import read_text
+from cosmop.io import read_bytes, read_text
 from cosmop.maps.grid import MapError, OccupancyGrid
 from cosmop.reading import load_yaml
 
 __all__ = ["read_pgm", "read_ros_map"]
-
-
-def _read_bytes(path: Path) -> bytes:
-    try:
-        return path.read_bytes()
-    except FileNotFoundError:
-        raise MapError("file not found", file=os.fspath(path)) from None
-    except OSError as err:
-        raise MapError(f"cannot read the file: {err.strerror or err}", file=os.fspath(path)) from None
 
 
 def read_pgm(path: str | os.PathLike[str]) -> tuple[np.ndarray, int]:
@@ -54,7 +45,7 @@ def read_pgm(path: str | os.PathLike[str]) -> tuple[np.ndarray, int]:
         The largest possible pixel value (255 for 8-bit images).
     """
     file = os.fspath(path)
-    data = _read_bytes(Path(path))
+    data = read_bytes(path, MapError, "a PGM image")
     magic = data[:2]
     if magic not in (b"P5", b"P2"):
         raise MapError(f"expected a PGM image (P5 or P2), got the start {data[:8]!r}", file=file)

@@ -671,14 +671,26 @@ def _check_options(
 
 
 def _write_frames(writer: Any, animator: _Animator, indices: Sequence[int], path: Path, dpi: float) -> None:
-    """Draw the frames `indices` and have `writer` write them to `path`, finishing it even on failure."""
+    """Draw the frames `indices` and have `writer` write them to `path`; on a failure or Ctrl-C,
+    abandon the file (:func:`_abandon`), which the staging folder's removal then takes away."""
     writer.setup(animator.fig, os.fspath(path), dpi)
     try:
         for index in indices:
             animator.draw(index)
             writer.grab_frame()
     except BaseException:
-        with contextlib.suppress(Exception):
-            writer.finish()  # reap ffmpeg; the partial file is removed with the temporary folder
+        _abandon(writer)
         raise
     writer.finish()
+
+
+def _abandon(writer: Any) -> None:
+    """Stop `writer` without finishing its file: ffmpeg (MP4) is killed and reaped, a GIF's
+    frames are dropped.  Finishing would encode every frame drawn so far (Pillow writes a GIF's
+    frames all at once, seconds for a few hundred) only to throw the file away, and would keep
+    Ctrl-C waiting that long."""
+    proc = getattr(writer, "_proc", None)
+    if proc is not None:
+        with contextlib.suppress(OSError):
+            proc.kill()
+            proc.communicate()

@@ -1,0 +1,102 @@
+"""Ctrl-C at any moment: ``interrupted``, exit status 130, no traceback, no process left, nothing
+half-written (issue 39, point 4).
+
+A small seeded sample of the moments ``benchmarks/sweep_sigint.py`` sweeps (100 of them on the
+MovingAI warehouse): each run is a fresh ``cosmop`` process in a process group of its own, and
+SIGINT goes to the whole group, as a terminal's Ctrl-C does (the worker processes get it too).
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+import random
+import sys
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "benchmarks"))
+from cosmop.pipeline import _Workers, plan_team  # noqa: E402
+from cosmop.scenario import load_scenario  # noqa: E402
+from sweep_sigint import commands, interrupt  # noqa: E402
+
+pytestmark = pytest.mark.skipif(os.name != "posix", reason="process groups and SIGINT are POSIX's")
+
+EXAMPLES = ROOT / "examples"
+_RNG = random.Random(39)
+MOMENTS = [_RNG.uniform(low, high) for low, high in ((0.2, 1.5), (1.5, 4.0), (4.0, 7.0))]
+"""Seconds after the start, one while the command line loads (a second or two), two later,
+while it plans or simulates (the 10x10 plans for 30 s and more; the runs below take 10 s and
+more)."""
+
+
+def _clean(row: dict) -> None:
+    assert not row["finished"], "the run ended before its interrupt: nothing was tested"
+    assert row["problems"] == [], f"{row['problems']}\n{row['stderr']}"
+
+
+@pytest.mark.parametrize("at", MOMENTS, ids=lambda at: f"{at:.1f}s")
+def test_ctrl_c_during_plan_with_png_ends_cleanly(tmp_path, at):
+    command, outputs = commands(EXAMPLES / "02_warehouse_10x10" / "scenario.yaml", tmp_path, False)
+    _clean(interrupt(command, outputs, at))
+
+
+@pytest.fixture(scope="module")
+def plan_2x2(tmp_path_factory) -> Path:
+    scenario = EXAMPLES / "01_warehouse_2x2" / "scenario.yaml"
+    path = tmp_path_factory.mktemp("plan") / "plan.json"
+    plan_team(load_scenario(scenario), workers=1).plans.save(path)
+    return path
+
+
+@pytest.mark.parametrize("at", MOMENTS, ids=lambda at: f"{at:.1f}s")
+def test_ctrl_c_during_simulate_with_gif_ends_cleanly(tmp_path, plan_2x2, at):
+    command, outputs = commands(EXAMPLES / "01_warehouse_2x2" / "scenario.yaml", tmp_path, True)
+    _clean(interrupt([*command, "--plan", str(plan_2x2)], outputs, at))
+
+
+@pytest.mark.parametrize("second", [0.2, 0.01])
+def test_a_second_ctrl_c_ends_at_once_and_cleanly(tmp_path, second):
+    # the 10x10 with its two workers, the case of issue 39: cosmop and its workers were left running
+    command, outputs = commands(EXAMPLES / "02_warehouse_10x10" / "scenario.yaml", tmp_path, False)
+    row = interrupt(command, outputs, 4.0, second=second)
+    _clean(row)
+    assert row["latency_s"] < 10
+
+
+def _sleep(seconds: float) -> float:
+    time.sleep(seconds)
+    return seconds
+
+
+def test_stopping_the_workers_ends_a_running_synthesis_at_once():
+    pool = _Workers(2)
+    futures = [pool.submit(_sleep, 60.0) for _ in range(3)]  # two run, one waits
+    workers, manager = list(pool._processes.values()), pool._executor_manager_thread
+    time.sleep(0.5)
+    start = time.perf_counter()
+    pool.stop()
+    assert time.perf_counter() - start < 10
+    assert not any(w.is_alive() for w in workers) and not manager.is_alive()
+    assert all(f.done() for f in futures)
+
+
+def test_an_interrupt_inside_the_planner_leaves_no_worker_and_no_thread():
+    # the interrupt comes in the progress callback, after the first synthesis, while the other
+    # robots' still run in the workers (which the planner used to leave running)
+    scenario = load_scenario(EXAMPLES / "02_warehouse_10x10" / "scenario.yaml")
+    threads = set(threading.enumerate())
+
+    def interrupted(robot, result):
+        raise KeyboardInterrupt
+
+    start = time.perf_counter()
+    with pytest.raises(KeyboardInterrupt):
+        plan_team(scenario, workers=2, on_robot=interrupted)
+    assert time.perf_counter() - start < 60
+    assert multiprocessing.active_children() == []
+    assert set(threading.enumerate()) <= threads
