@@ -192,7 +192,12 @@ def plan_with_progress(
 def _print_coordination(console: Console, result: Any) -> None:
     """The formal verdict: coordination pairs, messages, conflicts ordered, and the expected finish."""
     v, safety = result.verification, result.safety
-    ordered = f"{safety.conflicts} conflict(s) between plans, " if safety is not None else ""
+    ordered = ""
+    if safety is not None:
+        ordered = f"{safety.conflicts} conflict(s) between plans"
+        if safety.chosen:  # the orders that went against the robots' own itineraries
+            ordered += f", {safety.flipped} of {safety.chosen} orders against the itinerary"
+        ordered += ", "
     console.print(
         Text(
             f"formally: coordination: {len(result.plans.coordination)} pair(s), "
