@@ -194,3 +194,18 @@ def test_a_synthesis_runs_with_the_collector_paused(small, monkeypatch):
     res = synthesize(small.scene, "R2", small.mission.tasks["R2"])
     assert res.feasible and seen == [False]
     assert gc.isenabled()  # and running again after it
+
+
+@pytest.mark.parametrize(
+    ("word", "why"),
+    [
+        (["drop(R1,O1,W1)"], "drop(R1,O1,W1) (event 1): its hands are empty"),
+        (["pick(R1,O1)", "pick(R1,O2)"], "pick(R1,O2) (event 2) while it carries O1"),
+        (["pick(R1,O1)", "drop(R1,O2,W1)"], "drop(R1,O2,W1) (event 2): it carries O1"),
+    ],
+)
+def test_a_word_the_hands_cannot_do_is_refused_without_the_solver(small, word, why):
+    # one good at a time, picked with empty hands, dropped only when carried: no horizon helps
+    result = synthesize(small.scene, "R1", word)
+    assert not result.feasible and why in result.reason
+    assert result.horizon is None

@@ -289,7 +289,7 @@ def _local_mission(
     else:
         automaton, full = None, events_of(mission)
         events = strip_messages(full)
-        walled_off = unreachable(scene, robot, events, origin)
+        walled_off = _out_of_hand(robot, events, start) or unreachable(scene, robot, events, origin)
         lower = _least_steps(events)
     tasks = sum(1 for e in events if e.kind not in MESSAGE_KINDS)  # what the scenario bounds too
     if walled_off is None and automaton is None and tasks > MAX_TASK_EVENTS:
@@ -303,6 +303,26 @@ def _local_mission(
             f"({max_horizon} steps)"
         )
     return _Mission(automaton, full, events, lower, walled_off)
+
+
+def _out_of_hand(robot: str, events: Iterable[Event], start: State | None) -> str | None:
+    """Why no plan can do `events` in that order by what the robot holds: it carries one good at
+    a time, picks only with empty hands and drops only what it carries (``None``: it can)."""
+    held = None
+    if start is not None:
+        held = next((o for o, state in start.objects.items() if state.carried), None)
+    for n, event in enumerate(events, 1):
+        if event.kind == "pick":
+            if held is not None:
+                why = f"while it carries {held}: it carries one good at a time"
+                return f"{robot} cannot {event.name} (event {n}) {why}"
+            held = event.obj
+        elif event.kind == "drop":
+            if held != event.obj:
+                holding = f"it carries {held}" if held is not None else "its hands are empty"
+                return f"{robot} cannot {event.name} (event {n}): {holding}"
+            held = None
+    return None
 
 
 def _least_steps(events: Iterable[Event]) -> int:
