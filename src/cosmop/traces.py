@@ -9,7 +9,7 @@ animations and the web viewer (:mod:`cosmop.viz`) and the ROS 2 bag export
 Its file (:meth:`Trace.to_json`, :meth:`Trace.save`, :func:`load_trace`) is JSON: ``format``
 (:data:`TRACE_FORMAT`), ``scenario``, ``units`` (absent in older files: mm, degrees, s), ``dt``
 (s), ``frames`` (each with ``t`` in s, ``robots`` ``{id: {"pose": [x, y, heading], "v", "w",
-"carrying", "primitive", "waiting"}}``, ``humans`` and ``objects`` ``{id: [x, y]}``) and
+"carrying", "primitive", "waiting", "delayed"}}``, ``humans`` and ``objects`` ``{id: [x, y]}``) and
 ``messages`` (each a mapping with at least ``t``, ``from`` and ``to``; other keys are kept as
 they are, so new kinds of message pass through).  :func:`check_trace` checks that shape and
 names the first field that is wrong.
@@ -71,6 +71,7 @@ _STATE_KEYS = {  # the optional keys of a robot's state in a frame: a test and w
     "carrying": (_is_name, "the id of the object carried, or null"),
     "primitive": (_is_name, "the name of a primitive, or null"),
     "waiting": (lambda value: isinstance(value, bool), "true or false"),
+    "delayed": (lambda value: isinstance(value, bool), "true or false"),
 }
 
 
@@ -159,6 +160,7 @@ _ARRAYS = {  # every array of a Trace: its dtype, the ids along its second axis,
     "carrying": (int, "robot_ids", ()),
     "primitive": (int, "robot_ids", ()),
     "waiting": (bool, "robot_ids", ()),
+    "delayed": (bool, "robot_ids", ()),
     "humans": (float, "human_ids", (2,)),
     "objects": (float, "object_ids", (2,)),
 }
@@ -190,6 +192,9 @@ class Trace:
         What the `primitive` indices stand for (the simulator's 0 is None: finished).
     waiting : ndarray of bool, shape (n, R), optional
         Whether each robot waits for an answer (a ``Req``).
+    delayed : ndarray of bool, shape (n, R), optional
+        Whether a delay has stopped each robot (:mod:`cosmop.sim.delays`); None: a run without
+        delays (older files have none either).
     human_ids, object_ids : tuple of str
         The people and objects, in the order of their arrays' second axis.
     humans, objects : ndarray, shape (n, H, 2) and (n, O, 2)
@@ -221,6 +226,7 @@ class Trace:
     primitive: np.ndarray | None = None
     primitive_names: tuple[str | None, ...] = ()
     waiting: np.ndarray | None = None
+    delayed: np.ndarray | None = None
     human_ids: tuple[str, ...] = ()
     humans: np.ndarray | None = None
     object_ids: tuple[str, ...] = ()
@@ -336,9 +342,9 @@ class Trace:
         """The robot states of the frames `rows` as the file writes them (this trace already
         :meth:`rounded`)."""
         objects, names = [*self.object_ids, None], self.primitive_names  # carrying -1: objects[-1], None
-        poses, v, w, carrying, primitive, waiting = (
+        poses, v, w, carrying, primitive, waiting, delayed = (
             None if a is None else a[rows]
-            for a in (self.poses, self.v, self.w, self.carrying, self.primitive, self.waiting)
+            for a in (self.poses, self.v, self.w, self.carrying, self.primitive, self.waiting, self.delayed)
         )
         columns = {"pose": poses.tolist()}
         for key, array, to_json in (
@@ -347,6 +353,7 @@ class Trace:
             ("carrying", carrying, objects.__getitem__),
             ("primitive", primitive, names.__getitem__),
             ("waiting", waiting, None),
+            ("delayed", delayed, None),
         ):
             if array is not None:
                 values = array.tolist()
@@ -371,7 +378,7 @@ class Trace:
 
         The ids of each kind are taken in the order the frames first name them (objects that
         are only ever carried come last); a frame that does not name one is NaN there.  Keys no
-        robot state has (``v``, ``w``, ``carrying``, ``primitive``, ``waiting``) give None.
+        robot state has (``v``, ``w``, ``carrying``, ``primitive``, ``waiting``, ``delayed``) give None.
 
         Raises
         ------
@@ -478,13 +485,13 @@ def _first_seen(frames: Sequence[Mapping[str, Any]], group: str) -> tuple[str, .
 def _robot_columns(frames: Sequence[Mapping[str, Any]], robot_ids: Sequence[str]) -> dict[str, Any]:
     """``poses`` (n, R, 3) and every optional key some robot state has, frame by frame.
 
-    ``v`` and ``w`` are arrays (NaN where not given), ``waiting`` a boolean array, ``carrying``
+    ``v`` and ``w`` are arrays (NaN where not given), ``waiting`` and ``delayed`` boolean arrays, ``carrying``
     and ``primitive`` lists of rows of names (None where not given), still to be numbered.
     """
     n, index = len(frames), {rid: i for i, rid in enumerate(robot_ids)}
     columns: dict[str, Any] = {"poses": np.full((n, len(robot_ids), 3), np.nan)}
     given: set[str] = set()
-    for key, empty in (("v", np.nan), ("w", np.nan), ("waiting", False)):
+    for key, empty in (("v", np.nan), ("w", np.nan), ("waiting", False), ("delayed", False)):
         columns[key] = np.full((n, len(robot_ids)), empty)
     for key in ("carrying", "primitive"):
         columns[key] = [[None] * len(robot_ids) for _ in range(n)]

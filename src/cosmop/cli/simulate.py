@@ -17,11 +17,20 @@ from cosmop.io import check_writable, uninterrupted
 from cosmop.planning.checker import check_plan
 from cosmop.planning.plan import PlanSet, load_plan
 from cosmop.scene import Scenario
+from cosmop.sim import Delays, SimSettings
 
 if TYPE_CHECKING:
     from cosmop.traces import Trace
 
 __all__ = ["simulate"]
+
+
+def _parse_delays(text: str) -> Delays:
+    """``--delays P:MIN:MAX``: the delays, or a usage error naming the option (exit 2)."""
+    try:
+        return Delays.parse(text)
+    except ValueError as err:
+        raise typer.BadParameter(str(err)) from None
 
 
 def simulate(
@@ -34,7 +43,19 @@ def simulate(
             show_default=False,
         ),
     ] = None,
-    seed: Annotated[int, typer.Option(help="Seed of the people's random walks (0 or more).", min=0)] = 0,
+    seed: Annotated[
+        int, typer.Option(help="Seed of the people's random walks and of the delays (0 or more).", min=0)
+    ] = 0,
+    delays: Annotated[
+        Delays | None,
+        typer.Option(
+            parser=_parse_delays,
+            metavar="P:MIN:MAX",
+            help="Every simulated second each robot stops with probability P for MIN to MAX s "
+            "(e.g. 0.01:2:10).",
+            show_default=False,
+        ),
+    ] = None,
     summary: Annotated[
         Path | None, typer.Option(help="Write the summary (cosmop.sim/1 JSON) here.", show_default=False)
     ] = None,
@@ -73,6 +94,7 @@ def simulate(
 
     Every cycle each robot drives (GoTo), docks (PickUp, DropOff), waits for an answer (Req) or
     sends one (Res); a monitor records every contact and whether the robot was moving then.
+    With ``--delays`` robots stop at random for a while, and the messages keep their order.
     Without ``--plan`` the team is planned first, as ``cosmop plan`` does (``--workers``,
     ``--scheduler``).  Exit status 0 when every robot finished with no contact while moving, 1
     otherwise, 2 on bad input.
@@ -81,7 +103,8 @@ def simulate(
     loaded = load(scenario)
     _check_outputs(summary=summary, trace=trace, gif=gif, mp4=mp4, bag=bag)
     plans = _plans_to_run(loaded, plan_file, workers, scheduler)
-    result = _run_with_progress(loaded, plans, seed, max_time, replan)
+    settings = SimSettings(max_time=max_time, replan=replan, delays=delays)
+    result = _run_with_progress(loaded, plans, seed, settings)
     # one Trace for the file, the bag and the animations, made only when one of them is asked for
     run = result.trace() if any(p is not None for p in (trace, bag, gif, mp4)) else None
     with uninterrupted():  # the trace and its summary: both or neither
@@ -141,16 +164,12 @@ def _plans_to_run(
     return plans
 
 
-def _run_with_progress(
-    loaded: Scenario, plans: PlanSet, seed: int, max_time: float | None, replan: bool
-) -> Any:
+def _run_with_progress(loaded: Scenario, plans: PlanSet, seed: int, settings: SimSettings) -> Any:
     """:func:`cosmop.sim.simulate` under a bar of simulated time and robots done."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
-    from cosmop.sim import SimSettings, time_limit
     from cosmop.sim import simulate as run_simulate
-
-    settings = SimSettings(max_time=max_time, replan=replan)
+    from cosmop.sim import time_limit
 
     columns = (
         TextColumn("simulating"),
@@ -187,15 +206,18 @@ def _animate(
 
 def _robots_table(loaded: Scenario, result: Any, seed: int) -> Table:
     """One row per robot: where it ended, how far it drove, whether and when it finished."""
-    table = Table(title=Text(f"simulation of {loaded.name} (seed {seed})"), header_style="bold")
+    delays = result.delays
+    title = f"simulation of {loaded.name} (seed {seed}" + (f"; delays {delays.show()})" if delays else ")")
+    table = Table(title=Text(title), header_style="bold")
     metres = loaded.units == "m"  # the scenario file's units: metres and radians, or mm and degrees
     pose_column = "pose [m, rad]" if metres else "pose [mm, deg]"
-    for column in ("robot", pose_column, "distance", "finished", "done at (planned)"):
+    columns = ["robot", pose_column, "distance", "finished", "done at (planned)"]
+    for column in columns + (["stopped by delays"] if delays else []):
         table.add_column(Text(column))  # Text: "[mm, deg]" is not markup
     finished = result.finished
     for rid, (pose, dist) in result.robots.items():
         x, y, heading = pose
-        table.add_row(
+        row = [
             rid,
             f"{x / 1000:.3f}, {y / 1000:.3f}, {math.radians(heading):.2f}"
             if metres
@@ -203,8 +225,18 @@ def _robots_table(loaded: Scenario, result: Any, seed: int) -> Table:
             f"{dist / 1000:.2f} m" if metres else f"{dist:.0f} mm",
             "yes" if finished[rid] else Text("no", style="red"),
             _done_at(result.steps.get(rid, ()), finished[rid]),
-        )
+        ]
+        if delays:
+            row.append(_stopped(result.stops.get(rid, ())))
+        table.add_row(*row)
     return table
+
+
+def _stopped(stops) -> str:
+    """How often and how long a delay stopped a robot: ``2 times, 12.3 s`` (``-``: never)."""
+    if not stops:
+        return "-"
+    return f"{len(stops)} time{'s' if len(stops) > 1 else ''}, {sum(s for _, s in stops):.1f} s"
 
 
 def _verdict(loaded: Scenario, result: Any, plans: PlanSet) -> str:
@@ -218,8 +250,16 @@ def _verdict(loaded: Scenario, result: Any, plans: PlanSet) -> str:
         + f"{result.wall_time_s:.1f} s, {speed:.0f}x real time); "
         f"objects in place {sum(delivered.values())}/{len(delivered)}; contacts {len(result.contacts)}, "
         f"while moving {result.contacts_while_moving}; messages {len(result.messages)}; "
-        f"replans {result.replans}"
+        f"replans {result.replans}" + _delays_said(result)
     )
+
+
+def _delays_said(result: Any) -> str:
+    """The delays in the closing line: how often robots stopped and for how long in all."""
+    report = result.delay_report()
+    if report is None:
+        return ""
+    return f"; delays stopped robots {report['count']} times, {report['seconds']:.1f} s in all"
 
 
 def _done_at(rows, finished: bool) -> str:

@@ -2,11 +2,13 @@
 
 :func:`simulate` runs a ``cosmop.plan/1`` plan set in the scenario's world
 (:mod:`cosmop.sim.simulation`); people walk their paths (:mod:`cosmop.sim.humans`); a stalled
-robot replans its remaining mission from where it is (:mod:`cosmop.sim.replan`).  The result
+robot replans its remaining mission from where it is (:mod:`cosmop.sim.replan`); robots may be
+delayed at random (:mod:`cosmop.sim.delays`).  The result
 carries the ``cosmop.sim/1`` summary, with every step's planned and realised times
 (:mod:`cosmop.sim.timing`), and the ``cosmop.trace/1`` trace (:mod:`cosmop.sim.result`).
 """
 
+from cosmop.sim.delays import Delays
 from cosmop.sim.monitor import footprint_overlaps
 from cosmop.sim.replan import replan, sensed_scene
 from cosmop.sim.result import SIM_FORMAT, Contact, Message, SimResult, SimSettings
@@ -18,6 +20,7 @@ __all__ = [
     "SIM_FORMAT",
     "TRACE_FORMAT",
     "Contact",
+    "Delays",
     "Message",
     "SimResult",
     "SimSettings",

@@ -39,7 +39,7 @@ from cosmop.control.safety import stopping_margin
 from cosmop.docking import docking_pose, in_front
 from cosmop.events import Primitive
 from cosmop.planning.plan import Step
-from cosmop.sim.motion import HOLD, REPLANNED, brake, creep_is_safe, creep_out, drive
+from cosmop.sim.motion import HOLD, REPLANNED, brake, creep_is_safe, creep_out, drive, halt
 from cosmop.sim.world import TOUCH, Action, Agent, World
 
 __all__ = [
@@ -63,8 +63,11 @@ def decide(world: World, agent: Agent) -> Action:
     ``("move", (v, w))`` or ``("dock", pose)`` (:data:`~cosmop.sim.world.Action`).
 
     Steps that are done at once (a message sent, a drive already at its goal) are completed in
-    the same cycle; a robot that has finished brakes.
+    the same cycle; a robot that has finished brakes.  A robot a delay has stopped
+    (:mod:`cosmop.sim.delays`) brakes along its arc and stands, its step left as it was.
     """
+    if agent.stopped_until is not None:
+        return halt(world, agent.index)
     while not agent.done:
         step = agent.step
         action = EXECUTORS[step.primitive](world, agent, step)

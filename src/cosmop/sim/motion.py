@@ -38,6 +38,7 @@ __all__ = [
     "detour",
     "drive",
     "find_way_out",
+    "halt",
     "route",
 ]
 
@@ -56,6 +57,16 @@ _REJOIN_AHEAD = (4000.0, 8000.0, 16000.0)  # mm along the path: where a detour m
 def brake(world: World, i: int) -> Action:
     """Robot `i`'s command to brake with :math:`-b` (the always-safe choice), not turning."""
     return ("move", (max(0.0, world.v[i] - world.limits.braking[i] * world.dt), 0.0))
+
+
+def halt(world: World, i: int) -> Action:
+    """Robot `i`'s command to brake with :math:`-b` along its current arc, and stand.
+
+    The arc is the one the dynamic window chose last cycle, whose braking its safety check
+    covered (:mod:`cosmop.control.dwa`); standing, it stops turning too.
+    """
+    v = float(world.v[i])
+    return ("move", (max(0.0, v - world.limits.braking[i] * world.dt), float(world.w[i]) if v > 0 else 0.0))
 
 
 def route(world: World, i: int, goal: tuple, origin: tuple | None) -> tuple[GlobalPath, tuple | None]:

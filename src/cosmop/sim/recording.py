@@ -13,7 +13,7 @@ from cosmop.sim.world import World
 
 __all__ = ["Recorder"]
 
-_FIELDS = ("t", "pose", "v", "w", "carrying", "primitive", "waiting", "humans", "objects")
+_FIELDS = ("t", "pose", "v", "w", "carrying", "primitive", "waiting", "delayed", "humans", "objects")
 
 
 class Recorder:
@@ -40,6 +40,7 @@ class Recorder:
             np.array([0 if a.done else FRAME_PRIMITIVES.index(a.step.primitive) for a in world.agents])
         )
         rows["waiting"].append(np.array([a.waiting for a in world.agents]))
+        rows["delayed"].append(np.array([a.stopped_until is not None for a in world.agents]))
         rows["humans"].append(np.array([w.position for w in world.walkers]).reshape(-1, 2))
         rows["objects"].append(world.object_positions())
 

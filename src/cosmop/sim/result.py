@@ -21,6 +21,7 @@ from cosmop.events import Event
 from cosmop.io import write_atomic
 from cosmop.planning.plan import PRIMITIVES, PlanSet
 from cosmop.scene import Scenario, Scene
+from cosmop.sim.delays import Delays
 from cosmop.sim.timing import StepTimes
 from cosmop.traces import Trace
 from cosmop.units import INTERNAL_UNITS
@@ -96,6 +97,9 @@ class SimSettings:
         Give each robot's dynamic window only the walls and bodies within its reach
         (:mod:`cosmop.control.neighbourhood`; the commands are the same, the cost linear in the
         team).  ``False`` scores everything against everything, to compare.
+    delays : Delays or None
+        Robots stop at random (:mod:`cosmop.sim.delays`), drawn from the run's seed; ``None``
+        (the default): never.
     """
 
     max_time: float | None = None
@@ -116,6 +120,7 @@ class SimSettings:
     rlimit: int = 10_000_000
     dwa: DwaSettings = field(default_factory=DwaSettings)
     neighbourhood: bool = True
+    delays: Delays | None = None
 
 
 @dataclass(frozen=True)
@@ -187,7 +192,8 @@ class SimResult:
     frames : Mapping[str, ndarray]
         Per cycle arrays: ``t`` (n,), ``pose`` (n, R, 3; degrees), ``v`` (n, R), ``w``
         (n, R; deg/s), ``carrying`` (n, R; object index or -1), ``primitive`` (n, R; index in
-        :data:`FRAME_PRIMITIVES`), ``waiting`` (n, R), ``humans`` (n, H, 2), ``objects``
+        :data:`FRAME_PRIMITIVES`), ``waiting`` (n, R), ``delayed`` (n, R: a delay has stopped
+        the robot), ``humans`` (n, H, 2), ``objects``
         (n, O, 2); lengths in mm, speeds in mm/s.
     robot_ids, human_ids, object_ids : tuple of str
     replan_log : tuple of dict
@@ -204,6 +210,11 @@ class SimResult:
     steps : Mapping[str, tuple of StepTimes]
         Every robot's steps with their planned (the plan set's itinerary) and realised start
         and end (:mod:`cosmop.sim.timing`).
+    delays : Delays or None
+        The delays the run drew (``SimSettings.delays``); ``None``: none.
+    stops : Mapping[str, tuple of (float, float)]
+        Per robot, the delays that stopped it: ``(time, seconds)``, s (a stop the run's end cut
+        short counts the seconds it lasted).
     """
 
     scenario: str
@@ -227,6 +238,8 @@ class SimResult:
     added: tuple[str, ...] = ()
     replan_log: tuple[dict[str, Any], ...] = ()
     steps: Mapping[str, tuple[StepTimes, ...]] = field(default_factory=dict)
+    delays: Delays | None = None
+    stops: Mapping[str, tuple[tuple[float, float], ...]] = field(default_factory=dict)
 
     def executed_word(self) -> tuple[str, ...]:
         """The mission events the run realised, in time order (messages and the events of tasks
@@ -247,6 +260,28 @@ class SimResult:
         return {
             "planned": round(max(planned), 3) if planned else None,
             "realised": round(max(realised, default=0.0), 3) if self.completed else None,
+        }
+
+    def delay_report(self) -> dict[str, Any] | None:
+        """The delays of the run (``None`` when it drew none): the model, how many stops and how
+        many seconds stopped in all and per robot, and every stop.
+
+        The makespan the delays cost is not in one run: it is the realised makespan against
+        that of the same seed without delays (``benchmarks/sweep_delays.py`` compares them).
+        """
+        if self.delays is None:
+            return None
+        robots = {
+            rid: {"count": len(stops), "seconds": round(sum(s for _, s in stops), 3)}
+            for rid, stops in self.stops.items()
+        }
+        log = sorted((t, rid, s) for rid, stops in self.stops.items() for t, s in stops)
+        return {
+            **self.delays.to_dict(),
+            "count": sum(r["count"] for r in robots.values()),
+            "seconds": round(sum(s for _, _, s in log), 3),
+            "robots": robots,
+            "log": [{"t": round(t, 6), "robot": rid, "seconds": round(s, 3)} for t, rid, s in log],
         }
 
     @property
@@ -272,6 +307,7 @@ class SimResult:
             "events": [{"t": t, "robot": r, "event": e} for t, r, e in self.events],
             "replan_log": list(self.replan_log),
             "makespan": self.makespan,
+            "delays": self.delay_report(),
             "itinerary": {rid: [row.to_dict() for row in rows] for rid, rows in self.steps.items()},
             "objects": {
                 oid: {"position": [round(p[0], 3), round(p[1], 3)], "carried_by": by}
@@ -303,6 +339,7 @@ class SimResult:
             primitive=f["primitive"],
             primitive_names=FRAME_PRIMITIVES,
             waiting=f["waiting"],
+            delayed=f["delayed"] if self.delays is not None else None,  # (a run without: as before)
             human_ids=self.human_ids,
             humans=f["humans"],
             object_ids=self.object_ids,

@@ -41,8 +41,14 @@ progress for ``stall_time`` replans its remaining mission from where it is, with
 people it senses added to the scene (:mod:`cosmop.sim.replan`).  Units: mm, mm/s, degrees at
 the interfaces, seconds.
 
+Robots may be delayed (``SimSettings.delays``, :mod:`cosmop.sim.delays`): every simulated
+second each robot still executing its plan stops, with some probability, for a random time.
+A stopped robot brakes and stands, and then carries on; the messages keep the order between
+the robots whatever their speed.
+
 The code is split along those jobs; :func:`simulate` runs one control cycle after the other:
 
+0. delays end and strike (:func:`_delays`);
 1. every robot decides what to do for its current step (:func:`cosmop.sim.execute.decide`,
    one executor per primitive, the motion in :mod:`cosmop.sim.motion`; a stalled robot
    replans, :func:`cosmop.sim.replan.replan_stalled`);
@@ -92,6 +98,8 @@ __all__ = [
     "time_limit",
 ]
 
+_EPS = 1e-9  # s: the clock, summed from its cycles, may fall a hair short of a stop's end
+
 
 def simulate(
     scenario: Scenario,
@@ -110,7 +118,8 @@ def simulate(
     plans : PlanSet
         A feasible ``cosmop.plan/1`` plan set for the scenario (with its coordination pairs).
     seed : int
-        Seeds the people's random walks; the run is deterministic given the seed.
+        Seeds the people's random walks and the delays (``settings.delays``), each with a
+        generator of its own; the run is deterministic given the seed.
     settings : SimSettings, optional
     on_cycle : callable, optional
         Called every cycle with ``(t, robots done, robots)`` (the CLI's progress bar).
@@ -164,7 +173,8 @@ def _time_limit(settings: SimSettings, planned: Itinerary | None) -> float:
 
 
 def _cycle(world: World) -> None:
-    """One control cycle of the whole world (the module docstring's steps 1 to 4)."""
+    """One control cycle of the whole world (the module docstring's steps 0 to 4)."""
+    _delays(world)
     # the dynamic window senses the world as it was when the cycle began: an object picked
     # up or dropped during the decisions is sensed next cycle
     sensed = world.obstacles()
@@ -176,6 +186,20 @@ def _cycle(world: World) -> None:
     world.t += world.dt
     monitor(world, moving)
     let_go(world)
+
+
+def _delays(world: World) -> None:
+    """The robots' delays (:mod:`cosmop.sim.delays`): the stops that are over end, then the
+    draws due now strike the robots that still execute their plan and are not stopped."""
+    if world.delay_draws is None:
+        return
+    for agent in world.agents:
+        if agent.stopped_until is not None and world.t >= agent.stopped_until - _EPS:
+            agent.resume(world.t)
+    for i, seconds in world.delay_draws.due(world.t):
+        agent = world.agents[i]
+        if not agent.done and agent.stopped_until is None:
+            agent.stop_for(world.t, seconds)
 
 
 @dataclass
@@ -289,6 +313,8 @@ def _result(
         events=tuple(world.events),
         added=tuple(e.name for task in plans.added for e in task.events),
         replan_log=tuple(world.replan_log),
+        delays=world.settings.delays,
+        stops={a.id: tuple((t, min(seconds, world.t - t)) for t, seconds in a.stops) for a in world.agents},
         steps=step_times(
             {rid: [s.label for s in p.steps] for rid, p in plans.robots.items()},
             planned,

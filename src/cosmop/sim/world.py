@@ -24,6 +24,7 @@ from cosmop.physics import TOUCH  # the one tolerance under which two squares to
 from cosmop.planning.plan import PlanSet, RobotPlan, Step
 from cosmop.planning.realisation import event_instants
 from cosmop.scene import Scenario
+from cosmop.sim.delays import DelayDraws
 from cosmop.sim.humans import Walker
 from cosmop.sim.result import Contact, Message, SimSettings, drop_holds
 
@@ -73,6 +74,8 @@ class Agent:
         self.answers_sent: dict[str, int] = {}  # Res steps done per object
         # where it creeps out of touch before driving off: None not looked for yet, False none
         self.way_out: tuple[float, float] | bool | None = None
+        self.stopped_until: float | None = None  # a delay holds it until then, s (None: not stopped)
+        self.stops: list[tuple[float, float]] = []  # the delays that struck it: (time, seconds), s
 
     @property
     def mission(self) -> list[Event]:
@@ -103,6 +106,19 @@ class Agent:
     def step(self) -> Step:
         """The step being executed."""
         return self.steps[self.step_index]
+
+    def stop_for(self, t: float, seconds: float) -> None:
+        """A delay strikes at time `t` (s): the robot stops for `seconds` (:mod:`cosmop.sim.delays`)."""
+        self.stopped_until = t + seconds
+        self.stops.append((t, seconds))
+
+    def resume(self, t: float) -> None:
+        """The delay is over at time `t` (s).  The clocks of progress and of detours move on by
+        the time the robot stood, so that its own stop is not taken for a stall."""
+        stood = t - self.stops[-1][0]
+        self.last_progress_t += stood
+        self.detour_until += stood
+        self.stopped_until = None
 
     def restart_step(self) -> None:
         """Forget how the current step was being executed: it starts afresh next cycle."""
@@ -146,10 +162,13 @@ class World:
         self.object_xy = np.array([o.position for o in objects], dtype=float).reshape(-1, 2)  # resting ones
         self.object_half = np.array([o.size / 2.0 for o in objects])
         self.carried_by = np.full(len(self.object_ids), -1)  # robot index, -1: resting
-        rng = np.random.default_rng(seed)  # the people's random walks: the only randomness
+        rng = np.random.default_rng(seed)  # the people's random walks
         self.walkers = [Walker(humans[h], self.walls, rng) for h in self.human_ids]
         self.human_half = np.array([w.half for w in self.walkers])
         self.human_speed = np.array([humans[h].speed for h in self.human_ids])  # at most, mm/s
+        # the robots' delays: a generator of their own, so that the people walk the same without them
+        delays = settings.delays
+        self.delay_draws = None if delays is None else DelayDraws(delays, seed, len(self.robot_ids))
         self.agents = []
         for i, rid in enumerate(self.robot_ids):
             plan = plans.robots.get(rid)
