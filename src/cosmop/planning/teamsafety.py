@@ -199,8 +199,34 @@ def make_team_safe(
         )
         for r, p in plans.items()
     }
-    if settings.cut:
-        plans = _cut_where_shared(scene, plans, settings, starts, positions, walls)
+    context = (scene, settings, starts, positions, about, used)
+    uncut = frozenset() if settings.cut else frozenset(plans)
+    best = None
+    while True:
+        cut = _cut_where_shared(scene, plans, settings, starts, positions, walls, uncut)
+        attempt = _order(context, cut, waypoints)
+        if best is None or len(attempt[2]) < len(best[2]):
+            best = attempt
+        if not attempt[2] or uncut == frozenset(plans):
+            break
+        # a cut leaves a place to stand in the middle of a drive, and standing there may close
+        # a cycle: drives of the robots in unresolved conflicts are ordered whole, then all are
+        involved = {r for c in attempt[2] for r in c.robots} - uncut
+        uncut = uncut | involved if involved else frozenset(plans)
+    new_plans, messages, unresolved, stats = best
+    if used is not None:  # each attempt named its messages in a copy; the kept one's are taken
+        used |= {m.event for m in messages}
+    return TeamSafety(
+        new_plans, messages, stats[0], stats[1], unresolved, stats[2], stats[3],
+        time.perf_counter() - t0, stats[4], stats[5], stats[6],
+    )  # fmt: skip
+
+
+def _order(context, plans: Mapping[str, RobotPlan], waypoints):
+    """One ordering of every conflict between `plans` (already cut): the plans with their new
+    messages, those messages, the conflicts left unresolved, and the statistics of
+    :class:`TeamSafety` (found, ordered before, makespan alone, makespan, fixed, chosen, flipped)."""
+    scene, settings, starts, positions, about, used = context
     horizons = {r: p.horizon for r, p in plans.items()}
     links = message_links(plans)
     times = durations(scene, plans, starts=starts)
@@ -214,7 +240,8 @@ def make_team_safe(
     fixed = fixed_places(items)
     chosen, unresolved = order_conflicts(found, horizons, links, [], times, fixed=fixed)
     kept = _reduce(horizons, links, chosen)
-    new_plans, placed = place_edges(scene, plans, [edge for edge, _ in kept], "clear", used, starts)
+    taken = set(used or ())
+    new_plans, placed = place_edges(scene, plans, [edge for edge, _ in kept], "clear", taken, starts)
     new_plans = {r: merge_drives(p, waypoints[r]) for r, p in new_plans.items()}
     messages = tuple(
         PlanMessage(name, "conflict", _protects(new_plans, name, conflict), conflict.place)
@@ -226,19 +253,8 @@ def make_team_safe(
         (),
         durations(scene, new_plans, starts=starts),
     )
-    return TeamSafety(
-        new_plans,
-        messages,
-        len(found),
-        ordered,
-        tuple(unresolved),
-        alone,
-        final.makespan,
-        time.perf_counter() - t0,
-        fixed,
-        len(chosen),
-        _flipped(chosen, precedence),
-    )
+    stats = (len(found), ordered, alone, final.makespan, fixed, len(chosen), _flipped(chosen, precedence))
+    return new_plans, messages, tuple(unresolved), stats
 
 
 def _flipped(chosen, alone: Precedence) -> int:
@@ -252,19 +268,25 @@ def _flipped(chosen, alone: Precedence) -> int:
     return out
 
 
-def _cut_where_shared(scene, plans, settings, starts, positions, walls) -> dict[str, RobotPlan]:
-    """Every drive cut where it enters and where it leaves a place another robot uses.
+def _cut_where_shared(scene, plans, settings, starts, positions, walls, uncut) -> dict[str, RobotPlan]:
+    """Every drive cut where it enters and where it leaves a place another robot uses, except
+    the drives of the robots in `uncut`.
 
     A conflict then holds only the piece of the drive inside the shared place, so the robot
     waits just before it enters, not before its whole drive, and the other is told as soon as
     it leaves (the temporal plan graph's grain: an order between the pieces of two drives that
     share a region).  The plans stay sound: a piece sweeps part of what the drive swept.
     """
+    if uncut >= set(plans):
+        return dict(plans)
     precedence = Precedence({r: p.horizon for r, p in plans.items()}, message_links(plans))
     items, _ = occupancies(scene, plans, precedence, settings, starts, positions)
     tree = shapely.STRtree([item.region for item in items])
     out = {}
     for robot, plan in plans.items():
+        if robot in uncut:
+            out[robot] = plan
+            continue
         grown = scene.robots[robot].size + settings.clearance
         poses = [start_pose(scene, robot, starts), *(step.robot for step in plan.steps)]
         cuts: dict[int, list[float]] = {}
