@@ -47,6 +47,7 @@ from cosmop.missions.team import TeamVerdict, blocking_word, check_words
 from cosmop.planning.aside import ROOM, dock_slots, handover_spot, place_aside
 from cosmop.planning.checker import CheckReport, check_plan
 from cosmop.planning.conflicts import ConflictSettings
+from cosmop.planning.lanes import lanes
 from cosmop.planning.plan import MAX_STEPS, AddedTask, Coordination, PlanMessage, PlanSet, RobotPlan
 from cosmop.planning.realisation import request_phases
 from cosmop.planning.synthesis import DEFAULT_RLIMIT, Synthesis, synthesize
@@ -59,6 +60,15 @@ from cosmop.units import show_point
 __all__ = ["TeamResult", "plan_team"]
 
 _AROUND = ConflictSettings(clearance=2 * ROOM)  # walls around goods set aside: ROOM off them
+
+WAYS_AROUND = 4
+"""Re-plans :func:`plan_team` tries, at most, to take a way around a long wait for a shared place."""
+
+TRIAL_STEPS = 2
+"""Steps a way around may add to a robot's plan: a trial searches no longer plans."""
+
+MIN_WAIT = 2.0
+"""Expected seconds of a wait below which no way around is tried: a detour rarely costs less."""
 
 PHASES = ("decompose", "allocate", "synthesize", "coordinate", "conflicts", "verify", "check")
 """The phases whose seconds :attr:`TeamResult.phases` records."""
@@ -120,6 +130,7 @@ class _Job:
     unrequestable: frozenset[str] = frozenset()
     explain: bool = True  # an infeasible answer says why (costs more solver calls)
     spots: tuple[tuple[Event, tuple[float, float]], ...] = ()  # drops pinned for a hand-over
+    min_horizon: int = 0  # no shorter plan exists (a re-plan with more walls)
 
 
 def _automaton_key(dfa: DFA) -> tuple:
@@ -138,6 +149,7 @@ def _synthesize(job: _Job) -> Synthesis:
         unrequestable=job.unrequestable,
         explain=job.explain,
         spots=job.spots,
+        min_horizon=job.min_horizon,
     )
 
 
@@ -231,9 +243,19 @@ class _Planner:
             tuple(sorted(self.spots.get(robot, {}).items())),
         )
 
-    def key(self, robot: str, events: tuple[Event, ...] | DFA, explain: bool = True) -> tuple:
+    def key(
+        self, robot: str, events: tuple[Event, ...] | DFA, explain: bool = True, window: tuple | None = None
+    ) -> tuple:
+        """The cache's key of a question; `window` (the lengths searched, when not every one)
+        keys an answer that found no plan in it."""
         mission = _automaton_key(events) if isinstance(events, DFA) else tuple(events)
-        return (robot, mission, *self.restrictions(robot), *(() if explain else ("unexplained",)))
+        return (
+            robot,
+            mission,
+            *self.restrictions(robot),
+            *(() if explain else ("unexplained",)),
+            *(() if window is None else (window,)),
+        )
 
     def remember(self, robot: str, events: tuple[Event, ...], forbidden: frozenset[str], result: Synthesis):
         """Keep `result` as the answer for `events` with `forbidden` (one it answers exactly)."""
@@ -245,7 +267,9 @@ class _Planner:
         self.placed.setdefault(handover.receiver, {})[handover.obj] = spot
         self.spots.setdefault(handover.giver, {})[handover.drop] = spot
 
-    def job(self, robot: str, events: tuple[Event, ...] | DFA, explain: bool = True) -> _Job:
+    def job(
+        self, robot: str, events: tuple[Event, ...] | DFA, explain: bool = True, window: tuple | None = None
+    ) -> _Job:
         scene = self.scenario.scene
         extra = self.obstacles.get(robot, ())
         if extra:
@@ -258,23 +282,50 @@ class _Planner:
         # a branching mission gets the horizon of its alphabet: no word of it has more events
         mission = tuple(parse_event(e) for e in events.alphabet) if branching else tuple(events)
         horizon = self.max_horizon if self.max_horizon is not None else default_horizon(mission)
+        least = 0
+        if window is not None:
+            least, horizon = window[0], min(horizon, window[1])
         forbidden = self.forbidden.get(robot, frozenset())
         spots = tuple(sorted(self.spots.get(robot, {}).items()))
         return _Job(
-            scene, robot, events if branching else mission, horizon, self.rlimit, forbidden, explain, spots
+            scene,
+            robot,
+            events if branching else mission,
+            horizon,
+            self.rlimit,
+            forbidden,
+            explain,
+            spots,
+            least,
         )
 
-    def run(self, jobs: Mapping[str, tuple[Event, ...]], explain: bool = True) -> dict[str, Synthesis]:
-        """Each robot's synthesis; with `explain` false an infeasible one only says so (trials)."""
+    def run(
+        self,
+        jobs: Mapping[str, tuple[Event, ...]],
+        explain: bool = True,
+        windows: Mapping[str, tuple[int, int]] | None = None,
+    ) -> dict[str, Synthesis]:
+        """Each robot's synthesis; with `explain` false an infeasible one only says so (trials).
+
+        `windows` gives robots the lengths to search, ``(least, most)``: the least known (no
+        shorter plan exists), the most a trial's bound; a plan found is the shortest all the same.
+        """
         t0 = time.perf_counter()
+        windows = windows or {}
         out: dict[str, Synthesis] = {}
         for robot, events in jobs.items():
             hit = self.cache.get(self.key(robot, events))  # an explained answer serves every call
             if hit is None and not explain:
                 hit = self.cache.get(self.key(robot, events, explain=False))
+            if hit is None and robot in windows:
+                hit = self.cache.get(self.key(robot, events, explain, windows[robot]))
             if hit is not None:
                 out[robot] = hit
-        work = {robot: self.job(robot, events, explain) for robot, events in jobs.items() if robot not in out}
+        work = {
+            robot: self.job(robot, events, explain, windows.get(robot))
+            for robot, events in jobs.items()
+            if robot not in out
+        }
         if self.executor is None or len(work) < 2:
             for robot, job in work.items():
                 out[robot] = _synthesize(job)
@@ -295,7 +346,8 @@ class _Planner:
                         future.cancel()
                 raise
         for robot, events in jobs.items():
-            self.cache[self.key(robot, events, explain=explain or out[robot].feasible)] = out[robot]
+            window = windows.get(robot) if not out[robot].feasible else None
+            self.cache[self.key(robot, events, explain or out[robot].feasible, window)] = out[robot]
         self.phases["synthesize"] += time.perf_counter() - t0
         return {robot: out[robot] for robot in jobs}
 
@@ -310,6 +362,7 @@ def plan_team(
     executor: Executor | None = None,
     on_robot: Callable[[str, Synthesis], None] | None = None,
     conflicts: ConflictSettings | None = None,
+    ways_around: int = WAYS_AROUND,
 ) -> TeamResult:
     """Plan, coordinate, make team-safe and verify the whole team (see the module docstring).
 
@@ -332,6 +385,9 @@ def plan_team(
         Called after every synthesis (progress display).
     conflicts : ConflictSettings, optional
         How conflicts between plans are found.
+    ways_around : int
+        Re-plans tried to take a way around a long wait for a shared place instead of waiting
+        (:func:`_shorten_waits`; 0: none).
 
     Raises
     ------
@@ -362,7 +418,9 @@ def plan_team(
             except MissionTooLargeError as err:
                 raise _in_file(err, scenario) from None
             phases["allocate"] = time.perf_counter() - t - (phases["synthesize"] - before)
-        return _loop(scenario, mission, words, notes, reasons, planner, max_iterations, conflicts, choice)
+        return _loop(
+            scenario, mission, words, notes, reasons, planner, max_iterations, conflicts, choice, ways_around
+        )
     except BaseException:  # an interrupt or an error: do not wait for the workers' syntheses
         if pool is not None:
             pool.stop()
@@ -422,6 +480,7 @@ def _loop(
     max_iterations: int,
     settings: ConflictSettings | None,
     choice: Choice | None = None,
+    ways_around: int = 0,
 ) -> TeamResult:
     """Coordinate requests, make the plans team-safe, verify and check (steps 2-5)."""
     phases = planner.phases
@@ -440,6 +499,8 @@ def _loop(
     safety, plans = None, {r: res.plan for r, res in results.items() if res.plan is not None}
     if not reasons:  # the scenario with the places of goods set aside, if any
         safety = _make_safe(planner.scenario, current, results, planner, settings, reasons, replans)
+        if not reasons and ways_around > 0:
+            safety = _shorten_waits(current, results, planner, settings, safety, replans, ways_around)
         plans = dict(safety.plans)
     verdict = None
     if not reasons:
@@ -893,17 +954,13 @@ def _detour(planner, current, moves, settings, replans) -> tuple[dict[str, Synth
 
     Returns the new syntheses and, for each robot that failed, its first conflict and why."""
     saved = dict(planner.obstacles)
-    objects = frozenset(planner.scenario.scene.objects)
+    walls = {}
     for robot, items in moves.items():
-        walls = tuple(
+        walls[robot] = tuple(
             w for _, keep in items for w in _walls_around(keep.region, settings, f"the space of {keep.label}")
         )
-        planner.obstacles[robot] = planner.obstacles.get(robot, ()) + walls
-        # the requests are settled: a detour may ask only for what the robot already asks for
-        asked = {e.obj for e in current[robot] if e.kind == "away" and e.receiver == robot}
-        planner.forbidden[robot] = planner.forbidden.get(robot, frozenset()) | (objects - asked)
         replans.append(f"{robot} re-planned around the space it shares: {items[0][0].describe()}")
-    fresh = planner.run({robot: current[robot] for robot in moves})
+    fresh = _replan_within(planner, current, walls)
     failed = {}
     for robot, res in list(fresh.items()):
         if not res.feasible:
@@ -913,6 +970,123 @@ def _detour(planner, current, moves, settings, replans) -> tuple[dict[str, Synth
                 del planner.obstacles[robot]
             del fresh[robot]
     return fresh, failed
+
+
+def _replan_within(
+    planner: _Planner,
+    current: Mapping[str, tuple[Event, ...]],
+    walls: Mapping[str, tuple[Wall, ...]],
+    explain: bool = True,
+    windows: Mapping[str, tuple[int, int]] | None = None,
+) -> dict[str, Synthesis]:
+    """Every robot of `walls` re-planned with them added to its walls (kept in the planner).
+
+    The requests are settled by now: a re-plan may ask only for goods the robot already asks
+    for.  With `explain` false an infeasible answer only says so (a trial); `windows` bounds
+    the lengths searched (:meth:`_Planner.run`).
+    """
+    objects = frozenset(planner.scenario.scene.objects)
+    for robot, extra in walls.items():
+        planner.obstacles[robot] = planner.obstacles.get(robot, ()) + extra
+        asked = {e.obj for e in current[robot] if e.kind == "away" and e.receiver == robot}
+        planner.forbidden[robot] = planner.forbidden.get(robot, frozenset()) | (objects - asked)
+    return planner.run({robot: current[robot] for robot in walls}, explain, windows)
+
+
+def _shorten_waits(
+    current: Mapping[str, tuple[Event, ...]],
+    results: dict[str, Synthesis],
+    planner: _Planner,
+    settings: ConflictSettings | None,
+    safety: TeamSafety,
+    replans: list[str],
+    budget: int,
+) -> TeamSafety:
+    """Where waiting for a shared place costs the team more than a way around, take the way around.
+
+    Each robot was planned alone, so its route ignores the others; the conflict step then makes
+    robots wait for each other.  The waits on the itinerary's critical path
+    (:attr:`~cosmop.planning.teamsafety.Wait.critical`; no other wait, shortened, ends the team
+    sooner), the longest first, get the ways around that apply (:func:`_ways_around`): the
+    two robots re-planned to pass each other in lanes, or the waiting robot re-planned with the
+    other's occupancy as walls.  A way is kept when the plans stay team-safe and the team's
+    expected makespan goes down; else the robots keep their plans and walls.  At most `budget`
+    ways are tried (each one synthesis per robot re-planned, both robots' at once, of at most
+    :data:`TRIAL_STEPS` steps more than its plan, and one conflict step), so that planning time
+    stays bounded.
+    """
+    settings = settings or ConflictSettings()
+    scene = planner.scenario.scene
+    tried: set = set()
+    while budget > 0:
+        worth = (w for w in safety.waits if w.critical and w.seconds >= MIN_WAIT)
+        way = next(
+            (way for w in worth for way in _ways_around(w, safety, scene, settings) if way[0] not in tried),
+            None,
+        )
+        if way is None:
+            break
+        key, why, walls = way
+        tried.add(key)
+        budget -= 1
+        saved = dict(planner.obstacles), dict(planner.forbidden)
+        # with more walls no plan is shorter than the robot's; a way much longer is no way round
+        windows = {r: (results[r].horizon, results[r].horizon + TRIAL_STEPS) for r in walls}
+        fresh = _replan_within(planner, current, walls, False, windows)
+        if all(res.feasible for res in fresh.values()):
+            plans = {r: (fresh.get(r) or res).plan for r, res in results.items()}
+            used = {name for p in plans.values() for name in p.mission if name.startswith("msg(")}
+            t0 = time.perf_counter()
+            candidate = make_team_safe(scene, plans, settings=settings, used=used)
+            planner.phases["conflicts"] += time.perf_counter() - t0
+            if candidate.safe and candidate.makespan < safety.makespan - 1e-6:
+                replans.append(
+                    f"{why}: the team is expected done in {candidate.makespan:.1f} s instead of "
+                    f"{safety.makespan:.1f} s"
+                )
+                results.update(fresh)
+                safety = candidate
+                continue
+        planner.obstacles, planner.forbidden = saved
+    return safety
+
+
+def _ways_around(wait, safety: TeamSafety, scene: Scene, settings: ConflictSettings) -> list[tuple]:
+    """The ways around one wait, to try in order: ``(key, why, robot -> walls)``.
+
+    Two robots that drive head-on through a place wide enough for both pass each other in
+    lanes (:func:`cosmop.planning.lanes.lanes`); the waiting robot can keep out of what it
+    waits for, where that leaves its fixed places free (:meth:`TeamSafety.detours`).
+    """
+    out = []
+    robot, other = wait.robot, wait.other
+    if wait.drives is not None:
+        shared = wait.first.region.intersection(wait.then.region)
+        drives = {other: wait.drives[0], robot: wait.drives[1]}
+        keep = lanes(scene, drives, shared, settings.clearance, safety.fixed)
+        if keep is not None:
+            walls = {
+                r: _walls_around(region, settings, f"the lane {next(o for o in keep if o != r)} keeps to")
+                for r, region in keep.items()
+            }
+            key = (
+                "lanes",
+                *sorted((r, tuple(round(v) for v in region.bounds)) for r, region in keep.items()),
+            )
+            why = (
+                f"{robot} and {other} re-planned to pass each other in lanes instead of {robot} waiting "
+                f"{wait.seconds:.1f} s where {wait.conflict.describe()}"
+            )
+            out.append((key, why, walls))
+    for _, mover, keep in safety.detours(wait.conflict):
+        if mover == robot:
+            walls = {robot: _walls_around(keep.region, settings, f"the space of {keep.label}")}
+            why = (
+                f"{robot} re-planned around the space of {keep.label} instead of waiting {wait.seconds:.1f} s"
+            )
+            out.append((("around", robot, keep.label), why, walls))
+            break
+    return out
 
 
 def _walls_around(region, settings: ConflictSettings, label: str) -> tuple[Wall, ...]:

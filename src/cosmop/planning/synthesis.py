@@ -175,6 +175,7 @@ def synthesize(
     margin: float = MOTION_MARGIN,
     lazy: bool = True,
     spots: tuple[tuple[Event, tuple[float, float]], ...] = (),
+    min_horizon: int = 0,
 ) -> Synthesis:
     """The shortest safe plan of motion primitives for one robot's local mission.
 
@@ -212,6 +213,10 @@ def synthesize(
         eager encoding (``False``: every obstacle from the start), proved there.
     spots : tuple of (Event, (float, float))
         Drops pinned to one spot (:attr:`~cosmop.planning.specification.RobotProblem.spots`).
+    min_horizon : int
+        A length below which the caller knows that no plan exists (the robot re-planned with
+        more walls than a plan of this length had): the search starts there, and
+        ``unsat_horizons`` lists only the horizons searched.
 
     Returns
     -------
@@ -236,7 +241,7 @@ def synthesize(
         margin=margin,
         spots=spots,
     )
-    found = _shortest_plan(p, m.lower, max_horizon, rlimit, incremental, lazy)
+    found = _shortest_plan(p, max(m.lower, min_horizon), max_horizon, rlimit, incremental, lazy)
     if found.plan is not None:
         return found.synthesis(robot, t0, plan=_place_messages(p, found.plan, m.full))
     if found.gave_up is not None:  # the solver could not decide a horizon: claim nothing beyond

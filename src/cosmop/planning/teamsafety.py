@@ -19,7 +19,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import shapely
 
@@ -30,6 +30,7 @@ from cosmop.planning.conflict_order import order_conflicts
 from cosmop.planning.conflicts import (
     Conflict,
     ConflictSettings,
+    Occupancy,
     conflicts,
     fixed_places,
     is_ordered,
@@ -43,7 +44,43 @@ from cosmop.planning.timing import durations, start_pose
 from cosmop.scene import Scene
 from cosmop.squares import swept_square
 
-__all__ = ["TeamSafety", "make_team_safe"]
+__all__ = ["TeamSafety", "Wait", "make_team_safe"]
+
+
+@dataclass(frozen=True)
+class Wait:
+    """How long one conflict's order keeps a robot waiting, by the itinerary.
+
+    Attributes
+    ----------
+    seconds : float
+        Expected seconds the robot waits at the message's ``Req`` (0 when the other has left
+        the shared place before it gets there).
+    robot, other : str
+        The robot that waits and the robot it waits for.
+    message : str
+        The message's event name.
+    conflict : Conflict
+        The conflict the message orders.
+    first, then : Occupancy
+        The occupancy that goes first (`other`'s side) and the one that waits for it.
+    drives : tuple or None
+        When both sides are drives: ``((p, q), (p', q'))``, the centres (mm) at the two ends of
+        the first's drive and of the waiting one's.
+    critical : bool
+        Whether the wait lies on the path of waits and steps that ends the team's itinerary
+        last: only such a wait, made shorter, can end the team sooner.
+    """
+
+    seconds: float
+    robot: str
+    other: str
+    message: str
+    conflict: Conflict = field(repr=False)
+    first: Occupancy = field(repr=False)
+    then: Occupancy = field(repr=False)
+    drives: tuple[tuple[tuple[float, float], tuple[float, float]], ...] | None = None
+    critical: bool = False
 
 
 @dataclass(frozen=True)
@@ -75,6 +112,8 @@ class TeamSafety:
     flipped : int
         Of those, the orders that let go first the robot the itineraries expect there later:
         where a cycle made the search depart from time (:mod:`cosmop.planning.conflict_search`).
+    waits : tuple of Wait
+        Every conflict message's expected wait, the longest first.
     """
 
     plans: Mapping[str, RobotPlan]
@@ -88,6 +127,7 @@ class TeamSafety:
     fixed: Mapping[str, list] = field(default_factory=dict, repr=False)
     chosen: int = 0
     flipped: int = 0
+    waits: tuple[Wait, ...] = ()
 
     @property
     def safe(self) -> bool:
@@ -205,27 +245,22 @@ def make_team_safe(
     while True:
         cut = _cut_where_shared(scene, plans, settings, starts, positions, walls, uncut)
         attempt = _order(context, cut, waypoints)
-        if best is None or len(attempt[2]) < len(best[2]):
+        if best is None or len(attempt.unresolved) < len(best.unresolved):
             best = attempt
-        if not attempt[2] or uncut == frozenset(plans):
+        if attempt.safe or uncut == frozenset(plans):
             break
         # a cut leaves a place to stand in the middle of a drive, and standing there may close
         # a cycle: drives of the robots in unresolved conflicts are ordered whole, then all are
-        involved = {r for c in attempt[2] for r in c.robots} - uncut
+        involved = {r for c in attempt.unresolved for r in c.robots} - uncut
         uncut = uncut | involved if involved else frozenset(plans)
-    new_plans, messages, unresolved, stats = best
     if used is not None:  # each attempt named its messages in a copy; the kept one's are taken
-        used |= {m.event for m in messages}
-    return TeamSafety(
-        new_plans, messages, stats[0], stats[1], unresolved, stats[2], stats[3],
-        time.perf_counter() - t0, stats[4], stats[5], stats[6],
-    )  # fmt: skip
+        used |= {m.event for m in best.messages}
+    return replace(best, time_s=time.perf_counter() - t0)
 
 
-def _order(context, plans: Mapping[str, RobotPlan], waypoints):
-    """One ordering of every conflict between `plans` (already cut): the plans with their new
-    messages, those messages, the conflicts left unresolved, and the statistics of
-    :class:`TeamSafety` (found, ordered before, makespan alone, makespan, fixed, chosen, flipped)."""
+def _order(context, plans: Mapping[str, RobotPlan], waypoints) -> TeamSafety:
+    """One ordering of every conflict between `plans` (already cut; `waypoints` are the
+    robots' own, where pieces are joined again after), its time not yet set."""
     scene, settings, starts, positions, about, used = context
     horizons = {r: p.horizon for r, p in plans.items()}
     links = message_links(plans)
@@ -253,8 +288,73 @@ def _order(context, plans: Mapping[str, RobotPlan], waypoints):
         (),
         durations(scene, new_plans, starts=starts),
     )
-    stats = (len(found), ordered, alone, final.makespan, fixed, len(chosen), _flipped(chosen, precedence))
-    return new_plans, messages, tuple(unresolved), stats
+    return TeamSafety(
+        new_plans,
+        messages,
+        len(found),
+        ordered,
+        tuple(unresolved),
+        alone,
+        final.makespan,
+        0.0,
+        fixed,
+        len(chosen),
+        _flipped(chosen, precedence),
+        _waits(new_plans, final, placed, kept, _drive_ends(scene, plans, starts)),
+    )
+
+
+def _drive_ends(scene: Scene, plans: Mapping[str, RobotPlan], starts) -> dict[Node, tuple]:
+    """The centres at the two ends of every GoTo step of `plans`: ``(robot, k) -> (p, q)``."""
+    out = {}
+    for robot, plan in plans.items():
+        pose = start_pose(scene, robot, starts)
+        for k, step in enumerate(plan.steps, 1):
+            if step.primitive == Primitive.GOTO:
+                out[(robot, k)] = ((pose[0], pose[1]), (step.robot[0], step.robot[1]))
+            pose = step.robot
+    return out
+
+
+def _waits(plans, order: Precedence, placed, kept, ends: Mapping[Node, tuple]) -> tuple[Wait, ...]:
+    """Each conflict message's wait in `order` (the final plans' itinerary), longest first.
+
+    `placed` and `kept` pair each message with its conflict (`plans` wait for it at their
+    ``Req`` of it); `ends` gives the drives of the plans the conflicts were found on
+    (:func:`_drive_ends`).
+    """
+    critical = _critical_waits(plans, order)
+    out = []
+    for (name, _, _), ((first_step, _), conflict) in zip(placed, kept, strict=True):
+        robot = parse_event(name).receiver
+        k = next(k for k, s in enumerate(plans[robot].steps, 1) if s.message == name)
+        first, then = (conflict.a, conflict.b) if conflict.a.last == first_step else (conflict.b, conflict.a)
+        seconds = float(order.finish[robot][k] - order.finish[robot][k - 1])
+        drives = None
+        if first.first is not None and first.first == first.last and then.first == then.last:
+            drives = (ends[first.first], ends[then.first])
+        other = parse_event(name).sender
+        out.append(Wait(seconds, robot, other, name, conflict, first, then, drives, (robot, k) in critical))
+    return tuple(sorted(out, key=lambda w: (-w.seconds, w.message)))
+
+
+def _critical_waits(plans: Mapping[str, RobotPlan], order: Precedence) -> set[Node]:
+    """The ``Req`` steps on the path that ends the itinerary last: from the robot done last
+    back through its steps, and at a ``Req`` that waited, on to the step that sent its message."""
+    if not plans:
+        return set()
+    senders = {(link.receiver, link.wait): (link.sender, link.send) for link in message_links(plans)}
+    robot = max(plans, key=lambda r: (order.finish[r][plans[r].horizon], r))
+    k, out = plans[robot].horizon, set()
+    while k >= 1:
+        source = senders.get((robot, k))
+        waited = order.finish[robot][k] > order.finish[robot][k - 1] + 1e-9
+        if source is not None and source[1] is not None and waited:
+            out.add((robot, k))
+            robot, k = source
+            continue
+        k -= 1
+    return out
 
 
 def _flipped(chosen, alone: Precedence) -> int:
