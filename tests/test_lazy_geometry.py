@@ -64,18 +64,18 @@ def start(request, monkeypatch):
     return request.param
 
 
-def test_thirty_generated_shelf_rooms_agree(start):
-    """Fifteen rooms each way (thirty in all; ``benchmarks/sweep_lazy.py`` runs more)."""
+def test_sixteen_generated_shelf_rooms_agree(start):
+    """Eight rooms each way (a sample: ``benchmarks/sweep_lazy.py`` runs thirty and more)."""
     admitted, requested, feasible = 0, 0, 0
-    for seed in range(15) if start == "box" else range(15, 30):
+    for seed in range(8) if start == "box" else range(15, 23):
         scene = parse_scenario(shelves(seed)).scene
         lazy, _ = _agree(scene, "R1", FETCH, max_horizon=12)
         feasible += lazy.feasible
         admitted += lazy.admitted
         requested += bool(lazy.requests)
-    assert feasible >= 12 and requested >= 2  # some rooms need a request: the minimum is compared too
+    assert feasible >= 6 and requested >= 2  # some rooms need a request: the minimum is compared too
     if start == "nothing near":
-        assert admitted >= 15  # every wall the plans need was found by the loop
+        assert admitted >= 8  # every wall the plans need was found by the loop
 
 
 def test_a_branching_mission_gets_the_same_horizon(start):

@@ -590,7 +590,7 @@ def traces(draw) -> list[dict]:
     ]
 
 
-@settings(max_examples=1000, deadline=None)
+@settings(max_examples=400, deadline=None)
 @given(formula=formulas(), trace=traces())
 def test_encoding_agrees_with_evaluation(formula, trace):
     K = len(trace) - 1

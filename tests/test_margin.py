@@ -182,7 +182,7 @@ def test_the_numeric_test_of_the_ends_never_passes_what_the_formula_breaks(monke
     geometry._write([k for k in walls + keys if k not in geometry._written])
     rng = random.Random(7)
     sure, bites = 0, 0
-    for _ in range(300):
+    for _ in range(150):
         points = _about_an_end(rng, len(trace))
         moved = [{**s, "x": x, "y": y} for s, (x, y) in zip(trace, points, strict=True)]
         unsure = set(geometry._sides.unsure(keys, moved))

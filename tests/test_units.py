@@ -190,7 +190,9 @@ def test_simulates_table_shows_poses_and_distances_in_the_files_units(tmp_path):
 
     from cosmop.cli.simulate import _robots_table
 
-    run = SimpleNamespace(robots={"R1": ((-2000.0, -1000.0, 90.0), 12345.0)}, finished={"R1": True}, steps={})
+    run = SimpleNamespace(
+        robots={"R1": ((-2000.0, -1000.0, 90.0), 12345.0)}, finished={"R1": True}, steps={}, delays=None
+    )
     si = tmp_path / "si.yaml"
     si.write_text(SI_TEXT)
     for scenario, pose, distance in (
