@@ -11,7 +11,13 @@ Each scene is planned (``cosmop plan``) and, when feasible, simulated from that 
 plan's verdict, whether the run completed, the contacts while moving, the simulated and wall
 times.
 
-Usage: ``python benchmarks/sweep_generated.py [--seeds 0:200] [--timeout 600] [--out NAME]``
+With ``--alone`` (issue 36, point 4: complete as a team), every scene the team is not planned
+for (infeasible or out of time) is planned again robot by robot, each alone in the same scene
+(the other robots removed, every object kept): ``alone`` is true when every robot alone has a
+plan, so that the team's verdict is one a team planner should not give.  The row keeps the
+plan's reason.
+
+Usage: ``python benchmarks/sweep_generated.py [--seeds 0:200] [--timeout 600] [--alone] [--out NAME]``
 (``results/NAME.json``; default ``sweep_generated``).
 """
 
@@ -76,23 +82,40 @@ def scene(seed: int) -> dict:
         return data
 
 
-def run_seed(seed: int, timeout: float, folder: Path) -> dict:
+def run_seed(seed: int, timeout: float, folder: Path, alone: bool = False) -> dict:
     data = scene(seed)
     row = {"seed": seed, "robots": len(data["scene"]["robots"]), "walls": len(data["scene"]["obstacles"])}
-    return row | plan_and_simulate(data, folder / f"scene_{seed}", timeout)
+    row |= plan_and_simulate(data, folder / f"scene_{seed}", timeout)
+    if alone and row["plan"] != "feasible":
+        plan = folder / f"scene_{seed}_plan.json"
+        if plan.exists():
+            row["reason"] = json.loads(plan.read_text()).get("reason")
+        row["alone"] = all(_alone_feasible(data, robot) for robot in data["scene"]["robots"])
+    return row
+
+
+def _alone_feasible(data: dict, robot: str) -> bool:
+    """Whether `robot` has a plan in the scene of `data` with the other robots removed."""
+    from cosmop.pipeline import plan_team
+
+    one = json.loads(json.dumps(data))
+    one["scene"]["robots"] = {robot: data["scene"]["robots"][robot]}
+    one["mission"]["tasks"] = {robot: data["mission"]["tasks"][robot]}
+    return plan_team(parse_scenario(one), workers=1).plans.feasible
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", default="0:200", help="first:last (exclusive)")
     parser.add_argument("--timeout", type=float, default=600.0)
+    parser.add_argument("--alone", action="store_true", help="plan each robot of a team not planned alone")
     parser.add_argument("--out", default="sweep_generated", help="results/OUT.json")
     args = parser.parse_args(argv)
     first, last = (int(v) for v in args.seeds.split(":"))
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for seed in range(first, last):
-            rows.append(run_seed(seed, args.timeout, Path(tmp)))
+            rows.append(run_seed(seed, args.timeout, Path(tmp), args.alone))
             print(json.dumps(rows[-1]), flush=True)
     save_results(args.out, rows)
     feasible = [r for r in rows if r["plan"] == "feasible"]
@@ -101,6 +124,9 @@ def main(argv: list[str] | None = None) -> int:
         f"{len(rows)} scenes: {len(feasible)} feasible, {len(done)} completed in simulation, "
         f"{sum(r.get('contacts_while_moving', 0) for r in feasible)} contacts while moving"
     )
+    if args.alone:
+        wrong = [r["seed"] for r in rows if r.get("alone")]
+        print(f"not planned as a team although every robot alone is: {len(wrong)} {wrong}")
     return 0
 
 

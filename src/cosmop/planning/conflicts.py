@@ -14,7 +14,11 @@ from the start of one step to the completion of another (:class:`Occupancy`):
 
 Robot regions are grown by half the clearance the simulator keeps between moving robots
 (:attr:`ConflictSettings.clearance`), so that two of them closer than that overlap; objects are
-not grown.  Two occupancies of different robots (an object counts for the robots that move it)
+not grown.  Two robots whose start poses the scene puts closer than the clearance keep only
+that gap while one of them stands at its start and the other stands at its own or drives off
+it: the scene put them there, and no plan could otherwise ever let them leave (robots that come
+back closer than the clearance are held to it: the simulator's standoff would stop them).
+Two occupancies of different robots (an object counts for the robots that move it)
 *conflict* when their regions' interiors overlap, and the conflict is *ordered* when one of
 them always ends before the other starts (:meth:`cosmop.missions.precedence.Precedence.before_start`).
 A plan set is team-safe when every conflict is ordered: then no execution the messages allow
@@ -124,6 +128,9 @@ class Occupancy:
         those instants is the robot's plan not already checked against them.
     units : {"mm", "m"}, optional
         The units its words show lengths in: the scenario file's (``Scene.units``).
+    start : shapely geometry, optional
+        A robot's occupancy at its start: its square there (no clearance), when it stands at
+        its start from instant 0 or is its first drive, off it; else ``None``.
     """
 
     what: str
@@ -137,6 +144,12 @@ class Occupancy:
     units: UnitSystem = field(default="mm", repr=False, compare=False)
     states: tuple[int, int] | None = None
     unseen: tuple[tuple[str, frozenset[int]], ...] = ()
+    start: BaseGeometry | None = field(default=None, repr=False, compare=False)
+
+    @property
+    def is_drive(self) -> bool:
+        """Whether it is what one GoTo step sweeps (a standing spans more than one step)."""
+        return self.first is not None and self.first == self.last
 
     def accounts_for(self, other: Occupancy) -> bool:
         """Whether this occupancy and `other` never need an order: they are the same robot's,
@@ -206,6 +219,8 @@ def _robot_occupancies(
     K = plan.horizon
     poses = [start.robot, *(s.robot for s in plan.steps)]
     party = frozenset((robot,))
+    bare = square(poses[0][0], poses[0][1], side - grow)  # its body at its start
+    first_drive = next((k for k, s in enumerate(plan.steps, 1) if s.primitive == Primitive.GOTO), 0)
     out: list[Occupancy] = []
     k = 0
     while k <= K:
@@ -233,6 +248,7 @@ def _robot_occupancies(
                 square(x, y, side - grow + 2 * rest),
                 units,
                 (k, end),
+                start=bare if k == 0 else None,
             )
         )
         k = end + 1
@@ -252,6 +268,7 @@ def _robot_occupancies(
                     swept_square(p, q, side - grow),
                     units,
                     (k - 1, k),
+                    start=bare if k == first_drive else None,
                 )
             )
     return out
@@ -413,8 +430,14 @@ def occupancies(
     return out + objects, problems
 
 
-def conflicts(items: Sequence[Occupancy]) -> list[Conflict]:
-    """Pairs of occupancies of disjoint parties whose regions' interiors overlap."""
+def conflicts(items: Sequence[Occupancy], clearance: float | None = None) -> list[Conflict]:
+    """Pairs of occupancies of disjoint parties whose regions' interiors overlap.
+
+    `clearance` (mm; default :attr:`ConflictSettings.clearance`) is the one the robots'
+    regions were grown by: two robots that start closer than that keep only their start gap
+    where one stands at its start and the other stands at or drives off its own
+    (:func:`_given_gap`).
+    """
     if not items:
         return []
     regions = [item.region for item in items]
@@ -434,7 +457,28 @@ def conflicts(items: Sequence[Occupancy]) -> list[Conflict]:
         first.append(i if robots else len(items) + i)
         second.append(j if robots else len(items) + j)
     overlap = _overlap(shapes, first, second)
-    return [Conflict(a, b) for (a, b), real in zip(pairs, overlap, strict=True) if real]
+    clearance = ConflictSettings().clearance if clearance is None else clearance
+    return [
+        Conflict(a, b)
+        for (a, b), real in zip(pairs, overlap, strict=True)
+        if real and not _given_gap(a, b, clearance)
+    ]
+
+
+def _given_gap(a: Occupancy, b: Occupancy, clearance: float) -> bool:
+    """Whether the overlap of `a` and `b` (robots' occupancies at their starts, one standing) is
+    only the clearance the scene's start poses already break: their bare shapes, grown by half
+    the gap between the two starts (L-infinity, mm), do not overlap."""
+    if a.start is None or b.start is None or (a.is_drive and b.is_drive):
+        return False
+    (ax0, ay0, ax1, ay1), (bx0, by0, bx1, by1) = a.start.bounds, b.start.bounds
+    gap = max(bx0 - ax1, ax0 - bx1, by0 - ay1, ay0 - by1)
+    if gap >= clearance:
+        return False
+    shapes = [
+        (o.body if o.is_drive else o.start).buffer(max(gap, 0.0) / 2, join_style="mitre") for o in (a, b)
+    ]
+    return not _overlap(_geometries(shapes), [0], [1])[0]
 
 
 def _overlap(shapes: np.ndarray, first: list[int], second: list[int]) -> list[bool]:

@@ -128,7 +128,7 @@ def check_team(
     violations += _itinerary(plan, links)
     items, problems = occupancies(scene, plans, precedence, settings)
     violations += [_violation(None, None, "conflict", text) for text in problems]
-    for conflict in conflicts(items):
+    for conflict in conflicts(items, settings.clearance if settings else None):
         if not is_ordered(conflict, precedence):
             violations.append(
                 _violation(

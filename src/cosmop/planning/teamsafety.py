@@ -270,7 +270,7 @@ def _order(context, plans: Mapping[str, RobotPlan], waypoints) -> TeamSafety:
         raise ValueError("the plans' own messages deadlock; order them before the conflicts")
     alone = max((sum(d) for d in times.values()), default=0.0)
     items, _ = occupancies(scene, plans, precedence, settings, starts, positions)
-    found = [c for c in conflicts(items) if about is None or about in c.robots]
+    found = [c for c in conflicts(items, settings.clearance) if about is None or about in c.robots]
     ordered = sum(1 for c in found if is_ordered(c, precedence))
     fixed = fixed_places(items)
     chosen, unresolved = order_conflicts(found, horizons, links, [], times, fixed=fixed)

@@ -54,6 +54,11 @@ _EXIT_REACH = 80  # mm: how far a way out is looked for
 _REJOIN_AHEAD = (4000.0, 8000.0, 16000.0)  # mm along the path: where a detour may rejoin it
 
 
+REACH = 1.25
+"""How far ahead of the robot its dynamic window's target lies at least, in top-speed horizons
+(:attr:`~cosmop.control.dwa.DwaSettings.lookahead` when that is farther)."""
+
+
 def brake(world: World, i: int) -> Action:
     """Robot `i`'s command to brake with :math:`-b` (the always-safe choice), not turning."""
     return ("move", (max(0.0, world.v[i] - world.limits.braking[i] * world.dt), 0.0))
@@ -129,7 +134,10 @@ def drive(
         if action is not None:  # (waiting for someone to pass counts towards a stall)
             waited = action[0] == "move" and world.t - agent.last_progress_t > s.stall_time
             return (_on_stall(world, agent) or action) if waited else action
-    target, left = agent.path.lookahead((float(xy[0]), float(xy[1])), s.dwa.lookahead)
+    # the target lies beyond where the robot gets in one horizon at its top speed: a nearer one
+    # would be overshot by a faster arc, so progress alone would hold the robot below its top
+    reach = max(s.dwa.lookahead, REACH * world.limits.max_speed[i] * s.dwa.horizon)
+    target, left = agent.path.lookahead((float(xy[0]), float(xy[1])), reach)
     agent.path_left = left
     if left < agent.best_path_left - s.stall_progress:
         agent.best_path_left = left

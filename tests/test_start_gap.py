@@ -1,0 +1,87 @@
+"""Robots the scene starts closer than the clearance: they may leave, not come back that close.
+
+The conflict rule grows robots by the 100 mm the simulator keeps between them; two robots
+parked side by side at the start (touching) would then overlap from instant 0, and no order
+could ever let either leave.  Where one of them stands at its start, the other standing at or
+driving off its own keeps only the gap the scene gave them.
+"""
+
+from __future__ import annotations
+
+import copy
+
+import pytest
+
+from cosmop.missions.precedence import Precedence
+from cosmop.pipeline import plan_team
+from cosmop.planning.checker import check_plan
+from cosmop.planning.conflicts import ConflictSettings, conflicts, occupancies
+from cosmop.planning.realisation import message_links
+from cosmop.scenario import parse_scenario
+from cosmop.sim import footprint_overlaps, simulate
+
+ROOM = [
+    [[-4000, -3000], [4000, -3000]],
+    [[4000, -3000], [4000, 3000]],
+    [[4000, 3000], [-4000, 3000]],
+    [[-4000, 3000], [-4000, -3000]],
+]
+SIDE_BY_SIDE = {
+    "name": "side-by-side",
+    "scene": {
+        "obstacles": ROOM,
+        "robots": {"R1": {"size": 400, "pose": [0, 0, 0]}, "R2": {"size": 400, "pose": [0, 400, 0]}},
+        "objects": {
+            "O1": {"size": 100, "position": [-3000, -2000]},
+            "O2": {"size": 100, "position": [3000, 2000]},
+        },
+        "workspaces": {
+            "W1": {"x": [2500, 3500], "y": [-2500, -1500]},
+            "W2": {"x": [-3500, -2500], "y": [1500, 2500]},
+        },
+    },
+    "mission": {"tasks": {"R1": ["pick O1", "drop O1 at W1"], "R2": ["pick O2", "drop O2 at W2"]}},
+}
+
+
+@pytest.fixture(scope="module")
+def planned():
+    scenario = parse_scenario(SIDE_BY_SIDE)
+    return scenario, plan_team(scenario, workers=1)
+
+
+def test_robots_parked_touching_are_planned_checked_and_leave(planned):
+    scenario, result = planned
+    assert result.plans.feasible, result.plans.reason
+    assert check_plan(scenario, result.plans).ok
+    run = simulate(scenario, result.plans)
+    assert run.completed and run.contacts_while_moving == 0
+    assert not footprint_overlaps(scenario.scene, run)
+
+
+def test_only_the_starts_keep_the_smaller_gap(planned):
+    scenario, result = planned
+    plans = result.plans.robots
+    order = Precedence({r: p.horizon for r, p in plans.items()}, message_links(plans))
+    items, _ = occupancies(scenario.scene, plans, order, ConflictSettings())
+    starts = [o for o in items if o.start is not None]
+    # each robot: its standing from instant 0 and its first drive, nothing later
+    assert sorted((o.what, o.is_drive) for o in starts) == [
+        ("R1", False),
+        ("R1", True),
+        ("R2", False),
+        ("R2", True),
+    ]
+    both = [c for c in conflicts(items) if c.a.first is None and c.b.first is None]
+    assert not both  # the two starts touch: no conflict between them
+    # told the regions were grown by nothing, the rule exempts nothing: the grown starts conflict
+    grown = [c for c in conflicts(items, clearance=0.0) if c.a.first is None and c.b.first is None]
+    assert len(grown) == 1
+
+
+def test_robots_that_come_back_closer_than_the_clearance_are_held_to_it():
+    data = copy.deepcopy(SIDE_BY_SIDE)
+    data["mission"]["tasks"] = {r: [*tasks, "return"] for r, tasks in data["mission"]["tasks"].items()}
+    result = plan_team(parse_scenario(data), workers=1)
+    assert not result.plans.feasible
+    assert "R1 and R2" in result.plans.reason and "standing at" in result.plans.reason
