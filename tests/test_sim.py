@@ -455,7 +455,8 @@ def test_a_robot_waiting_for_a_message_holds_no_robot_that_must_send_it():
     r2.step_index = next(k for k, s in enumerate(r2.steps) if s.primitive == "Req")
     r2.waiting = True
     world.pose[r1.index] = [*r1.step.robot[:2], r1.step.robot[2]]
-    world.pose[r2.index] = world.pose[r1.index] + [0.0, 400.0 + 50.0, 0.0]  # 50 mm apart
+    inside = world.settings.dwa.standoff / 2  # apart by half the standoff: within it
+    world.pose[r2.index] = world.pose[r1.index] + [0.0, 400.0 + inside, 0.0]
     world.v[:] = 0.0
     assert world.parked().all() and not world.received(r2, r2.step)
     assert not world.crowded(r1.index)

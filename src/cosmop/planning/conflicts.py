@@ -69,7 +69,8 @@ class ConflictSettings:
     ----------
     clearance : float
         Distance (mm) two robots keep when both may move: their regions are grown by half of it
-        (the simulator's standoff, 100 mm by default).
+        (100 mm by default; twice the simulator's standoff, so that a robot tracking its plan
+        a little off still passes where the plans let it).
     segment : float
         Drives longer than this (mm) are cut into pieces before ordering, so that a robot waits
         only until another has passed the place they share (default 1500).

@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING
 from cosmop.control.geometry import box_gaps
 from cosmop.events import Event, Primitive
 from cosmop.planning.checker import check_robot_plan
+from cosmop.planning.conflicts import ConflictSettings
 from cosmop.planning.plan import ObjectState, RobotPlan, State, initial_state
 from cosmop.scene import Scene, Wall
 from cosmop.sim.recoordinate import recoordinate_world
@@ -150,16 +151,17 @@ def replan_stalled(world: World, agent: Agent) -> None:
 
 def _sensed(world: World, agent: Agent) -> list[tuple[float, float, float]]:
     """The robots and people `agent` senses, as boxes ``x, y, half side`` (mm) grown by the
-    room to keep: robots the clearance the team-safety layer checks (the standoff), people a
-    little.  A robot that has finished stays where it is for good: sensed however far."""
+    room to keep: robots the clearance the team-safety layer checks, people a little.  A robot
+    that has finished stays where it is for good: sensed however far."""
     s = world.settings
     i = agent.index
+    room = ConflictSettings().clearance
     sensed = world.obstacles()
     boxes, names = sensed.boxes, list(sensed.names)
     gaps = box_gaps(world.pose[i, :2], world.robot_half[i], boxes)
     finished = {a.id for a in world.agents if a.done}
     return [
-        (float(b[0]), float(b[1]), float(b[2]) + (s.dwa.standoff if n in world.robot_ids else _PERSON_ROOM))
+        (float(b[0]), float(b[1]), float(b[2]) + (room if n in world.robot_ids else _PERSON_ROOM))
         for b, n, g in zip(boxes, names, gaps, strict=True)
         if n != agent.id and n not in world.object_ids and (g < s.sense_range or n in finished)
     ]
