@@ -1,7 +1,7 @@
 """Plans that ``plan`` calls feasible execute: a sample of the generated-scenes sweep (issue 12, point 5).
 
 ``benchmarks/sweep_generated.py`` draws 200 seeded scenes (2 to 5 robots, random walls) and
-runs each as a user does; this is a sample of 10 of its seeds, in this process, chosen among
+runs each as a user does; this is a sample of 6 of its seeds, in this process, chosen among
 those whose plans once failed in simulation (a pose flush against a wall, a pick pose reached
 along the object's face, a corridor 20 mm wider than the robot, a drop next to a waiting robot,
 a back-off into another robot's clearance, a wall corner touched while braking).
@@ -22,7 +22,7 @@ from cosmop.scenario import parse_scenario
 from cosmop.sim import SimSettings, simulate
 from sweep_generated import scene
 
-SEEDS = (15, 41, 52, 53, 57, 99, 125, 162, 186, 187)
+SEEDS = (15, 41, 53, 99, 162, 187)
 
 
 def _run(seed: int) -> tuple[int, bool, bool, int]:

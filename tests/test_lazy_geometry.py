@@ -65,18 +65,18 @@ def start(request, monkeypatch):
     return request.param
 
 
-def test_sixteen_generated_shelf_rooms_agree(start):
-    """Eight rooms each way (a sample: ``benchmarks/sweep_lazy.py`` runs thirty and more)."""
+def test_twelve_generated_shelf_rooms_agree(start):
+    """Six rooms each way (a sample: ``benchmarks/sweep_lazy.py`` runs thirty and more)."""
     admitted, requested, feasible = 0, 0, 0
-    for seed in range(8) if start == "box" else range(15, 23):
+    for seed in range(6) if start == "box" else range(15, 21):
         scene = parse_scenario(shelves(seed)).scene
         lazy, _ = _agree(scene, "R1", FETCH, max_horizon=12)
         feasible += lazy.feasible
         admitted += lazy.admitted
         requested += bool(lazy.requests)
-    assert feasible >= 6 and requested >= 2  # some rooms need a request: the minimum is compared too
+    assert feasible >= 5 and requested >= 2  # some rooms need a request: the minimum is compared too
     if start == "nothing near":
-        assert admitted >= 8  # every wall the plans need was found by the loop
+        assert admitted >= 6  # every wall the plans need was found by the loop
 
 
 def test_a_branching_mission_gets_the_same_horizon(start):
