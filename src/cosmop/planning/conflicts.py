@@ -17,7 +17,7 @@ Robot regions are grown by half the clearance the simulator keeps between moving
 not grown.  Two robots whose start poses the scene puts closer than the clearance keep only
 that gap while one of them stands at its start and the other stands at its own or drives off
 it: the scene put them there, and no plan could otherwise ever let them leave (robots that come
-back closer than the clearance are held to it: the simulator's standoff would stop them).
+back are held to the clearance, as every other pair).
 Two occupancies of different robots (an object counts for the robots that move it)
 *conflict* when their regions' interiors overlap, and the conflict is *ordered* when one of
 them always ends before the other starts (:meth:`cosmop.missions.precedence.Precedence.before_start`).
