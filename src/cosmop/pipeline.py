@@ -274,10 +274,7 @@ class _Planner:
         extra = self.obstacles.get(robot, ())
         if extra:
             scene = replace(scene, obstacles=scene.obstacles + extra)
-        placed = self.placed.get(robot)
-        if placed:
-            objects = {o: replace(v, position=placed.get(o, v.position)) for o, v in scene.objects.items()}
-            scene = replace(scene, objects=objects)
+        scene = _goods_at(scene, self.placed.get(robot, {}))
         branching = isinstance(events, DFA)
         # a branching mission gets the horizon of its alphabet: no word of it has more events
         mission = tuple(parse_event(e) for e in events.alphabet) if branching else tuple(events)
@@ -624,15 +621,21 @@ def _choose_spot(handover: Handover, planner: _Planner) -> bool:
     handed over at; whether there is a new one."""
     scene = planner.scenario.scene
     spots = {o: p for placed in planner.placed.values() for o, p in placed.items() if o != handover.obj}
-    if spots:
-        objects = {o: replace(v, position=spots.get(o, v.position)) for o, v in scene.objects.items()}
-        scene = replace(scene, objects=objects)
+    scene = _goods_at(scene, spots)
     robots = (handover.giver, handover.receiver)
     spot = handover_spot(scene, handover.obj, handover.drop.workspace, robots)
     if spot is None or planner.placed.get(handover.receiver, {}).get(handover.obj) == spot:
         return False
     planner.hand_over(handover, spot)
     return True
+
+
+def _goods_at(scene: Scene, positions: Mapping[str, tuple[float, float]]) -> Scene:
+    """`scene` with the goods of `positions` lying there (mm) instead."""
+    if not positions:
+        return scene
+    objects = {o: replace(v, position=positions.get(o, v.position)) for o, v in scene.objects.items()}
+    return replace(scene, objects=objects)
 
 
 def _drop_spot(plan: RobotPlan, handover: Handover) -> tuple[float, float] | None:
@@ -889,11 +892,7 @@ def _make_safe(
             return make_team_safe(
                 scenario.scene, {r: res.plan for r, res in results.items()}, settings=settings
             )
-        plans = {r: res.plan for r, res in results.items()}
-        used = {name for p in plans.values() for name in p.mission if name.startswith("msg(")}
-        t0 = time.perf_counter()
-        safety = make_team_safe(scenario.scene, plans, settings=settings, used=used)
-        planner.phases["conflicts"] += time.perf_counter() - t0
+        safety = _team_safe(planner, {r: res.plan for r, res in results.items()}, settings)
         if safety.safe:
             return safety
         left = len(safety.unresolved)
@@ -920,6 +919,16 @@ def _make_safe(
         if reasons:
             return safety
         results.update(fresh)
+    return safety
+
+
+def _team_safe(planner: _Planner, plans: Mapping[str, RobotPlan], settings: ConflictSettings) -> TeamSafety:
+    """:func:`make_team_safe` of `plans`, its new messages named apart from those the plans
+    already send, timed as the conflict phase."""
+    used = {name for p in plans.values() for name in p.mission if name.startswith("msg(")}
+    t0 = time.perf_counter()
+    safety = make_team_safe(planner.scenario.scene, plans, settings=settings, used=used)
+    planner.phases["conflicts"] += time.perf_counter() - t0
     return safety
 
 
@@ -1034,11 +1043,9 @@ def _shorten_waits(
         windows = {r: (results[r].horizon, results[r].horizon + TRIAL_STEPS) for r in walls}
         fresh = _replan_within(planner, current, walls, False, windows)
         if all(res.feasible for res in fresh.values()):
-            plans = {r: (fresh.get(r) or res).plan for r, res in results.items()}
-            used = {name for p in plans.values() for name in p.mission if name.startswith("msg(")}
-            t0 = time.perf_counter()
-            candidate = make_team_safe(scene, plans, settings=settings, used=used)
-            planner.phases["conflicts"] += time.perf_counter() - t0
+            candidate = _team_safe(
+                planner, {r: (fresh.get(r) or res).plan for r, res in results.items()}, settings
+            )
             if candidate.safe and candidate.makespan < safety.makespan - 1e-6:
                 replans.append(
                     f"{why}: the team is expected done in {candidate.makespan:.1f} s instead of "

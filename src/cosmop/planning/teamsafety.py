@@ -241,10 +241,11 @@ def make_team_safe(
     }
     context = (scene, settings, starts, positions, about, used)
     uncut = frozenset() if settings.cut else frozenset(plans)
+    # each robot's cuts depend on the others' whole drives only: made once, undone robot by robot
+    cut = _cut_where_shared(scene, plans, settings, starts, positions, walls) if settings.cut else plans
     best = None
     while True:
-        cut = _cut_where_shared(scene, plans, settings, starts, positions, walls, uncut)
-        attempt = _order(context, cut, waypoints)
+        attempt = _order(context, {r: p if r in uncut else cut[r] for r, p in plans.items()}, waypoints)
         if best is None or len(attempt.unresolved) < len(best.unresolved):
             best = attempt
         if attempt.safe or uncut == frozenset(plans):
@@ -368,25 +369,19 @@ def _flipped(chosen, alone: Precedence) -> int:
     return out
 
 
-def _cut_where_shared(scene, plans, settings, starts, positions, walls, uncut) -> dict[str, RobotPlan]:
-    """Every drive cut where it enters and where it leaves a place another robot uses, except
-    the drives of the robots in `uncut`.
+def _cut_where_shared(scene, plans, settings, starts, positions, walls) -> dict[str, RobotPlan]:
+    """Every drive cut where it enters and where it leaves a place another robot uses.
 
     A conflict then holds only the piece of the drive inside the shared place, so the robot
     waits just before it enters, not before its whole drive, and the other is told as soon as
     it leaves (the temporal plan graph's grain: an order between the pieces of two drives that
     share a region).  The plans stay sound: a piece sweeps part of what the drive swept.
     """
-    if uncut >= set(plans):
-        return dict(plans)
     precedence = Precedence({r: p.horizon for r, p in plans.items()}, message_links(plans))
     items, _ = occupancies(scene, plans, precedence, settings, starts, positions)
     tree = shapely.STRtree([item.region for item in items])
     out = {}
     for robot, plan in plans.items():
-        if robot in uncut:
-            out[robot] = plan
-            continue
         grown = scene.robots[robot].size + settings.clearance
         poses = [start_pose(scene, robot, starts), *(step.robot for step in plan.steps)]
         cuts: dict[int, list[float]] = {}
