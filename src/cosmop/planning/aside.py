@@ -120,20 +120,13 @@ def handover_spot(scene: Scene, obj: str, workspace: str, robots: tuple[str, ...
         reach = free_component(scene, body.size / 2.0, body.pose[:2])
         stand = _standing(scene, obj, body.size)
         gap = (body.size + size) / 2.0
-        regions = [
-            tuple(
-                zip(wall_regions(w.start, w.end, body.size), wall_regions(w.start, w.end, size), strict=True)
-            )
-            for w in scene.obstacles
-        ]
+        regions = _wall_sides(scene, body.size, size)
         for n, (x, y) in enumerate(spots):
             poses = [docking_pose((x, y), gap, h) for h in scene.objects[obj].headings]
             dockable[n] &= any(
                 (reach is None or reach.covers(shapely.Point(pose)))
                 and not stand.intersects(shapely.Point(pose))
-                and all(
-                    any(a.contains(*pose[:2]) and b.contains(x, y) for a, b in pairs) for pairs in regions
-                )
+                and _no_wall_between(regions, pose[:2], (x, y))
                 for pose in poses
             )
     if not dockable.any():
@@ -214,12 +207,7 @@ def _dockable_slots(
     ys = np.linspace(y0, y1, max(1, round((y1 - y0) / step) + 1))
     reach = free_component(scene, body.size / 2.0, body.pose[:2])
     walls = shapely.MultiLineString([[w.start, w.end] for w in scene.obstacles]) if scene.obstacles else None
-    near = shapely.box(x0, y0, x1, y1).buffer(body.size + size)
-    regions = [
-        tuple(zip(wall_regions(w.start, w.end, body.size), wall_regions(w.start, w.end, size), strict=True))
-        for w in scene.obstacles
-        if near.intersects(shapely.LineString([w.start, w.end]))
-    ]
+    regions = _wall_sides(scene, body.size, size, near=shapely.box(x0, y0, x1, y1).buffer(body.size + size))
     gap = (body.size + size) / 2.0
     rows = []
     for x, y in itertools.product(xs, ys):
@@ -229,9 +217,27 @@ def _dockable_slots(
                 continue
             if walls is not None and square(px, py, body.size).buffer(-1e-6).intersects(walls):
                 continue
-            if all(any(a.contains(px, py) and b.contains(x, y) for a, b in pairs) for pairs in regions):
+            if _no_wall_between(regions, (px, py), (x, y)):
                 rows.append((x, y, px, py, body.size / 2.0 + rest))
     return np.array(rows, dtype=float).reshape(-1, 5)
+
+
+def _wall_sides(scene: Scene, robot: float, good: float, near=None) -> list[tuple]:
+    """Per wall (those meeting the geometry `near`, when given), its regions for a robot's square
+    of side `robot` paired with the same regions for a good's of side `good` (mm)
+    (:func:`~cosmop.planning.regions.wall_regions`)."""
+    return [
+        tuple(zip(wall_regions(w.start, w.end, robot), wall_regions(w.start, w.end, good), strict=True))
+        for w in scene.obstacles
+        if near is None or near.intersects(shapely.LineString([w.start, w.end]))
+    ]
+
+
+def _no_wall_between(regions: list[tuple], robot: tuple, good: tuple) -> bool:
+    """Whether no wall comes between a robot centred at `robot` and a good at `good`: for every
+    wall of :func:`_wall_sides`, both squares lie in one of its regions (the specification's
+    gripper)."""
+    return all(any(a.contains(*robot) and b.contains(*good) for a, b in pairs) for pairs in regions)
 
 
 def _pack(
