@@ -72,10 +72,9 @@ def allocate(
         choice = replace(choice, method=f"{choice.method}; {how}")
     if choice.alternative is None:
         why = {}
-        for n, (robot, word) in enumerate(choice.unplannable):  # the first few, with the solver's why
+        for robot, word in list(choice.unplannable)[:_EXPLAINED]:  # the first few, with the solver's why
             forbidden = next((k[2] for k in costs if k[:2] == (robot, word)), frozenset())
-            if n < _EXPLAINED:
-                why[(robot, word)] = _explained(planner, robot, [mission.events[e] for e in word], forbidden)
+            why[(robot, word)] = _explained(planner, robot, [mission.events[e] for e in word], forbidden)
         choice = replace(choice, unplannable=MappingProxyType({**choice.unplannable, **why}))
         return {r: () for r in robots}, {}, [_no_alternative(choice, found.exhaustive)], choice
     words = dict(choice.alternative.words)
