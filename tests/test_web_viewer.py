@@ -32,7 +32,8 @@ def test_the_page_is_self_contained_and_carries_the_run():
     data = json.loads(re.search(r'id="cosmop-data">(.*?)</script>', html, re.S).group(1))
     assert set(data["robots"]) == {"R1", "R2"} and data["robots"]["R1"]["steps"] == 7
     assert len(data["walls"]) == len(scenario.scene.obstacles)
-    assert data["messages"] == [{"t": result.messages[0].t, "from": "R2", "to": "R1", "label": "O2"}]
+    why = "R1 waits for R2 to move O2 out of its way"  # in plain words, from the plans
+    assert data["messages"] == [{"t": result.messages[0].t, "from": "R2", "to": "R1", "label": "O2", "why": why}]
     assert len(data["trace"]["t"]) == len(result.trace().t)  # short runs keep every frame
     small = render_html(scenario.scene, plans=plans, trace=result.trace(), max_frames=50)
     trace = json.loads(re.search(r'id="cosmop-data">(.*?)</script>', small, re.S).group(1))["trace"]

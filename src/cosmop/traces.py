@@ -9,10 +9,13 @@ animations and the web viewer (:mod:`cosmop.viz`) and the ROS 2 bag export
 Its file (:meth:`Trace.to_json`, :meth:`Trace.save`, :func:`load_trace`) is JSON: ``format``
 (:data:`TRACE_FORMAT`), ``scenario``, ``units`` (absent in older files: mm, degrees, s), ``dt``
 (s), ``frames`` (each with ``t`` in s, ``robots`` ``{id: {"pose": [x, y, heading], "v", "w",
-"carrying", "primitive", "waiting", "delayed"}}``, ``humans`` and ``objects`` ``{id: [x, y]}``) and
-``messages`` (each a mapping with at least ``t``, ``from`` and ``to``; other keys are kept as
-they are, so new kinds of message pass through).  :func:`check_trace` checks that shape and
-names the first field that is wrong.
+"carrying", "primitive", "waiting", "delayed", "awaits", "yields_to"}}``, ``humans`` and ``objects``
+``{id: [x, y]}``), ``messages`` (each a mapping with at least ``t``, ``from`` and ``to``; other
+keys are kept as they are, so new kinds of message pass through) and ``replans`` (absent when
+none: each accepted replan's ``t``, ``robot`` and ``route``, where the robot went on from and
+the steps it had left).  A robot state leaves out ``awaits`` (the message it waits for) and
+``yields_to`` (the robot or person it gives way to) when they are null.  :func:`check_trace`
+checks that shape and names the first field that is wrong.
 """
 
 from __future__ import annotations
@@ -72,7 +75,10 @@ _STATE_KEYS = {  # the optional keys of a robot's state in a frame: a test and w
     "primitive": (_is_name, "the name of a primitive, or null"),
     "waiting": (lambda value: isinstance(value, bool), "true or false"),
     "delayed": (lambda value: isinstance(value, bool), "true or false"),
+    "awaits": (_is_name, "the name of the message the robot waits for, or null"),
+    "yields_to": (_is_name, "the id of the robot or person the robot gives way to, or null"),
 }
+_SPARSE_KEYS = ("awaits", "yields_to")  # written only where not null: most robots wait for nothing
 
 
 def _check_frame(frame: Any, k: int, fail) -> None:
@@ -130,7 +136,42 @@ def check_trace(data: Any, file: str | os.PathLike[str] | None = None) -> dict[s
             fail(f"messages[{k}]", "a mapping with a time t (s), from and to")
         if not (isinstance(message.get("from"), str) and isinstance(message.get("to"), str)):
             fail(f"messages[{k}]", "a mapping with the robot ids from and to")
+    _check_replans(data.get("replans", []), fail)
     return dict(data)
+
+
+def _check_replans(replans: Any, fail) -> None:
+    """The ``replans`` list: each a time, a robot and a route (``from`` a pose, ``steps``)."""
+    if not isinstance(replans, list):
+        fail("replans", "a list of replans")
+    for k, entry in enumerate(replans):
+        route = entry.get("route") if isinstance(entry, Mapping) else None
+        if not (
+            isinstance(entry, Mapping)
+            and _is_number(entry.get("t"))
+            and isinstance(entry.get("robot"), str)
+            and isinstance(route, Mapping)
+        ):
+            fail(f"replans[{k}]", "a mapping with a time t (s), a robot id and its route")
+        start = route.get("from")
+        if not (isinstance(start, list) and len(start) == 3 and all(_is_number(v) for v in start)):
+            fail(f"replans[{k}].route.from", "[x, y, heading] (mm, mm, degrees)")
+        steps = route.get("steps")
+        if not isinstance(steps, list):
+            fail(f"replans[{k}].route.steps", "a list of steps")
+        for j, step in enumerate(steps):
+            pose = step.get("pose") if isinstance(step, Mapping) else None
+            if not (
+                isinstance(pose, list)
+                and len(pose) == 3
+                and all(_is_number(v) for v in pose)
+                and isinstance(step.get("primitive"), str)
+                and _is_name(step.get("about"))
+            ):
+                fail(
+                    f"replans[{k}].route.steps[{j}]",
+                    "a pose [x, y, heading], a primitive and what it is about",
+                )
 
 
 @dataclass(frozen=True)
@@ -161,6 +202,8 @@ _ARRAYS = {  # every array of a Trace: its dtype, the ids along its second axis,
     "primitive": (int, "robot_ids", ()),
     "waiting": (bool, "robot_ids", ()),
     "delayed": (bool, "robot_ids", ()),
+    "awaits": (object, "robot_ids", ()),
+    "yields_to": (object, "robot_ids", ()),
     "humans": (float, "human_ids", (2,)),
     "objects": (float, "object_ids", (2,)),
 }
@@ -195,12 +238,22 @@ class Trace:
     delayed : ndarray of bool, shape (n, R), optional
         Whether a delay has stopped each robot (:mod:`cosmop.sim.delays`); None: a run without
         delays (older files have none either).
+    awaits : ndarray of object, shape (n, R), optional
+        The name of the message each robot stands waiting for (``msg(...)`` or ``away(...)``),
+        None where it waits for none; None: the trace does not say.
+    yields_to : ndarray of object, shape (n, R), optional
+        The id of the robot or person each robot gives way to (it stands although its step
+        would have it move, :data:`cosmop.sim.recording.YIELD_AFTER_S`), None where none.
     human_ids, object_ids : tuple of str
         The people and objects, in the order of their arrays' second axis.
     humans, objects : ndarray, shape (n, H, 2) and (n, O, 2)
         Positions, mm; NaN where a frame lacks them.  None (the default): none.
     messages : tuple of Mapping
         The messages, as given: ``t`` (s), ``from``, ``to`` and any other keys.
+    replans : tuple of Mapping
+        The accepted replans in time order: ``t`` (s), ``robot`` and ``route`` (``from``: the
+        pose it went on from; ``steps``: each step left, ``pose``, ``primitive`` and ``about``,
+        the object or message it is about).
     scenario : str or None
         The scenario's name.
     dt : float or None
@@ -227,17 +280,20 @@ class Trace:
     primitive_names: tuple[str | None, ...] = ()
     waiting: np.ndarray | None = None
     delayed: np.ndarray | None = None
+    awaits: np.ndarray | None = None
+    yields_to: np.ndarray | None = None
     human_ids: tuple[str, ...] = ()
     humans: np.ndarray | None = None
     object_ids: tuple[str, ...] = ()
     objects: np.ndarray | None = None
     messages: tuple[Mapping[str, Any], ...] = ()
+    replans: tuple[Mapping[str, Any], ...] = ()
     scenario: str | None = None
     dt: float | None = None
     units: Mapping[str, str] = field(default_factory=lambda: MappingProxyType(dict(INTERNAL_UNITS)))
 
     def __post_init__(self) -> None:
-        for name in ("robot_ids", "primitive_names", "human_ids", "object_ids", "messages"):
+        for name in ("robot_ids", "primitive_names", "human_ids", "object_ids", "messages", "replans"):
             object.__setattr__(self, name, tuple(getattr(self, name)))
         object.__setattr__(self, "units", MappingProxyType(dict(self.units)))
         t = np.asarray(self.t, dtype=float)
@@ -317,6 +373,7 @@ class Trace:
             **self._json_head(),
             "frames": self.rounded()._json_frames(slice(None)),
             "messages": [dict(m) for m in self.messages],
+            **({"replans": [dict(r) for r in self.replans]} if self.replans else {}),
         }
 
     def _json_head(self) -> dict[str, Any]:
@@ -342,10 +399,13 @@ class Trace:
         """The robot states of the frames `rows` as the file writes them (this trace already
         :meth:`rounded`)."""
         objects, names = [*self.object_ids, None], self.primitive_names  # carrying -1: objects[-1], None
-        poses, v, w, carrying, primitive, waiting, delayed = (
+        poses, v, w, carrying, primitive, waiting, delayed, awaits, yields_to = (
             None if a is None else a[rows]
-            for a in (self.poses, self.v, self.w, self.carrying, self.primitive, self.waiting, self.delayed)
-        )
+            for a in (
+                self.poses, self.v, self.w, self.carrying, self.primitive, self.waiting, self.delayed,
+                self.awaits, self.yields_to,
+            )
+        )  # fmt: skip
         columns = {"pose": poses.tolist()}
         for key, array, to_json in (
             ("v", v, None),
@@ -354,6 +414,8 @@ class Trace:
             ("primitive", primitive, names.__getitem__),
             ("waiting", waiting, None),
             ("delayed", delayed, None),
+            ("awaits", awaits, None),
+            ("yields_to", yields_to, None),
         ):
             if array is not None:
                 values = array.tolist()
@@ -365,10 +427,16 @@ class Trace:
             robots = {}
             for i, rid in enumerate(self.robot_ids):
                 if not holes:
-                    robots[rid] = {key: values[k][i] for key, values in columns.items()}
+                    state = {key: values[k][i] for key, values in columns.items()}
                 elif not math.isnan(columns["pose"][k][i][0]):  # else: this frame does not show it
                     state = {key: values[k][i] for key, values in columns.items()}
-                    robots[rid] = {n: x for n, x in state.items() if not (isinstance(x, float) and x != x)}
+                    state = {n: x for n, x in state.items() if not (isinstance(x, float) and x != x)}
+                else:
+                    continue
+                for key in _SPARSE_KEYS:
+                    if key in state and state[key] is None:
+                        del state[key]
+                robots[rid] = state
             frames.append(robots)
         return frames
 
@@ -378,7 +446,8 @@ class Trace:
 
         The ids of each kind are taken in the order the frames first name them (objects that
         are only ever carried come last); a frame that does not name one is NaN there.  Keys no
-        robot state has (``v``, ``w``, ``carrying``, ``primitive``, ``waiting``, ``delayed``) give None.
+        robot state has (``v``, ``w``, ``carrying``, ``primitive``, ``waiting``, ``delayed``,
+        ``awaits``, ``yields_to``) give None.
 
         Raises
         ------
@@ -410,6 +479,7 @@ class Trace:
             object_ids=object_ids,
             objects=_point_columns(frames, "objects", object_ids),
             messages=tuple(checked.get("messages", [])),
+            replans=tuple(checked.get("replans", [])),
             scenario=checked.get("scenario"),
             dt=checked.get("dt"),
             units=checked.get("units") or INTERNAL_UNITS,
@@ -433,7 +503,10 @@ class Trace:
             for start in range(0, len(exact.t), _FRAMES_PER_BLOCK):
                 block = _compact(exact._json_frames(slice(start, start + _FRAMES_PER_BLOCK)))
                 out.write(("," if start else "") + block[1:-1])  # the frames without their brackets
-            out.write('],"messages":' + _compact([dict(m) for m in self.messages]) + "}\n")
+            out.write('],"messages":' + _compact([dict(m) for m in self.messages]))
+            if self.replans:
+                out.write(',"replans":' + _compact([dict(r) for r in self.replans]))
+            out.write("}\n")
 
 
 _FRAMES_PER_BLOCK = 500  # frames made into JSON at a time by Trace.save
@@ -495,6 +568,8 @@ def _robot_columns(frames: Sequence[Mapping[str, Any]], robot_ids: Sequence[str]
         columns[key] = np.full((n, len(robot_ids)), empty)
     for key in ("carrying", "primitive"):
         columns[key] = [[None] * len(robot_ids) for _ in range(n)]
+    for key in _SPARSE_KEYS:
+        columns[key] = np.full((n, len(robot_ids)), None, dtype=object)
     for k, frame in enumerate(frames):
         for rid, state in frame.get("robots", {}).items():
             i = index[rid]
@@ -548,8 +623,12 @@ def load_trace(path: str | os.PathLike[str]) -> Trace:
 
 
 def message_label(message: Mapping[str, Any]) -> str:
-    """A short text for a message of any kind: its object, else its event, kind or type, else "message"."""
+    """A short text for a message of any kind: its object, else its event (a ``msg``'s tag), kind or
+    type, else "message"."""
     for key in ("object", "event", "kind", "type"):
-        if isinstance(message.get(key), str):
-            return message[key]
+        value = message.get(key)
+        if isinstance(value, str):
+            if key == "event" and value.startswith("msg(") and value.count(",") == 2:
+                return value[:-1].rsplit(",", 1)[-1]  # a msg event's tag says what it is about
+            return value
     return "message"

@@ -16,7 +16,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Sequence
 from dataclasses import replace
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from cosmop.control.geometry import box_gaps
 from cosmop.events import Event, Primitive
@@ -29,7 +29,7 @@ from cosmop.sim.recoordinate import recoordinate_world
 if TYPE_CHECKING:
     from cosmop.sim.world import Agent, World
 
-__all__ = ["replan", "replan_stalled", "sensed_scene"]
+__all__ = ["replan", "replan_stalled", "route", "sensed_scene"]
 
 _PERSON_ROOM = 10.0  # mm added around a sensed person (a robot gets the standoff)
 
@@ -147,6 +147,24 @@ def replan_stalled(world: World, agent: Agent) -> None:
     )
     if accepted:
         world.replans += 1
+        world.replan_log[-1]["route"] = route(agent, start.robot)
+
+
+def route(agent: Agent, start: Sequence[float]) -> dict[str, Any]:
+    """What `agent` does from now on, for the pictures: where it starts (mm, mm, degrees) and
+    each step left with its pose, primitive and what it is about (an object or a message)."""
+    steps = agent.steps[agent.step_index :]
+    return {
+        "from": [round(float(v), 3) for v in start],
+        "steps": [
+            {
+                "pose": [round(float(v), 3) for v in s.robot],
+                "primitive": str(s.primitive),
+                "about": s.object or s.message,
+            }
+            for s in steps
+        ],
+    }
 
 
 def _sensed(world: World, agent: Agent) -> list[tuple[float, float, float]]:

@@ -193,12 +193,14 @@ class SimResult:
         Per cycle arrays: ``t`` (n,), ``pose`` (n, R, 3; degrees), ``v`` (n, R), ``w``
         (n, R; deg/s), ``carrying`` (n, R; object index or -1), ``primitive`` (n, R; index in
         :data:`FRAME_PRIMITIVES`), ``waiting`` (n, R), ``delayed`` (n, R: a delay has stopped
-        the robot), ``humans`` (n, H, 2), ``objects``
-        (n, O, 2); lengths in mm, speeds in mm/s.
+        the robot), ``awaits`` and ``yields_to`` (n, R; objects: the message a robot waits for,
+        the robot or person it gives way to, or None; :mod:`cosmop.sim.recording`), ``humans``
+        (n, H, 2), ``objects`` (n, O, 2); lengths in mm, speeds in mm/s.
     robot_ids, human_ids, object_ids : tuple of str
     replan_log : tuple of dict
         Every replan attempt: ``t``, ``robot``, ``accepted`` (its new plan was ordered with the
-        others' again, :mod:`cosmop.sim.recoordinate`), ``why`` not, and the ``messages`` added.
+        others' again, :mod:`cosmop.sim.recoordinate`), ``why`` not, the ``messages`` added, and
+        for an accepted one its ``route`` (:func:`cosmop.sim.replan.route`).
     events : tuple of (float, str, str)
         ``(t, robot, event)``: the mission events and messages as the robots realised them --
         a pick when the gripper closes, a drop when the object lies in its workspace, a return
@@ -340,11 +342,18 @@ class SimResult:
             primitive_names=FRAME_PRIMITIVES,
             waiting=f["waiting"],
             delayed=f["delayed"] if self.delays is not None else None,  # (a run without: as before)
+            awaits=f.get("awaits"),
+            yields_to=f.get("yields_to"),
             human_ids=self.human_ids,
             humans=f["humans"],
             object_ids=self.object_ids,
             objects=f["objects"],
             messages=tuple(m.to_dict() for m in self.messages),
+            replans=tuple(
+                {"t": r["t"], "robot": r["robot"], "route": r["route"]}
+                for r in self.replan_log
+                if "route" in r
+            ),
             scenario=self.scenario,
             dt=self.dt,
         ).rounded()

@@ -436,6 +436,14 @@ class World:
         self.sent_messages.add(event.name)
         self.events.append((round(self.t, 6), agent.id, event.name))
 
+    def awaited(self, agent: Agent, step: Step) -> Event | None:
+        """The message a ``Req`` step waits for: its ``msg``, or the first ``away`` request about
+        its object not yet answered (None when every one has been)."""
+        if step.message is not None:
+            return parse_event(step.message)
+        pending = [e for e in agent.realising(Primitive.REQ, step.object) if e.name not in self.sent_messages]
+        return pending[0] if pending else None
+
     def received(self, agent: Agent, step: Step) -> bool:
         """Whether the message a ``Req`` step waits for has been sent."""
         if step.message is not None:

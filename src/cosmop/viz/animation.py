@@ -5,7 +5,9 @@ cycle: times, the robots' poses, what they carry and whether they wait, the peop
 objects' positions, and the messages.  Coordinates are mm, headings degrees, times seconds.
 :func:`save_animation` draws the walls, workspaces, objects, robots (with their trails, planned
 paths, carried objects, a ``?`` while waiting for an answer and a ``!`` just after sending a
-message) and humans, frame by frame, and writes the file atomically. matplotlib is imported
+message, and in plain words why a robot stands, :mod:`cosmop.viz.explain`) and humans, frame
+by frame, and writes the file atomically.  A robot that replans has its planned path redrawn
+from that moment. matplotlib is imported
 lazily (``pip install 'cosmop[viz]'``, Agg backend); MP4 also needs the ffmpeg binary of
 ``imageio-ffmpeg`` (``pip install 'cosmop[video]'``).
 """
@@ -26,6 +28,7 @@ from cosmop.io import atomic_path
 from cosmop.planning.plan import PlanSet
 from cosmop.scene import Scene
 from cosmop.traces import RobotState, Trace, as_trace, message_label
+from cosmop.viz.explain import Explainer, waiting_words
 from cosmop.viz.labels import text_marker
 from cosmop.viz.scene import (
     ANIMATION_STYLE,
@@ -235,7 +238,9 @@ class _Animator:
             humans=ids_with_trace(scene.humans, trace, "humans"),
         )
         self._take_pieces(scene, drawn)
-        self._draw_plans(scene, plans, drawn.colours)
+        self.explainer = Explainer(scene, plans)
+        self.words = waiting_words(scene, plans)
+        self.plan_lines = self._draw_plans(scene, plans, drawn.colours)
         self._add_robot_marks(drawn.colours)
         messages = trace.messages
         self.sent = _sent_times(messages, self.robot_ids)
@@ -262,15 +267,32 @@ class _Animator:
         self.object_label = {oid: piece.label for oid, piece in self.objects.items()}
         self.human_artists = {hid: (piece.patch, piece.label) for hid, piece in self.humans.items()}
 
-    def _draw_plans(self, scene: Scene, plans: PlanSet | None, colours: Mapping[str, Any]) -> None:
-        """Each robot's planned path, dashed in its colour (part of the still background)."""
+    def _draw_plans(
+        self, scene: Scene, plans: PlanSet | None, colours: Mapping[str, Any]
+    ) -> dict[str, list[tuple[float, Any]]]:
+        """Each robot's planned path, dashed in its colour; the paths of its replans too, each
+        from its time on.  Returns the lines of the robots that replan, with their start
+        times (s): they move; the others' stay in the still background."""
+        paths: dict[str, list[tuple[float, list]]] = {}
         for rid in self.robot_ids:
             plan = plans.robots.get(rid) if plans is not None else None
             if plan is not None and rid in scene.robots:
-                path = planned_path(scene.robots[rid], plan)
-                self.ax.plot(
-                    *zip(*path, strict=True), color=colours[rid], lw=0.8, ls="--", alpha=0.8, zorder=1
-                )
+                paths[rid] = [(-math.inf, planned_path(scene.robots[rid], plan))]
+        for replan in self.trace.replans:
+            route = replan["route"]
+            path = [route["from"][:2]] + [s["pose"][:2] for s in route["steps"] if s["primitive"] == "GoTo"]
+            if replan["robot"] in self.robot_ids:
+                paths.setdefault(replan["robot"], []).append((float(replan["t"]), path))
+        lines: dict[str, list[tuple[float, Any]]] = {}
+        for rid, versions in paths.items():
+            for k, (t, path) in enumerate(versions):
+                (line,) = self.ax.plot(
+                    *zip(*path, strict=True), color=colours[rid], lw=0.8, ls="--", alpha=0.8, zorder=1,
+                    visible=k == 0,
+                )  # fmt: skip
+                if len(versions) > 1:
+                    lines.setdefault(rid, []).append((t, line))
+        return lines
 
     def _add_robot_marks(self, colours: Mapping[str, Any]) -> None:
         """Per robot, beside its square and id: trail, heading tick, cargo, '?' and '!'."""
@@ -294,7 +316,12 @@ class _Animator:
                 "cargo": cargo,
                 "question": text_marker(ax, "?", colour, 14, weight="bold", va="bottom", zorder=7),
                 "bang": text_marker(ax, "!", colour, 14, weight="bold", va="bottom", zorder=7),
-            }
+                "why": ax.text(
+                    0, 0, "", fontsize=6, style="italic", color="black", ha="center", va="top", zorder=7,
+                    visible=False,
+                    bbox={"boxstyle": "round,pad=0.1", "fc": "white", "ec": "none", "alpha": 0.75},
+                ),
+            }  # fmt: skip
 
     def _moving_artists(self) -> list[Any]:
         """Everything that moves, in drawing order: drawn over a background rendered once (blitting)."""
@@ -306,6 +333,7 @@ class _Animator:
             moving += [disc, label]
         for arrow, text, _ in self.arrows:
             moving += [arrow, text]
+        moving += [line for versions in self.plan_lines.values() for _, line in versions]
         return sorted(moving, key=lambda artist: artist.get_zorder())
 
     def _message_arrows(
@@ -423,6 +451,11 @@ class _Animator:
         robots = trace.robots_at(index)
         for rid in self.robot_ids:
             self._show_robot(rid, robots.get(rid), index, t)
+            self._show_why(rid, robots.get(rid), index)
+        for versions in self.plan_lines.values():
+            now = max(k for k, (start, _) in enumerate(versions) if start <= t)
+            for k, (_, line) in enumerate(versions):
+                line.set_visible(k == now)
         self._show_objects(trace.points_at("objects", index), set(trace.carried_at(index)))
         self._show_messages(t, robots)
         humans = trace.points_at("humans", index)
@@ -462,6 +495,34 @@ class _Animator:
         a["bang"].set_visible(recent)
         a["bang"].set_data([x + shift], [y + 1.1 * h])
 
+    def _show_why(self, rid: str, state: RobotState | None, index: int) -> None:
+        """Under robot `rid`'s id, why it stands in frame `index`, in plain words (if it does)."""
+        text = self.artists[rid]["why"]
+        words = self._reason(rid, index) if state is not None else ""
+        text.set_visible(bool(words))
+        if words:
+            x, y, _ = state.pose
+            below = 1.1 * self.robots[rid].size / 2 + 9 * self.mm_per_pt  # under the id
+            text.set_position((x, y - below))
+            if text.get_text() != words:
+                text.set_text(words)
+
+    def _reason(self, rid: str, index: int) -> str:
+        """Why robot `rid` stands in frame `index` ("" when it does not)."""
+        trace = self.trace
+        if rid not in trace.robot_ids:
+            return ""
+        i = trace.robot_ids.index(rid)
+        awaited = trace.awaits[index, i] if trace.awaits is not None else None
+        if awaited is not None:
+            return self.words.get(awaited) or self.explainer.awaits(awaited)
+        who = trace.yields_to[index, i] if trace.yields_to is not None else None
+        if who is not None:
+            return self.explainer.yields(who)
+        if trace.delayed is not None and trace.delayed[index, i]:
+            return "stopped by a delay"
+        return ""
+
     def _show_objects(self, objects: Mapping[str, tuple[float, float]], carried: set[str]) -> None:
         """The objects on the ground where the frame (or an earlier one) puts them, with their ids."""
         for oid, piece in self.objects.items():
@@ -494,6 +555,7 @@ def _legend(ax: Any) -> None:
         Line2D([], [], ls="none", marker="o", color="orange", ms=6, label="person"),
         symbol("?", "waits for an answer (Req)"),
         symbol("!", "sent an answer (Res)"),
+        Line2D([], [], ls="none", marker="$abc$", color="black", ms=9, label="why a robot stands"),
         Line2D([], [], color="grey", lw=1.5, marker=">", ms=4, label="message → receiver, time"),
     ]
     ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=6, frameon=False)
