@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -229,3 +230,69 @@ def _position(path: Path, needle: str) -> str:
         if needle in line:
             return f"line {number}, column {line.index('drop O1') + 1}"
     raise AssertionError(needle)
+
+
+PEOPLE_FILE = EXAMPLE_DIR.parent / "03_people_2x2" / "scenario.yaml"
+WIDE = {"COLUMNS": "200"}  # one line per row of the table, so that phrases are not wrapped apart
+
+
+def _row(out: str, part: str) -> list[str]:
+    """The details of a summary row, one entry per printed line (a row may hold several)."""
+    lines = out.splitlines()
+    start = next(i for i, line in enumerate(lines) if line.startswith(f"│ {part} "))
+    end = start + 1
+    while lines[end].startswith("│") and not lines[end].split("│")[1].strip():  # no part: the same row
+        end += 1
+    return [line.split("│")[3].strip() for line in lines[start:end]]
+
+
+def test_validate_shows_people_and_dynamics_in_mm() -> None:
+    result = runner.invoke(app, ["validate", str(PEOPLE_FILE)], env=WIDE)
+    assert result.exit_code == 0, result.output
+    assert "│ people     │     2 │" in result.stdout
+    assert _row(result.stdout, "people") == [
+        "H1, 400 mm wide, walks at 600 mm/s: a route of 3 points once (stopping 2 s), "
+        "then at random in x [-2200, 2200], y [-2200, -400] mm",
+        "H2, 400 mm wide, walks at 600 mm/s: from (1800, 1500) at random in x [400, 2200], y [400, 2200] mm",
+    ]
+    assert _row(result.stdout, "dynamics") == [
+        "defaults: top speed 750 mm/s, acceleration 300 mm/s^2, braking 500 mm/s^2, turning 100°/s, "
+        "control cycle 0.1 s"
+    ]
+
+
+def test_validate_says_no_people() -> None:
+    result = runner.invoke(app, ["validate", str(TASKS_FILE)], env=WIDE)
+    assert result.exit_code == 0, result.output
+    assert "│ people     │     0 │ no people" in result.stdout
+    assert _row(result.stdout, "dynamics")[0].startswith("defaults: top speed 750 mm/s")
+
+
+def test_validate_shows_a_metres_file_in_metres(tmp_path: Path) -> None:
+    # the people example in metres, with limits set for the scene and for R1
+    text = PEOPLE_FILE.read_text()
+    text = text[text.index("name:") :].replace("name: warehouse-2x2-people", "name: si\nunits: m")
+    text = text.replace(
+        "R1: {size: 400, pose: [-2000, -1000, 0]}",
+        "R1: {size: 400, pose: [-2000, -1000, 0], dynamics: {max_speed: 500}}",
+    )
+    text = text.replace("  humans:", "  dynamics: {braking: 800, turn_rate: 1.5}\n  humans:")
+    text = text.replace("      loop: false\n", "")  # H1 walks its route over and over
+    numbers = re.compile(r"(?<![\w.])-?\d{3,5}(?![\w.])")
+    text = numbers.sub(lambda m: repr(int(m.group(0)) / 1000), text)  # mm -> m; rad/s stay
+    path = tmp_path / "si.yaml"
+    write_atomic(path, text)
+    result = runner.invoke(app, ["validate", str(path)], env=WIDE)
+    assert result.exit_code == 0, result.output
+    assert _row(result.stdout, "people") == [
+        "H1, 0.4 m wide, walks at 0.6 m/s: a route of 3 points over and over "
+        "(stopping 2 s; its walk area is never used)",
+        "H2, 0.4 m wide, walks at 0.6 m/s: from (1.8, 1.5) at random in x [0.4, 2.2], y [0.4, 2.2] m",
+    ]
+    assert _row(result.stdout, "dynamics") == [
+        "R1: top speed 0.5 m/s, braking 0.8 m/s^2, turning 1.5 rad/s (set in the file); "
+        "defaults: acceleration 0.3 m/s^2, control cycle 0.1 s",
+        "R2: braking 0.8 m/s^2, turning 1.5 rad/s (set in the file); "
+        "defaults: top speed 0.75 m/s, acceleration 0.3 m/s^2, control cycle 0.1 s",
+    ]
+    assert "mm" not in result.stdout[: result.stdout.index(str(path))]  # the table, not the file's name

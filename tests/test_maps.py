@@ -200,3 +200,103 @@ def test_cli_import_map_bad_input_exits_2_and_writes_nothing(tmp_path):
     other.write_bytes(b"\x89PNG")
     result = runner.invoke(app, ["import-map", str(other), "-o", str(out)])
     assert result.exit_code == 2 and "expected a MovingAI .map file or a ROS map .yaml" in result.stderr
+
+
+# The example's scenario as a user would write it before importing the map: comments above,
+# beside and below, flow-style lines, a blank line, and no walls yet.
+COMMENTED_TEMPLATE = """\
+# Our warehouse, drawn by hand first.
+# Robots start in opposite corners.
+name: grid-warehouse   # keep this name
+scene:
+  # the robots, one per corner
+  robots:
+    R1: {size: 400, pose: [500, 500, 0]}      # bottom left
+    R2: {size: 400, pose: [9500, 5500, 180]}  # top right
+
+  objects:   # goods on the shelves
+    O1: {size: 100, position: [2500, 3500]}
+    O2: {size: 100, position: [8000, 2500]}
+  workspaces:
+    W1: {x: [8000, 9500], y: [3000, 3800]}
+    W2: {x: [500, 2000], y: [5200, 5800]}
+# each robot fetches one object and comes home
+mission:
+  tasks: {R1: [pick O1, drop O1 at W1, return], R2: [pick O2, drop O2 at W2, return]}
+"""
+
+
+def _import_with(template: Path, out: Path) -> str:
+    args = ["import-map", str(EXAMPLE / "warehouse.map"), "--cell-size", "500", "-o", str(out)]
+    result = runner.invoke(app, [*args, "--template", str(template)])
+    assert result.exit_code == 0, result.output
+    return out.read_text()
+
+
+def test_import_map_keeps_the_templates_comments_and_order(tmp_path):
+    template = tmp_path / "template.yaml"
+    template.write_text(COMMENTED_TEMPLATE)
+    text = _import_with(template, tmp_path / "scenario.yaml")
+    # every line of the template is there, in its order: only the walls and the header are new
+    lines = text.splitlines()
+    at = [lines.index(line) for line in COMMENTED_TEMPLATE.splitlines()]
+    assert at == sorted(at)
+    new = [line for line in lines if line not in COMMENTED_TEMPLATE.splitlines()]
+    assert new[0].startswith("# Imported by cosmop import-map from warehouse.map")
+    assert new[2] == "  obstacles:" and len(new) == 3 + 28
+    assert text.index("  obstacles:") < text.index("  # the robots, one per corner")  # walls first
+    data = yaml.safe_load(text)
+    assert list(data) == ["name", "scene", "mission"]
+    assert list(data["scene"]) == ["obstacles", "robots", "objects", "workspaces"]
+    assert load_scenario(tmp_path / "scenario.yaml").scene == load_scenario(EXAMPLE / "scenario.yaml").scene
+
+
+def test_import_map_replaces_walls_in_place_with_the_comments_around_them(tmp_path):
+    # walls last in the scene, a note on their key, a note on an old wall, a comment after them
+    template = tmp_path / "template.yaml"
+    old_walls = "  obstacles:      # replaced by the map\n    - [[0, 0], [1, 0]]   # a stub\n\n"
+    template.write_text(
+        COMMENTED_TEMPLATE.replace("# each robot fetches", old_walls + "# each robot fetches")
+    )
+    text = _import_with(template, tmp_path / "scenario.yaml")
+    assert "  obstacles:      # replaced by the map\n    - [[0, 0], [10000, 0]]\n" in text  # as indented
+    assert "# a stub" not in text  # it was about the old wall
+    assert (
+        "    - [[10000, 0], [10000, 6000]]\n\n# each robot fetches one object and comes home\nmission:"
+        in text
+    )
+    assert list(yaml.safe_load(text)["scene"]) == ["robots", "objects", "workspaces", "obstacles"]
+    # the new walls and the template's name, asked for another
+    again = tmp_path / "again.yaml"
+    args = ["import-map", str(EXAMPLE / "warehouse.map"), "--cell-size", "500", "-o", str(again)]
+    assert runner.invoke(app, [*args, "--template", str(template), "--name", "renamed"]).exit_code == 0
+    named = next(line for line in again.read_text().splitlines() if line.startswith("name:"))
+    assert named.split() == ["name:", "renamed", "#", "keep", "this", "name"]  # the comment kept its column
+
+
+def test_importing_the_example_into_itself_gives_it_back(tmp_path):
+    # the earlier import's header is replaced, not stacked
+    example = EXAMPLE / "scenario.yaml"
+    assert _import_with(example, tmp_path / "scenario.yaml") == example.read_text()
+
+
+def test_a_template_ruamel_cannot_keep_is_written_plainly(tmp_path, monkeypatch):
+    import cosmop.maps.scene as scene_module
+
+    def fail(*args, **kwargs):
+        raise ValueError("ruamel could not")
+
+    monkeypatch.setattr(scene_module, "merge_walls", fail)
+    template = tmp_path / "template.yaml"
+    template.write_text(COMMENTED_TEMPLATE)
+    text = _import_with(template, tmp_path / "scenario.yaml")
+    assert "# (The template's comments could not be kept" in text and "# bottom left" not in text
+    assert load_scenario(tmp_path / "scenario.yaml").scene == load_scenario(EXAMPLE / "scenario.yaml").scene
+
+
+def test_merge_walls_writes_numbers_yaml_1_1_reads_as_numbers():
+    from cosmop.maps.template import merge_walls
+
+    text = merge_walls("name: n\nscene:\n  robots: {}\n", [[[1e-05, 0.5], [1e17, 2]]])
+    assert "[[1.0e-05, 0.5], [1.0e+17, 2]]" in text
+    assert yaml.safe_load(text)["scene"]["obstacles"] == [[[1e-05, 0.5], [1e17, 2]]]

@@ -66,7 +66,7 @@ def import_map(
     template: Annotated[
         Path | None,
         typer.Option(
-            help="A scenario whose robots, objects, workspaces and mission to keep (its walls are replaced).",
+            help="A scenario to keep, comments and all; only its walls are replaced.",
             show_default=False,
         ),
     ] = None,
@@ -75,8 +75,9 @@ def import_map(
     """Turn a grid map into scenario walls: blocked cells merged into rectangles and walled in.
 
     Without --template it writes the scene's walls only (add robots, objects, workspaces and a
-    mission); with one, a whole scenario, which is validated before it is written. Exit status
-    0 written, 2 bad input (nothing written).
+    mission); with one, a whole scenario, which is validated before it is written: the template
+    as it was (comments, key order, one-line lists) with its walls replaced. Exit status 0
+    written, 2 bad input (nothing written).
     """
     from cosmop.maps import import_map as read_map
     from cosmop.maps import scenario_text

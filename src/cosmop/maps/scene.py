@@ -3,7 +3,8 @@
 :func:`import_map` reads a MovingAI ``.map`` or a ROS ``map.yaml``, covers the blocked cells
 with rectangles and walls them in (:mod:`cosmop.maps.cover`); :func:`scenario_text` writes the
 walls as ``scene.obstacles`` of a scenario, either alone (the user adds robots, objects,
-workspaces and a mission) or merged into a template scenario whose obstacles it replaces.
+workspaces and a mission) or merged into a template scenario whose obstacles it replaces
+(:mod:`cosmop.maps.template` keeps the template's comments).
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from cosmop.maps.cover import Rect, boundary_walls, rectangle_cover, rectangle_w
 from cosmop.maps.grid import MapError, OccupancyGrid
 from cosmop.maps.movingai import read_movingai
 from cosmop.maps.rosmap import read_ros_map
+from cosmop.maps.template import merge_walls
 from cosmop.reading import load_yaml
 from cosmop.units import m_from_mm
 
@@ -134,12 +136,14 @@ def _number(value: float, units: str) -> int | float:
     return int(v) if float(v).is_integer() else v
 
 
-def _load_template(path: str | os.PathLike[str]) -> dict[str, Any]:
+def _load_template(path: str | os.PathLike[str]) -> tuple[str, dict[str, Any]]:
+    """The template's text and what cosmop reads in it (its errors are the scenario loader's)."""
     file = os.fspath(path)
-    data, _ = load_yaml(read_text(path, MapError, "a scenario file"), file, MapError)
+    text = read_text(path, MapError, "a scenario file")
+    data, _ = load_yaml(text, file, MapError)
     if not isinstance(data, dict) or not isinstance(data.get("scene"), dict):
         raise MapError("expected a scenario with a scene mapping to take robots and mission from", file=file)
-    return data
+    return text, data
 
 
 def scenario_text(
@@ -161,7 +165,9 @@ def scenario_text(
         units than asked for is an error.
     template : str or os.PathLike, optional
         A scenario whose robots, objects, workspaces, people and mission are kept; its
-        obstacles are replaced by the map's walls.
+        obstacles are replaced by the map's walls. Its text is kept as written, comments,
+        blank lines, key order and one-line lists included (:func:`cosmop.maps.template.merge_walls`);
+        should that not read back the same, it is written plainly, with a header line saying so.
 
     Returns
     -------
@@ -173,7 +179,7 @@ def scenario_text(
     MapError
         If the template cannot be read or its units differ from `units`.
     """
-    data: dict[str, Any] = _load_template(template) if template is not None else {}
+    text, data = _load_template(template) if template is not None else ("", {})
     file_units = data.get("units", "mm")
     if units is not None and template is not None and units != file_units:
         raise MapError(
@@ -182,22 +188,51 @@ def scenario_text(
             field="units",
         )
     units = file_units if template is not None else (units or "mm")
+    walls = [[[_number(v, units) for v in p] for p in wall] for wall in imported.walls]
     out: dict[str, Any] = {"name": name or data.get("name") or Path(imported.source).stem}
     if units == "m":
         out["units"] = "m"
     scene = dict(data.get("scene", {}))
-    scene["obstacles"] = [[[_number(v, units) for v in p] for p in wall] for wall in imported.walls]
-    out["scene"] = {"obstacles": scene.pop("obstacles"), **scene}
+    out["scene"] = {"obstacles": walls, **{k: v for k, v in scene.items() if k != "obstacles"}}
     out.update({k: v for k, v in data.items() if k not in ("name", "units", "scene")})
+    header = _header(imported, units)
+    if template is None:
+        header.append("# Add robots, objects, workspaces and a mission to make it a scenario.")
+        return "\n".join(header) + "\n" + _plain_yaml(out)
+    expected = {**data, "name": out["name"], "scene": {**data["scene"], "obstacles": walls}}
+    kept = _keep_template(text, expected, walls, out["name"] if out["name"] != data.get("name") else None)
+    if kept is None:
+        header.append("# (The template's comments could not be kept: ruamel.yaml read it otherwise.)")
+    return "\n".join(header) + "\n" + (kept or _plain_yaml(out))
+
+
+def _header(imported: ImportedMap, units: str) -> list[str]:
+    """The comment lines that say where the walls came from."""
     g = imported.grid
     rows, cols = g.shape
     unit = "m" if units == "m" else "mm"
-    header = [
+    return [
         f"# Imported by cosmop import-map from {Path(imported.source).name}: {cols} x {rows} cells of "
         f"{_number(g.cell_size, units)} {unit},",
         f"# {int(g.blocked.sum())} blocked cells in {len(imported.rectangles)} rectangles, walled in by "
         f"{len(imported.walls)} wall segments. Lengths in {unit}.",
     ]
-    if template is None:
-        header.append("# Add robots, objects, workspaces and a mission to make it a scenario.")
-    return "\n".join(header) + "\n" + yaml.dump(out, Dumper=_Dumper, sort_keys=False, width=110)
+
+
+def _plain_yaml(data: dict[str, Any]) -> str:
+    return yaml.dump(data, Dumper=_Dumper, sort_keys=False, width=110)
+
+
+def _keep_template(text: str, expected: dict[str, Any], walls: list, name: str | None) -> str | None:
+    """The template's own text (comments, order, layout) with the new walls and name, or None
+    when that text would not read back as `expected` (then the caller writes it plainly).
+
+    ruamel.yaml reads YAML 1.2 and cosmop YAML 1.1, which differ on a few spellings (``0755``,
+    ``1e-05``); rather than trust every corner, the result is read back the way cosmop will.
+    """
+    try:
+        merged = merge_walls(text, walls, name)
+        same = load_yaml(merged, None, MapError)[0] == expected
+    except Exception:  # ruamel fails on odd input (or its comment bookkeeping does): write plainly
+        return None
+    return merged if same else None
