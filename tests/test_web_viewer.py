@@ -10,6 +10,7 @@ import io
 import json
 import os
 import re
+from pathlib import Path
 
 import pytest
 from typer.testing import CliRunner
@@ -33,7 +34,9 @@ def test_the_page_is_self_contained_and_carries_the_run():
     assert set(data["robots"]) == {"R1", "R2"} and data["robots"]["R1"]["steps"] == 7
     assert len(data["walls"]) == len(scenario.scene.obstacles)
     why = "R1 waits for R2 to move O2 out of its way"  # in plain words, from the plans
-    assert data["messages"] == [{"t": result.messages[0].t, "from": "R2", "to": "R1", "label": "O2", "why": why}]
+    assert data["messages"] == [
+        {"t": result.messages[0].t, "from": "R2", "to": "R1", "label": "O2", "why": why}
+    ]
     assert len(data["trace"]["t"]) == len(result.trace().t)  # short runs keep every frame
     small = render_html(scenario.scene, plans=plans, trace=result.trace(), max_frames=50)
     trace = json.loads(re.search(r'id="cosmop-data">(.*?)</script>', small, re.S).group(1))["trace"]
@@ -62,6 +65,18 @@ def test_cli_view_writes_the_page_and_rejects_bad_input(tmp_path):
     )
     assert bad.exit_code == 2 and "bad.json: format: expected 'cosmop.trace/1'" in bad.stderr
     assert not (tmp_path / "x.html").exists()
+
+
+def test_simulate_writes_the_page_of_its_run_and_says_where(tmp_path):
+    plan = Path(__file__).resolve().parent / "data" / "plan_2x2.json"  # cosmop plan of EXAMPLE
+    out = tmp_path / "run.html"
+    ran = runner.invoke(app, ["simulate", str(EXAMPLE), "--plan", str(plan), "--html", str(out)])
+    assert ran.exit_code == 0, ran.output
+    assert out.read_text().startswith("<!DOCTYPE html>")
+    assert f"wrote {out}: open it in a browser, {out.as_uri()}" in " ".join(ran.stdout.split())
+    data = json.loads(re.search(r'id="cosmop-data">(.*?)</script>', out.read_text(), re.S).group(1))
+    assert data["trace"] is not None and data["plans"]["R1"][0]["t"] is None
+    assert any(words.startswith("waits for R2 to") for words in data["waits"].values())
 
 
 @pytest.fixture(scope="module")
@@ -148,3 +163,174 @@ def test_a_screenshot_shows_the_scene(page):
     dark = sum(n for rgb, n in counts.items() if max(rgb) < 60)  # walls and text
     blue = sum(n for rgb, n in counts.items() if rgb == (0x1F, 0x77, 0xB4))  # R1's colour
     assert dark > 2000 and blue > 50
+
+
+# -- a big map: the MovingAI warehouse with the work in one corner --------------------------------
+
+
+def _corner_of_movingai():
+    """The MovingAI warehouse's walls with three robots at work in its lower left corner, and a
+    made-up run: R1 drives 6 m, R2 waits for R1's message, R3 gives way to R1, then replans."""
+    import sys
+
+    import numpy as np
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+    from cosmop.scenario import parse_scenario
+    from cosmop.traces import Trace
+    from movingai_gen import movingai_warehouse
+
+    data = movingai_warehouse(3, 0)
+    # in the aisles of the first shelf rows (y 4.5, 7.5 and 10.5 m), at the dock area's edge
+    data["scene"]["robots"] = {f"R{i}": {"size": 500, "pose": [22500, 1500 + 3000 * i, 0]} for i in (1, 2, 3)}
+    data["scene"]["objects"] = {"O1": {"size": 200, "position": [30500, 10100]}}
+    data["scene"]["workspaces"] = {"W1": {"x": [17000, 18000], "y": [5000, 6000]}}
+    data["mission"] = {"tasks": {"R1": ["pick O1", "drop O1 at W1"]}}
+    scene = parse_scenario(data).scene
+    n = 61
+    t = np.linspace(0.0, 30.0, n)
+    poses = np.zeros((n, 3, 3))
+    for i in range(3):
+        poses[:, i] = [22500, 1500 + 3000 * (i + 1), 0]
+    poses[:, 0, 0] += np.linspace(0, 6000, n)
+    awaits = np.full((n, 3), None, dtype=object)
+    awaits[10:30, 1] = "msg(R1,R2,clear1)"
+    yields = np.full((n, 3), None, dtype=object)
+    yields[30:40, 2] = "R1"
+    waiting = np.array([[False, v is not None, False] for v in awaits[:, 1]])
+    replan = {
+        "t": 20.0,
+        "robot": "R3",
+        "route": {
+            "from": [22500, 10500, 0],
+            "steps": [{"pose": [30000, 10500, 0], "primitive": "GoTo", "about": None}],
+        },
+    }
+    trace = Trace(
+        t=t, robot_ids=("R1", "R2", "R3"), poses=poses, waiting=waiting, awaits=awaits, yields_to=yields,
+        messages=({"t": 15.0, "from": "R1", "to": "R2", "event": "msg(R1,R2,clear1)"},),
+        replans=(replan,), scenario="movingai-corner",
+    )  # fmt: skip
+    return scene, trace
+
+
+@pytest.fixture(scope="module")
+def big_map(tmp_path_factory):
+    if CHROMIUM is None:
+        pytest.skip("no Chromium found: apt-get install chromium (or set COSMOP_CHROMIUM)")
+    scene, trace = _corner_of_movingai()
+    path = tmp_path_factory.mktemp("view") / "movingai.html"
+    save_html(scene, path, trace=trace, title="movingai-corner")
+    browser = Browser(CHROMIUM)
+    try:
+        browser.open(path.as_uri())
+        yield browser, scene
+    finally:
+        browser.close()
+
+
+def _keep(browser, name):
+    """Keep a screenshot in ``$COSMOP_SCREENSHOT_DIR`` (benchmarks/results keeps the last ones)."""
+    folder = os.environ.get("COSMOP_SCREENSHOT_DIR")
+    if folder:
+        with open(os.path.join(folder, name), "wb") as handle:
+            handle.write(browser.screenshot())
+
+
+def _mouse(browser, kind, x, y, **extra):
+    browser.call("Input.dispatchMouseEvent", {"type": kind, "x": x, "y": y, **extra}, session=True)
+
+
+def _svg_centre(browser):
+    return browser.evaluate(
+        "(() => { const r = document.getElementById('scene').getBoundingClientRect();"
+        " return [r.left + r.width / 2, r.top + r.height / 2]; })()"
+    )
+
+
+def test_a_big_map_opens_fitted_to_the_robots(big_map):
+    browser, scene = big_map
+    assert browser.errors == []
+    x0, x1, y0, y1 = browser.evaluate("window.cosmopViewer.view()")
+    walls = [p for w in scene.obstacles for p in (w.start, w.end)]
+    map_width = max(p[0] for p in walls) - min(p[0] for p in walls)
+    assert x1 - x0 < 0.4 * map_width  # the corner, not the 161 m map
+    for robot in scene.robots.values():
+        assert x0 < robot.pose[0] < x1 and y0 < robot.pose[1] < y1
+    assert x1 > 28500  # and where R1 drives to
+    _keep(browser, "viewer_movingai_fitted.png")
+    browser.evaluate("document.getElementById('whole').click()")
+    wx0, wx1, _, _ = browser.evaluate("window.cosmopViewer.view()")
+    assert wx1 - wx0 > map_width
+    browser.evaluate("document.getElementById('fit').click()")
+    assert browser.evaluate("window.cosmopViewer.view()") == [x0, x1, y0, y1]
+
+
+def test_the_wheel_zooms_about_the_pointer_and_a_drag_pans(big_map):
+    browser, _ = big_map
+    browser.evaluate("window.cosmopViewer.fit()")
+    before = browser.evaluate("window.cosmopViewer.view()")
+    cx, cy = _svg_centre(browser)
+    _mouse(browser, "mouseWheel", cx, cy, deltaX=0, deltaY=-400)
+    zoomed = browser.evaluate("window.cosmopViewer.view()")
+    ratio = (zoomed[1] - zoomed[0]) / (before[1] - before[0])
+    assert 0.4 < ratio < 0.7  # wheel up: closer
+    # about the pointer: the centre of the view stays where it was
+    assert abs((zoomed[0] + zoomed[1]) / 2 - (before[0] + before[1]) / 2) < 0.02 * (before[1] - before[0])
+    _keep(browser, "viewer_movingai_zoomed.png")
+    unit = (zoomed[1] - zoomed[0]) / browser.evaluate(
+        "document.getElementById('scene').getBoundingClientRect().width"
+    )
+    _mouse(browser, "mousePressed", cx, cy, button="left", buttons=1, clickCount=1)
+    _mouse(browser, "mouseMoved", cx + 60, cy + 30, button="left", buttons=1)
+    _mouse(browser, "mouseMoved", cx + 120, cy + 60, button="left", buttons=1)
+    _mouse(browser, "mouseReleased", cx + 120, cy + 60, button="left", buttons=0, clickCount=1)
+    panned = browser.evaluate("window.cosmopViewer.view()")
+    # dragged right and down: the world moves with the pointer, so the view goes left and up
+    assert panned[0] == pytest.approx(zoomed[0] - 120 * unit, rel=0.05, abs=5 * unit)
+    assert panned[2] == pytest.approx(zoomed[2] + 60 * unit, rel=0.05, abs=5 * unit)
+    _keep(browser, "viewer_movingai_panned.png")
+    assert browser.errors == []
+
+
+def test_a_standing_robot_says_why_and_a_replan_redraws_its_path(big_map):
+    browser, _ = big_map
+    browser.evaluate("window.cosmopViewer.fit()")
+    _seek(browser, 20)
+    words = browser.evaluate("document.getElementById('robot-R2').dataset.why")
+    assert words.startswith("waits for a message from R1")  # no plans: the message's sender
+    assert "R2 waits for a message from R1" in browser.evaluate("document.getElementById('why').textContent")
+    assert browser.evaluate("document.getElementById('plan-R3-0').getAttribute('visibility')") == "hidden"
+    _seek(browser, 35)  # t = 17.5 s
+    assert browser.evaluate("document.getElementById('robot-R3').dataset.why") == "gives way to R1"
+    assert browser.evaluate("document.getElementById('robot-R2').dataset.why") == ""
+    _seek(browser, 45)  # t = 22.5 s: R3 replanned at 20 s
+    assert browser.evaluate("document.getElementById('plan-R3-0').getAttribute('visibility')") == "visible"
+    _keep(browser, "viewer_movingai_waiting.png")
+    assert browser.errors == []
+
+
+def test_a_metres_file_is_shown_in_metres_on_the_page():
+    from dataclasses import replace
+
+    from cosmop.planning.plan import load_plan
+    from cosmop.scenario import load_scenario
+
+    plans = load_plan(Path(__file__).resolve().parent / "data" / "plan_2x2.json")
+    scene = load_scenario(EXAMPLE).scene
+    pages = {}
+    for units in ("mm", "m"):  # the same scene, written in mm or in metres
+        html = render_html(replace(scene, units=units), plans=plans)
+        pages[units] = json.loads(re.search(r'id="cosmop-data">(.*?)</script>', html, re.S).group(1))
+    assert "scenario file: m and radians" in pages["m"]["units_text"]
+    assert "mm and degrees" in pages["mm"]["units_text"]
+    places = [w for w in pages["m"]["waits"].values() if " at (" in w]
+    assert places and all(w.endswith(") m") for w in places)
+    assert all(w.endswith(") mm") for w in pages["mm"]["waits"].values() if " at (" in w)
+
+    # the same place, in the file's units: (1380, -1000) mm is (1.38, -1) m
+    def first(words):
+        return float(words.split(" at (")[1].split(",")[0])
+
+    name = next(n for n, w in pages["mm"]["waits"].items() if " at (" in w)
+    assert first(pages["m"]["waits"][name]) == pytest.approx(first(pages["mm"]["waits"][name]) / 1000)

@@ -11,6 +11,7 @@ import numpy as np
 from cosmop.pipeline import plan_team
 from cosmop.scenario import load_scenario
 from cosmop.sim import simulate
+from cosmop.viz.explain import Explainer
 
 HERE = Path(__file__).resolve().parent
 
@@ -22,6 +23,11 @@ entered = float(frames["t"][np.argmax(frames["pose"][:, r1, 1] > 0)])  # above y
 leaves = scenario.scene.humans["H1"].path[0][2]
 print(f"the person leaves the doorway at {leaves:.0f} s; R1 enters the room at {entered:.1f} s")
 print(f"R1 waited for the doorway: {entered >= leaves}; replan attempts: {result.replan_attempts}")
+# the trace records whom a standing robot gives way to; the pictures say it in words
+said = {
+    Explainer(scenario.scene, plans).yields(who) for who in result.trace().yields_to[:, r1].tolist() if who
+}
+print(f"the run says why R1 stood ({', '.join(sorted(said))}): {'waits for H1 (a person) to pass' in said}")
 print(
     f"every robot finished: {result.completed}; no contact while moving: {result.contacts_while_moving == 0}"
 )

@@ -63,6 +63,13 @@ def simulate(
         Path | None,
         typer.Option(help="Write the trace, every cycle (cosmop.trace/1 JSON).", show_default=False),
     ] = None,
+    html: Annotated[
+        Path | None,
+        typer.Option(
+            help="Write a web page of the run: scene, plans, robots moving, why they wait (cosmop view).",
+            show_default=False,
+        ),
+    ] = None,
     gif: Annotated[Path | None, typer.Option(help="Write an animation (GIF).", show_default=False)] = None,
     mp4: Annotated[Path | None, typer.Option(help="Write an animation (MP4).", show_default=False)] = None,
     speed: Annotated[
@@ -102,11 +109,12 @@ def simulate(
     check_engine(workers, scheduler)
     loaded = load(scenario)
     _check_outputs(summary=summary, trace=trace, gif=gif, mp4=mp4, bag=bag)
+    check_writable(html, "--html")
     plans = _plans_to_run(loaded, plan_file, workers, scheduler)
     settings = SimSettings(max_time=max_time, replan=replan, delays=delays)
     result = _run_with_progress(loaded, plans, seed, settings)
     # one Trace for the file, the bag and the animations, made only when one of them is asked for
-    run = result.trace() if any(p is not None for p in (trace, bag, gif, mp4)) else None
+    run = result.trace() if any(p is not None for p in (trace, bag, gif, mp4, html)) else None
     with uninterrupted():  # the trace and its summary: both or neither
         if trace is not None:
             run.save(trace)
@@ -117,10 +125,17 @@ def simulate(
     for path in (gif, mp4):
         if path is not None:
             _animate(loaded, run, plans, path, speed, size)
+    if html is not None:
+        from cosmop.viz.web import save_html
+
+        save_html(loaded.scene, html, plans=plans, trace=run, title=loaded.name)
     console = stdout()
     console.print(_robots_table(loaded, result, seed))
     ok = result.completed and result.contacts_while_moving == 0
     console.print(Text(_verdict(loaded, result, plans), style="green" if ok else "red"))
+    for path, what in ((html, "open it in a browser"), (gif, "the animation"), (mp4, "the animation")):
+        if path is not None:
+            console.print(Text(f"wrote {path}: {what}, {path.resolve().as_uri()}"))
     raise typer.Exit(0 if ok else 1)
 
 
