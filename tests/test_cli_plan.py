@@ -39,7 +39,11 @@ def test_plan_writes_a_checked_plan_and_a_png(tmp_path):
     assert "O2 to R1" in result.stdout and "deadlock-free" in result.stdout and "all valid" in result.stdout
 
 
-def test_infeasible_robot_exits_1_and_still_writes_the_file(tmp_path):
+def test_infeasible_robot_exits_1_and_still_writes_the_file(tmp_path, monkeypatch):
+    import cosmop.viz
+
+    drawn, draw = [], cosmop.viz.save_plan_png
+    monkeypatch.setattr(cosmop.viz, "save_plan_png", lambda *a, **k: (drawn.append(k), draw(*a, **k)))
     data = yaml.safe_load(TASKS_FILE.read_text())
     # box R2 in: four walls tight around its square
     data["scene"]["obstacles"] += [
@@ -50,9 +54,12 @@ def test_infeasible_robot_exits_1_and_still_writes_the_file(tmp_path):
     ]
     scenario = tmp_path / "boxed.yaml"
     scenario.write_text(yaml.safe_dump(data))
-    out = tmp_path / "plan.json"
-    result = runner.invoke(app, ["plan", str(scenario), "-o", str(out), "--max-horizon", "8"])
+    out, png = tmp_path / "plan.json", tmp_path / "plan.png"
+    result = runner.invoke(
+        app, ["plan", str(scenario), "-o", str(out), "--max-horizon", "8", "--png", str(png), "--full-map"]
+    )
     assert result.exit_code == 1, result.output
+    assert drawn == [{"full_map": True}] and png.read_bytes()[:4] == b"\x89PNG"  # the whole map, asked
     written = json.loads(out.read_text())
     assert written["feasible"] is False
     assert "R2" in written["reason"] and "pick(R2,O2)" in written["reason"] and "wall" in written["reason"]

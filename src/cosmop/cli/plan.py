@@ -86,6 +86,13 @@ def plan(
     png: Annotated[
         Path | None, typer.Option(help="Also draw the scene and the plans into this PNG.", show_default=False)
     ] = None,
+    full_map: Annotated[
+        bool,
+        typer.Option(
+            "--full-map",
+            help="Draw the whole map in the --png picture \\[default: where the team works, and a margin]",
+        ),
+    ] = False,
     max_horizon: Annotated[
         int | None,
         typer.Option(
@@ -106,8 +113,9 @@ def plan(
     verified against the global mission, and every plan passes the exact checker before it is
     written.  The file is written even when infeasible (``"feasible": false`` and a reason).
     The syntheses run in local processes, or on a Dask cluster with ``--scheduler``; the plans
-    are the same.  Exit status 0 feasible, 1 infeasible, 2 bad input (an unreachable scheduler
-    included).
+    are the same.  The PNG shows where the team works (``--full-map``: the whole map) and says
+    in its title whether the plans are feasible, and if not why.  Exit status 0 feasible,
+    1 infeasible, 2 bad input (an unreachable scheduler included).
     """
     check_engine(workers, scheduler)
     loaded = load(scenario)
@@ -120,7 +128,7 @@ def plan(
     if png is not None:
         from cosmop.viz import save_plan_png
 
-        save_plan_png(loaded.scene, result.plans, png)
+        save_plan_png(loaded.scene, result.plans, png, full_map=full_map)
     console = stdout()
     console.print(_plan_table(loaded, result))
     if result.plans.feasible:

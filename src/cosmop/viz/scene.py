@@ -318,7 +318,7 @@ def _draw_robot(
     piece.move(x, y)
     if style.placed_ids:
         text = {"fontsize": style.font, "color": colour, "weight": "bold"}
-        labels.append(Label(x, y, rid, text, center=True))
+        labels.append(Label(x, y, rid, text, center=True, keep=True))  # a robot's id always shows
     return piece
 
 
