@@ -135,7 +135,8 @@ def simulate(
     console.print(Text(_verdict(loaded, result, plans), style="green" if ok else "red"))
     for path, what in ((html, "open it in a browser"), (gif, "the animation"), (mp4, "the animation")):
         if path is not None:
-            console.print(Text(f"wrote {path}: {what}, {path.resolve().as_uri()}"))
+            # not wrapped: a path cut in two cannot be copied or clicked
+            console.print(Text(f"wrote {path}: {what}, {path.resolve().as_uri()}"), soft_wrap=True)
     raise typer.Exit(0 if ok else 1)
 
 
