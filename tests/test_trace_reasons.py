@@ -114,3 +114,24 @@ def test_plain_words_for_every_reason():
     assert explain.yields("R2") == "gives way to R2"
     in_metres = Explainer(replace(scene, units="m"), plans)
     assert in_metres.awaits("msg(R2,R1,clear2)") == "waits for R2 to clear the way at (-8.9, -8.8) m"
+
+
+def test_the_closing_line_says_which_contacts_were_people_walking_into_a_standing_robot():
+    from cosmop.cli.simulate import _contacts_said
+    from cosmop.sim.result import Contact
+
+    loaded = load_scenario(PEOPLE)
+    contacts = (
+        Contact(1.0, "R1", "H1", False),
+        Contact(2.0, "R1", "R2", False),
+        Contact(3.0, "R2", "H2", False),
+    )
+    result = SimpleNamespace(contacts=contacts, contacts_while_moving=0)
+    assert (
+        _contacts_said(loaded, result)
+        == "contacts 3, while moving 0 (2 a person walking into a standing robot)"
+    )
+    assert (
+        _contacts_said(loaded, SimpleNamespace(contacts=(), contacts_while_moving=0))
+        == "contacts 0, while moving 0"
+    )

@@ -264,10 +264,18 @@ def _verdict(loaded: Scenario, result: Any, plans: PlanSet) -> str:
         f"{'completed' if result.completed else 'not completed'} in {result.sim_time_s:.1f} s simulated "
         + (f"(planned {planned:.1f} s; " if planned is not None else "(")
         + f"{result.wall_time_s:.1f} s, {speed:.0f}x real time); "
-        f"objects in place {sum(delivered.values())}/{len(delivered)}; contacts {len(result.contacts)}, "
-        f"while moving {result.contacts_while_moving}; messages {len(result.messages)}; "
+        f"objects in place {sum(delivered.values())}/{len(delivered)}; {_contacts_said(loaded, result)}; "
+        f"messages {len(result.messages)}; "
         f"replans {result.replans}" + _delays_said(result)
     )
+
+
+def _contacts_said(loaded: Scenario, result: Any) -> str:
+    """The contacts in the closing line, with how many were people walking into a standing robot
+    (passive safety keeps a robot from moving into anything, not people from walking into it)."""
+    people = sum(1 for c in result.contacts if not c.moving and c.other in loaded.scene.humans)
+    said = f"contacts {len(result.contacts)}, while moving {result.contacts_while_moving}"
+    return said + (f" ({people} a person walking into a standing robot)" if people else "")
 
 
 def _delays_said(result: Any) -> str:
