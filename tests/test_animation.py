@@ -295,3 +295,37 @@ def test_no_pyplot_figure_is_left_open(tmp_path):
     before = plt.get_fignums()
     save_animation(SCENE, make_trace(3), tmp_path / "run.gif", dpi=DPI)
     assert plt.get_fignums() == before
+
+
+def test_a_frame_says_why_a_robot_stands_and_a_replan_redraws_its_path():
+    trace = make_trace(20, dt=0.1)
+    for k, frame in enumerate(trace["frames"]):
+        if frame["robots"]["R2"]["waiting"]:
+            frame["robots"]["R2"]["awaits"] = "msg(R1,R2,clear1)"
+        if 12 <= k <= 14:
+            frame["robots"]["R1"]["yields_to"] = "H1"
+    route = {
+        "from": [0, -1000, 0],
+        "steps": [{"pose": [-1500, 2000, 90], "primitive": "GoTo", "about": None}],
+    }
+    trace["replans"] = [{"t": 1.0, "robot": "R1", "route": route}]
+    scene = types.SimpleNamespace(
+        obstacles=SCENE.obstacles,
+        robots=SCENE.robots,
+        objects=SCENE.objects,
+        workspaces=SCENE.workspaces,
+        humans={"H1": types.SimpleNamespace(size=600)},
+        units="mm",
+    )
+    animator = animation_module._Animator(scene, trace, make_plans(), "demo", DPI, shown=1.0)
+    r1, r2 = animator.artists["R1"], animator.artists["R2"]
+    (planned, _), (replanned, _) = [(line, t) for t, line in animator.plan_lines["R1"]]
+    animator.draw(0)
+    assert r2["why"].get_visible() and r2["why"].get_text() == "waits for a message from R1 (clear1)"
+    assert not r1["why"].get_visible()
+    assert planned.get_visible() and not replanned.get_visible()
+    animator.draw(13)  # t = 1.3 s: R1 stands for the person, on the path of its replan
+    assert r1["why"].get_visible() and r1["why"].get_text() == "waits for H1 (a person) to pass"
+    assert not r2["why"].get_visible()
+    assert replanned.get_visible() and not planned.get_visible()
+    assert list(replanned.get_xdata()) == [0, -1500]

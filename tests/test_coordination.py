@@ -1,7 +1,8 @@
 """Requests become per-requester request/response pairs, placed so that the team cannot deadlock.
 
 Reproduced: the 2x2 example gets the pair (O2, R1, R2); the 10x10 example gets exactly the
-coordination structure of DESIGN.md, deadlock-free, and every robot re-planned with its
+coordination structure of the paper's example (R1 <- O2, O3; R2 <- O3; R4 <- O5, O6; R5 <- O6;
+R7 <- O8; R9 <- O10), deadlock-free, and every robot re-planned with its
 coordinated mission passes the exact checker; the coordinated local missions satisfy the
 global mission (verified by assume-guarantee).
 """

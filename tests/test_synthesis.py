@@ -3,7 +3,8 @@
 Reproduced: in Example 1, R2's shortest plan has 6 steps; R1 is infeasible without requests
 (the reason names O2), and its shortest plan with requests has 7 steps with Req(O2) first.
 Minimality: no plan of length K - 1 exists.  In the 10x10 example every robot gets a checked
-shortest plan whose requests form the coordination structure of DESIGN.md.  These results
+shortest plan whose requests form the coordination structure of the paper's 10x10 example
+(R1 <- O2, O3; R2 <- O3; R4 <- O5, O6; R5 <- O6; R7 <- O8; R9 <- O10).  These results
 hold under the paper's rule that goods are handled from their west side (:func:`west_only`);
 from any side R1 needs no request at all.
 """

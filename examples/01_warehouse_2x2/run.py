@@ -8,16 +8,16 @@ reasoning with an L*-learned assumption (Fig. A1).
 
 from pathlib import Path
 
+import cosmop
 from cosmop.automata import equivalent
 from cosmop.missions.decomposition import decompose
 from cosmop.missions.mission import GlobalMission
 from cosmop.missions.verification import verify
-from cosmop.scenario import load_scenario
 
 HERE = Path(__file__).resolve().parent
 
-tasks = GlobalMission.from_scenario(load_scenario(HERE / "scenario.yaml"))
-explicit = GlobalMission.from_scenario(load_scenario(HERE / "scenario_dfa.yaml"))
+tasks = GlobalMission.from_scenario(cosmop.load(HERE / "scenario.yaml"))
+explicit = GlobalMission.from_scenario(cosmop.load(HERE / "scenario_dfa.yaml"))
 k = explicit.automaton.components[0]
 same = equivalent(k, tasks.automaton.build())
 print(f"global mission: {k.n_states} states; same language as the tasks form: {same}")

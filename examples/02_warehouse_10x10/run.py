@@ -7,12 +7,12 @@ verification work on its factors and never build it.
 
 from pathlib import Path
 
+import cosmop
 from cosmop.missions.decomposition import decompose
 from cosmop.missions.mission import GlobalMission
 from cosmop.missions.verification import verify
-from cosmop.scenario import load_scenario
 
-mission = GlobalMission.from_scenario(load_scenario(Path(__file__).resolve().parent / "scenario.yaml"))
+mission = GlobalMission.from_scenario(cosmop.load(Path(__file__).resolve().parent / "scenario.yaml"))
 result = decompose(mission)
 proof = verify(mission, result.local_missions)
 for robot, local in result.local_missions.items():

@@ -8,16 +8,14 @@ anything (people may walk into a standing robot; passive safety rules out the re
 import sys
 from pathlib import Path
 
-from cosmop.pipeline import plan_team
-from cosmop.scenario import load_scenario
-from cosmop.sim import simulate
+import cosmop
 
 HERE = Path(__file__).resolve().parent
 seed = int(sys.argv[1]) if len(sys.argv) > 1 else 0
 
-scenario = load_scenario(HERE / "scenario.yaml")
-plans = plan_team(scenario).plans
-result = simulate(scenario, plans, seed=seed)
+scenario = cosmop.load(HERE / "scenario.yaml")
+plans = cosmop.plan(scenario)
+result = cosmop.simulate(scenario, plans, seed=seed)
 delivered = result.objects_in_workspaces(scenario, plans)
 print(f"{scenario.name}, seed {seed}: {result.sim_time_s:.1f} s simulated in {result.wall_time_s:.1f} s")
 print(f"every robot finished: {result.completed}")

@@ -8,16 +8,14 @@ from pathlib import Path
 
 import numpy as np
 
-from cosmop.pipeline import plan_team
-from cosmop.scenario import load_scenario
-from cosmop.sim import simulate
+import cosmop
 from cosmop.viz.explain import Explainer
 
 HERE = Path(__file__).resolve().parent
 
-scenario = load_scenario(HERE / "scenario.yaml")
-plans = plan_team(scenario).plans
-result = simulate(scenario, plans)
+scenario = cosmop.load(HERE / "scenario.yaml")
+plans = cosmop.plan(scenario)
+result = cosmop.simulate(scenario, plans)
 frames, r1 = result.frames, result.robot_ids.index("R1")
 entered = float(frames["t"][np.argmax(frames["pose"][:, r1, 1] > 0)])  # above y = 0: the left room
 leaves = scenario.scene.humans["H1"].path[0][2]

@@ -7,15 +7,15 @@ touch O1 (the cold store is walled off), simulates the plans and checks the run.
 
 from pathlib import Path
 
+import cosmop
 from cosmop.missions.mission import GlobalMission
 from cosmop.pipeline import plan_team
 from cosmop.planning.synthesis import synthesize
-from cosmop.scenario import load_scenario
-from cosmop.sim import footprint_overlaps, simulate
+from cosmop.sim import footprint_overlaps
 
 HERE = Path(__file__).resolve().parent
 
-scenario = load_scenario(HERE / "scenario.yaml")
+scenario = cosmop.load(HERE / "scenario.yaml")
 mission = GlobalMission.from_scenario(scenario)
 walled = synthesize(scenario.scene, "R2", [mission.events["pick(R2,O1)"]])
 print(f"R2 alone cannot fetch O1: {not walled.feasible} ({walled.reason})")
@@ -28,7 +28,7 @@ for obj, robot in result.plans.allocation.items():
 print(f"  busiest robot's load {choice.makespan} steps, {choice.total} in all ({choice.method})")
 heavy = result.plans.allocation["O5"] in ("R3", "R4")
 print(f"O5 moved by R3 or R4, as the mission allows: {heavy}")
-run = simulate(scenario, result.plans)
+run = cosmop.simulate(scenario, result.plans)
 print(f"completed in {run.sim_time_s:.1f} s: {run.completed}")
 print(f"the run is a complete word of the mission: {mission.is_complete_word(run.executed_word())}")
 picked = sorted(e.split(",")[1].rstrip(")") for _, _, e in run.events if e.startswith("pick("))

@@ -7,15 +7,15 @@ simulates it, and checks that the run is a complete word of the mission.
 
 from pathlib import Path
 
+import cosmop
 from cosmop.missions.allocation import alternatives
 from cosmop.missions.mission import GlobalMission
 from cosmop.pipeline import plan_team
-from cosmop.scenario import load_scenario
-from cosmop.sim import footprint_overlaps, simulate
+from cosmop.sim import footprint_overlaps
 
 HERE = Path(__file__).resolve().parent
 
-scenario = load_scenario(HERE / "scenario.yaml")
+scenario = cosmop.load(HERE / "scenario.yaml")
 mission = GlobalMission.from_scenario(scenario)
 ways = alternatives(mission)
 print(f"{len(ways.items)} ways to complete the mission (all found: {ways.exhaustive}):")
@@ -28,7 +28,7 @@ print(f"planned: {result.plans.feasible}; chosen: {choice.alternative.label()}")
 print(f"  longest plan {choice.makespan} steps, {choice.total} in all")
 print(f"  who moves what: {dict(result.plans.allocation)}")
 print(f"messages: {[m.event for m in result.plans.messages]}")
-run = simulate(scenario, result.plans)
+run = cosmop.simulate(scenario, result.plans)
 print(f"completed in {run.sim_time_s:.1f} s: {run.completed}")
 print(f"the run is a complete word of the mission: {mission.is_complete_word(run.executed_word())}")
 picked = sorted(e.split(",")[1].rstrip(")") for _, _, e in run.events if e.startswith("pick("))

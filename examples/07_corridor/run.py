@@ -10,19 +10,19 @@ from pathlib import Path
 
 import numpy as np
 
+import cosmop
 from cosmop.missions.mission import GlobalMission
 from cosmop.pipeline import plan_team
-from cosmop.scenario import load_scenario
-from cosmop.sim import footprint_overlaps, simulate
+from cosmop.sim import footprint_overlaps
 
 HERE = Path(__file__).resolve().parent
 
-scenario = load_scenario(HERE / "scenario.yaml")
+scenario = cosmop.load(HERE / "scenario.yaml")
 result = plan_team(scenario)
 plans = result.plans
 print(f"plan: {len(plans.messages)} messages keep the robots apart, e.g.")
 print(f"  {plans.messages[0].event}: {plans.messages[0].protects}")
-run = simulate(scenario, plans)
+run = cosmop.simulate(scenario, plans)
 x, y = run.frames["pose"][:, :, 0], run.frames["pose"][:, :, 1]
 inside = (np.abs(x) < 1500) & (np.abs(y) < 250)  # a robot's centre in the corridor
 backed_out = False

@@ -8,15 +8,15 @@ team, and checks that R2 picked O2 only after R1 had dropped O1.
 
 from pathlib import Path
 
+import cosmop
 from cosmop.missions.decomposition import decompose, resynthesize
 from cosmop.missions.mission import GlobalMission
 from cosmop.pipeline import plan_team
-from cosmop.scenario import load_scenario
-from cosmop.sim import footprint_overlaps, simulate
+from cosmop.sim import footprint_overlaps
 
 HERE = Path(__file__).resolve().parent
 
-scenario = load_scenario(HERE / "scenario.yaml")
+scenario = cosmop.load(HERE / "scenario.yaml")
 mission = GlobalMission.from_scenario(scenario)
 split = decompose(mission)
 pruned = resynthesize(mission, split.local_missions)
@@ -29,7 +29,7 @@ print(f"no task lost: {split.resynthesis is None and split.messaging is not None
 
 result = plan_team(scenario)
 print(f"planned: {result.plans.feasible}; messages: {[m.event for m in result.plans.messages]}")
-run = simulate(scenario, result.plans)
+run = cosmop.simulate(scenario, result.plans)
 when = {event: t for t, _, event in run.events}
 print(f"completed in {run.sim_time_s:.1f} s: {run.completed}")
 print(f"R1 dropped O1 at {when['drop(R1,O1,W1)']:.1f} s, R2 picked O2 at {when['pick(R2,O2)']:.1f} s")

@@ -8,20 +8,18 @@ simulator's verdict.
 
 from pathlib import Path
 
+import cosmop
 from cosmop.missions.mission import GlobalMission
-from cosmop.pipeline import plan_team
-from cosmop.scenario import load_scenario
-from cosmop.sim import simulate
 
 HERE = Path(__file__).resolve().parent
 
-scenario = load_scenario(HERE / "scenario.yaml")
-plans = plan_team(scenario).plans
+scenario = cosmop.load(HERE / "scenario.yaml")
+plans = cosmop.plan(scenario)
 (task,) = plans.added
 print(f"added: {task.robot} sets {task.object} down at {task.point}: {task.why}")
 pick = next(s for s in plans.robots["R1"].steps if s.primitive == "PickUp" and s.object == "O1")
 print(f"R1 picks O1 from the north, facing south: {pick.robot[2] % 360 == 270}")
-run = simulate(scenario, plans)
+run = cosmop.simulate(scenario, plans)
 print(f"completed in {run.sim_time_s:.1f} s: {run.completed}")
 print(f"no contact while moving: {run.contacts_while_moving == 0}")
 placed = run.objects_in_workspaces(scenario, plans)

@@ -9,14 +9,14 @@ map's, and plans the two robots' missions.
 
 from pathlib import Path
 
+import cosmop
 from cosmop.maps import import_map
 from cosmop.pipeline import plan_team
-from cosmop.scenario import load_scenario
 
 HERE = Path(__file__).resolve().parent
 
 imported = import_map(HERE / "warehouse.map", cell_size=500)
-scenario = load_scenario(HERE / "scenario.yaml")
+scenario = cosmop.load(HERE / "scenario.yaml")
 walls = {(w.start, w.end) for w in scenario.scene.obstacles}
 rows, cols = imported.grid.shape
 print(

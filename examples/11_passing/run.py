@@ -12,15 +12,15 @@ from pathlib import Path
 
 import numpy as np
 
+import cosmop
 from cosmop.missions.mission import GlobalMission
 from cosmop.pipeline import plan_team
-from cosmop.scenario import load_scenario
-from cosmop.sim import footprint_overlaps, simulate
+from cosmop.sim import footprint_overlaps
 
 HERE = Path(__file__).resolve().parent
 AISLE_X = (-3000.0, 3000.0)  # the aisle's ends, mm (scenario.yaml)
 
-scenario = load_scenario(HERE / "scenario.yaml")
+scenario = cosmop.load(HERE / "scenario.yaml")
 result = plan_team(scenario)
 plans, safety = result.plans, result.safety
 print(f"planned: {plans.feasible}; the exact checker accepts the plans: {result.report.ok}")
@@ -34,7 +34,7 @@ print(
 alone = safety.makespan <= safety.makespan_alone + 1e-6
 print(f"the team takes no longer than its slowest robot's own plan: {alone}")
 
-run = simulate(scenario, plans)
+run = cosmop.simulate(scenario, plans)
 x = run.frames["pose"][:, :, 0]
 v = run.frames["v"]
 inside = np.all((x > AISLE_X[0]) & (x < AISLE_X[1]), axis=1) & np.all(v > 1.0, axis=1)

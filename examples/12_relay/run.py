@@ -8,14 +8,14 @@ mission asks, with no replan and no contact.
 
 from pathlib import Path
 
+import cosmop
 from cosmop.missions.mission import GlobalMission
 from cosmop.pipeline import plan_team
-from cosmop.scenario import load_scenario
-from cosmop.sim import footprint_overlaps, simulate
+from cosmop.sim import footprint_overlaps
 
 HERE = Path(__file__).resolve().parent
 
-scenario = load_scenario(HERE / "scenario.yaml")
+scenario = cosmop.load(HERE / "scenario.yaml")
 result = plan_team(scenario)
 plans = result.plans
 r1, r2 = plans.robots["R1"], plans.robots["R2"]
@@ -24,7 +24,7 @@ picked = next(s for s in r2.steps if s.primitive == "PickUp").objects["O1"].posi
 print(f"planned: {plans.feasible}; R1 drops O1 at {dropped}, R2 picks it at {picked}")
 print(f"R2 picks O1 where R1 puts it down: {dropped == picked}")
 print(f"the exact checker accepts the plans: {result.report.ok}")
-run = simulate(scenario, plans)
+run = cosmop.simulate(scenario, plans)
 when = {event: t for t, _, event in run.events}
 print(f"completed in {run.sim_time_s:.1f} s: {run.completed}; replans: {run.replans}")
 print(f"R1 dropped O1 at {when['drop(R1,O1,H)']:.1f} s, R2 picked it at {when['pick(R2,O1)']:.1f} s")

@@ -4,7 +4,9 @@ When robot A's plan asks for object O to be moved away (a Req step), the robot B
 picks O must answer after it has picked O.  Every such need becomes one *coordination event*
 ``away(O, A, B)``, shared by A (the request ``?O Away``) and B (the response ``!O Away``).  The
 pair is keyed by (object, requester, responder): one event per requester, never one event
-shared by three robots (DESIGN.md; the paper's figures draw R3's two answers as two events).
+shared by three robots (one event shared by two requesters and a responder would make the
+synchronous product wait for all three at once, and the team deadlock; the paper's figures draw
+R3's two answers as two events).
 
 * In A's sequence ``away(O, A, B)`` goes just before the mission event during whose approach
   the Req was taken.

@@ -2,8 +2,9 @@
 
 The paper's GoTo specification (Section IV-B) keeps both ends of each straight motion in one
 region "below, above, left or right" of every wall segment.  Its formulas have sign typos and
-a ``(1 + m)`` factor that is wrong for a square footprint (see DESIGN.md).  This module states
-the intent exactly and soundly.
+a ``(1 + m)`` factor that is wrong for a square footprint: a square of half-side :math:`h`
+reaches :math:`h(|n_x| + |n_y|)` along a wall's normal :math:`n`, not :math:`h(1 + m)` for the
+slope :math:`m`.  This module states the intent exactly and soundly.
 
 For a wall from :math:`p` to :math:`q`, direction :math:`w = q - p` and normal
 :math:`n = (-w_y, w_x)`, and a robot whose footprint is the axis-aligned square of half-side

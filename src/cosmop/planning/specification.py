@@ -259,7 +259,8 @@ class RobotProblem:
     Notes
     -----
     With the default library PickUp and DropOff apply to the objects the mission picks, Req to
-    every other object (never one the robot carries, has placed or must pick, DESIGN.md), Res
+    every other object (never one the robot carries, has placed or must pick: asking another
+    robot to move goods the robot itself handles would make it wait on itself), Res
     to the objects of the ``away`` events the robot answers.
     """
 

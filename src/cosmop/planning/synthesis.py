@@ -6,9 +6,10 @@ grows (:class:`cosmop.logic.IncrementalUnrolling`, the horizon chosen by an assu
 a fresh solver per K (:class:`cosmop.logic.Unrolling`).  The first
 satisfiable K is the shortest plan length; unsatisfiability at K - 1 is part of the result.
 Among the plans of that length, the number of Req steps is then minimised by tightening a
-bound until unsat (a request costs another robot's time, DESIGN.md).  If no K up to the bound
-works, the mission is searched prefix by prefix for the first event that cannot be reached.
-An unsat core over the specification's named parts, at the bound, names what blocks it.
+bound until unsat (a request costs another robot's time: it must come and move the goods).
+If no K up to the bound works, the mission is searched prefix by prefix for the first event
+that cannot be reached.  An unsat core over the specification's named parts, at the bound,
+names what blocks it.
 
 A branching local mission (a DFA over the robot's events) is solved the same way with the
 automaton in the formula (:func:`cosmop.planning.specification.automaton_parts`): the first

@@ -217,6 +217,10 @@ class SimResult:
     stops : Mapping[str, tuple of (float, float)]
         Per robot, the delays that stopped it: ``(time, seconds)``, s (a stop the run's end cut
         short counts the seconds it lasted).
+    scene : Scene or None
+        The scene the run happened in (for :meth:`plot`).
+    plans : PlanSet or None
+        The plans it executed (for :meth:`plot`).
     """
 
     scenario: str
@@ -242,6 +246,24 @@ class SimResult:
     steps: Mapping[str, tuple[StepTimes, ...]] = field(default_factory=dict)
     delays: Delays | None = None
     stops: Mapping[str, tuple[tuple[float, float], ...]] = field(default_factory=dict)
+    scene: Scene | None = field(default=None, repr=False, compare=False)
+    plans: PlanSet | None = field(default=None, repr=False, compare=False)
+
+    def plot(self, index: int = -1, *, title: str | None = None) -> Any:
+        """A matplotlib figure of the run at frame `index`, by default its end: every robot's
+        path driven and planned, where it stands and why, the people (the ``viz`` extra;
+        :func:`cosmop.viz.draw_frame`).
+
+        Raises
+        ------
+        ValueError
+            If the result does not know its scene (a result built by hand without one).
+        """
+        if self.scene is None:
+            raise ValueError("this SimResult has no scene to draw: give SimResult(scene=...)")
+        from cosmop.viz.animation import draw_frame  # matplotlib only when a picture is asked for
+
+        return draw_frame(self.scene, self.trace(), index, plans=self.plans, title=title)
 
     def executed_word(self) -> tuple[str, ...]:
         """The mission events the run realised, in time order (messages and the events of tasks

@@ -315,6 +315,8 @@ def _result(
         replan_log=tuple(world.replan_log),
         delays=world.settings.delays,
         stops={a.id: tuple((t, min(seconds, world.t - t)) for t, seconds in a.stops) for a in world.agents},
+        scene=scenario.scene,
+        plans=plans,
         steps=step_times(
             {rid: [s.label for s in p.steps] for rid, p in plans.robots.items()},
             planned,

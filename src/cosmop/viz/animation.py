@@ -41,7 +41,7 @@ from cosmop.viz.scene import (
     scene_legend,
 )
 
-__all__ = ["save_animation", "video_available"]
+__all__ = ["draw_frame", "save_animation", "video_available"]
 
 _SUFFIXES = (".gif", ".mp4")
 _MAX_FPS = 20.0
@@ -288,9 +288,9 @@ class _Animator:
             for k, (t, path) in enumerate(versions):
                 (line,) = self.ax.plot(
                     *zip(*path, strict=True), color=colours[rid], lw=0.8, ls="--", alpha=0.8, zorder=1,
-                    visible=k == 0,
+                    visible=k == 0 and t == -math.inf,
                 )  # fmt: skip
-                if len(versions) > 1:
+                if len(versions) > 1 or t > -math.inf:  # it changes during the run
                     lines.setdefault(rid, []).append((t, line))
         return lines
 
@@ -453,7 +453,7 @@ class _Animator:
             self._show_robot(rid, robots.get(rid), index, t)
             self._show_why(rid, robots.get(rid), index)
         for versions in self.plan_lines.values():
-            now = max(k for k, (start, _) in enumerate(versions) if start <= t)
+            now = max((k for k, (start, _) in enumerate(versions) if start <= t), default=-1)
             for k, (_, line) in enumerate(versions):
                 line.set_visible(k == now)
         self._show_objects(trace.points_at("objects", index), set(trace.carried_at(index)))
@@ -535,6 +535,44 @@ class _Animator:
                 piece.move(*where)
         for oid, (x, y) in self._object_spots(carried).items():
             self.object_label[oid].set_data([x], [y])
+
+
+def draw_frame(
+    scene: Scene,
+    trace: Trace | Mapping[str, Any],
+    index: int = -1,
+    *,
+    plans: PlanSet | None = None,
+    title: str | None = None,
+    dpi: float = 100.0,
+) -> Any:
+    """One frame of a run as a matplotlib figure, drawn as the animation draws it.
+
+    The robots where frame `index` has them, each with the path it drove so far (the whole run
+    for the last frame), its planned path (a replan's from its time on), what it carries, why it
+    stands, the messages of the last two seconds, the people; the title gives the time.
+
+    Parameters
+    ----------
+    scene : Scene
+    trace : Trace or Mapping
+        The run (:class:`~cosmop.traces.Trace` or its ``cosmop.trace/1`` JSON).
+    index : int
+        The frame; negative counts from the end (default: the last).
+    plans : PlanSet, optional
+        The planned paths to draw, dashed.
+    title : str, optional
+        Default: the trace's scenario name.
+    dpi : float
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Made without pyplot: nothing to close, the user's backend untouched.
+    """
+    animator = _Animator(scene, trace, plans, title, dpi)
+    animator.update(range(len(animator.trace.t))[index])
+    return animator.fig
 
 
 def _legend(ax: Any) -> None:
