@@ -23,7 +23,7 @@ LAYERS: tuple[frozenset[str], ...] = tuple(
         "physics traces maps planning",  # bodies overlapping; traces; grid maps; bottom-up synthesis
         "scenario viz allocate",  # the scenario loader; pictures; choosing robots
         "sim pipeline export",  # the simulator (its results draw); plan, coordinate, verify; ROS 2 bags
-        "cluster",  # the syntheses on a Dask cluster (its workers import the pipeline)
+        "cluster lifelong",  # a Dask cluster's executor; a fleet serving a stream of orders
         "cli",  # the command line
         "_entry",  # the program, with Ctrl-C answered while it starts
         "__main__",  # python -m cosmop

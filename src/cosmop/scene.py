@@ -34,6 +34,7 @@ __all__ = [
     "Human",
     "Mission",
     "MovableObject",
+    "Order",
     "Robot",
     "Scenario",
     "Scene",
@@ -554,6 +555,33 @@ class Delivery:
 
 
 @dataclass(frozen=True)
+class Order:
+    """An order of a lifelong run: at time `at` an object becomes due at one of some workspaces.
+
+    The goods exist from the start, where the scene puts them; the order makes them due.  It is
+    a delivery (:class:`Delivery`) with a release time.
+
+    Parameters
+    ----------
+    at : float
+        When the order is released, s from the start of the run (>= 0).
+    object : str
+        The object to deliver.
+    to : tuple of str
+        The workspaces it may go to (any one of them).
+    by : tuple of str
+        The robots that may deliver it (all the scene's robots when the file does not say).
+    """
+
+    __reduce__ = reduce_frozen
+
+    at: float
+    object: str
+    to: tuple[str, ...]
+    by: tuple[str, ...]
+
+
+@dataclass(frozen=True)
 class Scenario:
     """A validated scenario.
 
@@ -563,21 +591,24 @@ class Scenario:
         The scenario's name.
     scene : Scene
         Walls, robots, objects, workspaces and people.
-    mission : Mission
-        The global mission.
+    mission : Mission or None
+        The global mission; None for a scenario that holds only an order stream.
     source : pathlib.Path, optional
         The file it was loaded from, as given to :func:`cosmop.scenario.load_scenario`.
     warnings : tuple of InputWarning, optional
         What the loader found implausible but not wrong (a robot 400 m wide in a metres
         file, ...), one record per finding; the library never prints them.  They describe the
         file, not the scenario, so two scenarios that differ only here are equal.
+    orders : tuple of Order, optional
+        The orders released over time, for a lifelong run (``cosmop run``), by release time.
     """
 
     name: str
     scene: Scene
-    mission: Mission
+    mission: Mission | None
     source: Path | None = None
     warnings: tuple[InputWarning, ...] = field(default=(), compare=False)
+    orders: tuple[Order, ...] = ()
 
     @property
     def units(self) -> Literal["mm", "m"]:

@@ -8,14 +8,14 @@ well-formed problem without a solution (e.g. an infeasible scenario), 130 after 
 the program answers (:mod:`cosmop._entry`, the ``cosmop`` command).
 
 One module per command (or family of commands), registered here, in order, on the one
-:data:`~cosmop.cli._app.app`: ``validate``, ``decompose``, ``plan`` and ``check``, ``simulate``, and the
-ecosystem's ``import-map``, ``export`` and ``view``; :mod:`cosmop.cli.words` says what a verdict
-means.  To add a command, write a thin function, list it here, and let it load its
-input with :func:`cosmop.cli._app.load` and leave the work to the library; input errors need no
-handling there.
+:data:`~cosmop.cli._app.app`: ``validate``, ``decompose``, ``plan`` and ``check``, ``simulate``,
+``run`` (a lifelong run), and the ecosystem's ``import-map``, ``export`` and ``view``;
+:mod:`cosmop.cli.words` says what a verdict means.  To add a command, write a thin function,
+list it here, and let it load its input with :func:`cosmop.cli._app.load` and leave the work
+to the library; input errors need no handling there.
 """
 
-from cosmop.cli import decompose, ecosystem, plan, simulate, validate
+from cosmop.cli import decompose, ecosystem, plan, run, simulate, validate
 from cosmop.cli._app import EXIT_INPUT_ERROR, app
 
 __all__ = ["EXIT_INPUT_ERROR", "app", "main"]
@@ -27,6 +27,7 @@ for _name, _command in (
     ("check", plan.check),
     ("plan", plan.plan),
     ("simulate", simulate.simulate),
+    ("run", run.run),
     ("import-map", ecosystem.import_map),
     ("export", ecosystem.export),
     ("view", ecosystem.view),

@@ -17,7 +17,7 @@ from rich.console import Console
 from typer.core import TyperGroup
 
 from cosmop import __version__
-from cosmop.errors import CosmopInputError, EventSyntaxError
+from cosmop.errors import CosmopInputError, EventSyntaxError, ScenarioError
 from cosmop.scenario import load_scenario
 from cosmop.scene import Scenario
 
@@ -109,13 +109,21 @@ def stdout() -> Console:
     return Console(file=sys.stdout, highlight=False)
 
 
-def load(path: Path) -> Scenario:
+def load(path: Path, *, mission: bool = True) -> Scenario:
     """Load a scenario for a command; a bad file raises ScenarioError, reported by the group.
 
     What the loader found implausible (``Scenario.warnings``) is printed on standard error, one
-    line each, ``warning: ...``; it changes nothing else.
+    line each, ``warning: ...``; it changes nothing else.  A command that plans a mission
+    (`mission`) refuses a file that holds only orders, naming ``cosmop run``.
     """
     scenario = load_scenario(path)
+    if mission and scenario.mission is None:
+        raise ScenarioError(
+            "expected a mission (tasks, dfa or deliveries): this file holds only orders, "
+            "which a lifelong run serves (cosmop run)",
+            file=path,
+            field="mission",
+        )
     for warning in scenario.warnings:
         typer.echo(f"warning: {warning}", err=True)  # plain echo: field paths are not markup
     return scenario

@@ -194,7 +194,7 @@ def export(
     from cosmop.planning.plan import load_plan
     from cosmop.traces import load_trace
 
-    loaded = load(scenario)
+    loaded = load(scenario, mission=False)
     data = load_trace(trace)
     plans = load_plan(plan_file) if plan_file is not None else None
     check_bag_target(bag)
@@ -225,7 +225,7 @@ def view(
     from cosmop.traces import load_trace
     from cosmop.viz.web import save_html
 
-    loaded = load(scenario)
+    loaded = load(scenario, mission=False)
     check_writable(output, "-o")
     plans = load_plan(plan_file) if plan_file is not None else None
     data = load_trace(trace) if trace is not None else None

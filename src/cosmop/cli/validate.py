@@ -24,7 +24,7 @@ __all__ = ["validate"]
 def validate(scenario: ScenarioArgument) -> None:
     """Check a scenario file and summarise it: robots and their speed limits, objects,
     workspaces, walls, people walking through, the mission and when it is complete."""
-    loaded = load(scenario)
+    loaded = load(scenario, mission=False)
     console = stdout()
     console.print(_summary_table(loaded))
     console.print(Text(f"{scenario}: valid", style="green"))
@@ -54,6 +54,11 @@ def _summary_table(scenario: Scenario) -> Table:
     row("walls", len(scene.obstacles), "wall segments")
     people = [_person(h, scenario.units) for h in scene.humans.values()]
     row("people", len(people), "\n".join(people) or "no people")
+    if scenario.orders:
+        row("orders", len(scenario.orders), _orders(scenario))
+    if mission is None:
+        row("mission", "-", "none: the orders are served by a lifelong run (cosmop run)")
+        return table
     events = mission.events
     if mission.tasks is not None:
         steps = sum(len(seq) for seq in mission.tasks.values())
@@ -82,6 +87,17 @@ def _summary_table(scenario: Scenario) -> Table:
         )
     row("complete", *_completion(mission))
     return table
+
+
+def _orders(scenario: Scenario) -> str:
+    """The order stream in a line: how many, over what time, for which goods and docks."""
+    orders = scenario.orders
+    first, last = orders[0].at, orders[-1].at
+    docks = sorted({w for o in orders for w in o.to})
+    return (
+        f"released from {first:g} s to {last:g} s, {len({o.object for o in orders})} goods, "
+        f"to {', '.join(docks)}"
+    )
 
 
 def _completion(mission) -> tuple[int, str]:

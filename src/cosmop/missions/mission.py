@@ -226,7 +226,15 @@ class GlobalMission:
 
     @classmethod
     def from_scenario(cls, scenario: Scenario) -> GlobalMission:
-        """The mission of a loaded scenario, with the scene's robots as the team."""
+        """The mission of a loaded scenario, with the scene's robots as the team.
+
+        Raises
+        ------
+        ValueError
+            For a scenario that holds only orders (a lifelong run's, ``cosmop run``).
+        """
+        if scenario.mission is None:
+            raise ValueError(f"{scenario.name} has no mission, only orders: a lifelong run serves them")
         return cls.from_mission(scenario.mission, scenario.scene.robots)
 
     @classmethod

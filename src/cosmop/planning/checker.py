@@ -716,7 +716,7 @@ def check_plan(scenario: Scenario, plan: PlanSet) -> CheckReport:
         violations.extend(check_robot_plan(scene, robot_id, robot_plan, moved=moved))
         if robot_id in scene.robots:
             checked += robot_plan.horizon
-    tasks = scenario.mission.tasks
+    tasks = scenario.mission.tasks if scenario.mission is not None else None
     if tasks is not None and plan.feasible:
         added = {}
         for task in plan.added:

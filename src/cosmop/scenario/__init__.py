@@ -12,6 +12,9 @@ A scenario file (format version 1) is YAML::
       humans:     {H1: {size: 400, speed: 600, path: [[0, -1500], [0, -2200, 5]]}, ...}
     mission:
       tasks: {R1: [pick O1, drop O1 at W1, return], ...}   # or: dfa: {initial, transitions, ...}
+    orders:                     # optional: released over time, for a lifelong run (cosmop run)
+      - {at: 0, object: O1, to: W1}
+      - {at: 35.5, object: O2, to: [W2, W3], by: [R1, R2]}
 
 Lengths are millimetres, angles degrees and times seconds (a file with ``units: m`` gives
 metres and radians instead, converted at load time: :mod:`cosmop.units`); robots, objects and people are
@@ -24,7 +27,9 @@ control: each walks along its ``path`` of points ``[x, y]`` or ``[x, y, dwell]``
 ``walk: {x: [lo, hi], y: [lo, hi]}`` area roams there at random once its path ends (at once,
 if the path is only its start point).  An object's optional ``sides`` are the sides a robot
 may stand on to pick it up or drop it off (``west``, ``south``, ``east``, ``north``; all four
-by default).
+by default).  A scenario may hold ``orders`` and no ``mission``: an order makes goods that lie
+in the scene from the start due at a workspace from its time ``at`` (s) on; :func:`load_orders`
+reads a stream from a file of its own (its key ``orders``, the same form).
 
 :func:`load_scenario` reads such a file and :func:`parse_scenario` validates an already-parsed
 mapping; both return an immutable :class:`~cosmop.scene.Scenario` or raise
@@ -35,7 +40,7 @@ schema, in which a key repeated inside one mapping is an error, with bounds on n
 (aliases expanded) and integer length, so a hostile file is answered quickly and clearly.
 """
 
-from cosmop.scenario.build import load_scenario, parse_scenario
+from cosmop.scenario.build import load_orders, load_scenario, parse_scenario
 from cosmop.scenario.schema import MAX_DFA_STATES, SCENARIO_VERSION
 
-__all__ = ["MAX_DFA_STATES", "SCENARIO_VERSION", "load_scenario", "parse_scenario"]
+__all__ = ["MAX_DFA_STATES", "SCENARIO_VERSION", "load_orders", "load_scenario", "parse_scenario"]

@@ -35,6 +35,8 @@ from cosmop.scenario.schema import (
     _lookup,
     _MissionModel,
     _model_at,
+    _OrderModel,
+    _OrdersFileModel,
     _ScenarioModel,
     _SceneModel,
     _show,
@@ -51,6 +53,7 @@ from cosmop.scene import (
     Human,
     Mission,
     MovableObject,
+    Order,
     Robot,
     Scenario,
     Scene,
@@ -165,9 +168,40 @@ class _Builder:
         self.check_precision(scene)
         self.check_headings(scene)
         self.check_bodies(scene)
-        mission = self.build_mission(model.mission, scene)
+        if model.mission is None and model.orders is None:
+            self.fail(
+                ("mission",),
+                "missing required key 'mission': expected a mission (tasks, dfa or deliveries), "
+                "or orders released over time (a lifelong run)",
+            )
+        mission = self.build_mission(model.mission, scene) if model.mission is not None else None
+        orders = self.build_orders(model.orders, scene) if model.orders is not None else ()
         warnings = tuple(self.warning(path, problem) for path, problem in implausible(written, self.units))
-        return Scenario(name=model.name, scene=scene, mission=mission, source=source, warnings=warnings)
+        return Scenario(
+            name=model.name, scene=scene, mission=mission, source=source, warnings=warnings, orders=orders
+        )
+
+    def build_orders(self, models: list[_OrderModel], scene: Scene) -> tuple[Order, ...]:
+        """The orders with their ids checked against the scene, by release time (stable)."""
+        out = []
+        for index, model in enumerate(models):
+            path = ("orders", index)
+            if model.object not in scene.objects:
+                self.fail(
+                    (*path, "object"), f"unknown object {model.object!r}; {_known('objects', scene.objects)}"
+                )
+            for k, ws in enumerate(model.to):
+                if ws not in scene.workspaces:
+                    self.fail(
+                        (*path, "to", k),
+                        f"unknown workspace {ws!r}; {_known('workspaces', scene.workspaces)}",
+                    )
+            for k, robot in enumerate(model.by or ()):
+                if robot not in scene.robots:
+                    self.fail((*path, "by", k), f"unknown robot {robot!r}; {_known('robots', scene.robots)}")
+            by = tuple(dict.fromkeys(model.by)) if model.by else tuple(scene.robots)
+            out.append(Order(float(model.at), model.object, tuple(dict.fromkeys(model.to)), by))
+        return tuple(sorted(out, key=lambda order: order.at))
 
     def build_scene(self, model: _SceneModel) -> Scene:
         owner_of_id: dict[str, FieldPath] = {}
@@ -666,6 +700,45 @@ def parse_scenario(data: Mapping[str, Any], source: str | os.PathLike[str] | Non
     """
     file = None if source is None else os.fspath(source)
     return _Builder(data, file, None).build(None if source is None else Path(source))
+
+
+class _OrdersBuilder(_Builder):
+    """Reads an order stream of its own file: the scenario's ``orders`` key, nothing else."""
+
+    def validate_structure(self) -> _OrdersFileModel:
+        if not isinstance(self.data, Mapping):
+            self.fail((), "expected a mapping with the key orders at the top level")
+        try:
+            return _OrdersFileModel.model_validate(self.data)
+        except ValidationError as exc:
+            self._structure_error(exc.errors(include_url=False)[0])
+
+
+def load_orders(path: str | os.PathLike[str], scenario: Scenario) -> tuple[Order, ...]:
+    """Read an order stream file (``orders:`` as in a scenario) for `scenario`'s scene.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A YAML file whose top-level key ``orders`` lists orders ``{at, object, to, by}``.
+    scenario : Scenario
+        Its objects, workspaces and robots are the ids the orders may name.
+
+    Returns
+    -------
+    tuple of Order
+        By release time.
+
+    Raises
+    ------
+    ScenarioError
+        Naming the file, the field and what was expected there.
+    """
+    file = os.fspath(path)
+    text = read_text(path, ScenarioError, "an orders file")
+    data, marks = load_yaml(text, file, ScenarioError)
+    builder = _OrdersBuilder(data, file, marks)
+    return builder.build_orders(builder.validate_structure().orders, scenario.scene)
 
 
 def load_scenario(path: str | os.PathLike[str]) -> Scenario:

@@ -145,12 +145,27 @@ class _MissionModel(_Model):
     returns: Annotated[bool | None, Field(strict=True, alias="return")] = None
 
 
+class _OrderModel(_Model):
+    at: Annotated[float, Field(strict=True, allow_inf_nan=False, ge=0)]
+    object: _Text
+    to: Annotated[list[_Text], BeforeValidator(_one_to_list), Field(min_length=1)]
+    by: Annotated[list[_Text], BeforeValidator(_one_to_list), Field(min_length=1)] | None = None
+
+
 class _ScenarioModel(_Model):
     version: Annotated[int, Field(strict=True)] | None = None
     name: Annotated[str, Field(strict=True, min_length=1), AfterValidator(_printable)]
     scene: _SceneModel
-    mission: _MissionModel
+    mission: _MissionModel | None = None
+    orders: Annotated[list[_OrderModel], Field(min_length=1)] | None = None
     units: Literal[SCENARIO_UNITS] | None = None  # type: ignore[valid-type]
+
+
+class _OrdersFileModel(_Model):
+    """An order stream in a file of its own (``cosmop run --orders FILE``): its fields are the
+    scenario's ``orders`` (so that errors name the same paths)."""
+
+    orders: Annotated[list[_OrderModel], Field(min_length=1)]
 
 
 _WALL = "a wall [[x1, y1], [x2, y2]]: two points of two numbers each (mm)"
@@ -211,6 +226,14 @@ _EXPECTED: dict[tuple[str, ...], str] = {
     ("mission", "deliveries", "#", "by"): "a robot id or a non-empty list of them",
     ("mission", "deliveries", "#", "by", "#"): "a robot id",
     ("mission", "return"): "true or false (deliveries: robots that moved something end at home)",
+    ("orders",): "a non-empty list of orders {at, object, to, by (optional)}",
+    ("orders", "#"): "an order {at: 35.5, object: O1, to: W1 or [W1, W2], by: [R1, R2] (optional)}",
+    ("orders", "#", "at"): "a release time in seconds, a number >= 0",
+    ("orders", "#", "object"): "an object id",
+    ("orders", "#", "to"): "a workspace id or a non-empty list of them",
+    ("orders", "#", "to", "#"): "a workspace id",
+    ("orders", "#", "by"): "a robot id or a non-empty list of them",
+    ("orders", "#", "by", "#"): "a robot id",
     ("mission", "tasks"): "a mapping from robot ids to lists of task steps",
     ("mission", "tasks", "*"): "a list of task steps such as [pick O1, drop O1 at W1, return]",
     ("mission", "tasks", "*", "#"): "a task step (text) such as 'pick O1', 'drop O1 at W1' or 'return'",

@@ -176,7 +176,9 @@ def recoordinate_world(
                 tuple(other.steps[other.step_index :]), tuple(e.name for e in todo), _state_now(world, other)
             )
     positions = {
-        oid: None if world.carried_by[j] >= 0 else tuple(float(v) for v in world.object_xy[j])
+        oid: None
+        if world.carried_by[j] >= 0 or world.shipped[j]
+        else tuple(float(v) for v in world.object_xy[j])
         for j, oid in enumerate(world.object_ids)
     }
     result = recoordinate(

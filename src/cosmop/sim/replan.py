@@ -29,7 +29,7 @@ from cosmop.sim.recoordinate import recoordinate_world
 if TYPE_CHECKING:
     from cosmop.sim.world import Agent, World
 
-__all__ = ["replan", "replan_stalled", "route", "sensed_scene"]
+__all__ = ["replan", "replan_stalled", "route", "sensed_scene", "start_state"]
 
 _PERSON_ROOM = 10.0  # mm added around a sensed person (a robot gets the standoff)
 
@@ -117,7 +117,7 @@ def replan_stalled(world: World, agent: Agent) -> None:
     remaining = [
         e for e in todo if e.name not in world.conflict_messages and e.name not in world.sent_messages
     ]
-    start = _start_state(world, agent, {e.obj for e in remaining if e.kind == "pick"})
+    start = start_state(world, agent, {e.obj for e in remaining if e.kind == "pick"})
     # A replan should not be much longer than what is left of the plan: bound the search there
     # (an infeasible replan -- a blocked doorway -- would otherwise search every horizon).
     horizon = min(s.max_horizon, len(agent.steps) - agent.step_index + 4)
@@ -185,7 +185,7 @@ def _sensed(world: World, agent: Agent) -> list[tuple[float, float, float]]:
     ]
 
 
-def _start_state(world: World, agent: Agent, picks: set[str | None] = frozenset()) -> State:
+def start_state(world: World, agent: Agent, picks: set[str | None] = frozenset()) -> State:
     """Where `agent` replans from: its pose and every object, rounded to integer mm and degrees.
 
     An object another robot carries, or one it has asked to be moved away (a ``Req`` step done),
@@ -207,7 +207,7 @@ def _start_state(world: World, agent: Agent, picks: set[str | None] = frozenset(
         if oid in picks and not carried and oid in expected and not expected[oid].carried:
             objects[oid] = ObjectState(expected[oid].position, carried=False, away=False)
             continue
-        away = world.carried_by[j] >= 0 and not carried
+        away = (world.carried_by[j] >= 0 and not carried) or bool(world.shipped[j])  # not in its way
         away = away or any(st.primitive == Primitive.REQ and st.object == oid for st in done_steps)
         pos = world.object_xy[j]
         objects[oid] = ObjectState(

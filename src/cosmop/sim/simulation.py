@@ -93,6 +93,7 @@ __all__ = [
     "Message",
     "SimResult",
     "SimSettings",
+    "advance",
     "footprint_overlaps",
     "simulate",
     "time_limit",
@@ -145,7 +146,7 @@ def simulate(
     completed = False
     cycles = 0
     for _ in range(math.ceil(_time_limit(settings, planned) / world.dt)):
-        _cycle(world)
+        advance(world)
         cycles += 1
         recorder.record(world)
         done = sum(a.done for a in world.agents)
@@ -172,8 +173,9 @@ def _time_limit(settings: SimSettings, planned: Itinerary | None) -> float:
     return max(DEFAULT_TIME_LIMIT, 3.0 * (planned.makespan if planned is not None else 0.0))
 
 
-def _cycle(world: World) -> None:
-    """One control cycle of the whole world (the module docstring's steps 0 to 4)."""
+def advance(world: World) -> None:
+    """One control cycle of the whole world (the module docstring's steps 0 to 4); a lifelong
+    run (:mod:`cosmop.lifelong`) drives the world with it between its dispatches."""
     _delays(world)
     # the dynamic window senses the world as it was when the cycle began: an object picked
     # up or dropped during the decisions is sensed next cycle

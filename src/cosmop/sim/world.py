@@ -162,6 +162,8 @@ class World:
         self.object_xy = np.array([o.position for o in objects], dtype=float).reshape(-1, 2)  # resting ones
         self.object_half = np.array([o.size / 2.0 for o in objects])
         self.carried_by = np.full(len(self.object_ids), -1)  # robot index, -1: resting
+        # goods a lifelong run has shipped: they left their dock and the world (cosmop.lifelong)
+        self.shipped = np.zeros(len(self.object_ids), dtype=bool)
         rng = np.random.default_rng(seed)  # the people's random walks
         self.walkers = [Walker(humans[h], self.walls, rng) for h in self.human_ids]
         self.human_half = np.array([w.half for w in self.walkers])
@@ -220,8 +222,16 @@ class World:
 
     def resting_boxes(self) -> np.ndarray:
         """Every resting (not carried) object as a box ``x, y, half side`` (mm)."""
-        keep = self.carried_by < 0
+        keep = self.resting()
         return np.column_stack([self.object_xy[keep], self.object_half[keep]])
+
+    def resting(self) -> np.ndarray:
+        """Which objects rest in the world: not carried, not shipped."""
+        return (self.carried_by < 0) & ~self.shipped
+
+    def ship(self, obj: str) -> None:
+        """Goods delivered in a lifelong run leave the world: no longer sensed, drawn or planned."""
+        self.shipped[self.object_ids.index(obj)] = True
 
     def people_boxes(self) -> np.ndarray:
         """Every person as a box ``x, y, half side`` (mm); call only with people."""
@@ -258,7 +268,7 @@ class World:
         they are kept until then."""
         key = self._layout_now()
         if self._layout_key != key:
-            resting = np.flatnonzero(self.carried_by < 0)
+            resting = np.flatnonzero(self.resting())
             names = tuple(self.object_ids[j] for j in resting) + self.robot_ids + self.human_ids
             self._layout_key = key
             self._layout = (self.resting_boxes(), names, np.arange(len(names)) >= len(resting))
@@ -266,7 +276,7 @@ class World:
 
     def _layout_now(self) -> tuple[bytes, bytes]:
         """Where the objects are and who carries them: the layout changes only when it does."""
-        return self.carried_by.tobytes(), self.object_xy.tobytes()
+        return self.carried_by.tobytes() + self.shipped.tobytes(), self.object_xy.tobytes()
 
     def first_robot_box(self, count: int) -> int:
         """Where the robots' boxes begin among `count` sensed boxes (:meth:`obstacles`,
@@ -333,7 +343,7 @@ class World:
             unsure = gap > _NEAR - half
             if unsure.any() and not near.all():
                 gap[unsure] = (point_segment_linf(points[unsure], self.walls) - half).min(axis=1)
-        if (self.carried_by < 0).any():
+        if self.resting().any():
             gap = np.minimum(gap, box_gaps(points, half, self.resting_boxes()).min(axis=1))
         return gap
 
@@ -369,11 +379,12 @@ class World:
         return box_gaps(self.pose[i, :2], self.robot_half[i], self.robot_boxes())
 
     def object_positions(self) -> np.ndarray:
-        """Where every object is now (a carried one at its robot's centre), (O, 2) mm."""
+        """Where every object is now (a carried one at its robot's centre; NaN: shipped), (O, 2) mm."""
         positions = self.object_xy.copy()
         for j, r in enumerate(self.carried_by):
             if r >= 0:
                 positions[j] = self.pose[r, :2]
+        positions[self.shipped] = np.nan
         return positions
 
     def creep_speed(self, i: int) -> float:

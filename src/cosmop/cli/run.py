@@ -1,0 +1,178 @@
+"""``cosmop run``: a fleet that keeps working while orders stream in (a lifelong run)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.table import Table
+from rich.text import Text
+
+from cosmop.cli._app import EXIT_INPUT_ERROR, ScenarioArgument, load, stderr, stdout
+from cosmop.cli.simulate import _parse_delays
+from cosmop.io import check_writable, uninterrupted
+from cosmop.lifelong import Failure, FleetResult, FleetSettings, run_fleet
+from cosmop.scenario import load_orders
+from cosmop.sim import Delays, SimSettings
+
+__all__ = ["run"]
+
+
+def _parse_failure(text: str) -> Failure:
+    """``--fail R3@600``: the failure, or a usage error naming the option (exit 2)."""
+    try:
+        return Failure.parse(text)
+    except ValueError as err:
+        raise typer.BadParameter(str(err)) from None
+
+
+def run(
+    scenario: ScenarioArgument,
+    until: Annotated[float, typer.Option(help="Simulated seconds the run lasts.", min=1.0)],
+    orders: Annotated[
+        Path | None,
+        typer.Option(
+            help="An orders file (orders: as in a scenario); default: the scenario's.", show_default=False
+        ),
+    ] = None,
+    seed: Annotated[int, typer.Option(help="Seed of the people's walks and of the delays.", min=0)] = 0,
+    fail: Annotated[
+        list[Failure] | None,
+        typer.Option(
+            parser=_parse_failure,
+            metavar="ROBOT@SECONDS",
+            help="A robot stops for good at that time (repeat the option for several).",
+            show_default=False,
+        ),
+    ] = None,
+    delays: Annotated[
+        Delays | None,
+        typer.Option(
+            parser=_parse_delays,
+            metavar="P:MIN:MAX",
+            help="Every simulated second each robot stops with probability P for MIN to MAX s.",
+            show_default=False,
+        ),
+    ] = None,
+    summary: Annotated[
+        Path | None, typer.Option(help="Write the summary (cosmop.run/1 JSON) here.", show_default=False)
+    ] = None,
+    trace: Annotated[
+        Path | None, typer.Option(help="Write the trace (cosmop.trace/1 JSON).", show_default=False)
+    ] = None,
+    plot: Annotated[
+        Path | None,
+        typer.Option(
+            help="Write a PNG of the orders released and delivered over time (the viz extra).",
+            show_default=False,
+        ),
+    ] = None,
+) -> None:
+    """Run the fleet while orders arrive: each goes to an idle robot, planned and ordered with
+    the others' committed plans while they keep moving.
+
+    Prints a live progress line, a table per robot and the totals (deliveries per hour, each
+    order's wait, contacts).  Exit status 0 when no contact happened while a robot moved and no
+    order was lost, 1 otherwise, 2 on bad input.
+    """
+    loaded = load(scenario, mission=False)
+    stream = load_orders(orders, loaded) if orders is not None else loaded.orders
+    if not stream:
+        typer.echo(f"error: {scenario}: orders: expected orders in the scenario or --orders FILE", err=True)
+        raise typer.Exit(EXIT_INPUT_ERROR)
+    for option, path in (("--summary", summary), ("--trace", trace), ("--plot", plot)):
+        check_writable(path, option)
+    if plot is not None:
+        from cosmop.viz import available
+
+        if not available():
+            typer.echo("error: --plot needs pip install 'cosmop[viz]'", err=True)
+            raise typer.Exit(EXIT_INPUT_ERROR)
+    for failure in fail or ():
+        if failure.robot not in loaded.scene.robots:
+            typer.echo(f"error: --fail: {failure.robot} is not a robot of {loaded.name}", err=True)
+            raise typer.Exit(EXIT_INPUT_ERROR)
+    result = _run_with_progress(loaded, stream, until, seed, SimSettings(delays=delays), tuple(fail or ()))
+    with uninterrupted():  # the summary and its trace: both or neither
+        if trace is not None:
+            result.trace().save(trace)
+        if summary is not None:
+            result.save_summary(summary)
+    if plot is not None:
+        result.save_plot(plot)
+    console = stdout()
+    console.print(_robots_table(result))
+    ok = result.contacts_while_moving == 0 and result.lost == 0
+    console.print(Text(_verdict(result), style="green" if ok else "red"))
+    for path in (summary, trace, plot):
+        if path is not None:
+            console.print(Text(f"wrote {path}"), soft_wrap=True)
+    raise typer.Exit(0 if ok else 1)
+
+
+def _run_with_progress(loaded, stream, until, seed, settings, failures) -> FleetResult:
+    """:func:`cosmop.lifelong.run_fleet` under a live line: time, released, delivered."""
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+    columns = (
+        TextColumn("running"),
+        BarColumn(),
+        TextColumn(
+            "t = {task.completed:.0f} s, {task.fields[released]} released, {task.fields[delivered]} delivered"
+        ),
+        TimeElapsedColumn(),
+    )
+    with Progress(*columns, console=stderr(), transient=True) as progress:
+        task = progress.add_task("running", total=until, released=0, delivered=0)
+        return run_fleet(
+            loaded,
+            stream,
+            fleet=FleetSettings(until=until),
+            seed=seed,
+            settings=settings,
+            failures=failures,
+            on_cycle=lambda t, delivered, released: progress.update(
+                task, completed=t, delivered=delivered, released=released
+            ),
+        )
+
+
+def _robots_table(result: FleetResult) -> Table:
+    """One row per robot: deliveries made, share of the run serving orders, failure."""
+    table = Table(
+        title=Text(f"lifelong run of {result.scenario} ({result.until:.0f} s)"), header_style="bold"
+    )
+    for column in ("robot", "delivered", "busy", "failed"):
+        table.add_column(column)
+    done = {}
+    for order in result.orders:
+        if order.delivered is not None and order.robot is not None:
+            done[order.robot] = done.get(order.robot, 0) + 1
+    for rid in result.robot_ids:
+        failure = result.failures.get(rid)
+        failed = (
+            f"at {failure['t']:.0f} s"
+            + (f", carrying {', '.join(failure['carrying'])}" if failure["carrying"] else "")
+            if failure
+            else "-"
+        )
+        table.add_row(rid, str(done.get(rid, 0)), f"{100 * result.utilisation[rid]:.0f} %", Text(failed))
+    return table
+
+
+def _verdict(result: FleetResult) -> str:
+    """The closing line: throughput, waits, lost orders, safety."""
+    wait = result.wait_s()
+    waits = (
+        f"wait p50 {wait['p50']:.1f} s, p95 {wait['p95']:.1f} s, max {wait['max']:.1f} s"
+        if wait["p50"] is not None
+        else "no order delivered"
+    )
+    pending = result.released - result.delivered - result.lost
+    return (
+        f"{result.delivered} of {result.released} orders delivered "
+        f"({result.deliveries_per_hour:.1f} per hour; "
+        f"{pending} pending, {result.lost} lost); {waits}; contacts {len(result.contacts)}, while moving "
+        f"{result.contacts_while_moving}; messages {len(result.messages)}; replans {result.replans}"
+    )

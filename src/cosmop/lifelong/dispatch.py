@@ -1,0 +1,112 @@
+"""Which robot serves which order, and its next mission: the dispatcher of a lifelong run.
+
+Released orders wait in a pool, oldest first.  An order goes to an idle robot that may serve
+it (``Order.by``): the one with the least estimated work, the L1 distance from where it stands
+to the goods and from the goods to the nearest of the order's docks (mm).  A robot that is busy
+takes the next order as soon as it is idle again, so among busy robots the one whose committed
+plan ends soonest is served first.  The mission handed over is the order's delivery and the way
+home: ``pick``, ``drop`` at that dock, ``return``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+
+from cosmop.events import Event
+from cosmop.scene import Order, Scene
+
+__all__ = ["Assignment", "OrderState", "choose_robot", "delivery_events"]
+
+
+@dataclass
+class OrderState:
+    """What became of an order during a run (mutable: the run fills it in).
+
+    Attributes
+    ----------
+    order : Order
+    index : int
+        Its place in the stream.
+    robot : str or None
+        The robot serving it now (None: in the pool, or done).
+    served_by : str or None
+        The robot it was last given to.
+    assigned : float or None
+        When a robot took it, s.
+    delivered : float or None
+        When its goods lay in the dock, s.
+    lost : str or None
+        Why it will never be delivered (a robot failed carrying the goods, no robot can plan it).
+    tries : int
+        Plans tried for it that were not handed over.
+    retry_at : float
+        Not tried again before this time, s.
+    """
+
+    order: Order
+    index: int
+    robot: str | None = None
+    served_by: str | None = None
+    assigned: float | None = None
+    delivered: float | None = None
+    lost: str | None = None
+    tries: int = 0
+    retry_at: float = 0.0
+
+    @property
+    def wait(self) -> float | None:
+        """Release to delivery, s (None: not delivered)."""
+        return None if self.delivered is None else self.delivered - self.order.at
+
+
+@dataclass(frozen=True)
+class Assignment:
+    """An order given to a robot, with the events of its next mission."""
+
+    state: OrderState
+    robot: str
+    events: tuple[Event, ...]
+
+
+def _l1(a: Sequence[float], b: Sequence[float]) -> float:
+    return abs(a[0] - b[0]) + abs(a[1] - b[1])
+
+
+def _dock(scene: Scene, order: Order, goods: Sequence[float]) -> str:
+    """The order's dock nearest the goods (L1 to the workspace's centre)."""
+    return min(order.to, key=lambda w: (_l1(scene.workspaces[w].center, goods), w))
+
+
+def delivery_events(scene: Scene, robot: str, order: Order, goods: Sequence[float]) -> tuple[Event, ...]:
+    """The mission that serves `order` by `robot`: pick the goods (lying at `goods`, mm), drop
+    them at the nearest of the order's docks, and go home."""
+    dock = _dock(scene, order, goods)
+    return (
+        Event("pick", robot, obj=order.object),
+        Event("drop", robot, obj=order.object, workspace=dock),
+        Event("return", robot),
+    )
+
+
+def choose_robot(
+    scene: Scene, order: Order, idle: Iterable[tuple[str, Sequence[float]]], goods: Sequence[float]
+) -> str | None:
+    """The idle robot with the least estimated work for `order`, or None when none may serve it.
+
+    Parameters
+    ----------
+    scene : Scene
+    order : Order
+    idle : iterable of (str, (float, float))
+        The idle robots and where they stand (mm).
+    goods : (float, float)
+        Where the order's goods lie (mm).
+
+    Returns
+    -------
+    str or None
+    """
+    dock = scene.workspaces[_dock(scene, order, goods)].center
+    work = [(_l1(at, goods) + _l1(goods, dock), rid) for rid, at in idle if rid in order.by]
+    return min(work)[1] if work else None

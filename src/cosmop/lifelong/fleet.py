@@ -1,0 +1,331 @@
+"""A lifelong run: a fleet that keeps working while orders stream in and robots fail.
+
+:func:`run_fleet` simulates the scenario's world as :func:`cosmop.sim.simulate` does, cycle by
+cycle (:func:`cosmop.sim.simulation.advance`), and between cycles it
+
+1. releases the orders whose time has come into a pool (:mod:`.dispatch`);
+2. every ``dispatch_every`` seconds gives pooled orders to idle robots: the robot's next
+   mission (pick, drop, home) is planned from where it stands, with the robots that stand
+   (idle or failed) as obstacles (:func:`cosmop.sim.replan.replan`, every plan passing the
+   exact checker), then ordered against the plans the others have committed to, by the same
+   messages and exact checks as a planned team (:func:`cosmop.sim.recoordinate.recoordinate_world`:
+   the conflicts of every robot's rest are ordered again and the team proved deadlock-free);
+   only then is it handed over.  The robots not involved keep their plans and keep moving.
+   An order whose plan is refused waits ``retry_after`` seconds; after ``max_tries`` it is
+   lost, with the reason;
+3. ships delivered goods: once the drop is recorded the goods leave the world, so docks do not
+   fill up (:meth:`cosmop.sim.world.World.ship`);
+4. fails robots (:class:`Failure`): a failed robot stands for good, its order returns to the
+   pool unless it carries the goods (then the order is lost, and the goods are reported where
+   they stand), and the others are ordered again around it.
+
+Units: mm, degrees, seconds.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from cosmop.events import parse_event
+from cosmop.lifelong.dispatch import OrderState, choose_robot, delivery_events
+from cosmop.lifelong.result import FleetResult
+from cosmop.planning.conflicts import ConflictSettings
+from cosmop.planning.plan import PlanSet, RobotPlan
+from cosmop.scene import Order, Scenario
+from cosmop.sim.recoordinate import recoordinate_world
+from cosmop.sim.recording import Recorder
+from cosmop.sim.replan import replan, start_state
+from cosmop.sim.result import SimSettings
+from cosmop.sim.simulation import advance
+from cosmop.sim.world import Agent, World
+
+__all__ = ["Failure", "FleetSettings", "run_fleet"]
+
+
+@dataclass(frozen=True)
+class Failure:
+    """A robot that stops for good at time `at` (s).
+
+    Examples
+    --------
+    >>> Failure.parse("R3@600")
+    Failure(robot='R3', at=600.0)
+    """
+
+    robot: str
+    at: float
+
+    @classmethod
+    def parse(cls, text: str) -> Failure:
+        """``ROBOT@SECONDS``, e.g. ``R3@600``.
+
+        Raises
+        ------
+        ValueError
+            When `text` is not of that form or the time is negative.
+        """
+        match = re.fullmatch(r"\s*([A-Za-z_][A-Za-z0-9_-]*)@([0-9]+(?:\.[0-9]*)?)\s*", text)
+        if match is None:
+            raise ValueError(f"expected ROBOT@SECONDS such as R3@600, got {text!r}")
+        return cls(match.group(1), float(match.group(2)))
+
+
+@dataclass(frozen=True)
+class FleetSettings:
+    """How the dispatcher works.
+
+    Attributes
+    ----------
+    until : float
+        Simulated seconds the run lasts.
+    dispatch_every : float
+        Seconds between two dispatches (each may hand over several orders).
+    retry_after : float
+        Seconds an order waits after its plan was refused before it is tried again.
+    max_tries : int
+        Refused plans after which an order is lost.
+    max_horizon : int
+        Longest plan of one order (steps).
+    rlimit : int
+        The solver's resource limit per plan.
+    """
+
+    until: float
+    dispatch_every: float = 1.0
+    retry_after: float = 5.0
+    max_tries: int = 3
+    max_horizon: int = 16
+    rlimit: int = 50_000_000
+
+
+@dataclass
+class _Run:
+    """The dispatcher's state during a run (mutable)."""
+
+    world: World
+    states: list[OrderState]
+    fleet: FleetSettings
+    pool: list[OrderState] = field(default_factory=list)
+    busy: dict[str, OrderState] = field(default_factory=dict)
+    busy_since: dict[str, float] = field(default_factory=dict)
+    busy_time: dict[str, float] = field(default_factory=dict)
+    failed: dict[str, dict] = field(default_factory=dict)
+    log: list[dict] = field(default_factory=list)
+    seen_events: int = 0
+
+
+def run_fleet(
+    scenario: Scenario,
+    orders: Sequence[Order] | None = None,
+    *,
+    fleet: FleetSettings,
+    seed: int = 0,
+    settings: SimSettings | None = None,
+    failures: Sequence[Failure] = (),
+    on_cycle: Callable[[float, int, int], None] | None = None,
+) -> FleetResult:
+    """Run the fleet while `orders` (by default the scenario's) are released over time.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The scene; its ``mission`` is not used (a lifelong run serves orders).
+    orders : sequence of Order, optional
+        The stream; by default ``scenario.orders``.
+    fleet : FleetSettings
+        How long the run lasts and how the dispatcher works.
+    seed : int
+        Seeds the people's walks and the delays.
+    settings : SimSettings, optional
+        The simulator's settings (``delays`` included); ``max_time`` is ignored.
+    failures : sequence of Failure
+        Robots that stop for good, and when.
+    on_cycle : callable, optional
+        Called every cycle with ``(t, delivered, released)`` (a progress line).
+
+    Returns
+    -------
+    FleetResult
+
+    Raises
+    ------
+    ValueError
+        For a failure naming no robot of the scene.
+    """
+    for failure in failures:
+        if failure.robot not in scenario.scene.robots:
+            raise ValueError(f"--fail names {failure.robot}, which is not a robot of the scene")
+    stream = sorted(orders if orders is not None else scenario.orders, key=lambda o: o.at)
+    world = World(scenario, PlanSet(scenario.name, True, {}), seed, settings or SimSettings())
+    run = _Run(world, [OrderState(o, k) for k, o in enumerate(stream)], fleet)
+    run.busy_time = {rid: 0.0 for rid in world.robot_ids}
+    recorder = Recorder()
+    recorder.record(world)
+    due = sorted(failures, key=lambda f: f.at)
+    released = next_dispatch = 0
+    for _ in range(math.ceil(fleet.until / world.dt)):
+        while released < len(run.states) and run.states[released].order.at <= world.t:
+            run.pool.append(run.states[released])
+            released += 1
+        while due and due[0].at <= world.t:
+            _fail(run, due.pop(0).robot)
+        if world.t >= next_dispatch:
+            _dispatch(run)
+            next_dispatch = world.t + fleet.dispatch_every
+        advance(world)
+        _deliveries(run)  # before the frame is recorded: delivered goods are gone from it
+        _idle_again(run)
+        recorder.record(world)
+        if on_cycle is not None:
+            on_cycle(world.t, sum(s.delivered is not None for s in run.states), released)
+    for rid, since in run.busy_since.items():
+        run.busy_time[rid] += world.t - since
+    return FleetResult.of(
+        scenario, world, recorder.frames(world), run.states, run.busy_time, run.failed, run.log
+    )
+
+
+def _dispatch(run: _Run) -> None:
+    """Hand pooled orders, oldest first, to idle robots (module docstring, step 2)."""
+    world = run.world
+    idle = {a.id: a for a in world.agents if a.done and a.id not in run.busy and a.id not in run.failed}
+    for state in list(run.pool):
+        if not idle:
+            return
+        if state.retry_at > world.t:
+            continue
+        j = world.object_ids.index(state.order.object)
+        if world.carried_by[j] >= 0 or world.shipped[j]:
+            continue  # another order's robot has these goods: wait for them to rest again
+        goods = tuple(float(v) for v in world.object_xy[j])
+        robot = choose_robot(
+            world.scenario.scene,
+            state.order,
+            ((r, tuple(world.pose[a.index, :2])) for r, a in idle.items()),
+            goods,
+        )
+        if robot is None:
+            continue
+        if _hand_over(run, idle[robot], state, goods):
+            del idle[robot]
+
+
+def _hand_over(run: _Run, agent: Agent, state: OrderState, goods: tuple[float, float]) -> bool:
+    """Plan `agent`'s mission for `state`'s order, order it with the others' and hand it over."""
+    world, fleet = run.world, run.fleet
+    scene = world.scenario.scene
+    events = delivery_events(scene, agent.id, state.order, goods)
+    start = start_state(world, agent, {state.order.object})
+    plan = replan(
+        scene,
+        agent.id,
+        events,
+        start,
+        _standing(run, agent),
+        max_horizon=fleet.max_horizon,
+        rlimit=fleet.rlimit,
+    )
+    accepted, why = False, "no plan from where it stands"
+    if plan is not None:
+        accepted, why, _ = recoordinate_world(world, agent, plan, start)
+    run.log.append(
+        {
+            "t": round(world.t, 6),
+            "order": state.index,
+            "robot": agent.id,
+            "accepted": accepted,
+            "why": why or None,
+        }
+    )
+    if not accepted:
+        state.tries += 1
+        state.retry_at = world.t + fleet.retry_after
+        if state.tries >= fleet.max_tries:
+            state.lost = f"no robot could be given it ({state.tries} tries; last: {agent.id}, {why})"
+            run.pool.remove(state)
+        return False
+    state.robot, state.served_by, state.assigned = agent.id, agent.id, world.t
+    run.pool.remove(state)
+    run.busy[agent.id] = state
+    run.busy_since[agent.id] = world.t
+    return True
+
+
+def _standing(run: _Run, agent: Agent) -> list[tuple[float, float, float]]:
+    """The robots that stand still for now (idle or failed) as boxes ``x, y, half side`` (mm),
+    grown by the clearance the plans keep between robots: the new plan goes around them."""
+    world = run.world
+    room = ConflictSettings().clearance
+    return [
+        (
+            float(world.pose[a.index, 0]),
+            float(world.pose[a.index, 1]),
+            float(world.robot_half[a.index]) + room,
+        )
+        for a in world.agents
+        if a is not agent and (a.id in run.failed or (a.done and a.id not in run.busy))
+    ]
+
+
+def _deliveries(run: _Run) -> None:
+    """Record the drops of the cycle: the order is delivered and its goods are shipped."""
+    world = run.world
+    for t, robot, name in world.events[run.seen_events :]:
+        event = parse_event(name)
+        state = run.busy.get(robot)
+        if (
+            event.kind == "drop"
+            and state is not None
+            and state.order.object == event.obj
+            and state.delivered is None
+        ):
+            state.delivered = t
+            world.ship(event.obj)
+    run.seen_events = len(world.events)
+
+
+def _idle_again(run: _Run) -> None:
+    """Robots home again (their plan done) are idle: their order is over."""
+    for agent in run.world.agents:
+        state = run.busy.get(agent.id)
+        if state is not None and agent.done:
+            del run.busy[agent.id]
+            run.busy_time[agent.id] += run.world.t - run.busy_since.pop(agent.id)
+            if state.delivered is None and state.lost is None:
+                state.lost = f"{agent.id} ended its plan without delivering it"
+            state.robot = None
+
+
+def _fail(run: _Run, robot: str) -> None:
+    """`robot` stops for good (module docstring, step 4)."""
+    world = run.world
+    agent = next(a for a in world.agents if a.id == robot)
+    if robot in run.failed:
+        return
+    agent.stop_for(world.t, math.inf)
+    state = run.busy.pop(robot, None)
+    carrying = [world.object_ids[j] for j in np.flatnonzero(world.carried_by == agent.index)]
+    if robot in run.busy_since:
+        run.busy_time[robot] += world.t - run.busy_since.pop(robot)
+    if state is not None:
+        state.robot = None
+        if state.order.object in carrying:
+            state.lost = f"{robot} failed at {world.t:.1f} s carrying {state.order.object}"
+        elif state.delivered is None:
+            state.assigned = None
+            run.pool.insert(0, state)  # back to the pool, before the orders released later
+    start = start_state(world, agent)
+    accepted, why, _ = recoordinate_world(world, agent, RobotPlan.from_steps((), ()), start)
+    pose = [round(float(v), 3) for v in world.pose[agent.index, :2]]
+    run.failed[robot] = {
+        "t": round(world.t, 6),
+        "at": pose,
+        "carrying": carrying,
+        "recoordinated": accepted,
+        "why": why or None,
+    }

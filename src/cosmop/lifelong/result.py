@@ -1,0 +1,292 @@
+"""What a lifelong run reports: throughput, each order's wait, utilisation, safety, the trace.
+
+:class:`FleetResult` is the value :func:`cosmop.lifelong.run_fleet` returns.  Its summary
+(:data:`RUN_FORMAT`, what ``cosmop run --summary`` writes) holds the orders (released,
+delivered, lost, and each one's record), the deliveries per hour, the waits from release to
+delivery (p50, p95, max), each robot's utilisation (the share of the run it served an order),
+failures, the dispatcher's log, messages, replans and contacts.  Its trace is a
+``cosmop.trace/1`` file (:mod:`cosmop.traces`), so ``cosmop view`` and ``cosmop export`` read it;
+:meth:`FleetResult.plot` draws the deliveries over time.  Units: mm, degrees, seconds.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from cosmop.io import write_atomic
+from cosmop.scene import Scenario, Scene
+from cosmop.sim.result import FRAME_PRIMITIVES, Contact, Message
+from cosmop.traces import Trace
+from cosmop.units import INTERNAL_UNITS
+
+if TYPE_CHECKING:
+    from cosmop.lifelong.dispatch import OrderState
+    from cosmop.sim.world import World
+
+__all__ = ["RUN_FORMAT", "FleetResult", "OrderRecord"]
+
+RUN_FORMAT = "cosmop.run/1"
+"""The ``format`` of a lifelong run's summary."""
+
+
+@dataclass(frozen=True)
+class OrderRecord:
+    """One order and what became of it.
+
+    Attributes
+    ----------
+    index : int
+        Its place in the stream.
+    object : str
+    at : float
+        Released, s.
+    to : tuple of str
+        The docks it may go to.
+    robot : str or None
+        The robot it was last given to.
+    assigned, delivered : float or None
+        When a robot took it and when its goods lay in the dock, s.
+    lost : str or None
+        Why it will never be delivered.
+    """
+
+    index: int
+    object: str
+    at: float
+    to: tuple[str, ...]
+    robot: str | None
+    assigned: float | None
+    delivered: float | None
+    lost: str | None
+
+    @property
+    def wait(self) -> float | None:
+        """Release to delivery, s."""
+        return None if self.delivered is None else self.delivered - self.at
+
+    def to_dict(self) -> dict[str, Any]:
+        """The record as the summary writes it."""
+        rounded = {
+            k: None if v is None else round(v, 3)
+            for k, v in (("assigned", self.assigned), ("delivered", self.delivered))
+        }
+        return {
+            "index": self.index,
+            "object": self.object,
+            "at": self.at,
+            "to": list(self.to),
+            "robot": self.robot,
+            **rounded,
+            "lost": self.lost,
+        }
+
+
+@dataclass(frozen=True)
+class FleetResult:
+    """The outcome of a lifelong run (module docstring).
+
+    Attributes
+    ----------
+    scenario : str
+    until : float
+        Simulated seconds the run lasted.
+    orders : tuple of OrderRecord
+        Every order of the stream (those released after `until` included, never released).
+    utilisation : Mapping[str, float]
+        Per robot, the share of the run it served an order (0 to 1).
+    failures : Mapping[str, Mapping]
+        Per failed robot: when (``t``), where it stands (``at``), what it carries, and whether
+        the others could be ordered around it (``recoordinated``).
+    dispatch_log : tuple of Mapping
+        Every hand-over tried: ``t``, ``order``, ``robot``, ``accepted``, ``why`` not.
+    contacts : tuple of Contact
+    messages : tuple of Message
+    replans : int
+        Replans of stalled robots accepted.
+    frames : Mapping[str, ndarray]
+        The per-cycle arrays (:class:`cosmop.sim.result.SimResult`'s).
+    robot_ids, human_ids, object_ids : tuple of str
+    dt : float
+    scene : Scene or None
+    """
+
+    scenario: str
+    until: float
+    orders: tuple[OrderRecord, ...]
+    utilisation: Mapping[str, float]
+    failures: Mapping[str, Mapping[str, Any]]
+    dispatch_log: tuple[Mapping[str, Any], ...]
+    contacts: tuple[Contact, ...]
+    messages: tuple[Message, ...]
+    replans: int
+    frames: Mapping[str, np.ndarray] = field(repr=False)
+    robot_ids: tuple[str, ...] = ()
+    human_ids: tuple[str, ...] = ()
+    object_ids: tuple[str, ...] = ()
+    dt: float = 0.1
+    scene: Scene | None = field(default=None, repr=False, compare=False)
+
+    @classmethod
+    def of(
+        cls,
+        scenario: Scenario,
+        world: World,
+        frames: Mapping[str, np.ndarray],
+        states: Sequence[OrderState],
+        busy: Mapping[str, float],
+        failed: Mapping[str, Mapping[str, Any]],
+        log: Sequence[Mapping[str, Any]],
+    ) -> FleetResult:
+        """The result of a finished run (:func:`cosmop.lifelong.run_fleet` calls it)."""
+        orders = tuple(
+            OrderRecord(
+                s.index, s.order.object, s.order.at, s.order.to, s.served_by, s.assigned, s.delivered, s.lost
+            )
+            for s in states
+        )
+        span = max(world.t, 1e-9)
+        return cls(
+            scenario=scenario.name,
+            until=world.t,
+            orders=orders,
+            utilisation={rid: round(min(1.0, busy[rid] / span), 4) for rid in world.robot_ids},
+            failures=dict(failed),
+            dispatch_log=tuple(log),
+            contacts=tuple(world.contacts),
+            messages=tuple(world.messages),
+            replans=world.replans,
+            frames=frames,
+            robot_ids=world.robot_ids,
+            human_ids=world.human_ids,
+            object_ids=world.object_ids,
+            dt=world.dt,
+            scene=scenario.scene,
+        )
+
+    # -- what the operator watches ---------------------------------------------------------------
+
+    @property
+    def released(self) -> int:
+        """Orders released during the run."""
+        return sum(1 for o in self.orders if o.at <= self.until)
+
+    @property
+    def delivered(self) -> int:
+        return sum(1 for o in self.orders if o.delivered is not None)
+
+    @property
+    def lost(self) -> int:
+        """Orders that will never be delivered (a robot failed carrying the goods, no plan)."""
+        return sum(1 for o in self.orders if o.lost is not None)
+
+    @property
+    def deliveries_per_hour(self) -> float:
+        return self.delivered * 3600.0 / max(self.until, 1e-9)
+
+    @property
+    def contacts_while_moving(self) -> int:
+        return sum(1 for c in self.contacts if c.moving)
+
+    def wait_s(self) -> dict[str, float | None]:
+        """Release to delivery of the delivered orders, s: median, 95th percentile, maximum."""
+        waits = np.array([o.wait for o in self.orders if o.wait is not None])
+        if not len(waits):
+            return {"p50": None, "p95": None, "max": None}
+        p50, p95 = np.percentile(waits, [50, 95])
+        return {"p50": round(float(p50), 3), "p95": round(float(p95), 3), "max": round(float(waits.max()), 3)}
+
+    def summary(self) -> dict[str, Any]:
+        """The ``cosmop.run/1`` summary (what ``cosmop run --summary`` writes)."""
+        return {
+            "format": RUN_FORMAT,
+            "scenario": self.scenario,
+            "units": dict(INTERNAL_UNITS),
+            "until_s": round(self.until, 6),
+            "orders": {
+                "released": self.released,
+                "delivered": self.delivered,
+                "lost": self.lost,
+                "pending": self.released - self.delivered - self.lost,
+            },
+            "deliveries_per_hour": round(self.deliveries_per_hour, 3),
+            "wait_s": self.wait_s(),
+            "utilisation": dict(self.utilisation),
+            "failures": {rid: dict(f) for rid, f in self.failures.items()},
+            "contacts": len(self.contacts),
+            "contacts_while_moving": self.contacts_while_moving,
+            "messages": len(self.messages),
+            "replans": self.replans,
+            "order_log": [o.to_dict() for o in self.orders],
+            "dispatch_log": [dict(e) for e in self.dispatch_log],
+            "contact_log": [c.to_dict() for c in self.contacts],
+        }
+
+    def save_summary(self, path: str | os.PathLike[str]) -> None:
+        """Write :meth:`summary` as JSON, atomically."""
+        write_atomic(path, json.dumps(self.summary(), indent=2) + "\n")
+
+    def trace(self) -> Trace:
+        """The run as a ``cosmop.trace/1`` :class:`~cosmop.traces.Trace` (shipped goods absent)."""
+        f = self.frames
+        return Trace(
+            t=f["t"],
+            robot_ids=self.robot_ids,
+            poses=f["pose"],
+            v=f["v"],
+            w=f["w"],
+            carrying=f["carrying"],
+            primitive=f["primitive"],
+            primitive_names=FRAME_PRIMITIVES,
+            waiting=f["waiting"],
+            awaits=f.get("awaits"),
+            yields_to=f.get("yields_to"),
+            human_ids=self.human_ids,
+            humans=f["humans"],
+            object_ids=self.object_ids,
+            objects=f["objects"],
+            messages=tuple(m.to_dict() for m in self.messages),
+            scenario=self.scenario,
+            dt=self.dt,
+        ).rounded()
+
+    def deliveries(self) -> tuple[np.ndarray, np.ndarray]:
+        """The delivery times (s, sorted) and the count delivered by each."""
+        times = np.sort([o.delivered for o in self.orders if o.delivered is not None])
+        return times, np.arange(1, len(times) + 1)
+
+    def plot(self) -> Any:
+        """A matplotlib figure of the orders released and delivered over time (the viz extra)."""
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        from matplotlib.figure import Figure
+
+        fig = Figure(figsize=(7, 4), dpi=100)
+        FigureCanvasAgg(fig)
+        ax = fig.add_subplot()
+        released = np.sort([o.at for o in self.orders if o.at <= self.until])
+        ax.step(released, np.arange(1, len(released) + 1), where="post", label="released", color="grey")
+        times, counts = self.deliveries()
+        ax.step(times, counts, where="post", label="delivered", color="tab:blue")
+        ax.set_xlim(0, self.until)
+        ax.set_xlabel("time [s]")
+        ax.set_ylabel("orders")
+        ax.set_title(
+            f"{self.scenario}: {self.delivered} delivered, {self.deliveries_per_hour:.0f} per hour",
+            fontsize=10,
+        )
+        ax.legend(loc="upper left", frameon=False)
+        fig.tight_layout()
+        return fig
+
+    def save_plot(self, path: str | os.PathLike[str]) -> None:
+        """Write :meth:`plot` as a PNG, atomically."""
+        import io
+
+        buffer = io.BytesIO()
+        self.plot().savefig(buffer, format="png")
+        write_atomic(path, buffer.getvalue())

@@ -1,0 +1,142 @@
+"""Lifelong operation: orders released over time, served by a fleet that keeps working."""
+
+from __future__ import annotations
+
+import json
+from functools import lru_cache
+
+import numpy as np
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from cosmop.cli import app
+from cosmop.errors import ScenarioError
+from cosmop.lifelong import Failure, FleetSettings, run_fleet
+from cosmop.scenario import load_orders, load_scenario, parse_scenario
+from cosmop.traces import Trace
+from run_2x2 import EXAMPLE
+
+runner = CliRunner()
+
+
+def _data(orders=None) -> dict:
+    """The 2x2 warehouse with an order stream instead of a mission."""
+    data = yaml.safe_load(EXAMPLE.read_text())
+    del data["mission"]
+    data["name"] = "lifelong-2x2"
+    data["orders"] = orders or [
+        {"at": 5, "object": "O2", "to": ["W2", "W1"]},
+        {"at": 0, "object": "O1", "to": "W1"},
+    ]
+    return data
+
+
+@lru_cache(maxsize=4)
+def _run(failures: tuple[Failure, ...] = (), until: float = 150.0):
+    scenario = parse_scenario(_data())
+    return scenario, run_fleet(scenario, fleet=FleetSettings(until=until), failures=failures)
+
+
+def test_a_scenario_may_hold_only_orders_sorted_by_release():
+    scenario = parse_scenario(_data())
+    assert scenario.mission is None
+    assert [(o.at, o.object, o.to, o.by) for o in scenario.orders] == [
+        (0.0, "O1", ("W1",), ("R1", "R2")),
+        (5.0, "O2", ("W2", "W1"), ("R1", "R2")),
+    ]
+
+
+@pytest.mark.parametrize(
+    ("orders", "field", "words"),
+    [
+        ([{"at": 0, "object": "O9", "to": "W1"}], "orders[0].object", "unknown object 'O9'"),
+        ([{"at": -1, "object": "O1", "to": "W1"}], "orders[0].at", "a release time in seconds"),
+        ([{"at": 0, "object": "O1", "to": ["W1", "W7"]}], "orders[0].to[1]", "unknown workspace 'W7'"),
+        ([{"at": 0, "object": "O1", "to": "W1", "by": "R5"}], "orders[0].by[0]", "unknown robot 'R5'"),
+        ([{"at": 0, "object": "O1"}], "orders[0].to", "missing required key 'to'"),
+    ],
+)
+def test_a_bad_order_names_its_field(orders, field, words):
+    with pytest.raises(ScenarioError) as info:
+        parse_scenario(_data(orders))
+    assert info.value.field == field and words in str(info.value)
+
+
+def test_neither_mission_nor_orders_is_refused():
+    data = _data()
+    del data["orders"]
+    with pytest.raises(ScenarioError, match=r"expected a mission .* or orders"):
+        parse_scenario(data)
+
+
+def test_an_orders_file_is_read_against_the_scene(tmp_path):
+    scenario = load_scenario(EXAMPLE)
+    path = tmp_path / "orders.yaml"
+    path.write_text("orders:\n  - {at: 3, object: O2, to: W2}\n  - {at: 1.5, object: O1, to: W1, by: R1}\n")
+    assert [(o.at, o.object, o.by) for o in load_orders(path, scenario)] == [
+        (1.5, "O1", ("R1",)),
+        (3.0, "O2", ("R1", "R2")),
+    ]
+    path.write_text("orders:\n  - {at: 3, object: O2, to: W9}\n")
+    with pytest.raises(ScenarioError) as info:
+        load_orders(path, scenario)
+    assert str(info.value).startswith(f"{path}: orders[0].to[0]: unknown workspace 'W9'")
+
+
+def test_the_fleet_delivers_the_stream_safely_and_ships_the_goods():
+    _, result = _run()
+    summary = result.summary()
+    assert summary["orders"] == {"released": 2, "delivered": 2, "lost": 0, "pending": 0}
+    assert summary["contacts_while_moving"] == 0 and summary["messages"] > 0  # ordered by messages
+    assert summary["deliveries_per_hour"] == pytest.approx(2 * 3600 / result.until)
+    waits = [o.wait for o in result.orders]
+    assert summary["wait_s"]["max"] == pytest.approx(max(waits), abs=1e-3)
+    assert all(0 < u < 1 for u in summary["utilisation"].values())
+    assert [o.robot for o in result.orders] == ["R1", "R2"]  # each to the idle robot nearest its work
+    trace = result.trace()
+    back = Trace.from_json(json.loads(json.dumps(trace.to_json())))
+    assert back.robot_ids == ("R1", "R2")
+    shipped = trace.object_ids.index("O1")
+    after = np.searchsorted(trace.t, result.orders[0].delivered) + 1
+    assert np.isnan(trace.objects[after:, shipped]).all()  # delivered goods leave the world
+
+
+def test_a_robot_failing_with_the_goods_loses_the_order_and_says_where():
+    _, result = _run((Failure("R1", 25.0),))
+    failure = result.failures["R1"]
+    assert failure["carrying"] == ["O1"] and failure["t"] == pytest.approx(25.0)
+    lost = result.orders[0]
+    assert lost.lost == "R1 failed at 25.0 s carrying O1" and lost.delivered is None
+    assert result.orders[1].delivered is not None and result.contacts_while_moving == 0
+
+
+def test_a_robot_failing_before_it_picks_returns_the_order_to_the_pool():
+    _, result = _run((Failure("R2", 6.0),))
+    assert result.failures["R2"]["carrying"] == []
+    order = result.orders[1]  # R2 had taken it at 5.2 s
+    assert order.assigned is None or order.robot == "R1"
+    tries = [e for e in result.dispatch_log if e["order"] == 1]
+    assert len(tries) >= 2 and tries[0]["robot"] == "R2"  # given again after R2 failed
+
+
+def test_cosmop_run_writes_the_summary_and_refuses_bad_options(tmp_path):
+    scenario = tmp_path / "s.yaml"
+    scenario.write_text(yaml.safe_dump(_data()))
+    summary, trace = tmp_path / "sum.json", tmp_path / "t.json"
+    ran = runner.invoke(
+        app, ["run", str(scenario), "--until", "120", "--summary", str(summary), "--trace", str(trace)]
+    )
+    assert ran.exit_code == 0, ran.output
+    data = json.loads(summary.read_text())
+    assert data["format"] == "cosmop.run/1" and data["orders"]["delivered"] == 2
+    assert {"p50", "p95", "max"} <= set(data["wait_s"]) and "deliveries_per_hour" in data
+    assert "2 of 2 orders delivered" in " ".join(ran.stdout.split())
+    view = runner.invoke(app, ["view", str(scenario), "--trace", str(trace), "-o", str(tmp_path / "v.html")])
+    assert view.exit_code == 0, view.output
+    bad = runner.invoke(app, ["run", str(scenario), "--until", "60", "--fail", "R1-600"])
+    assert bad.exit_code == 2 and "ROBOT@SECONDS" in bad.stderr
+    unknown = runner.invoke(app, ["run", str(scenario), "--until", "60", "--fail", "R9@6"])
+    assert unknown.exit_code == 2 and "R9 is not a robot" in unknown.stderr
+    plan = runner.invoke(app, ["plan", str(scenario), "-o", str(tmp_path / "p.json")])
+    assert plan.exit_code == 2 and "cosmop run" in plan.stderr
