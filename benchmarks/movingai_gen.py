@@ -52,6 +52,19 @@ def _centre(row: int, col: int) -> list[float]:
     return [col * CELL + CELL / 2, (ROWS - 1 - row) * CELL + CELL / 2]
 
 
+def shelf_faces() -> list[tuple[int, int, int]]:
+    """Where goods may lie: ``(aisle row, column, +1 when the block is below the good, -1 when
+    above)`` for every cell along the top and bottom faces of the shelf blocks (not the ends)."""
+    faces = []
+    for by in range(BLOCKS_Y):
+        top = 2 + 3 * by
+        for bx in range(BLOCKS_X):
+            left = 1 + DOCK + (BLOCK_W + 1) * bx
+            faces += [(top - 1, left + dc, 1) for dc in range(1, BLOCK_W - 1)]
+            faces += [(top + BLOCK_H, left + dc, -1) for dc in range(1, BLOCK_W - 1)]
+    return faces
+
+
 def _instance(n: int, seed: int, docks: str):
     """The cells of a seeded instance: robots' parking cells, goods ``(aisle row, column, +1
     when the block is below the good)`` and dock cells (docks ``"near"`` the good or on the
@@ -59,14 +72,7 @@ def _instance(n: int, seed: int, docks: str):
     rng = random.Random(seed)
     parking = [(r, c) for r in range(2, ROWS - 2, 2) for c in (3, 6, 9, COLS - 4, COLS - 7, COLS - 10)]
     rng.shuffle(parking)
-    faces = []  # (aisle row, column, +1: the block is below the good, -1: above)
-    for by in range(BLOCKS_Y):
-        top = 2 + 3 * by
-        for bx in range(BLOCKS_X):
-            left = 1 + DOCK + (BLOCK_W + 1) * bx
-            faces += [(top - 1, left + dc, 1) for dc in range(1, BLOCK_W - 1)]
-            faces += [(top + BLOCK_H, left + dc, -1) for dc in range(1, BLOCK_W - 1)]
-    chosen = rng.sample(faces, n)
+    chosen = rng.sample(shelf_faces(), n)
     columns = {"left": 18, "right": COLS - 19}
     places = {side: [(r, c) for r in range(3, ROWS - 3, 3)] for side, c in columns.items()}
     for cells in places.values():

@@ -21,10 +21,6 @@ from pathlib import Path
 
 from _harness import emit_scenario
 from movingai_gen import (
-    BLOCK_H,
-    BLOCK_W,
-    BLOCKS_X,
-    BLOCKS_Y,
     CELL,
     COLS,
     DOCK,
@@ -33,21 +29,10 @@ from movingai_gen import (
     ROWS,
     _centre,
     movingai_warehouse,
+    shelf_faces,
 )
 
 DOCK_COLUMNS = {"left": DOCK - 2, "right": COLS - DOCK + 1}  # one column in from the shelves
-
-
-def _faces() -> list[tuple[int, int, int]]:
-    """Every shelf face cell: ``(aisle row, column, +1 when the block is below the good)``."""
-    faces = []
-    for by in range(BLOCKS_Y):
-        top = 2 + 3 * by
-        for bx in range(BLOCKS_X):
-            left = 1 + DOCK + (BLOCK_W + 1) * bx
-            faces += [(top - 1, left + dc, 1) for dc in range(1, BLOCK_W - 1)]
-            faces += [(top + BLOCK_H, left + dc, -1) for dc in range(1, BLOCK_W - 1)]
-    return faces
 
 
 def orders_warehouse(n: int, seed: int = 0, rate: float = 120.0, hours: float = 1.0) -> dict:
@@ -70,7 +55,7 @@ def orders_warehouse(n: int, seed: int = 0, rate: float = 120.0, hours: float = 
     while t < hours * 3600.0:
         times.append(round(t, 1))
         t += rng.expovariate(rate / 3600.0)
-    faces = rng.sample(_faces(), len(times))
+    faces = rng.sample(shelf_faces(), len(times))
     objects, orders = {}, []
     for k, (at, (row, col, below)) in enumerate(zip(times, faces, strict=True)):
         oid = f"O{k + 1}"

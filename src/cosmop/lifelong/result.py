@@ -21,7 +21,7 @@ import numpy as np
 
 from cosmop.io import write_atomic
 from cosmop.scene import Scenario, Scene
-from cosmop.sim.result import FRAME_PRIMITIVES, Contact, Message
+from cosmop.sim.result import Contact, Message, frames_trace
 from cosmop.traces import Trace
 from cosmop.units import INTERNAL_UNITS
 
@@ -233,27 +233,8 @@ class FleetResult:
 
     def trace(self) -> Trace:
         """The run as a ``cosmop.trace/1`` :class:`~cosmop.traces.Trace` (shipped goods absent)."""
-        f = self.frames
-        return Trace(
-            t=f["t"],
-            robot_ids=self.robot_ids,
-            poses=f["pose"],
-            v=f["v"],
-            w=f["w"],
-            carrying=f["carrying"],
-            primitive=f["primitive"],
-            primitive_names=FRAME_PRIMITIVES,
-            waiting=f["waiting"],
-            awaits=f.get("awaits"),
-            yields_to=f.get("yields_to"),
-            human_ids=self.human_ids,
-            humans=f["humans"],
-            object_ids=self.object_ids,
-            objects=f["objects"],
-            messages=tuple(m.to_dict() for m in self.messages),
-            scenario=self.scenario,
-            dt=self.dt,
-        ).rounded()
+        ids = (self.robot_ids, self.human_ids, self.object_ids)
+        return frames_trace(self.frames, ids=ids, messages=self.messages, scenario=self.scenario, dt=self.dt)
 
     def deliveries(self) -> tuple[np.ndarray, np.ndarray]:
         """The delivery times (s, sorted) and the count delivered by each."""

@@ -35,6 +35,7 @@ __all__ = [
     "SimResult",
     "SimSettings",
     "drop_holds",
+    "frames_trace",
 ]
 
 SIM_FORMAT = "cosmop.sim/1"
@@ -352,33 +353,19 @@ class SimResult:
         the pictures drawn from either.  The integer and boolean arrays are :attr:`frames`'
         own, as read-only views.
         """
-        f = self.frames
-        return Trace(
-            t=f["t"],
-            robot_ids=self.robot_ids,
-            poses=f["pose"],
-            v=f["v"],
-            w=f["w"],
-            carrying=f["carrying"],
-            primitive=f["primitive"],
-            primitive_names=FRAME_PRIMITIVES,
-            waiting=f["waiting"],
-            delayed=f["delayed"] if self.delays is not None else None,  # (a run without: as before)
-            awaits=f.get("awaits"),
-            yields_to=f.get("yields_to"),
-            human_ids=self.human_ids,
-            humans=f["humans"],
-            object_ids=self.object_ids,
-            objects=f["objects"],
-            messages=tuple(m.to_dict() for m in self.messages),
+        return frames_trace(
+            self.frames,
+            ids=(self.robot_ids, self.human_ids, self.object_ids),
+            messages=self.messages,
+            scenario=self.scenario,
+            dt=self.dt,
+            delays=self.delays is not None,  # (a run without: as before)
             replans=tuple(
                 {"t": r["t"], "robot": r["robot"], "route": r["route"]}
                 for r in self.replan_log
                 if "route" in r
             ),
-            scenario=self.scenario,
-            dt=self.dt,
-        ).rounded()
+        )
 
     def save_summary(self, path: str | os.PathLike[str]) -> None:
         """Write :meth:`summary` as JSON, atomically."""
@@ -398,6 +385,63 @@ class SimResult:
                     position, by = self.objects[event.obj]
                     out[event.obj] = by is None and drop_holds(scene, event, position)
         return out
+
+
+def frames_trace(
+    frames: Mapping[str, np.ndarray],
+    *,
+    ids: tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...]],
+    messages: Sequence[Message],
+    scenario: str,
+    dt: float,
+    delays: bool = False,
+    replans: tuple[Mapping[str, Any], ...] = (),
+) -> Trace:
+    """The :class:`~cosmop.traces.Trace` of a run's per-cycle arrays (:attr:`SimResult.frames`),
+    rounded as its file is.
+
+    Parameters
+    ----------
+    frames : Mapping[str, ndarray]
+        The recorder's arrays (:class:`cosmop.sim.recording.Recorder`).
+    ids : (robot ids, human ids, object ids)
+    messages : sequence of Message
+    scenario : str
+    dt : float
+        The control cycle, s.
+    delays : bool
+        Whether the run drew delays (its trace then says which robots a delay stopped).
+    replans : tuple of Mapping
+        The accepted replans' routes (:attr:`cosmop.traces.Trace.replans`).
+
+    Returns
+    -------
+    Trace
+    """
+    f = frames
+    robot_ids, human_ids, object_ids = ids
+    return Trace(
+        t=f["t"],
+        robot_ids=robot_ids,
+        poses=f["pose"],
+        v=f["v"],
+        w=f["w"],
+        carrying=f["carrying"],
+        primitive=f["primitive"],
+        primitive_names=FRAME_PRIMITIVES,
+        waiting=f["waiting"],
+        delayed=f["delayed"] if delays else None,
+        awaits=f.get("awaits"),
+        yields_to=f.get("yields_to"),
+        human_ids=human_ids,
+        humans=f["humans"],
+        object_ids=object_ids,
+        objects=f["objects"],
+        messages=tuple(m.to_dict() for m in messages),
+        replans=replans,
+        scenario=scenario,
+        dt=dt,
+    ).rounded()
 
 
 def drop_holds(scene: Scene, event: Event, position: Sequence[float]) -> bool:
