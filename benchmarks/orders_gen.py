@@ -35,7 +35,7 @@ from movingai_gen import (
 DOCK_COLUMNS = {"left": DOCK - 2, "right": COLS - DOCK + 1}  # one column in from the shelves
 
 
-def orders_warehouse(n: int, seed: int = 0, rate: float = 120.0, hours: float = 1.0) -> dict:
+def orders_warehouse(n: int, seed: int = 0, rate: float = 600.0, hours: float = 1.0) -> dict:
     """The scenario data: `n` robots, the goods of a Poisson stream of `rate` orders per hour
     over `hours`, and docks on both sides (``orders``, no ``mission``)."""
     rng = random.Random(seed)
@@ -74,7 +74,9 @@ def orders_warehouse(n: int, seed: int = 0, rate: float = 120.0, hours: float = 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("n", type=int)
-    parser.add_argument("--rate", type=float, default=120.0, help="orders per hour")
+    parser.add_argument(
+        "--rate", type=float, default=600.0, help="orders per hour (20 robots serve about 300)"
+    )
     parser.add_argument("--hours", type=float, default=1.0)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("-o", "--output", type=Path)

@@ -55,6 +55,11 @@ def test_a_scenario_may_hold_only_orders_sorted_by_release():
         ([{"at": 0, "object": "O1", "to": ["W1", "W7"]}], "orders[0].to[1]", "unknown workspace 'W7'"),
         ([{"at": 0, "object": "O1", "to": "W1", "by": "R5"}], "orders[0].by[0]", "unknown robot 'R5'"),
         ([{"at": 0, "object": "O1"}], "orders[0].to", "missing required key 'to'"),
+        (
+            [{"at": 0, "object": "O1", "to": "W1"}, {"at": 9, "object": "O1", "to": "W2"}],
+            "orders[1].object",
+            "O1 is already ordered by orders[0]",
+        ),
     ],
 )
 def test_a_bad_order_names_its_field(orders, field, words):

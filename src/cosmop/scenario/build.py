@@ -183,13 +183,18 @@ class _Builder:
 
     def build_orders(self, models: list[_OrderModel], scene: Scene) -> tuple[Order, ...]:
         """The orders with their ids checked against the scene, by release time (stable)."""
-        out = []
+        out, first = [], {}
         for index, model in enumerate(models):
             path = ("orders", index)
             if model.object not in scene.objects:
                 self.fail(
                     (*path, "object"), f"unknown object {model.object!r}; {_known('objects', scene.objects)}"
                 )
+            if model.object in first:  # goods are delivered once: they leave the world then
+                self.fail(
+                    (*path, "object"), f"{model.object} is already ordered by orders[{first[model.object]}]"
+                )
+            first[model.object] = index
             for k, ws in enumerate(model.to):
                 if ws not in scene.workspaces:
                     self.fail(
