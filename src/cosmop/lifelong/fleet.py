@@ -162,6 +162,7 @@ def run_fleet(
             raise ValueError(f"--fail names {failure.robot}, which is not a robot of the scene")
     stream = sorted(orders if orders is not None else scenario.orders, key=lambda o: o.at)
     world = World(scenario, PlanSet(scenario.name, True, {}), seed, settings or SimSettings())
+    world.conflict_settings = ConflictSettings(shipped_on_drop=True)  # delivered goods leave the world
     run = _Run(world, [OrderState(o, k) for k, o in enumerate(stream)], fleet)
     run.busy_time = {rid: 0.0 for rid in world.robot_ids}
     recorder = Recorder()

@@ -86,6 +86,10 @@ class ConflictSettings:
         How far (mm) before a cut a robot that drives on through it may already count as there
         (the simulator's pass tolerance, 150 mm): the cut where a drive leaves a shared place
         lies this much beyond it, so that the message sent there is never early.
+    shipped_on_drop : bool
+        Goods leave the world once a plan drops them (a lifelong run ships delivered goods,
+        :mod:`cosmop.lifelong`): they hold their dock only until the drop (default false: goods
+        rest where they are dropped for good).
     """
 
     clearance: float = 100.0
@@ -94,6 +98,7 @@ class ConflictSettings:
     cut: bool = True
     piece: float = 200.0
     passing: float = 150.0
+    shipped_on_drop: bool = False
 
 
 @dataclass(frozen=True)
@@ -281,11 +286,13 @@ def _object_occupancies(
     precedence: Precedence,
     models: Mapping[str, Sequence[State]],
     positions: Mapping[str, tuple[float, float] | None] | None = None,
+    shipped_on_drop: bool = False,
 ) -> tuple[list[Occupancy], list[str]]:
     """Where every moved object rests between the steps that handle it; problems found.
 
     `models` gives each robot's states, instant 0 first (what its plan knows of the objects);
-    `positions` where objects are at the start (``None``: carried), by default the scene's.
+    `positions` where objects are at the start (``None``: carried), by default the scene's;
+    goods `shipped_on_drop` leave the world at their last drop instead of resting there.
     The handlings of an object must be ordered, and each pick must find the object where the
     team's order leaves it: where the last drop before it put it (or where it starts).
     """
@@ -318,7 +325,7 @@ def _object_occupancies(
                 position = None
             else:
                 position, first = plans[robot].steps[k - 1].objects[oid].position, (robot, k)
-        if position is not None:
+        if position is not None and not (shipped_on_drop and first is not None):
             out.append(_resting(oid, spec.size, parties, position, first, None, models, scene.units))
     return out, problems
 
@@ -427,7 +434,9 @@ def occupancies(
         models[robot] = [start, *(step.state for step in plan.steps)]
         size, home = scene.robots[robot].size + grow, scene.robots[robot].pose
         out += _robot_occupancies(robot, plan, start, size, home, grow, settings.rest, scene.units)
-    objects, problems = _object_occupancies(scene, plans, precedence, models, positions)
+    objects, problems = _object_occupancies(
+        scene, plans, precedence, models, positions, settings.shipped_on_drop
+    )
     return out + objects, problems
 
 

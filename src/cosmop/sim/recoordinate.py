@@ -158,12 +158,13 @@ def recoordinate(
 
 
 def recoordinate_world(
-    world: World, agent: Agent, new: RobotPlan, start: State
+    world: World, agent: Agent, new: RobotPlan, start: State, settings: ConflictSettings | None = None
 ) -> tuple[bool, str, list[str]]:
     """Order the rest of every robot's plan again around `agent`'s `new` plan from `start`.
 
     When accepted, every robot's executor takes its new rest (``world.conflict_messages``
-    gains the messages added).  Returns ``(accepted, why not, messages added)``.
+    gains the messages added).  Returns ``(accepted, why not, messages added)``.  The conflicts
+    are found with `settings`, by default the world's (``World.conflict_settings``).
     """
     splits = {a.id: a.split_mission(world.scenario) for a in world.agents}
     rests = {}
@@ -189,6 +190,7 @@ def recoordinate_world(
         conflict_messages=world.conflict_messages,
         used=world.message_names,
         positions=positions,
+        settings=settings or world.conflict_settings,
     )
     if not result.accepted:
         return False, result.reason or "", []

@@ -21,6 +21,7 @@ from cosmop.control.paths import GlobalPath
 from cosmop.control.safety import Limits
 from cosmop.events import MESSAGE_KINDS, Event, Primitive, parse_event, realising_step
 from cosmop.physics import TOUCH  # the one tolerance under which two squares touch
+from cosmop.planning.conflicts import ConflictSettings
 from cosmop.planning.plan import PlanSet, RobotPlan, Step
 from cosmop.planning.realisation import event_instants
 from cosmop.scene import Scenario
@@ -164,6 +165,8 @@ class World:
         self.carried_by = np.full(len(self.object_ids), -1)  # robot index, -1: resting
         # goods a lifelong run has shipped: they left their dock and the world (cosmop.lifelong)
         self.shipped = np.zeros(len(self.object_ids), dtype=bool)
+        # how re-coordination finds conflicts (None: the defaults; a lifelong run ships goods on drop)
+        self.conflict_settings: ConflictSettings | None = None
         rng = np.random.default_rng(seed)  # the people's random walks
         self.walkers = [Walker(humans[h], self.walls, rng) for h in self.human_ids]
         self.human_half = np.array([w.half for w in self.walkers])
