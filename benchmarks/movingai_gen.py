@@ -77,11 +77,21 @@ def _instance(n: int, seed: int, docks: str):
     places = {side: [(r, c) for r in range(3, ROWS - 3, 3)] for side, c in columns.items()}
     for cells in places.values():
         rng.shuffle(cells)
+    # beyond 38 goods, a second column of docks three cells further out on each side, drawn
+    # from a generator of its own so that smaller instances stay as they were
+    spare = random.Random(seed + 1)
+    more = {
+        side: [(r, c - 3 if side == "left" else c + 3) for r in range(3, ROWS - 3, 3)]
+        for side, c in columns.items()
+    }
+    for cells in more.values():
+        spare.shuffle(cells)
     out = []
     for row, col, below in chosen:
         near, far = ("left", "right") if col < COLS // 2 else ("right", "left")
         first, second = (near, far) if docks == "near" else (far, near)
-        out.append((row, col, below, (places[first] or places[second]).pop()))
+        pool = places[first] or places[second] or more[first] or more[second]
+        out.append((row, col, below, pool.pop()))
     return parking[:n], out
 
 
