@@ -117,6 +117,7 @@ class _Run:
     failed: dict[str, dict] = field(default_factory=dict)
     log: list[dict] = field(default_factory=list)
     seen_events: int = 0
+    delivered: int = 0
 
 
 def run_fleet(
@@ -183,7 +184,7 @@ def run_fleet(
         _idle_again(run)
         recorder.record(world)
         if on_cycle is not None:
-            on_cycle(world.t, sum(s.delivered is not None for s in run.states), released)
+            on_cycle(world.t, run.delivered, released)
     for rid, since in run.busy_since.items():
         run.busy_time[rid] += world.t - since
     return FleetResult.of(
@@ -286,6 +287,7 @@ def _deliveries(run: _Run) -> None:
             and state.delivered is None
         ):
             state.delivered = t
+            run.delivered += 1
             world.ship(event.obj)
     run.seen_events = len(world.events)
 
