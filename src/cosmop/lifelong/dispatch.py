@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from cosmop.events import Event
 from cosmop.scene import Order, Scene
 
-__all__ = ["Assignment", "OrderState", "choose_robot", "delivery_events"]
+__all__ = ["OrderState", "choose_robot", "delivery_events"]
 
 
 @dataclass
@@ -58,15 +58,6 @@ class OrderState:
     def wait(self) -> float | None:
         """Release to delivery, s (None: not delivered)."""
         return None if self.delivered is None else self.delivered - self.order.at
-
-
-@dataclass(frozen=True)
-class Assignment:
-    """An order given to a robot, with the events of its next mission."""
-
-    state: OrderState
-    robot: str
-    events: tuple[Event, ...]
 
 
 def _l1(a: Sequence[float], b: Sequence[float]) -> float:

@@ -51,6 +51,13 @@ __all__ = ["Failure", "FleetSettings", "run_fleet"]
 class Failure:
     """A robot that stops for good at time `at` (s).
 
+    Attributes
+    ----------
+    robot : str
+        The robot that fails.
+    at : float
+        When it stops, s from the start of the run.
+
     Examples
     --------
     >>> Failure.parse("R3@600")
