@@ -244,15 +244,21 @@ def test_frames_are_still_written_when_the_canvas_cannot_be_taken_as_is(tmp_path
     assert gif_frames(path)[0] == count == 5
 
 
-def test_what_a_frame_shows():
-    trace = make_trace(20, dt=0.1)
-    scene = types.SimpleNamespace(
+def _with_person():
+    """The scene with the person H1 (600 mm) that the synthetic trace walks."""
+    return types.SimpleNamespace(
         obstacles=SCENE.obstacles,
         robots=SCENE.robots,
         objects=SCENE.objects,
         workspaces=SCENE.workspaces,
         humans={"H1": types.SimpleNamespace(size=600)},
+        units="mm",
     )
+
+
+def test_what_a_frame_shows():
+    trace = make_trace(20, dt=0.1)
+    scene = _with_person()
     animator = animation_module._Animator(scene, trace, make_plans(), "demo", DPI, shown=1.0)
     r1, r2 = animator.artists["R1"], animator.artists["R2"]
     animator.draw(0)
@@ -309,14 +315,7 @@ def test_a_frame_says_why_a_robot_stands_and_a_replan_redraws_its_path():
         "steps": [{"pose": [-1500, 2000, 90], "primitive": "GoTo", "about": None}],
     }
     trace["replans"] = [{"t": 1.0, "robot": "R1", "route": route}]
-    scene = types.SimpleNamespace(
-        obstacles=SCENE.obstacles,
-        robots=SCENE.robots,
-        objects=SCENE.objects,
-        workspaces=SCENE.workspaces,
-        humans={"H1": types.SimpleNamespace(size=600)},
-        units="mm",
-    )
+    scene = _with_person()
     animator = animation_module._Animator(scene, trace, make_plans(), "demo", DPI, shown=1.0)
     r1, r2 = animator.artists["R1"], animator.artists["R2"]
     (planned, _), (replanned, _) = [(line, t) for t, line in animator.plan_lines["R1"]]

@@ -54,11 +54,6 @@ class OrderState:
     tries: int = 0
     retry_at: float = 0.0
 
-    @property
-    def wait(self) -> float | None:
-        """Release to delivery, s (None: not delivered)."""
-        return None if self.delivered is None else self.delivered - self.order.at
-
 
 def _l1(a: Sequence[float], b: Sequence[float]) -> float:
     return abs(a[0] - b[0]) + abs(a[1] - b[1])

@@ -14,7 +14,7 @@ from fractions import Fraction
 from pathlib import Path
 from typing import Any, NoReturn
 
-from pydantic import ValidationError
+from pydantic import BaseModel, ValidationError
 
 from cosmop.errors import EventSyntaxError, InputWarning, ScenarioError
 from cosmop.events import ID_PATTERN, MESSAGE_KINDS, Event, parse_event
@@ -74,6 +74,9 @@ from cosmop.units import (
 class _Builder:
     """Validates one scenario mapping and builds the :class:`Scenario`."""
 
+    MODEL: type[BaseModel] = _ScenarioModel  # the structure of the file's top level
+    TOP_LEVEL = "a mapping with keys name, scene, mission at the top level"
+
     def __init__(self, data: Any, file: str | None, marks: Marks | None) -> None:
         self.data = data
         self.file = file
@@ -106,16 +109,17 @@ class _Builder:
 
     # -- structure ----------------------------------------------------------------------------
 
-    def validate_structure(self) -> _ScenarioModel:
+    def validate_structure(self) -> Any:
+        """The file's top level as :attr:`MODEL`; the first wrong field (by line) fails."""
         if not isinstance(self.data, Mapping):
             what = (
                 "the file is empty"
                 if self.data is None
                 else f"got {type(self.data).__name__} {_show(self.data)}"
             )
-            self.fail((), f"expected a mapping with keys name, scene, mission at the top level; {what}")
+            self.fail((), f"expected {self.TOP_LEVEL}; {what}")
         try:
-            return _ScenarioModel.model_validate(self.data)
+            return self.MODEL.model_validate(self.data)
         except ValidationError as exc:
             errors = exc.errors(include_url=False)
             first = min(
@@ -710,13 +714,8 @@ def parse_scenario(data: Mapping[str, Any], source: str | os.PathLike[str] | Non
 class _OrdersBuilder(_Builder):
     """Reads an order stream of its own file: the scenario's ``orders`` key, nothing else."""
 
-    def validate_structure(self) -> _OrdersFileModel:
-        if not isinstance(self.data, Mapping):
-            self.fail((), "expected a mapping with the key orders at the top level")
-        try:
-            return _OrdersFileModel.model_validate(self.data)
-        except ValidationError as exc:
-            self._structure_error(exc.errors(include_url=False)[0])
+    MODEL = _OrdersFileModel
+    TOP_LEVEL = "a mapping with the key orders at the top level"
 
 
 def load_orders(path: str | os.PathLike[str], scenario: Scenario) -> tuple[Order, ...]:

@@ -38,6 +38,7 @@ from cosmop.viz.scene import (
     draw_scene,
     ids_with_trace,
     planned_path,
+    replanned_path,
     scene_legend,
 )
 
@@ -279,10 +280,10 @@ class _Animator:
             if plan is not None and rid in scene.robots:
                 paths[rid] = [(-math.inf, planned_path(scene.robots[rid], plan))]
         for replan in self.trace.replans:
-            route = replan["route"]
-            path = [route["from"][:2]] + [s["pose"][:2] for s in route["steps"] if s["primitive"] == "GoTo"]
             if replan["robot"] in self.robot_ids:
-                paths.setdefault(replan["robot"], []).append((float(replan["t"]), path))
+                paths.setdefault(replan["robot"], []).append(
+                    (float(replan["t"]), replanned_path(replan["route"]))
+                )
         lines: dict[str, list[tuple[float, Any]]] = {}
         for rid, versions in paths.items():
             for k, (t, path) in enumerate(versions):

@@ -34,6 +34,7 @@ __all__ = [
     "draw_scene",
     "ids_with_trace",
     "planned_path",
+    "replanned_path",
     "scene_legend",
 ]
 
@@ -346,6 +347,14 @@ def scene_legend() -> list[Any]:
 def planned_path(robot: Robot, plan: RobotPlan) -> list[tuple[float, float]]:
     """The path a plan drives: the robot's initial position, then every GoTo's target (mm)."""
     return [tuple(robot.pose[:2])] + [tuple(s.robot[:2]) for s in plan.steps if s.primitive == "GoTo"]
+
+
+def replanned_path(route: Mapping[str, Any]) -> list[tuple[float, float]]:
+    """The path a replan drives: where it went on from, then every GoTo's target (mm); `route`
+    is a trace's ``replans[k].route`` (:attr:`cosmop.traces.Trace.replans`)."""
+    return [tuple(route["from"][:2])] + [
+        tuple(s["pose"][:2]) for s in route["steps"] if s["primitive"] == "GoTo"
+    ]
 
 
 def ids_with_trace(declared: Mapping[str, Any], trace: Trace | None, group: str) -> list[str]:

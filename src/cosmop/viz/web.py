@@ -29,7 +29,7 @@ from cosmop.traces import Trace, as_trace, message_label
 from cosmop.units import UnitSystem
 from cosmop.viz.explain import Explainer, waiting_words
 from cosmop.viz.palette import robot_colours, to_hex
-from cosmop.viz.scene import DEFAULT_ROBOT_SIZE, STEP_MARKS, ids_with_trace, planned_path
+from cosmop.viz.scene import DEFAULT_ROBOT_SIZE, STEP_MARKS, ids_with_trace, planned_path, replanned_path
 
 __all__ = ["FIT_BELOW", "MESSAGE_SHOWN_S", "render_html", "save_html"]
 
@@ -123,7 +123,7 @@ def _plans(scene: Scene, plans: PlanSet | None, trace: Trace | None) -> dict[str
     for replan in trace.replans if trace is not None else ():
         route = replan["route"]
         steps = route["steps"]
-        path = [route["from"][:2]] + [s["pose"][:2] for s in steps if s["primitive"] == "GoTo"]
+        path = [list(point) for point in replanned_path(route)]
         marks = [
             [
                 *s["pose"][:2],
