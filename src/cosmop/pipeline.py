@@ -196,7 +196,7 @@ class _Workers(ProcessPoolExecutor):
             for process in processes:
                 process.join()
             if results is not None:
-                results._writer.close()
+                results._writer.close()  # stdlib: the queue has no public way to close its end
             if manager is not None:
                 manager.join()
             if results is not None:

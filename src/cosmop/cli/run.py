@@ -10,7 +10,7 @@ from rich.table import Table
 from rich.text import Text
 
 from cosmop.cli._app import EXIT_INPUT_ERROR, ScenarioArgument, load, stderr, stdout
-from cosmop.cli.simulate import _parse_delays
+from cosmop.cli.simulate import parse_delays
 from cosmop.io import check_writable, uninterrupted
 from cosmop.lifelong import Failure, FleetResult, FleetSettings, run_fleet
 from cosmop.scenario import load_orders
@@ -49,7 +49,7 @@ def run(
     delays: Annotated[
         Delays | None,
         typer.Option(
-            parser=_parse_delays,
+            parser=parse_delays,
             metavar="P:MIN:MAX",
             help="Every simulated second each robot stops with probability P for MIN to MAX s.",
             show_default=False,

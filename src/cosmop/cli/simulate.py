@@ -25,8 +25,15 @@ if TYPE_CHECKING:
 __all__ = ["simulate"]
 
 
-def _parse_delays(text: str) -> Delays:
-    """``--delays P:MIN:MAX``: the delays, or a usage error naming the option (exit 2)."""
+def parse_delays(text: str) -> Delays:
+    """``--delays P:MIN:MAX``: the delays, or a usage error naming the option (exit 2).
+
+    Parameters
+    ----------
+    text : str
+        The option's value: a probability per robot and simulated second, then the shortest and
+        longest stop in seconds, separated by colons.
+    """
     try:
         return Delays.parse(text)
     except ValueError as err:
@@ -49,7 +56,7 @@ def simulate(
     delays: Annotated[
         Delays | None,
         typer.Option(
-            parser=_parse_delays,
+            parser=parse_delays,
             metavar="P:MIN:MAX",
             help="Every simulated second each robot stops with probability P for MIN to MAX s "
             "(e.g. 0.01:2:10).",

@@ -23,25 +23,25 @@ from cosmop.missions.handover import handovers
 from cosmop.reading import FieldPath, Marks, format_path, load_yaml
 from cosmop.scenario.plausible import implausible, out_of_range
 from cosmop.scenario.schema import (
-    _EXPECTED,
-    _RANGE,
+    EXPECTED,
     MAX_DFA_STATES,
+    RANGE,
     SCENARIO_VERSION,
     UNPRINTABLE,
-    _DeliveryModel,
-    _DfaModel,
-    _expected_at,
-    _HumanModel,
-    _lookup,
-    _MissionModel,
-    _model_at,
-    _OrderModel,
-    _OrdersFileModel,
-    _ScenarioModel,
-    _SceneModel,
-    _show,
-    _show_points,
-    _WorkspaceModel,
+    DeliveryModel,
+    DfaModel,
+    HumanModel,
+    MissionModel,
+    OrderModel,
+    OrdersFileModel,
+    ScenarioModel,
+    SceneModel,
+    WorkspaceModel,
+    expected_at,
+    lookup,
+    model_at,
+    show,
+    show_points,
 )
 from cosmop.scene import (
     LENGTH_GRID,
@@ -74,7 +74,7 @@ from cosmop.units import (
 class _Builder:
     """Validates one scenario mapping and builds the :class:`Scenario`."""
 
-    MODEL: type[BaseModel] = _ScenarioModel  # the structure of the file's top level
+    MODEL: type[BaseModel] = ScenarioModel  # the structure of the file's top level
     TOP_LEVEL = "a mapping with keys name, scene, mission at the top level"
 
     def __init__(self, data: Any, file: str | None, marks: Marks | None) -> None:
@@ -115,7 +115,7 @@ class _Builder:
             what = (
                 "the file is empty"
                 if self.data is None
-                else f"got {type(self.data).__name__} {_show(self.data)}"
+                else f"got {type(self.data).__name__} {show(self.data)}"
             )
             self.fail((), f"expected {self.TOP_LEVEL}; {what}")
         try:
@@ -142,21 +142,21 @@ class _Builder:
         if "[key]" in loc:
             cut = loc.index("[key]")
             key = loc[cut - 1]
-            self.fail(loc[: cut - 1], f"keys here must be ids (text), got {_show(key)}")
+            self.fail(loc[: cut - 1], f"keys here must be ids (text), got {show(key)}")
         if kind == "extra_forbidden":
-            model = _model_at(loc[:-1])
+            model = model_at(loc[:-1])
             keys = model.model_fields.items() if model is not None else ()
             allowed = ", ".join(f.alias or name for name, f in keys) or "none"
             self.fail(loc, f"unknown key {loc[-1]!r}; expected one of: {allowed}")
         if kind == "missing" and isinstance(loc[-1], str):
-            path, text = _expected_at(loc)
+            path, text = expected_at(loc)
             detail = f": expected {text}" if text is not None and path == loc else ""
             self.fail(loc, f"missing required key {loc[-1]!r}{detail}")
-        path, text = _expected_at(loc)
+        path, text = expected_at(loc)
         if text is None:
             self.fail(loc, str(error["msg"]))
-        found, value = _lookup(self.data, path)
-        shown = _show(value) if found else "nothing"
+        found, value = lookup(self.data, path)
+        shown = show(value) if found else "nothing"
         self.fail(path, f"expected {text}, got {shown}")
 
     # -- semantics ----------------------------------------------------------------------------
@@ -164,7 +164,7 @@ class _Builder:
     def build(self, source: Path | None) -> Scenario:
         model = self.validate_structure()
         if model.version is not None and model.version != SCENARIO_VERSION:
-            self.fail(("version",), f"expected {_EXPECTED[('version',)]}, got {model.version}")
+            self.fail(("version",), f"expected {EXPECTED[('version',)]}, got {model.version}")
         written = self.build_scene(model.scene)  # in the file's units
         if (problem := out_of_range(written, self.units)) is not None:
             self.fail(*problem, in_file_units=True)
@@ -185,7 +185,7 @@ class _Builder:
             name=model.name, scene=scene, mission=mission, source=source, warnings=warnings, orders=orders
         )
 
-    def build_orders(self, models: list[_OrderModel], scene: Scene) -> tuple[Order, ...]:
+    def build_orders(self, models: list[OrderModel], scene: Scene) -> tuple[Order, ...]:
         """The orders with their ids checked against the scene, by release time (stable)."""
         out, first = [], {}
         for index, model in enumerate(models):
@@ -212,7 +212,7 @@ class _Builder:
             out.append(Order(float(model.at), model.object, tuple(dict.fromkeys(model.to)), by))
         return tuple(sorted(out, key=lambda order: order.at))
 
-    def build_scene(self, model: _SceneModel) -> Scene:
+    def build_scene(self, model: SceneModel) -> Scene:
         owner_of_id: dict[str, FieldPath] = {}
         kinds = {
             "robots": "a robot",
@@ -239,7 +239,7 @@ class _Builder:
             if start == end:
                 self.fail(
                     ("scene", "obstacles", index),
-                    f"expected a wall with two distinct end points, got {_show_points(start, end)}",
+                    f"expected a wall with two distinct end points, got {show_points(start, end)}",
                 )
             walls.append(Wall(start, end))
 
@@ -276,7 +276,7 @@ class _Builder:
         for rid, robot in scene.robots.items():
             if not math.isfinite(robot.pose[2]):
                 path = ("scene", "robots", rid, "pose", 2)
-                written = _written(_lookup(self.data, path)[1])
+                written = _written(lookup(self.data, path)[1])
                 self.fail(
                     path, f"expected a finite heading (degrees), got {written}: beyond the range of numbers"
                 )
@@ -285,7 +285,7 @@ class _Builder:
         )
         for path, value in _planned_lengths(scene):
             if not abs(value) <= MAX_LENGTH:  # inf too: a metres file's 1e308 overflows in mm
-                written = _written(_lookup(self.data, path)[1])  # as the file wrote it
+                written = _written(lookup(self.data, path)[1])  # as the file wrote it
                 self.fail(
                     path, f"expected a length of at most {show_length(MAX_LENGTH, self.units)}, got {written}"
                 )
@@ -300,7 +300,7 @@ class _Builder:
         """Every heading is still a finite number of degrees (a huge one in radians overflows)."""
         for rid, robot in scene.robots.items():
             if not math.isfinite(robot.pose[2]):
-                given = _lookup(self.data, ("scene", "robots", rid, "pose", 2))[1]
+                given = lookup(self.data, ("scene", "robots", rid, "pose", 2))[1]
                 self.fail(
                     ("scene", "robots", rid, "pose", 2),
                     f"expected a heading that stays finite in the planner's angle unit, got {given!r}",
@@ -336,7 +336,7 @@ class _Builder:
             f"clock); this robot's is {odd.dynamics.cycle:g} s, {others} {common:g} s",
         )
 
-    def build_human(self, ident: str, model: _HumanModel) -> Human:
+    def build_human(self, ident: str, model: HumanModel) -> Human:
         path = ("scene", "humans", ident)
         for index, point in enumerate(model.path):
             if len(point) == 3 and point[2] < 0:
@@ -354,12 +354,12 @@ class _Builder:
             for axis in ("x", "y"):
                 lo, hi = getattr(model.walk, axis)
                 if lo > hi:
-                    self.fail((*path, "walk", axis), f"expected {_RANGE}, got lo = {lo:g} > hi = {hi:g}")
+                    self.fail((*path, "walk", axis), f"expected {RANGE}, got lo = {lo:g} > hi = {hi:g}")
             walk = (model.walk.x, model.walk.y)
         points = tuple((p[0], p[1], p[2] if len(p) == 3 else 0.0) for p in model.path)
         return Human(ident, model.size, model.speed, points, loop=model.loop, walk=walk)
 
-    def build_workspace(self, ident: str, model: _WorkspaceModel) -> Workspace:
+    def build_workspace(self, ident: str, model: WorkspaceModel) -> Workspace:
         path = ("scene", "workspaces", ident)
         if model.point is not None:
             if model.x is not None or model.y is not None:
@@ -370,12 +370,12 @@ class _Builder:
         for axis in ("x", "y"):
             bounds = getattr(model, axis)
             if bounds is None:
-                self.fail((*path, axis), f"missing required key {axis!r}: expected {_RANGE}")
+                self.fail((*path, axis), f"missing required key {axis!r}: expected {RANGE}")
             if bounds[0] > bounds[1]:
-                self.fail((*path, axis), f"expected {_RANGE}, got lo = {bounds[0]:g} > hi = {bounds[1]:g}")
+                self.fail((*path, axis), f"expected {RANGE}, got lo = {bounds[0]:g} > hi = {bounds[1]:g}")
         return Workspace(ident, x=model.x, y=model.y)
 
-    def build_mission(self, model: _MissionModel, scene: Scene) -> Mission:
+    def build_mission(self, model: MissionModel, scene: Scene) -> Mission:
         given = [k for k in ("tasks", "dfa", "deliveries") if getattr(model, k) is not None]
         if len(given) != 1:
             got = " and ".join(given) if given else "none"
@@ -391,7 +391,7 @@ class _Builder:
             return Mission(dfa=self.build_dfa(model.dfa, scene))
         return Mission(deliveries=self.build_deliveries(model.deliveries, scene), returns=bool(model.returns))
 
-    def build_deliveries(self, models: list[_DeliveryModel], scene: Scene) -> tuple[Delivery, ...]:
+    def build_deliveries(self, models: list[DeliveryModel], scene: Scene) -> tuple[Delivery, ...]:
         out, first = [], {}
         for index, model in enumerate(models):
             path = ("mission", "deliveries", index)
@@ -496,7 +496,7 @@ class _Builder:
                 ("mission", "tasks"), f"expected each robot to meet goods only where it left them: {why}"
             )
 
-    def build_dfa(self, model: _DfaModel, scene: Scene) -> DfaSpec:
+    def build_dfa(self, model: DfaModel, scene: Scene) -> DfaSpec:
         base = ("mission", "dfa")
         listed = self.unique_states((*base, "states"), model.states) if model.states is not None else None
 
@@ -636,7 +636,7 @@ def _written(value: Any) -> str:
     """A value as the file wrote it, for a message: numbers in full (``1e+308``, ``800000``)."""
     if isinstance(value, int | float) and not isinstance(value, bool):
         return plain(value)
-    return _show(value)
+    return show(value)
 
 
 def _known(group: str, ids: Mapping[str, Any]) -> str:
@@ -714,7 +714,7 @@ def parse_scenario(data: Mapping[str, Any], source: str | os.PathLike[str] | Non
 class _OrdersBuilder(_Builder):
     """Reads an order stream of its own file: the scenario's ``orders`` key, nothing else."""
 
-    MODEL = _OrdersFileModel
+    MODEL = OrdersFileModel
     TOP_LEVEL = "a mapping with the key orders at the top level"
 
 

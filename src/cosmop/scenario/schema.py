@@ -92,7 +92,7 @@ class _ObjectModel(_Model):
     )
 
 
-class _WorkspaceModel(_Model):
+class WorkspaceModel(_Model):
     x: _Pair | None = None
     y: _Pair | None = None
     point: _Pair | None = None
@@ -103,7 +103,7 @@ class _AreaModel(_Model):
     y: _Pair
 
 
-class _HumanModel(_Model):
+class HumanModel(_Model):
     size: _Positive
     speed: _Positive
     path: Annotated[list[Annotated[list[_Number], Field(min_length=2, max_length=3)]], Field(min_length=1)]
@@ -111,16 +111,16 @@ class _HumanModel(_Model):
     walk: _AreaModel | None = None
 
 
-class _SceneModel(_Model):
+class SceneModel(_Model):
     obstacles: Annotated[list[tuple[_Pair, _Pair]], _none_to([])] = []
     robots: Annotated[dict[_Text, _RobotModel], Field(min_length=1)]
     objects: Annotated[dict[_Text, _ObjectModel], _none_to({})] = {}
-    workspaces: Annotated[dict[_Text, _WorkspaceModel], _none_to({})] = {}
-    humans: Annotated[dict[_Text, _HumanModel], _none_to({})] = {}
+    workspaces: Annotated[dict[_Text, WorkspaceModel], _none_to({})] = {}
+    humans: Annotated[dict[_Text, HumanModel], _none_to({})] = {}
     dynamics: _DynamicsModel | None = None
 
 
-class _DfaModel(_Model):
+class DfaModel(_Model):
     initial: _StateName
     transitions: list[tuple[_StateName, _Text, _StateName]]
     states: list[_StateName] | None = None
@@ -132,44 +132,44 @@ def _one_to_list(value: Any) -> Any:
     return [value] if isinstance(value, str) else value
 
 
-class _DeliveryModel(_Model):
+class DeliveryModel(_Model):
     object: _Text
     to: Annotated[list[_Text], BeforeValidator(_one_to_list), Field(min_length=1)]
     by: Annotated[list[_Text], BeforeValidator(_one_to_list), Field(min_length=1)] | None = None
 
 
-class _MissionModel(_Model):
+class MissionModel(_Model):
     tasks: dict[_Text, Annotated[list[_Text], _none_to([])]] | None = None
-    dfa: _DfaModel | None = None
-    deliveries: Annotated[list[_DeliveryModel], Field(min_length=1)] | None = None
+    dfa: DfaModel | None = None
+    deliveries: Annotated[list[DeliveryModel], Field(min_length=1)] | None = None
     returns: Annotated[bool | None, Field(strict=True, alias="return")] = None
 
 
-class _OrderModel(_Model):
+class OrderModel(_Model):
     at: Annotated[float, Field(strict=True, allow_inf_nan=False, ge=0)]
     object: _Text
     to: Annotated[list[_Text], BeforeValidator(_one_to_list), Field(min_length=1)]
     by: Annotated[list[_Text], BeforeValidator(_one_to_list), Field(min_length=1)] | None = None
 
 
-class _ScenarioModel(_Model):
+class ScenarioModel(_Model):
     version: Annotated[int, Field(strict=True)] | None = None
     name: Annotated[str, Field(strict=True, min_length=1), AfterValidator(_printable)]
-    scene: _SceneModel
-    mission: _MissionModel | None = None
-    orders: Annotated[list[_OrderModel], Field(min_length=1)] | None = None
+    scene: SceneModel
+    mission: MissionModel | None = None
+    orders: Annotated[list[OrderModel], Field(min_length=1)] | None = None
     units: Literal[SCENARIO_UNITS] | None = None  # type: ignore[valid-type]
 
 
-class _OrdersFileModel(_Model):
+class OrdersFileModel(_Model):
     """An order stream in a file of its own (``cosmop run --orders FILE``): its fields are the
     scenario's ``orders`` (so that errors name the same paths)."""
 
-    orders: Annotated[list[_OrderModel], Field(min_length=1)]
+    orders: Annotated[list[OrderModel], Field(min_length=1)]
 
 
 _WALL = "a wall [[x1, y1], [x2, y2]]: two points of two numbers each (mm)"
-_RANGE = "a range [lo, hi] of two numbers with lo <= hi (mm)"
+RANGE = "a range [lo, hi] of two numbers with lo <= hi (mm)"
 _STATE = "a state name"
 _DYNAMICS = "a mapping with any of the keys max_speed, acceleration, braking, turn_rate, cycle"
 _DYNAMICS_FIELDS = {
@@ -181,7 +181,7 @@ _DYNAMICS_FIELDS = {
 }
 _WAYPOINT = "a point [x, y] or [x, y, dwell]: two or three numbers (mm, mm, seconds)"
 # What is expected at a field; "*" stands for any id, "#" for any list index.
-_EXPECTED: dict[tuple[str, ...], str] = {
+EXPECTED: dict[tuple[str, ...], str] = {
     ("version",): f"{SCENARIO_VERSION}, the scenario format version",
     ("name",): "a non-empty name (text)",
     ("units",): "mm (millimetres and degrees, the default) or m (metres and radians, SI)",
@@ -199,8 +199,8 @@ _EXPECTED: dict[tuple[str, ...], str] = {
     ("scene", "objects", "*", "sides", "#"): "one of west, south, east, north",
     ("scene", "workspaces"): "a mapping from workspace ids to {x: [lo, hi], y: [lo, hi]} or {point: [x, y]}",
     ("scene", "workspaces", "*"): "{x: [lo, hi], y: [lo, hi]} or {point: [x, y]}",
-    ("scene", "workspaces", "*", "x"): _RANGE,
-    ("scene", "workspaces", "*", "y"): _RANGE,
+    ("scene", "workspaces", "*", "x"): RANGE,
+    ("scene", "workspaces", "*", "y"): RANGE,
     ("scene", "workspaces", "*", "point"): "a point [x, y]: two numbers (mm)",
     ("scene", "humans"): "a mapping from human ids to {size, speed, path}",
     ("scene", "humans", "*", "size"): "a positive number (side of the square person, mm)",
@@ -209,8 +209,8 @@ _EXPECTED: dict[tuple[str, ...], str] = {
     ("scene", "humans", "*", "path", "#"): _WAYPOINT,
     ("scene", "humans", "*", "loop"): "true or false (whether to repeat the path)",
     ("scene", "humans", "*", "walk"): "an area {x: [lo, hi], y: [lo, hi]} (mm) to roam in",
-    ("scene", "humans", "*", "walk", "x"): _RANGE,
-    ("scene", "humans", "*", "walk", "y"): _RANGE,
+    ("scene", "humans", "*", "walk", "x"): RANGE,
+    ("scene", "humans", "*", "walk", "y"): RANGE,
     ("scene", "dynamics"): _DYNAMICS,
     ("scene", "robots", "*", "dynamics"): _DYNAMICS,
     **{("scene", "dynamics", key): text for key, text in _DYNAMICS_FIELDS.items()},
@@ -266,9 +266,9 @@ def _unwrap(annotation: Any) -> Any:
             return annotation
 
 
-def _model_at(path: FieldPath) -> type[BaseModel] | None:
+def model_at(path: FieldPath) -> type[BaseModel] | None:
     """The pydantic model describing the mapping at `path`, if that position is a model."""
-    annotation: Any = _ScenarioModel
+    annotation: Any = ScenarioModel
     for part in path:
         annotation = _unwrap(annotation)
         if isinstance(annotation, type) and issubclass(annotation, BaseModel):
@@ -290,16 +290,16 @@ def _describe_keys(model: type[BaseModel]) -> str:
     return "a mapping with keys " + ", ".join(keys)
 
 
-def _expected_at(loc: FieldPath) -> tuple[FieldPath, str | None]:
+def expected_at(loc: FieldPath) -> tuple[FieldPath, str | None]:
     """The field to report for an error at `loc`, and what is expected there."""
     for length in range(len(loc), -1, -1):
         prefix = loc[:length]
-        for pattern, text in _EXPECTED.items():
+        for pattern, text in EXPECTED.items():
             if len(pattern) == length and all(
                 _matches(p, part) for p, part in zip(pattern, prefix, strict=True)
             ):
                 return prefix, text
-        model = _model_at(prefix)
+        model = model_at(prefix)
         if model is not None:
             return prefix, _describe_keys(model)
     return loc, None
@@ -311,7 +311,7 @@ def _matches(pattern: str, part: str | int) -> bool:
     return pattern == "*" or pattern == part
 
 
-def _lookup(data: Any, path: FieldPath) -> tuple[bool, Any]:
+def lookup(data: Any, path: FieldPath) -> tuple[bool, Any]:
     for part in path:
         if isinstance(data, Mapping):
             if part not in data:
@@ -322,11 +322,11 @@ def _lookup(data: Any, path: FieldPath) -> tuple[bool, Any]:
     return True, data
 
 
-def _show_points(*points: Point) -> str:
+def show_points(*points: Point) -> str:
     return "[" + ", ".join(f"[{x:g}, {y:g}]" for x, y in points) + "]"
 
 
-def _show(value: Any) -> str:
+def show(value: Any) -> str:
     if value is None:
         return "nothing (null)"
     if isinstance(value, bool):
