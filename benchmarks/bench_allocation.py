@@ -1,7 +1,7 @@
 """Allocation of deliveries: plan time end to end, the makespan, and how far from the best.
 
 Generated warehouses in the deliveries form (``delivery_gen.py``), N robots and M goods, each
-planned in a fresh subprocess with :func:`cosmop.pipeline.plan_team`:
+planned in a fresh subprocess with :func:`cosmop.team.loop.plan_team`:
 
 * ``plan_s``: the whole planning (costing every (robot, good, dock) alone, the assignment,
   synthesis, coordination, team safety, verification, the checker);
@@ -54,8 +54,8 @@ def _lower_bound(options: dict, costs: dict, n: int) -> int:
 
 def one(n: int, m: int, seed: int) -> dict:
     sys.path.insert(0, str(HERE))
-    from cosmop.pipeline import plan_team
     from cosmop.scenario import parse_scenario
+    from cosmop.team.loop import plan_team
     from delivery_gen import delivery_warehouse
 
     scenario = parse_scenario(delivery_warehouse(n, m, seed))

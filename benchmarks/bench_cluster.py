@@ -1,9 +1,9 @@
 """Local worker processes against a Dask cluster of as many workers, side by side.
 
 For each team size N (generated warehouses, ``warehouse_gen.py``, seeded) and each repeat, one
-fresh process plans the team with :func:`cosmop.pipeline.plan_team` in local worker processes
+fresh process plans the team with :func:`cosmop.team.loop.plan_team` in local worker processes
 and the next plans it on a Dask ``LocalCluster`` of the same number of worker processes (one
-thread each), reached through :func:`cosmop.cluster.dask_executor` by its address, as a user
+thread each), reached through :func:`cosmop.team.cluster.dask_executor` by its address, as a user
 reaches a cluster.  The runs alternate, so the machine's drift hits both alike.  The cluster
 is started and connected to before the clock starts (a user's cluster is already running);
 its start-up and the connection (which checks and warms every worker) are recorded apart.
@@ -29,8 +29,8 @@ HERE = Path(__file__).resolve().parent
 
 def child(n: int, seed: int, engine: str, workers: int) -> dict:
     sys.path.insert(0, str(HERE))
-    from cosmop.pipeline import plan_team
     from cosmop.scenario import parse_scenario
+    from cosmop.team.loop import plan_team
     from warehouse_gen import warehouse
 
     scenario = parse_scenario(warehouse(n, seed))
@@ -38,7 +38,7 @@ def child(n: int, seed: int, engine: str, workers: int) -> dict:
     if engine == "dask":
         from distributed import LocalCluster
 
-        from cosmop.cluster import dask_executor
+        from cosmop.team.cluster import dask_executor
 
         t = time.perf_counter()
         cluster = LocalCluster(n_workers=workers, threads_per_worker=1, dashboard_address=":0")

@@ -33,9 +33,9 @@ KINDS = {"GoTo": "GoTo", "PickUp": "handling", "DropOff": "handling", "Req": "Re
 
 
 def measure(name: str) -> dict:
-    from cosmop.pipeline import plan_team
     from cosmop.scenario import load_scenario
     from cosmop.sim import simulate
+    from cosmop.team.loop import plan_team
 
     scenario = load_scenario(ROOT / "examples" / name / "scenario.yaml")
     plans = plan_team(scenario).plans

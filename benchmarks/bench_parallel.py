@@ -63,8 +63,8 @@ def _scenario(workload: str, n: int, seed: int):
 
 def cosmop_row(workload: str, n: int, seed: int, sim: bool) -> dict:
     """Plan (and simulate) the team, and every robot alone: the overheads."""
-    from cosmop.pipeline import plan_team
     from cosmop.sim import simulate
+    from cosmop.team.loop import plan_team
 
     scenario = _scenario(workload, n, seed)
     t = time.perf_counter()

@@ -1,6 +1,6 @@
 """End to end: decompose, plan, coordinate, verify, check, on the paper's 10x10 example.
 
-Median over ``--repeats`` fresh runs of :func:`cosmop.pipeline.plan_team` with one worker
+Median over ``--repeats`` fresh runs of :func:`cosmop.team.loop.plan_team` with one worker
 process and with one per core, with the time per phase and the peak memory of this process
 (worker processes not included).  Usage: ``python benchmarks/bench_pipeline.py``.
 """
@@ -16,8 +16,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from cosmop.pipeline import plan_team
 from cosmop.scenario import load_scenario
+from cosmop.team.loop import plan_team
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -5,7 +5,7 @@ For each N (default 10, 20, 30, 50, 100), seeded:
 1. **As a user plans**: ``cosmop plan scenario.yaml -o plan.json`` in a fresh process (2 worker
    processes, the default on this machine; process start and file writing included), wall
    time and the peak resident memory of the largest process of its tree.
-2. **Where the time goes**: :func:`cosmop.pipeline.plan_team` in a fresh process, with its
+2. **Where the time goes**: :func:`cosmop.team.loop.plan_team` in a fresh process, with its
    phases (``--phases``; skipped by default, the user run is the target).
 3. **As a user simulates**: ``cosmop simulate scenario.yaml --plan plan.json --summary s.json``,
    the whole run (``--sim-time T`` stops it at T simulated seconds instead), wall time, the
@@ -36,8 +36,8 @@ COSMOP = [sys.executable, "-m", "cosmop"]
 
 def child(n: int, seed: int) -> dict:
     sys.path.insert(0, str(HERE))
-    from cosmop.pipeline import plan_team
     from cosmop.scenario import parse_scenario
+    from cosmop.team.loop import plan_team
     from warehouse_gen import warehouse
 
     scenario = parse_scenario(warehouse(n, seed))

@@ -85,7 +85,7 @@ def child(workload: str, plans_dir: str) -> dict:
         seconds = time.perf_counter() - t0
         return {"s": seconds, "out": _digest([(r.horizon, list(r.requests)) for r in results])}
     if workload == "plan":
-        from cosmop.pipeline import plan_team
+        from cosmop.team.loop import plan_team
 
         sc = load_scenario(TEN)
         t0 = time.perf_counter()
@@ -157,7 +157,7 @@ def run_once(src: str, workload: str, plans_dir: Path) -> dict:
 def make_plans(src: str, plans_dir: Path) -> None:
     """The plan files the simulation workloads execute, made once with the tree `src`."""
     code = (
-        "import sys; from cosmop.scenario import load_scenario; from cosmop.pipeline import plan_team\n"
+        "import sys; from cosmop.scenario import load_scenario; from cosmop.team.loop import plan_team\n"
         "for path, name in zip(sys.argv[1::2], sys.argv[2::2]):\n"
         "    plan_team(load_scenario(path)).plans.save(name)\n"
     )

@@ -25,10 +25,10 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-from cosmop.pipeline import plan_team  # noqa: E402
 from cosmop.planning import PlanSet, plan_from_actions  # noqa: E402
 from cosmop.scenario import load_scenario, parse_scenario  # noqa: E402
 from cosmop.sim import SimSettings, simulate  # noqa: E402
+from cosmop.team.loop import plan_team  # noqa: E402
 from warehouse_gen import warehouse  # noqa: E402
 
 

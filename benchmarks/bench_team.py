@@ -42,9 +42,9 @@ def _alone(scenario, robot):
 
 
 def corridor() -> dict:
-    from cosmop.pipeline import plan_team
     from cosmop.scenario import load_scenario
     from cosmop.sim import simulate
+    from cosmop.team.loop import plan_team
 
     scenario = load_scenario(EXAMPLES / "07_corridor" / "scenario.yaml")
     team = plan_team(scenario)
@@ -69,9 +69,9 @@ def corridor() -> dict:
 def order() -> dict:
     from cosmop.missions.decomposition import decompose, resynthesize
     from cosmop.missions.mission import GlobalMission
-    from cosmop.pipeline import plan_team
     from cosmop.scenario import load_scenario
     from cosmop.sim import simulate
+    from cosmop.team.loop import plan_team
 
     scenario = load_scenario(EXAMPLES / "08_ordered" / "scenario.yaml")
     mission = GlobalMission.from_scenario(scenario)
@@ -93,9 +93,9 @@ def order() -> dict:
 def aisles(n: int, seed: int, max_time: float | None) -> dict:
     sys.path.insert(0, str(HERE))
     from aisle_gen import aisle_warehouse
-    from cosmop.pipeline import plan_team
     from cosmop.scenario import parse_scenario
     from cosmop.sim import SimSettings, simulate
+    from cosmop.team.loop import plan_team
 
     scenario = parse_scenario(aisle_warehouse(n, seed))
     t = time.perf_counter()

@@ -96,7 +96,7 @@ def run_seed(seed: int, timeout: float, folder: Path, alone: bool = False) -> di
 
 def _alone_feasible(data: dict, robot: str) -> bool:
     """Whether `robot` has a plan in the scene of `data` with the other robots removed."""
-    from cosmop.pipeline import plan_team
+    from cosmop.team.loop import plan_team
 
     one = json.loads(json.dumps(data))
     one["scene"]["robots"] = {robot: data["scene"]["robots"][robot]}

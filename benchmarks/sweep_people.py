@@ -16,9 +16,9 @@ import time
 from pathlib import Path
 
 from _harness import save_results
-from cosmop.pipeline import plan_team
 from cosmop.scenario import load_scenario
 from cosmop.sim import SimSettings, simulate
+from cosmop.team.loop import plan_team
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "03_people_2x2" / "scenario.yaml"
 

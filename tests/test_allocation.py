@@ -15,10 +15,10 @@ from cosmop.automata import DFA
 from cosmop.cli import app
 from cosmop.missions.allocation import Alternative, Alternatives, alternatives, choose
 from cosmop.missions.mission import GlobalMission
-from cosmop.pipeline import plan_team
 from cosmop.planning.synthesis import synthesize
 from cosmop.scenario import load_scenario, parse_scenario
 from cosmop.sim import simulate
+from cosmop.team.loop import plan_team
 from team_checks import assert_complete_word, assert_no_overlap
 
 ROOT = Path(__file__).resolve().parents[1]

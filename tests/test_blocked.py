@@ -13,13 +13,14 @@ import pytest
 from shapely import LineString
 
 from cosmop.events import parse_event
-from cosmop.pipeline import _with_task, plan_team
 from cosmop.planning.aside import ROOM, place_aside
 from cosmop.planning.checker import check_plan
 from cosmop.planning.plan import AddedTask, PlanError, PlanSet, load_plan, plan_from_actions
 from cosmop.scenario import parse_scenario
 from cosmop.sim.simulation import simulate
 from cosmop.squares import square, swept_square
+from cosmop.team.loop import plan_team
+from cosmop.team.requests import _with_task
 from rooms import box_walls
 
 

@@ -14,9 +14,9 @@ from typer.testing import CliRunner
 
 import cosmop
 from cosmop.cli import app
-from cosmop.cluster import ClusterError, dask_executor
-from cosmop.pipeline import plan_team
 from cosmop.scenario import load_scenario
+from cosmop.team.cluster import ClusterError, dask_executor
+from cosmop.team.loop import plan_team
 
 distributed = pytest.importorskip("distributed")
 
@@ -75,7 +75,7 @@ def test_local_worker_count_does_not_change_the_plan(local_plans, tmp_path):
 
 
 def test_an_unreachable_scheduler_is_bad_input_and_nothing_is_written(monkeypatch, tmp_path):
-    monkeypatch.setattr("cosmop.cluster.DEFAULT_TIMEOUT", 0.5)
+    monkeypatch.setattr("cosmop.team.cluster.DEFAULT_TIMEOUT", 0.5)
     out = tmp_path / "plans.json"
     result = runner.invoke(app, ["plan", str(SCENARIO), "-o", str(out), "--scheduler", "tcp://127.0.0.1:9"])
     assert result.exit_code == 2

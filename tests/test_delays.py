@@ -15,11 +15,11 @@ import pytest
 from typer.testing import CliRunner
 
 from cosmop.cli import app
-from cosmop.pipeline import plan_team
 from cosmop.scenario import load_scenario
 from cosmop.sim import Delays, SimSettings, simulate
 from cosmop.sim.delays import DelayDraws
 from cosmop.sim.world import Agent
+from cosmop.team.loop import plan_team
 from cosmop.traces import load_trace
 from team_checks import assert_complete_word, assert_no_overlap
 

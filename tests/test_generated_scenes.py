@@ -17,9 +17,9 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
 
-from cosmop.pipeline import plan_team
 from cosmop.scenario import parse_scenario
 from cosmop.sim import SimSettings, simulate
+from cosmop.team.loop import plan_team
 from sweep_generated import scene
 
 SEEDS = (15, 41, 53, 99, 162, 187)

@@ -11,11 +11,11 @@ import yaml
 from cosmop.errors import ScenarioError
 from cosmop.events import Primitive, parse_event
 from cosmop.missions.handover import handovers
-from cosmop.pipeline import plan_team
 from cosmop.planning.checker import check_plan
 from cosmop.planning.plan import PlanMessage, PlanSet, RobotPlan, Step, plan_from_actions
 from cosmop.planning.synthesis import synthesize
 from cosmop.scenario import load_scenario, parse_scenario
+from cosmop.team.loop import plan_team
 
 RELAY = Path(__file__).resolve().parents[1] / "examples" / "12_relay" / "scenario.yaml"
 

@@ -18,13 +18,13 @@ from typer.testing import CliRunner
 
 from cosmop.cli import app
 from cosmop.errors import ScenarioError
-from cosmop.pipeline import plan_team
 from cosmop.planning.checker import check_plan, check_robot_plan
 from cosmop.planning.plan import State, initial_state, load_plan
 from cosmop.planning.specification import RobotProblem, heading_sort
 from cosmop.planning.synthesis import synthesize
 from cosmop.scenario import load_scenario
 from cosmop.sim import SimSettings, simulate
+from cosmop.team.loop import plan_team
 
 ROOT = Path(__file__).resolve().parents[1]
 runner = CliRunner()

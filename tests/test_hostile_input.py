@@ -25,7 +25,6 @@ from typer.testing import CliRunner
 
 from cosmop.cli import app
 from cosmop.errors import CosmopInputError, ScenarioError
-from cosmop.pipeline import plan_team
 from cosmop.planning.checker import check_plan
 from cosmop.planning.plan import MAX_STEPS, PlanError, PlanSet, load_plan
 from cosmop.planning.synthesis import synthesize
@@ -41,6 +40,7 @@ from cosmop.reading import (
 )
 from cosmop.scenario import MAX_DFA_STATES, load_scenario, parse_scenario
 from cosmop.scene import MAX_TASK_EVENTS
+from cosmop.team.loop import plan_team
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "01_warehouse_2x2" / "scenario.yaml"

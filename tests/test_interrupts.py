@@ -20,8 +20,9 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
-from cosmop.pipeline import _Workers, plan_team  # noqa: E402
 from cosmop.scenario import load_scenario  # noqa: E402
+from cosmop.team.loop import plan_team  # noqa: E402
+from cosmop.team.planner import Workers  # noqa: E402
 from sweep_sigint import commands, interrupt  # noqa: E402
 
 pytestmark = pytest.mark.skipif(os.name != "posix", reason="process groups and SIGINT are POSIX's")
@@ -74,7 +75,7 @@ def _sleep(seconds: float) -> float:
 
 
 def test_stopping_the_workers_ends_a_running_synthesis_at_once():
-    pool = _Workers(2)
+    pool = Workers(2)
     futures = [pool.submit(_sleep, 60.0) for _ in range(3)]  # two run, one waits
     workers, manager = list(pool._processes.values()), pool._executor_manager_thread
     time.sleep(0.5)

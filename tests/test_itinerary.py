@@ -17,7 +17,6 @@ from typer.testing import CliRunner
 
 from cosmop.cli import app
 from cosmop.errors import CosmopInputError
-from cosmop.pipeline import plan_team
 from cosmop.planning.checker import check_plan
 from cosmop.planning.plan import Itinerary, PlanError, PlanSet, load_plan
 from cosmop.planning.realisation import message_links
@@ -25,6 +24,7 @@ from cosmop.planning.timing import durations, itinerary
 from cosmop.scenario import load_scenario
 from cosmop.sim import simulate
 from cosmop.sim.timing import StepTimes, carry_instants, step_times
+from cosmop.team.loop import plan_team
 
 CORRIDOR = Path(__file__).resolve().parents[1] / "examples" / "07_corridor" / "scenario.yaml"
 runner = CliRunner()

@@ -21,9 +21,9 @@ LAYERS: tuple[frozenset[str], ...] = tuple(
         "scene",  # the value types of a scenario
         "units missions control",  # SI units; top-down decomposition; reactive control
         "physics traces maps planning",  # bodies overlapping; traces; grid maps; bottom-up synthesis
-        "scenario viz allocate",  # the scenario loader; pictures; choosing robots
-        "sim pipeline export",  # the simulator (its results draw); plan, coordinate, verify; ROS 2 bags
-        "cluster lifelong",  # a Dask cluster's executor; a fleet serving a stream of orders
+        "scenario viz",  # the scenario loader; pictures
+        "sim team export",  # the simulator (its results draw); the team's planning loop; ROS 2 bags
+        "lifelong",  # a fleet serving a stream of orders
         "cli",  # the command line
         "_entry",  # the program, with Ctrl-C answered while it starts
         "__main__",  # python -m cosmop
@@ -109,6 +109,6 @@ def test_an_upward_import_is_seen() -> None:
     )
     found = _upward(source, "cosmop.planning.plan")
     assert [line.split(":")[0] for line in found] == ["line 3", "line 4", "line 5"]
-    assert _upward(source, "cosmop.cluster") == [
-        "line 5: cosmop.cluster (layer 7) imports cosmop.cli (layer 8)"
+    assert _upward(source, "cosmop.lifelong.fleet") == [
+        "line 5: cosmop.lifelong.fleet (layer 7) imports cosmop.cli (layer 8)"
     ]

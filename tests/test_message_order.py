@@ -7,8 +7,8 @@ import pytest
 from cosmop.errors import MissionTooLargeError
 from cosmop.missions.mission import GlobalMission
 from cosmop.missions.ordering import order_words
-from cosmop.pipeline import plan_team
 from cosmop.scenario import parse_scenario
+from cosmop.team.loop import plan_team
 
 
 def _returns(*robots: str) -> dict:

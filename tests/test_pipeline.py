@@ -6,8 +6,8 @@ from pathlib import Path
 
 import yaml
 
-from cosmop.pipeline import plan_team
 from cosmop.scenario import load_scenario, parse_scenario
+from cosmop.team.loop import plan_team
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "01_warehouse_2x2" / "scenario.yaml"

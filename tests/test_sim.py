@@ -15,11 +15,11 @@ from typer.testing import CliRunner
 
 from cosmop.cli import app
 from cosmop.control.geometry import box_gaps, point_segment_linf
-from cosmop.pipeline import plan_team
 from cosmop.planning import PlanSet
 from cosmop.scenario import load_scenario, parse_scenario
 from cosmop.sim import SIM_FORMAT, TRACE_FORMAT, SimSettings, simulate, time_limit
 from cosmop.sim.world import World
+from cosmop.team.loop import plan_team
 from cosmop.traces import Trace, TraceError, _rounded, as_trace, load_trace
 from team_checks import assert_complete_word, assert_no_overlap
 

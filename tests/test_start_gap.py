@@ -13,12 +13,12 @@ import copy
 import pytest
 
 from cosmop.missions.precedence import Precedence
-from cosmop.pipeline import plan_team
 from cosmop.planning.checker import check_plan
 from cosmop.planning.conflicts import ConflictSettings, conflicts, occupancies
 from cosmop.planning.realisation import message_links
 from cosmop.scenario import parse_scenario
 from cosmop.sim import footprint_overlaps, simulate
+from cosmop.team.loop import plan_team
 
 ROOM = [
     [[-4000, -3000], [4000, -3000]],

@@ -18,13 +18,13 @@ from cosmop.cli import app
 from cosmop.events import message, parse_event
 from cosmop.missions.mission import GlobalMission
 from cosmop.missions.precedence import Precedence
-from cosmop.pipeline import plan_team
 from cosmop.planning.conflicts import conflicts, is_ordered, occupancies
 from cosmop.planning.plan import load_plan
 from cosmop.planning.realisation import message_links
 from cosmop.scenario import load_scenario, parse_scenario
 from cosmop.sim import simulate
 from cosmop.sim.recoordinate import Remaining, recoordinate
+from cosmop.team.loop import plan_team
 from team_checks import assert_complete_word, assert_no_overlap
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -218,7 +218,7 @@ class _Safety:
 
 
 def test_two_robots_never_give_way_around_each_other_in_one_round():
-    from cosmop.pipeline import _give_way
+    from cosmop.team.detours import _give_way
 
     # R1's and R2's goods on one dock spot (either may drop elsewhere), and R2's drive through
     # R1's good (only R2 may move, the best kind of detour): R2 drives around; R1 avoiding R2

@@ -9,9 +9,9 @@ from pathlib import Path
 
 import cosmop
 from cosmop.missions.mission import GlobalMission
-from cosmop.pipeline import plan_team
 from cosmop.planning.synthesis import synthesize
 from cosmop.sim import footprint_overlaps
+from cosmop.team.loop import plan_team
 
 HERE = Path(__file__).resolve().parent
 

@@ -10,8 +10,8 @@ from pathlib import Path
 import cosmop
 from cosmop.missions.allocation import alternatives
 from cosmop.missions.mission import GlobalMission
-from cosmop.pipeline import plan_team
 from cosmop.sim import footprint_overlaps
+from cosmop.team.loop import plan_team
 
 HERE = Path(__file__).resolve().parent
 

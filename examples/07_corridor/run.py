@@ -12,8 +12,8 @@ import numpy as np
 
 import cosmop
 from cosmop.missions.mission import GlobalMission
-from cosmop.pipeline import plan_team
 from cosmop.sim import footprint_overlaps
+from cosmop.team.loop import plan_team
 
 HERE = Path(__file__).resolve().parent
 

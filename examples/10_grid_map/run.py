@@ -11,7 +11,7 @@ from pathlib import Path
 
 import cosmop
 from cosmop.maps import import_map
-from cosmop.pipeline import plan_team
+from cosmop.team.loop import plan_team
 
 HERE = Path(__file__).resolve().parent
 

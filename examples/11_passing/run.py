@@ -14,8 +14,8 @@ import numpy as np
 
 import cosmop
 from cosmop.missions.mission import GlobalMission
-from cosmop.pipeline import plan_team
 from cosmop.sim import footprint_overlaps
+from cosmop.team.loop import plan_team
 
 HERE = Path(__file__).resolve().parent
 AISLE_X = (-3000.0, 3000.0)  # the aisle's ends, mm (scenario.yaml)

@@ -11,7 +11,7 @@ The front door, for a script or a notebook::
     report = cosmop.check(scn, plans)  # the exact checker's verdict on any plan set
 
 Each verb is a thin door onto the layer that does the work: :func:`cosmop.scenario.load_scenario`,
-:func:`cosmop.pipeline.plan_team` (the whole team: decomposition, synthesis, coordination,
+:func:`cosmop.team.loop.plan_team` (the whole team: decomposition, synthesis, coordination,
 verification), :func:`cosmop.sim.simulate` and :func:`cosmop.planning.checker.check_plan`; the
 result types are :class:`Scenario`, :class:`PlanSet`, :class:`TeamResult`, :class:`SimResult`
 and :class:`CheckReport`.  ``import cosmop`` loads none of them until they are used, so the
@@ -25,11 +25,11 @@ import os
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
-    from cosmop.pipeline import TeamResult
     from cosmop.planning.checker import CheckReport
     from cosmop.planning.plan import PlanSet
     from cosmop.scene import Scenario
     from cosmop.sim import SimResult, SimSettings
+    from cosmop.team.loop import TeamResult
 
 __version__ = "0.1.0"
 
@@ -52,7 +52,7 @@ _TYPES = {
     "PlanSet": "cosmop.planning.plan",
     "Scenario": "cosmop.scene",
     "SimResult": "cosmop.sim",
-    "TeamResult": "cosmop.pipeline",
+    "TeamResult": "cosmop.team.loop",
 }
 
 
@@ -87,7 +87,7 @@ def load(path: str | os.PathLike[str]) -> Scenario:
 def plan(scenario: Scenario, *, max_horizon: int | None = None, workers: int | None = None) -> PlanSet:
     """The team's plans: each robot's shortest safe plan, coordinated, team-safe and checked.
 
-    :func:`cosmop.pipeline.plan_team` with its defaults; call it for its statistics (the
+    :func:`cosmop.team.loop.plan_team` with its defaults; call it for its statistics (the
     verification, the itinerary, the planning times) and its other settings.
 
     Parameters
@@ -103,7 +103,7 @@ def plan(scenario: Scenario, *, max_horizon: int | None = None, workers: int | N
     PlanSet
         ``feasible`` says whether every robot has a plan; if not, ``reason`` says why.
     """
-    from cosmop.pipeline import plan_team
+    from cosmop.team.loop import plan_team
 
     return plan_team(scenario, max_horizon=max_horizon, workers=workers).plans
 

@@ -1,7 +1,7 @@
 """The ``cosmop`` program: the command line, with Ctrl-C answered the same way at every moment.
 
 A terminal sends Ctrl-C (SIGINT) to every process of its foreground job: this program and the
-planner's worker processes, which ignore it (:class:`cosmop.pipeline._Workers`).  The program
+planner's worker processes, which ignore it (:class:`cosmop.team.planner.Workers`).  The program
 answers it with ``interrupted`` on standard error and exit status 130 (128 + SIGINT, as shells
 expect), no traceback, no process left and nothing half-written, in one of two ways:
 

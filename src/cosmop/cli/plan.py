@@ -167,20 +167,20 @@ def check_engine(workers: int | None, scheduler: str | None) -> None:
 def plan_with_progress(
     loaded: Scenario, max_horizon: int | None = None, workers: int | None = None, scheduler: str | None = None
 ) -> Any:
-    """:func:`cosmop.pipeline.plan_team` under a spinner that names each robot as it is planned;
+    """:func:`cosmop.team.loop.plan_team` under a spinner that names each robot as it is planned;
     in local processes, or on the Dask cluster whose scheduler is at `scheduler`."""
     from contextlib import nullcontext
 
     from rich.progress import Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
 
-    from cosmop.pipeline import plan_team
+    from cosmop.team.loop import plan_team
 
     columns = (SpinnerColumn(), TextColumn("{task.description}"), TimeElapsedColumn())
     with Progress(*columns, console=stderr(), transient=True) as progress:
         task = progress.add_task("planning", total=None)
         engine = nullcontext(None)
         if scheduler is not None:
-            from cosmop.cluster import dask_executor
+            from cosmop.team.cluster import dask_executor
 
             progress.update(task, description=f"connecting to the Dask scheduler at {scheduler}")
             engine = dask_executor(scheduler, field="--scheduler")

@@ -1,6 +1,6 @@
 """The robots' syntheses on a Dask cluster: connect to a scheduler and hand its workers the work.
 
-:func:`cosmop.pipeline.plan_team` runs each robot's synthesis wherever its ``executor`` says
+:func:`cosmop.team.loop.plan_team` runs each robot's synthesis wherever its ``executor`` says
 (any :class:`concurrent.futures.Executor`); the syntheses are independent and deterministic,
 so the plans do not depend on where they ran.  This module gives the executor of a Dask
 cluster: :func:`dask_executor` connects to a scheduler (``tcp://host:8786``), checks that it
@@ -20,12 +20,12 @@ side.  Each synthesis builds its own Z3 context, so threads are safe, only not f
 
 Examples
 --------
->>> from cosmop.cluster import dask_executor
+>>> from cosmop.team.cluster import dask_executor
 >>> with dask_executor("tcp://127.0.0.1:1", timeout=0.5) as executor:  # nothing listens there
 ...     pass
 Traceback (most recent call last):
 ...
-cosmop.cluster.ClusterError: scheduler: ...
+cosmop.team.cluster.ClusterError: scheduler: ...
 """
 
 from __future__ import annotations
@@ -54,7 +54,7 @@ def worker_version() -> str:
     Run on each worker when connecting: a worker that cannot plan fails here, before any work
     is submitted, and the imports (about a second) are not paid by the first synthesis.
     """
-    import cosmop.pipeline  # noqa: F401  (the module the syntheses are pickled from)
+    import cosmop.team.planner  # noqa: F401  (the module the syntheses are pickled from)
     from cosmop import __version__
 
     return __version__
@@ -101,7 +101,7 @@ def _connect(address: str, timeout: float, field: str) -> Any:
             "a Dask scheduler needs Dask on this machine: pip install 'cosmop[cluster]'", field=field
         ) from None
     try:
-        return Client(address, timeout=timeout, set_as_default=False)
+        return Client(address, timeout=timeout, set_as_default=False)  # type: ignore[no-untyped-call]
     except (OSError, TimeoutError, ValueError) as err:
         raise ClusterError(
             f"expected a Dask scheduler at {address}: none answered within {timeout:g} s ({err})",

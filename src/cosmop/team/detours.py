@@ -1,0 +1,340 @@
+"""Step 4 of the loop: the plans made team-safe, with detours where waiting cannot or should not do.
+
+Every place two plans share is ordered by a message (:func:`cosmop.planning.teamsafety.make_team_safe`).
+A conflict no order resolves (a robot parked for good where another must pass) is resolved by
+re-planning one robot with the other's space as walls (:func:`make_safe`).  Then, where waiting
+for a shared place costs the team more than a way around, the way around is taken
+(:func:`shorten_waits`): two robots pass each other in lanes, or the waiting robot drives
+around what it waits for.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Hashable, Iterable, Mapping
+from dataclasses import dataclass
+
+from cosmop.events import Event
+from cosmop.planning.conflicts import Conflict, ConflictSettings, Occupancy
+from cosmop.planning.lanes import lanes
+from cosmop.planning.plan import RobotPlan
+from cosmop.planning.synthesis import Synthesis
+from cosmop.planning.teamsafety import TeamSafety, Wait, make_team_safe
+from cosmop.scene import Scene, Wall
+from cosmop.team.planner import Planner, Window
+from cosmop.team.walls import walls_around
+
+__all__ = ["MIN_WAIT", "TRIAL_STEPS", "MadeSafe", "make_safe", "shorten_waits"]
+
+TRIAL_STEPS = 2
+"""Steps a way around may add to a robot's plan: a trial searches no longer plans."""
+
+MIN_WAIT = 2.0
+"""Expected seconds of a wait below which no way around is tried: a detour rarely costs less."""
+
+# robot -> the conflicts it gives way in, and the space it keeps out of in each
+_Moves = dict[str, list[tuple[Conflict, Occupancy]]]
+
+
+@dataclass(frozen=True)
+class MadeSafe:
+    """What step 4 did: the team-safe plans, or why the plans cannot be made safe.
+
+    Attributes
+    ----------
+    results : mapping of str to Synthesis
+        Every robot's synthesis now.
+    safety : TeamSafety
+        The conflicts between the plans and the messages that order them.
+    replans : tuple of str
+        Why robots were re-planned, in plain words.
+    reasons : tuple of str
+        Why the team cannot be planned (empty: the plans are team-safe).
+    """
+
+    results: Mapping[str, Synthesis]
+    safety: TeamSafety
+    replans: tuple[str, ...] = ()
+    reasons: tuple[str, ...] = ()
+
+    @property
+    def ok(self) -> bool:
+        """Whether the step worked (no reasons)."""
+        return not self.reasons
+
+
+def _plans(results: Mapping[str, Synthesis]) -> dict[str, RobotPlan]:
+    return {r: res.plan for r, res in results.items() if res.plan is not None}
+
+
+def make_safe(
+    current: Mapping[str, tuple[Event, ...]],
+    results: Mapping[str, Synthesis],
+    planner: Planner,
+    settings: ConflictSettings,
+    max_rounds: int = 6,
+    max_total: int = 16,
+) -> MadeSafe:
+    """Order every conflict by messages; re-plan around the ones no order resolves (step 4).
+
+    Each round, the robots that give way in unresolved conflicts (:func:`_give_way`) are
+    re-planned with the space of the other side as an obstacle, until the conflicts are
+    ordered, or `max_rounds` rounds pass without fewer unresolved conflicts than before (a
+    large team may need more rounds, each resolving some), or `max_total` rounds are spent.
+    A robot that cannot keep clear is given back its plan and the other side gives way instead,
+    where it can.
+
+    Parameters
+    ----------
+    current : mapping of str to tuple of Event
+        Each robot's word with its messages (what a re-plan plans).
+    results : mapping of str to Synthesis
+        Each robot's feasible synthesis.
+    planner : Planner
+        The team's planner (walls added for a detour are kept there).
+    settings : ConflictSettings
+        How conflicts are found (clearance, cuts).
+    max_rounds, max_total : int
+        Rounds without progress, and rounds in all, after which the step gives up.
+    """
+    results = dict(results)
+    replans: list[str] = []
+    best, since = None, 0
+    for n in range(max_total + 1):
+        safety = _team_safe(planner, _plans(results), settings)
+        if safety.safe:
+            return MadeSafe(results, safety, tuple(replans))
+        left = len(safety.unresolved)
+        best, since = (left, 0) if best is None or left < best else (best, since + 1)
+        last = since >= max_rounds or n == max_total
+        stuck = [c for c in safety.unresolved if not safety.detours(c)]
+        if stuck or last:
+            conflict = (stuck or list(safety.unresolved))[0]
+            why = f"no order or re-plan keeps {' and '.join(conflict.robots)} apart: {conflict.describe()}"
+            return MadeSafe(results, safety, tuple(replans), (why,))
+        moves = _give_way(safety, safety.unresolved)
+        step = _detour(planner, current, moves, settings)
+        fresh, failed = dict(step.results), step.failed
+        replans.extend(step.replans)
+        instead = _give_way(safety, [c for r in failed for c, _ in moves[r]], set(failed))
+        if instead:  # the other side of their conflicts gives way instead, where it can
+            again = _detour(planner, current, instead, settings)
+            fresh.update(again.results)
+            replans.extend(again.replans)
+            failed = again.failed
+        reasons = tuple(
+            f"{robot} cannot keep clear of the space it shares with another robot "
+            f"({conflict.describe()}): {why}"
+            for robot, (conflict, why) in failed.items()
+        )
+        if reasons:
+            return MadeSafe(results, safety, tuple(replans), reasons)
+        results.update(fresh)
+    return MadeSafe(results, safety, tuple(replans))
+
+
+def _team_safe(planner: Planner, plans: Mapping[str, RobotPlan], settings: ConflictSettings) -> TeamSafety:
+    """:func:`make_team_safe` of `plans`, its new messages named apart from those the plans
+    already send, timed as the conflict phase."""
+    used = {name for p in plans.values() for name in p.mission if name.startswith("msg(")}
+    t0 = time.perf_counter()
+    safety = make_team_safe(planner.scenario.scene, plans, settings=settings, used=used)
+    planner.phases["conflicts"] += time.perf_counter() - t0
+    return safety
+
+
+def _give_way(safety: TeamSafety, conflicts: Iterable[Conflict], exclude: Iterable[str] = ()) -> _Moves:
+    """Who gives way in which of `conflicts`: ``robot -> [(conflict, space to avoid)]``.
+
+    Each conflict's best way (:meth:`TeamSafety.detours`), the conflicts with the best ways
+    first, except that two robots never avoid each other in one round (each would wall itself
+    off from the other's old places, both may be shut out, as two goods meant for one dock
+    spot were): such a conflict waits for the next round, when the other's new plan may have
+    settled it.  Robots in `exclude` keep their plans.
+    """
+    excluded = frozenset(exclude)
+    moves: _Moves = {}
+    avoids: set[tuple[str | None, str | None]] = set()
+    best = {
+        c: next(((n, r, k) for n, r, k in safety.detours(c) if r not in excluded), None) for c in conflicts
+    }
+    ranked = sorted(((way, c) for c, way in best.items() if way is not None), key=lambda item: item[0][0])
+    for (_, robot, keep), conflict in ranked:
+        keeper = next((r for r in conflict.robots if r != robot), None)
+        if (keeper, robot) in avoids:
+            continue  # the two would avoid each other: next round
+        moves.setdefault(robot, []).append((conflict, keep))
+        avoids.add((robot, keeper))
+    return moves
+
+
+@dataclass(frozen=True)
+class _Detoured:
+    """The robots re-planned around their spaces, why, and for each that failed its conflict and why."""
+
+    results: Mapping[str, Synthesis]
+    replans: tuple[str, ...]
+    failed: Mapping[str, tuple[Conflict, str]]
+
+
+def _detour(
+    planner: Planner, current: Mapping[str, tuple[Event, ...]], moves: _Moves, settings: ConflictSettings
+) -> _Detoured:
+    """Re-plan every robot in `moves` around its spaces; a robot that fails gets its walls back."""
+    saved = dict(planner.obstacles)
+    walls = {
+        robot: tuple(
+            w
+            for _, keep in items
+            for w in walls_around(keep.region, settings.clearance, f"the space of {keep.label}")
+        )
+        for robot, items in moves.items()
+    }
+    replans = tuple(
+        f"{robot} re-planned around the space it shares: {items[0][0].describe()}"
+        for robot, items in moves.items()
+    )
+    fresh = _replan_within(planner, current, walls)
+    failed = {}
+    for robot, res in list(fresh.items()):
+        if not res.feasible:
+            failed[robot] = (moves[robot][0][0], res.reason or "")
+            planner.obstacles[robot] = saved.get(robot, ())
+            if not planner.obstacles[robot]:
+                del planner.obstacles[robot]
+            del fresh[robot]
+    return _Detoured(fresh, replans, failed)
+
+
+def _replan_within(
+    planner: Planner,
+    current: Mapping[str, tuple[Event, ...]],
+    walls: Mapping[str, tuple[Wall, ...]],
+    explain: bool = True,
+    windows: Mapping[str, Window] | None = None,
+) -> dict[str, Synthesis]:
+    """Every robot of `walls` re-planned with them added to its walls (kept in the planner).
+
+    The requests are settled by now: a re-plan may ask only for goods the robot already asks
+    for.  With `explain` false an infeasible answer only says so (a trial); `windows` bounds
+    the lengths searched (:meth:`Planner.run`).
+    """
+    objects = frozenset(planner.scenario.scene.objects)
+    for robot, extra in walls.items():
+        planner.wall_off(robot, extra)
+        asked = {e.obj for e in current[robot] if e.kind == "away" and e.receiver == robot and e.obj}
+        planner.forbid(robot, objects - asked)
+    return planner.run({robot: current[robot] for robot in walls}, explain=explain, windows=windows)
+
+
+def shorten_waits(
+    current: Mapping[str, tuple[Event, ...]],
+    made: MadeSafe,
+    planner: Planner,
+    settings: ConflictSettings,
+    budget: int,
+) -> MadeSafe:
+    """Where waiting for a shared place costs the team more than a way around, take the way around.
+
+    Each robot was planned alone, so its route ignores the others; the conflict step then makes
+    robots wait for each other.  The waits on the itinerary's critical path
+    (:attr:`~cosmop.planning.teamsafety.Wait.critical`; no other wait, shortened, ends the team
+    sooner), the longest first, get the ways around that apply (:func:`_ways_around`): the
+    two robots re-planned to pass each other in lanes, or the waiting robot re-planned with the
+    other's occupancy as walls.  A way is kept when the plans stay team-safe and the team's
+    expected makespan goes down; else the robots keep their plans and walls.  At most `budget`
+    ways are tried (each one synthesis per robot re-planned, both robots' at once, of at most
+    :data:`TRIAL_STEPS` steps more than its plan, and one conflict step), so that planning time
+    stays bounded.
+
+    Parameters
+    ----------
+    current : mapping of str to tuple of Event
+        Each robot's word with its messages.
+    made : MadeSafe
+        Team-safe plans (step 4's result).
+    planner : Planner
+        The team's planner.
+    settings : ConflictSettings
+        How conflicts are found.
+    budget : int
+        Ways around tried, at most.
+    """
+    scene = planner.scenario.scene
+    results, safety, replans = dict(made.results), made.safety, list(made.replans)
+    tried: set[Hashable] = set()
+    while budget > 0:
+        worth = (w for w in safety.waits if w.critical and w.seconds >= MIN_WAIT)
+        way = next(
+            (way for w in worth for way in _ways_around(w, safety, scene, settings) if way[0] not in tried),
+            None,
+        )
+        if way is None:
+            break
+        key, why, walls = way
+        tried.add(key)
+        budget -= 1
+        saved = planner.restrictions()
+        # with more walls no plan is shorter than the robot's; a way much longer is no way round
+        windows = {
+            r: (least, least + TRIAL_STEPS) for r in walls if (least := results[r].horizon) is not None
+        }
+        fresh = _replan_within(planner, current, walls, False, windows)
+        if all(res.feasible for res in fresh.values()):
+            candidate = _team_safe(planner, _plans({**results, **fresh}), settings)
+            if candidate.safe and candidate.makespan < safety.makespan - 1e-6:
+                replans.append(
+                    f"{why}: the team is expected done in {candidate.makespan:.1f} s instead of "
+                    f"{safety.makespan:.1f} s"
+                )
+                results.update(fresh)
+                safety = candidate
+                continue
+        planner.restore(saved)
+    return MadeSafe(results, safety, tuple(replans))
+
+
+_Way = tuple[Hashable, str, dict[str, tuple[Wall, ...]]]  # (key, why, robot -> walls)
+
+
+def _ways_around(wait: Wait, safety: TeamSafety, scene: Scene, settings: ConflictSettings) -> list[_Way]:
+    """The ways around one wait, to try in order: ``(key, why, robot -> walls)``.
+
+    Two robots that drive head-on through a place wide enough for both pass each other in
+    lanes (:func:`cosmop.planning.lanes.lanes`); the waiting robot can keep out of what it
+    waits for, where that leaves its fixed places free (:meth:`TeamSafety.detours`).
+    """
+    out: list[_Way] = []
+    robot, other = wait.robot, wait.other
+    if wait.drives is not None:
+        shared = wait.first.region.intersection(wait.then.region)
+        drives = {other: wait.drives[0], robot: wait.drives[1]}
+        keep = lanes(scene, drives, shared, settings.clearance, safety.fixed)
+        if keep is not None:
+            walls = {
+                r: walls_around(
+                    region, settings.clearance, f"the lane {next(o for o in keep if o != r)} keeps to"
+                )
+                for r, region in keep.items()
+            }
+            key = (
+                "lanes",
+                *sorted((r, tuple(round(v) for v in region.bounds)) for r, region in keep.items()),
+            )
+            why = (
+                f"{robot} and {other} re-planned to pass each other in lanes instead of {robot} waiting "
+                f"{wait.seconds:.1f} s where {wait.conflict.describe()}"
+            )
+            out.append((key, why, walls))
+    for _, mover, keep_out in safety.detours(wait.conflict):
+        if mover == robot:
+            walls = {
+                robot: walls_around(keep_out.region, settings.clearance, f"the space of {keep_out.label}")
+            }
+            why = (
+                f"{robot} re-planned around the space of {keep_out.label} instead of waiting "
+                f"{wait.seconds:.1f} s"
+            )
+            out.append((("around", robot, keep_out.label), why, walls))
+            break
+    return out
