@@ -127,7 +127,8 @@ def _axis_aligned(points: NDArray[np.float64], segments: NDArray[np.float64]) ->
     lo = np.minimum(segments[..., :2], segments[..., 2:])
     hi = np.maximum(segments[..., :2], segments[..., 2:])
     d = np.maximum(np.maximum(lo - p, p - hi), 0.0)
-    return np.maximum(d[..., 0], d[..., 1])
+    gaps: NDArray[np.float64] = np.maximum(d[..., 0], d[..., 1])
+    return gaps
 
 
 def _general(points: NDArray[np.float64], segments: NDArray[np.float64]) -> NDArray[np.float64]:
