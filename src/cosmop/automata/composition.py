@@ -111,6 +111,7 @@ def clusters(components: Sequence[DFA]) -> list[list[int]]:
     Parameters
     ----------
     components : sequence of DFA
+        The automata; two share a cluster when they share an event.
     """
     parent = list(range(len(components)))
 
@@ -213,6 +214,7 @@ def shortest_word(dfa: DFA) -> tuple[str, ...] | None:
     Parameters
     ----------
     dfa : DFA
+        The automaton :math:`G`.
     """
     delta = dfa.delta.astype(np.int64)
     ex = explore(dfa.initial, lambda codes: delta[codes], dfa.n_events, stop=lambda codes: dfa.marked[codes])

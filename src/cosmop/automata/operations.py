@@ -56,6 +56,7 @@ def extend_alphabet(dfa: DFA, events: Iterable[str]) -> DFA:
     Parameters
     ----------
     dfa : DFA
+        The automaton.
     events : iterable of str
         The events :math:`E` to add.
     """
@@ -88,6 +89,7 @@ def restrict(dfa: DFA, keep: np.ndarray) -> DFA:
     Parameters
     ----------
     dfa : DFA
+        The automaton.
     keep : ndarray of bool, shape (n,)
         Which states to keep.
     """
@@ -121,6 +123,7 @@ def with_marked(dfa: DFA, marked: ArrayLike) -> DFA:
     Parameters
     ----------
     dfa : DFA
+        The automaton.
     marked : array_like of bool, shape (n,)
         Whether each state is marked.
 
@@ -139,6 +142,7 @@ def accessible(dfa: DFA) -> DFA:
     Parameters
     ----------
     dfa : DFA
+        The automaton.
     """
     if _is_known_accessible(dfa):
         return dfa
@@ -152,6 +156,7 @@ def coaccessible_mask(dfa: DFA) -> np.ndarray:
     Parameters
     ----------
     dfa : DFA
+        The automaton.
     """
     return coreachable(dfa.delta, np.flatnonzero(dfa.marked))
 
@@ -164,6 +169,7 @@ def trim(dfa: DFA) -> DFA:
     Parameters
     ----------
     dfa : DFA
+        The automaton.
     """
     dfa = accessible(dfa)
     if dfa.marked.all():  # prefix-closed: every accessible state is co-accessible
@@ -181,6 +187,7 @@ def is_empty(dfa: DFA) -> bool:
     Parameters
     ----------
     dfa : DFA
+        The automaton :math:`G`.
     """
     if _is_known_accessible(dfa):
         return not dfa.marked.any()
@@ -193,6 +200,7 @@ def prefix_closure(dfa: DFA) -> DFA:
     Parameters
     ----------
     dfa : DFA
+        The automaton :math:`G`.
     """
     t = trim(dfa)
     if is_empty(t):
@@ -208,6 +216,7 @@ def complete(dfa: DFA, alphabet: Iterable[str] | None = None) -> DFA:
     Parameters
     ----------
     dfa : DFA
+        The automaton :math:`G`.
     alphabet : iterable of str, optional
         Extra events.
     """
@@ -224,6 +233,7 @@ def complement(dfa: DFA, alphabet: Iterable[str] | None = None) -> DFA:
     Parameters
     ----------
     dfa : DFA
+        The automaton :math:`G`.
     alphabet : iterable of str, optional
         Extra events.
     """
@@ -427,6 +437,7 @@ def inclusion_counterexample(a: DFA, b: DFA) -> tuple[str, ...] | None:
     Parameters
     ----------
     a, b : DFA
+        The two automata, compared by marked language.
     """
     alphabet = tuple(sorted(set(a.alphabet) | set(b.alphabet)))
     db = _columns(b, alphabet, "block")
@@ -535,6 +546,7 @@ def is_included(a: DFA, b: DFA) -> bool:
     Parameters
     ----------
     a, b : DFA
+        The two automata, compared by marked language.
     """
     return inclusion_counterexample(a, b) is None
 
@@ -545,6 +557,7 @@ def equivalence_counterexample(a: DFA, b: DFA) -> tuple[str, ...] | None:
     Parameters
     ----------
     a, b : DFA
+        The two automata, compared by marked language.
     """
     words = [w for w in (inclusion_counterexample(a, b), inclusion_counterexample(b, a)) if w is not None]
     return min(words, key=len) if words else None
@@ -556,6 +569,7 @@ def equivalent(a: DFA, b: DFA) -> bool:
     Parameters
     ----------
     a, b : DFA
+        The two automata, compared by marked language.
     """
     return equivalence_counterexample(a, b) is None
 
@@ -591,6 +605,7 @@ def canonical(dfa: DFA) -> DFA:
     Parameters
     ----------
     dfa : DFA
+        The automaton.
     """
     dfa = accessible(dfa)
     order = [dfa.initial]
@@ -619,6 +634,7 @@ def minimize(dfa: DFA) -> DFA:
     Parameters
     ----------
     dfa : DFA
+        The automaton :math:`G`.
     """
     t = trim(dfa)
     if is_empty(t):
@@ -650,6 +666,7 @@ def words(dfa: DFA, max_length: int, *, marked: bool = True) -> Iterator[tuple[s
     Parameters
     ----------
     dfa : DFA
+        The automaton :math:`G`.
     max_length : int
         The longest word listed.
     marked : bool, default True

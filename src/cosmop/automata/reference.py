@@ -599,6 +599,7 @@ def dfa_to_faudes(dfa: DFA) -> faudes.Generator:
     Parameters
     ----------
     dfa : DFA
+        The automaton to convert.
     """
     rows, cols = np.nonzero(dfa.delta >= 0)
     transitions = [(int(q), dfa.alphabet[j], int(dfa.delta[q, j])) for q, j in zip(rows, cols, strict=True)]

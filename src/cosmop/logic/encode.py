@@ -623,6 +623,7 @@ class IncrementalUnrolling(_Encoding):
         Parameters
         ----------
         formula : Formula or bool Var
+            The formula to require.
         k : int, default 0
             :math:`0 \\le k \\le K`.
         """

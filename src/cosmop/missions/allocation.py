@@ -199,7 +199,9 @@ def own_choices(found: Alternatives, robot: str, mission: GlobalMission) -> dict
     found : Alternatives
         The alternatives of the mission.
     robot : str
+        The robot whose choices are sought.
     mission : GlobalMission
+        The mission whose events the words name.
 
     Returns
     -------
@@ -235,6 +237,7 @@ def others(alt: Alternative, robot: str) -> Words:
     Parameters
     ----------
     alt : Alternative
+        An alternative of the team.
     robot : str
         The robot left out.
     """

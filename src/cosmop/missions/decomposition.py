@@ -278,6 +278,7 @@ def order_by_messages(mission: GlobalMission, local: Mapping[str, DFA]) -> Messa
     Parameters
     ----------
     mission : GlobalMission
+        The global mission, with its complete words.
     local : mapping of str to DFA
         The local missions by robot.
     """

@@ -56,6 +56,7 @@ def sequence_of(dfa: DFA) -> tuple[str, ...] | None:
     Parameters
     ----------
     dfa : DFA
+        A local mission.
     """
     q, seen = dfa.initial, {dfa.initial}
     seq: list[str] = []

@@ -280,6 +280,7 @@ def check_words(mission: GlobalMission, words: Mapping[str, Sequence[str]]) -> T
     Parameters
     ----------
     mission : GlobalMission
+        The global mission, with its complete words.
     words : mapping of str to sequence of str
         Every robot's word (event names), messages included.
     """
