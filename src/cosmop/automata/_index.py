@@ -164,7 +164,8 @@ def explore(
     index = CodeIndex()
     index.add(np.array([start], dtype=np.int64))
     frontier = np.array([start], dtype=np.int64)
-    codes, parents, vias, blocks = [frontier], [np.array([-1])], [np.array([-1])], []
+    codes, parents, vias = [frontier], [np.array([-1])], [np.array([-1])]
+    blocks: list[np.ndarray] = []
     if stop is not None and stop(frontier)[0]:
         return _finish(codes, parents, vias, blocks, n_events, 0)
     lo = 0
@@ -196,7 +197,14 @@ def explore(
     return _finish(codes, parents, vias, blocks, n_events, -1)
 
 
-def _finish(codes, parents, vias, blocks, n_events, stopped_at) -> Exploration:
+def _finish(
+    codes: list[np.ndarray],
+    parents: list[np.ndarray],
+    vias: list[np.ndarray],
+    blocks: list[np.ndarray],
+    n_events: int,
+    stopped_at: int,
+) -> Exploration:
     all_codes = np.concatenate(codes)
     delta = np.full((all_codes.size, n_events), -1, dtype=np.int32)
     if blocks:

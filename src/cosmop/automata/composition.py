@@ -44,7 +44,13 @@ class SizeLog:
     built: int = 0
 
     def observe(self, dfa: DFA) -> DFA:
-        """Record ``dfa`` and return it unchanged."""
+        """Record ``dfa`` and return it unchanged.
+
+        Parameters
+        ----------
+        dfa : DFA
+            An automaton just built.
+        """
         self.largest = max(self.largest, dfa.n_states)
         self.built += 1
         return dfa
@@ -76,17 +82,37 @@ class Composition:
         return self._alphabet
 
     def build(self, log: SizeLog | None = None) -> DFA:
-        """The product as one DFA (its size is the product of the components' sizes)."""
+        """The product as one DFA (its size is the product of the components' sizes).
+
+        Parameters
+        ----------
+        log : SizeLog, optional
+            Records the product's size.
+        """
         result = parallel(*self.components)
         return log.observe(result) if log else result
 
     def project(self, events: Iterable[str], log: SizeLog | None = None) -> DFA:
-        """:math:`P_{\\Sigma'}(\\|_j L_m(G_j))` without building the product."""
+        """:math:`P_{\\Sigma'}(\\|_j L_m(G_j))` without building the product.
+
+        Parameters
+        ----------
+        events : iterable of str
+            The target alphabet :math:`\\Sigma'`.
+        log : SizeLog, optional
+            Records every intermediate automaton.
+        """
         return project_composition(self.components, events, log=log)
 
 
 def clusters(components: Sequence[DFA]) -> list[list[int]]:
-    """Groups of components connected by shared events (union-find), in index order."""
+    """Groups of components connected by shared events (union-find), in index order.
+
+    Parameters
+    ----------
+    components : sequence of DFA
+        The automata; two share a cluster when they share an event.
+    """
     parent = list(range(len(components)))
 
     def find(i: int) -> int:
@@ -183,7 +209,13 @@ def project_composition(
 
 
 def shortest_word(dfa: DFA) -> tuple[str, ...] | None:
-    """A shortest word of :math:`L_m(G)` (``None`` if the language is empty)."""
+    """A shortest word of :math:`L_m(G)` (``None`` if the language is empty).
+
+    Parameters
+    ----------
+    dfa : DFA
+        The automaton :math:`G`.
+    """
     delta = dfa.delta.astype(np.int64)
     ex = explore(dfa.initial, lambda codes: delta[codes], dfa.n_events, stop=lambda codes: dfa.marked[codes])
     if ex.stopped_at < 0:
@@ -203,6 +235,15 @@ def lift_word(
     of its shortest marked words, appended at the end.
 
     Returns ``None`` when no word of the product projects onto ``word``.
+
+    Parameters
+    ----------
+    components : sequence of DFA
+        The factors :math:`G_j`.
+    word : sequence of str
+        A word over :math:`\\Sigma'`.
+    alphabet : iterable of str
+        :math:`\\Sigma'`, the alphabet `word` was projected onto.
     """
     # events of the target that no component knows never occur in the product
     known = set(alphabet) & {e for c in components for e in c.alphabet}

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -105,7 +106,13 @@ class DFA:
         return {e: j for j, e in enumerate(self.alphabet)}
 
     def name_of(self, state: int) -> str:
-        """Name of ``state`` (``q<i>`` when the DFA carries no names)."""
+        """Name of ``state`` (``q<i>`` when the DFA carries no names).
+
+        Parameters
+        ----------
+        state : int
+            A state's index.
+        """
         return self.state_names[state] if self.state_names is not None else f"q{state}"
 
     def __repr__(self) -> str:
@@ -116,6 +123,11 @@ class DFA:
         """State reached by ``word`` from :math:`q_0` (``-1`` if it leaves the generated language).
 
         Events outside the alphabet are undefined, so they also give ``-1``.
+
+        Parameters
+        ----------
+        word : iterable of str
+            A sequence of events.
         """
         index = self.event_index()
         q = self.initial
@@ -129,11 +141,23 @@ class DFA:
         return q
 
     def generates(self, word: Iterable[str]) -> bool:
-        """Whether ``word`` is in the generated language :math:`L(G)`."""
+        """Whether ``word`` is in the generated language :math:`L(G)`.
+
+        Parameters
+        ----------
+        word : iterable of str
+            A sequence of events.
+        """
         return self.run(word) >= 0
 
     def accepts(self, word: Iterable[str]) -> bool:
-        """Whether ``word`` is in the marked language :math:`L_m(G)`."""
+        """Whether ``word`` is in the marked language :math:`L_m(G)`.
+
+        Parameters
+        ----------
+        word : iterable of str
+            A sequence of events.
+        """
         q = self.run(word)
         return q >= 0 and bool(self.marked[q])
 
@@ -172,7 +196,7 @@ class DFA:
         ValueError
             On nondeterminism or a marked state that does not exist.
         """
-        transitions = [tuple(t) for t in transitions]
+        transitions = [(s, e, t) for s, e, t in transitions]
         order: dict[str, int] = {}
         for name in [*(states or []), initial, *[x for s, _, t in transitions for x in (s, t)]]:
             order.setdefault(name, len(order))
@@ -196,6 +220,11 @@ class DFA:
     @classmethod
     def from_words(cls, words: Iterable[Sequence[str]]) -> DFA:
         """The prefix tree of finitely many words: its marked language is exactly `words`.
+
+        Parameters
+        ----------
+        words : iterable of sequence of str
+            The words, each a sequence of events.
 
         Examples
         --------
@@ -224,6 +253,15 @@ class DFA:
         This is the paper's :math:`\\mathcal{DFA}(t)` used in membership queries.  With
         ``closed=True`` every prefix is marked, so the marked language is
         :math:`\\overline{w}`.
+
+        Parameters
+        ----------
+        word : sequence of str
+            The word :math:`w`.
+        alphabet : iterable of str, optional
+            Extra events (columns without transitions); the alphabet is sorted.
+        closed : bool, default True
+            Whether every prefix is marked, or only ``w`` itself.
         """
         events = sorted(set(word) | set(alphabet or ()))
         col = {e: j for j, e in enumerate(events)}
@@ -235,13 +273,25 @@ class DFA:
 
     @classmethod
     def universal(cls, alphabet: Iterable[str]) -> DFA:
-        """One marked state with a self-loop on every event: :math:`\\Sigma^*`."""
+        """One marked state with a self-loop on every event: :math:`\\Sigma^*`.
+
+        Parameters
+        ----------
+        alphabet : iterable of str
+            :math:`\\Sigma`.
+        """
         events = tuple(sorted(set(alphabet)))
         return cls(events, np.zeros((1, len(events)), dtype=np.int32), 0, np.ones(1, dtype=bool))
 
     @classmethod
     def empty(cls, alphabet: Iterable[str] = ()) -> DFA:
-        """The empty language: one unmarked state, no transitions."""
+        """The empty language: one unmarked state, no transitions.
+
+        Parameters
+        ----------
+        alphabet : iterable of str, optional
+            :math:`\\Sigma` (events without transitions).
+        """
         events = tuple(sorted(set(alphabet)))
         return cls(events, np.full((1, len(events)), -1, dtype=np.int32), 0, np.zeros(1, dtype=bool))
 
@@ -254,14 +304,19 @@ class DFA:
             for q, j in zip(rows, cols, strict=True)
         ]
 
-    def to_dict(self, *, with_alphabet: bool = False) -> dict:
+    def to_dict(self, *, with_alphabet: bool = False) -> dict[str, Any]:
         """The DFA form of the scenario file: ``initial``, ``transitions`` (+ ``states``, ``marked``).
 
         ``marked`` is omitted when every state is marked (a prefix-closed mission), ``states``
         when every state appears on a transition or is initial.  ``with_alphabet`` adds the
         sorted ``alphabet`` (events without transitions are otherwise lost).
+
+        Parameters
+        ----------
+        with_alphabet : bool, default False
+            Whether to add the ``alphabet`` entry.
         """
-        data: dict = {
+        data: dict[str, Any] = {
             "initial": self.name_of(self.initial),
             "transitions": [list(t) for t in self.transitions()],
         }
@@ -277,8 +332,14 @@ class DFA:
         return data
 
     @classmethod
-    def from_dict(cls, data: Mapping) -> DFA:
-        """Inverse of :meth:`to_dict` (also reads a scenario's ``mission.dfa`` block)."""
+    def from_dict(cls, data: Mapping[str, Any]) -> DFA:
+        """Inverse of :meth:`to_dict` (also reads a scenario's ``mission.dfa`` block).
+
+        Parameters
+        ----------
+        data : mapping
+            ``initial`` and optionally ``transitions``, ``marked``, ``states``, ``alphabet``.
+        """
         return cls.from_transitions(
             data["initial"],
             [tuple(t) for t in data.get("transitions", ())],
@@ -288,7 +349,13 @@ class DFA:
         )
 
     def to_dot(self, name: str = "G") -> str:
-        """Graphviz DOT text: marked states are double circles, parallel edges are merged."""
+        """Graphviz DOT text: marked states are double circles, parallel edges are merged.
+
+        Parameters
+        ----------
+        name : str, default "G"
+            The graph's name.
+        """
 
         def quote(text: str) -> str:
             return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
@@ -300,8 +367,8 @@ class DFA:
         lines.append(f"  __start -> {quote(self.name_of(self.initial))};")
         edges: dict[tuple[int, int], list[str]] = {}
         rows, cols = np.nonzero(self.delta >= 0)
-        for q, j in zip(rows, cols, strict=True):
-            edges.setdefault((int(q), int(self.delta[q, j])), []).append(self.alphabet[int(j)])
+        for row, j in zip(rows, cols, strict=True):
+            edges.setdefault((int(row), int(self.delta[row, j])), []).append(self.alphabet[int(j)])
         for (q, t), labels in edges.items():
             lines.append(
                 f"  {quote(self.name_of(q))} -> {quote(self.name_of(t))} [label={quote(', '.join(labels))}];"

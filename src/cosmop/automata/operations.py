@@ -20,6 +20,7 @@ from collections import deque
 from collections.abc import Iterable, Iterator, Sequence
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from cosmop.automata._index import coreachable, explore, fresh_states, reachable
 from cosmop.automata.dfa import DFA
@@ -50,7 +51,15 @@ def _columns(dfa: DFA, alphabet: Sequence[str], missing: str) -> np.ndarray:
 
 
 def extend_alphabet(dfa: DFA, events: Iterable[str]) -> DFA:
-    """The same language over :math:`\\Sigma \\cup E`: the new events never occur."""
+    """The same language over :math:`\\Sigma \\cup E`: the new events never occur.
+
+    Parameters
+    ----------
+    dfa : DFA
+        The automaton.
+    events : iterable of str
+        The events :math:`E` to add.
+    """
     alphabet = tuple(sorted(set(dfa.alphabet) | set(events)))
     return DFA(alphabet, _columns(dfa, alphabet, "block"), dfa.initial, dfa.marked, dfa.state_names)
 
@@ -75,7 +84,15 @@ def inverse_project(dfa: DFA, alphabet: Iterable[str]) -> DFA:
 
 
 def restrict(dfa: DFA, keep: np.ndarray) -> DFA:
-    """Sub-automaton on the states where ``keep`` holds (must include the initial state)."""
+    """Sub-automaton on the states where ``keep`` holds (must include the initial state).
+
+    Parameters
+    ----------
+    dfa : DFA
+        The automaton.
+    keep : ndarray of bool, shape (n,)
+        Which states to keep.
+    """
     keep = np.asarray(keep, dtype=bool)
     if not keep[dfa.initial]:
         raise ValueError("restrict must keep the initial state")
@@ -100,18 +117,33 @@ def _is_known_accessible(dfa: DFA) -> bool:
     return getattr(dfa, "_accessible", False)
 
 
-def with_marked(dfa: DFA, marked: np.ndarray) -> DFA:
+def with_marked(dfa: DFA, marked: ArrayLike) -> DFA:
     """The same automaton with the states `marked` (boolean, one per state) marked.
 
+    Parameters
+    ----------
+    dfa : DFA
+        The automaton.
+    marked : array_like of bool, shape (n,)
+        Whether each state is marked.
+
+    Examples
+    --------
     >>> with_marked(DFA.from_word(("a", "b")), [False, True, False]).accepts(("a",))
     True
     """
-    out = DFA(dfa.alphabet, dfa.delta, dfa.initial, marked, dfa.state_names)
+    out = DFA(dfa.alphabet, dfa.delta, dfa.initial, np.asarray(marked, dtype=bool), dfa.state_names)
     return _known_accessible(out) if _is_known_accessible(dfa) else out
 
 
 def accessible(dfa: DFA) -> DFA:
-    """Restriction to the states reachable from :math:`q_0` (same generated language)."""
+    """Restriction to the states reachable from :math:`q_0` (same generated language).
+
+    Parameters
+    ----------
+    dfa : DFA
+        The automaton.
+    """
     if _is_known_accessible(dfa):
         return dfa
     keep = reachable(dfa.delta, np.array([dfa.initial]))
@@ -119,7 +151,13 @@ def accessible(dfa: DFA) -> DFA:
 
 
 def coaccessible_mask(dfa: DFA) -> np.ndarray:
-    """States from which a marked state can be reached."""
+    """States from which a marked state can be reached.
+
+    Parameters
+    ----------
+    dfa : DFA
+        The automaton.
+    """
     return coreachable(dfa.delta, np.flatnonzero(dfa.marked))
 
 
@@ -127,6 +165,11 @@ def trim(dfa: DFA) -> DFA:
     """Accessible and co-accessible part: same marked language, no blocking states.
 
     The empty marked language trims to :meth:`DFA.empty` over the same alphabet.
+
+    Parameters
+    ----------
+    dfa : DFA
+        The automaton.
     """
     dfa = accessible(dfa)
     if dfa.marked.all():  # prefix-closed: every accessible state is co-accessible
@@ -139,14 +182,26 @@ def trim(dfa: DFA) -> DFA:
 
 
 def is_empty(dfa: DFA) -> bool:
-    """Whether :math:`L_m(G) = \\emptyset`."""
+    """Whether :math:`L_m(G) = \\emptyset`.
+
+    Parameters
+    ----------
+    dfa : DFA
+        The automaton :math:`G`.
+    """
     if _is_known_accessible(dfa):
         return not dfa.marked.any()
     return not reachable(dfa.delta, np.array([dfa.initial]))[dfa.marked].any()
 
 
 def prefix_closure(dfa: DFA) -> DFA:
-    """:math:`\\overline{L_m(G)}`: trim, then mark every state."""
+    """:math:`\\overline{L_m(G)}`: trim, then mark every state.
+
+    Parameters
+    ----------
+    dfa : DFA
+        The automaton :math:`G`.
+    """
     t = trim(dfa)
     if is_empty(t):
         return t
@@ -157,6 +212,13 @@ def complete(dfa: DFA, alphabet: Iterable[str] | None = None) -> DFA:
     """Same marked language over :math:`\\Sigma \\cup` ``alphabet`` with a total transition function.
 
     A non-marked sink state (the last state) absorbs every undefined transition.
+
+    Parameters
+    ----------
+    dfa : DFA
+        The automaton :math:`G`.
+    alphabet : iterable of str, optional
+        Extra events.
     """
     events = tuple(sorted(set(dfa.alphabet) | set(alphabet or ())))
     table = _columns(dfa, events, "block")
@@ -166,7 +228,15 @@ def complete(dfa: DFA, alphabet: Iterable[str] | None = None) -> DFA:
 
 
 def complement(dfa: DFA, alphabet: Iterable[str] | None = None) -> DFA:
-    """:math:`\\Sigma^* \\setminus L_m(G)` over :math:`\\Sigma \\cup` ``alphabet``."""
+    """:math:`\\Sigma^* \\setminus L_m(G)` over :math:`\\Sigma \\cup` ``alphabet``.
+
+    Parameters
+    ----------
+    dfa : DFA
+        The automaton :math:`G`.
+    alphabet : iterable of str, optional
+        Extra events.
+    """
     c = complete(dfa, alphabet)
     return with_marked(c, ~c.marked)
 
@@ -236,6 +306,11 @@ def parallel(*dfas: DFA) -> DFA:
     :math:`L_m(G_1 \\| G_2) = P_1^{-1}(L_m(G_1)) \\cap P_2^{-1}(L_m(G_2))` over
     :math:`\\Sigma_1 \\cup \\Sigma_2` (the paper's Definition of the synchronous product).
     Components are folded left to right; only accessible states are built.
+
+    Parameters
+    ----------
+    *dfas : DFA
+        The components, at least one.
     """
     return _fold(dfas, synchronous=True)
 
@@ -245,6 +320,11 @@ def product(*dfas: DFA) -> DFA:
 
     Languages are sets of words over the union of the alphabets, so an event that one
     component does not know is blocked.  With equal alphabets this equals :func:`parallel`.
+
+    Parameters
+    ----------
+    *dfas : DFA
+        The components, at least one.
     """
     return _fold(dfas, synchronous=False)
 
@@ -353,6 +433,11 @@ def inclusion_counterexample(a: DFA, b: DFA) -> tuple[str, ...] | None:
     not marked in ``b``) gives a shortest counterexample.  When a state of ``a`` meets a
     single state of ``b`` (the usual case) the search runs over ``a``'s states alone, first
     on ``a`` as given and, if that fails, on ``trim(a)``; else over the pairs.
+
+    Parameters
+    ----------
+    a, b : DFA
+        The two automata, compared by marked language.
     """
     alphabet = tuple(sorted(set(a.alphabet) | set(b.alphabet)))
     db = _columns(b, alphabet, "block")
@@ -388,7 +473,8 @@ def _inclusion_by_pairs(a: DFA, bc: DFA, da: np.ndarray) -> list[int] | None:
         return np.where(ta >= 0, ta * nb + tb, -1)
 
     def bad(codes: np.ndarray) -> np.ndarray:
-        return a.marked[codes // nb] & ~bc.marked[codes % nb]
+        found: np.ndarray = a.marked[codes // nb] & ~bc.marked[codes % nb]
+        return found
 
     ex = explore(a.initial * nb + bc.initial, successors, da.shape[1], stop=bad)
     return None if ex.stopped_at < 0 else ex.word_to(ex.stopped_at)
@@ -455,18 +541,36 @@ def _inclusion_by_partner(a: DFA, b: DFA, da: np.ndarray, db: np.ndarray) -> lis
 
 
 def is_included(a: DFA, b: DFA) -> bool:
-    """Whether :math:`L_m(a) \\subseteq L_m(b)`."""
+    """Whether :math:`L_m(a) \\subseteq L_m(b)`.
+
+    Parameters
+    ----------
+    a, b : DFA
+        The two automata, compared by marked language.
+    """
     return inclusion_counterexample(a, b) is None
 
 
 def equivalence_counterexample(a: DFA, b: DFA) -> tuple[str, ...] | None:
-    """A shortest word in the symmetric difference of the marked languages, or ``None``."""
+    """A shortest word in the symmetric difference of the marked languages, or ``None``.
+
+    Parameters
+    ----------
+    a, b : DFA
+        The two automata, compared by marked language.
+    """
     words = [w for w in (inclusion_counterexample(a, b), inclusion_counterexample(b, a)) if w is not None]
     return min(words, key=len) if words else None
 
 
 def equivalent(a: DFA, b: DFA) -> bool:
-    """Whether :math:`L_m(a) = L_m(b)`."""
+    """Whether :math:`L_m(a) = L_m(b)`.
+
+    Parameters
+    ----------
+    a, b : DFA
+        The two automata, compared by marked language.
+    """
     return equivalence_counterexample(a, b) is None
 
 
@@ -476,6 +580,13 @@ def satisfaction_counterexample(model: DFA, spec: DFA) -> tuple[str, ...] | None
     This is :math:`M \\models K` of the paper: :math:`P(L_m(M)) \\subseteq L_m(K)`,
     equivalently :math:`L_m(M) \\subseteq P^{-1}(L_m(K))`; the counterexample is a word of the
     model, over its own alphabet.
+
+    Parameters
+    ----------
+    model : DFA
+        :math:`M`.
+    spec : DFA
+        :math:`K`, over an alphabet that may be smaller than the model's.
     """
     return inclusion_counterexample(model, inverse_project(spec, model.alphabet))
 
@@ -490,6 +601,11 @@ def canonical(dfa: DFA) -> DFA:
 
     Two minimal DFAs of the same language over the same alphabet have identical canonical
     tables.
+
+    Parameters
+    ----------
+    dfa : DFA
+        The automaton.
     """
     dfa = accessible(dfa)
     order = [dfa.initial]
@@ -514,6 +630,11 @@ def minimize(dfa: DFA) -> DFA:
     Moore's partition refinement, vectorised: a class is refined by the tuple (own class,
     class of each successor), with ``-1`` standing for the implicit dead state, until the
     number of classes is stable.
+
+    Parameters
+    ----------
+    dfa : DFA
+        The automaton :math:`G`.
     """
     t = trim(dfa)
     if is_empty(t):
@@ -541,6 +662,15 @@ def words(dfa: DFA, max_length: int, *, marked: bool = True) -> Iterator[tuple[s
 
     In breadth-first (length, then alphabet column) order.  Meant for tests and small
     automata: the number of words can be exponential in ``max_length``.
+
+    Parameters
+    ----------
+    dfa : DFA
+        The automaton :math:`G`.
+    max_length : int
+        The longest word listed.
+    marked : bool, default True
+        Whether to list the marked language or the generated one.
     """
     queue: deque[tuple[int, tuple[str, ...]]] = deque([(dfa.initial, ())])
     while queue:

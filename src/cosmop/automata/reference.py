@@ -59,7 +59,7 @@ from collections import deque
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from types import ModuleType
-from typing import TYPE_CHECKING, TypeAlias
+from typing import TYPE_CHECKING, TypeAlias, cast
 
 import numpy as np
 
@@ -126,7 +126,7 @@ def _load() -> ModuleType:
             import faudes
     except ImportError as exc:
         raise ImportError(_INSTALL_HINT) from exc
-    return faudes
+    return cast(ModuleType, faudes)
 
 
 def is_available() -> bool:
@@ -327,10 +327,11 @@ def _state_index(q: object) -> object:
     return int(q) if isinstance(q, numbers.Integral) and not isinstance(q, bool) else q
 
 
-def _check_state(q: object, n_states: int, what: str) -> None:
-    """Raise :class:`ValueError` unless `q` is a state index in ``0 .. n_states - 1``."""
+def _check_state(q: object, n_states: int, what: str) -> int:
+    """`q`, after raising :class:`ValueError` unless it is a state index in ``0 .. n_states - 1``."""
     if not isinstance(q, int) or not 0 <= q < n_states:
         raise ValueError(f"{what} {q!r} is not a state index in 0..{n_states - 1}")
+    return q
 
 
 def _checked(
@@ -356,18 +357,18 @@ def _checked(
         raise ValueError(f"n_states must be a non-negative int, got {n_states!r}")
     if n_states > 0:
         _check_state(initial, n_states, "initial state")
-    for q in marked:
-        _check_state(q, n_states, "marked state")
+    states = [_check_state(q, n_states, "marked state") for q in marked]
     symbols = {ev: encode_event(ev) for ev in alphabet}
     delta: dict[tuple[int, str], int] = {}
     for src, ev, dst in transitions:
-        _check_state(src, n_states, "transition source")
-        _check_state(dst, n_states, "transition target")
+        source = _check_state(src, n_states, "transition source")
+        target = _check_state(dst, n_states, "transition target")
         if ev not in symbols:
             raise ValueError(f"transition event {ev!r} is not in the alphabet")
-        if delta.setdefault((src, ev), dst) != dst:
+        if delta.setdefault((source, ev), target) != target:
             raise ValueError(f"non-deterministic transitions from state {src} on {ev!r}")
-    return _Checked(symbols, n_states, initial, marked, delta)
+    # `initial` is checked above unless there are no states (then it is unused)
+    return _Checked(symbols, n_states, cast(int, initial), states, delta)
 
 
 def _generator(fd: ModuleType, plain: _Checked, name: str) -> faudes.Generator:
@@ -593,7 +594,13 @@ def minimal_states(g: GeneratorLike) -> int:
 
 
 def dfa_to_faudes(dfa: DFA) -> faudes.Generator:
-    """A :class:`cosmop.automata.DFA` as a libFAUDES generator (same marked language)."""
+    """A :class:`cosmop.automata.DFA` as a libFAUDES generator (same marked language).
+
+    Parameters
+    ----------
+    dfa : DFA
+        The automaton to convert.
+    """
     rows, cols = np.nonzero(dfa.delta >= 0)
     transitions = [(int(q), dfa.alphabet[j], int(dfa.delta[q, j])) for q, j in zip(rows, cols, strict=True)]
     return to_faudes(dfa.alphabet, dfa.n_states, dfa.initial, np.flatnonzero(dfa.marked), transitions)
@@ -603,6 +610,11 @@ def faudes_to_dfa(gen: faudes.Generator) -> DFA:
     """A deterministic libFAUDES generator as a :class:`cosmop.automata.DFA`.
 
     A generator without states (libFAUDES's empty language) becomes :meth:`DFA.empty`.
+
+    Parameters
+    ----------
+    gen : faudes.Generator
+        Deterministic.
     """
     alphabet, n, initial, marked, transitions = from_faudes(gen)
     if n == 0:

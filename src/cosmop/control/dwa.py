@@ -30,11 +30,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 from functools import lru_cache
+from typing import Any, TypeVar
 
 import numpy as np
+from numpy.typing import NDArray
 
 from cosmop.control.geometry import box_gaps, point_segment_linf
 from cosmop.control.safety import Limits, obstacle_speed, own_margin, stopping_horizon
+
+_Scalar = TypeVar("_Scalar", bound=np.generic)
 
 __all__ = ["Drivers", "DwaCommand", "DwaSettings", "Obstacles", "dwa_commands", "robot_gaps"]
 
@@ -105,19 +109,33 @@ class DwaCommand:
         Smallest L-infinity gap to any obstacle, mm.
     """
 
-    v: np.ndarray
-    w: np.ndarray
-    safe: np.ndarray
-    gap: np.ndarray
+    v: NDArray[np.float64]
+    w: NDArray[np.float64]
+    safe: NDArray[np.bool_]
+    gap: NDArray[np.float64]
 
 
 def robot_gaps(
-    centres: np.ndarray, half: np.ndarray, walls: np.ndarray, boxes: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
+    centres: NDArray[np.float64],
+    half: NDArray[np.float64],
+    walls: NDArray[np.float64],
+    boxes: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """L-infinity gaps of robot squares to walls ``(R, W)`` and to boxes ``(R, M)``, every box
     measured (a caller hides the boxes a robot does not sense for each use of the gaps).
     `walls` and `boxes` are shared by every robot, or one set per robot
     (:meth:`Obstacles.per_driver`).
+
+    Parameters
+    ----------
+    centres : ndarray, shape (R, 2)
+        The robots' centres, mm.
+    half : ndarray, shape (R,)
+        Their half sides, mm.
+    walls : ndarray, shape (W, 4) or (R, W, 4)
+        Wall segments ``x1, y1, x2, y2``, mm.
+    boxes : ndarray, shape (M, 3) or (R, M, 3)
+        Boxes ``x, y, half side``, mm.
     """
     R = len(centres)
     wall_gap = point_segment_linf(centres, walls) - half[:, None] if walls.shape[-2] else np.zeros((R, 0))
@@ -125,19 +143,35 @@ def robot_gaps(
     return wall_gap, box_gap
 
 
-def first_true(mask: np.ndarray) -> np.ndarray:
+def first_true(mask: NDArray[np.bool_]) -> NDArray[np.intp]:
     """Each row's indices of the True columns of `mask` ``(R, M)``, in order, padded with ``M``
     to the longest row: ``(R, m)`` (the form :meth:`Obstacles.take` and :func:`take_columns`
-    take)."""
+    take).
+
+    Parameters
+    ----------
+    mask : ndarray of bool, shape (R, M)
+        Which columns each row keeps.
+    """
     counts = mask.sum(axis=1)
     width = int(counts.max(initial=0))
     order = np.argsort(~mask, axis=1, kind="stable")[:, :width]  # the True columns first, in order
     return np.where(np.arange(width) < counts[:, None], order, mask.shape[1])
 
 
-def take_columns(values: np.ndarray, index: np.ndarray, fill=False) -> np.ndarray:
+def take_columns(values: NDArray[_Scalar], index: NDArray[np.intp], fill: float = False) -> NDArray[_Scalar]:
     """`values` ``(R, M)`` at the columns `index`: one list for every row ``(m,)``, or one per
-    row ``(R, m)`` where ``M`` (padding) gives `fill`."""
+    row ``(R, m)`` where ``M`` (padding) gives `fill`.
+
+    Parameters
+    ----------
+    values : ndarray, shape (R, M)
+        One value per row and box.
+    index : ndarray of int, shape (m,) or (R, m)
+        The columns to take, as from :func:`first_true`.
+    fill : float or bool, default False
+        The value of the padding columns.
+    """
     if index.ndim == 1:
         return values[:, index]
     padded = np.concatenate([values, np.full((len(values), 1), fill, dtype=values.dtype)], axis=1)
@@ -152,17 +186,17 @@ _LARGE = 50_000
 
 def _large(points: int, obstacles: Obstacles) -> bool:
     """Whether measuring `points` points against every box of `obstacles` is worth a pruning."""
-    return points * obstacles.boxes.shape[-2] > _LARGE
+    return bool(points * obstacles.boxes.shape[-2] > _LARGE)
 
 
 def _without_far(
     obstacles: Obstacles,
-    centres: np.ndarray,
-    half: np.ndarray,
-    wall_beyond: np.ndarray,
-    box_beyond: np.ndarray,
-    *columns,
-) -> tuple[Obstacles, tuple]:
+    centres: NDArray[np.float64],
+    half: NDArray[np.float64],
+    wall_beyond: NDArray[np.float64],
+    box_beyond: NDArray[np.float64],
+    *columns: tuple[NDArray[Any], float],
+) -> tuple[Obstacles, tuple[NDArray[Any], ...]]:
     """Per driver, the walls and the boxes whose gap now (mm, as :func:`robot_gaps` measures
     it) is at most `wall_beyond` ``(R, 1)`` and `box_beyond` ``(R, M)``; `columns` (``(values
     (R, M), fill)`` pairs, over the boxes) taken alike.
@@ -205,19 +239,25 @@ class Obstacles:
         The id of each box (for the caller; the controller does not read it).
     """
 
-    walls: np.ndarray
-    boxes: np.ndarray
-    speed: np.ndarray
-    velocity: np.ndarray | None = None
-    acceleration: np.ndarray | None = None
-    agents: np.ndarray | None = None
+    walls: NDArray[np.float64]
+    boxes: NDArray[np.float64]
+    speed: NDArray[np.float64]
+    velocity: NDArray[np.float64] | None = None
+    acceleration: NDArray[np.float64] | None = None
+    agents: NDArray[np.bool_] | None = None
     names: tuple[str, ...] = ()
 
-    def select(self, walls: np.ndarray, boxes: np.ndarray) -> Obstacles:
+    def select(self, walls: NDArray[np.intp], boxes: NDArray[np.intp]) -> Obstacles:
         """The walls and boxes at the indices `walls` and `boxes` (kept in their order); of
-        one shared set, or of every row of per-driver sets alike."""
+        one shared set, or of every row of per-driver sets alike.
 
-        def pick(values):
+        Parameters
+        ----------
+        walls, boxes : ndarray of int, shape (W',) and (M',)
+            Indices of the walls and of the boxes to keep.
+        """
+
+        def pick(values: NDArray[np.float64] | None) -> NDArray[np.float64] | None:
             return None if values is None else values[..., boxes, :]
 
         return Obstacles(
@@ -230,17 +270,21 @@ class Obstacles:
             tuple(self.names[j] for j in boxes) if self.names else (),
         )
 
-    def take(self, walls: np.ndarray, boxes: np.ndarray) -> Obstacles:
+    def take(self, walls: NDArray[np.intp], boxes: NDArray[np.intp]) -> Obstacles:
         """One set per driver: row ``r`` holds the walls ``walls[r]`` and the boxes ``boxes[r]``
         (index matrices ``(R, W')`` and ``(R, M')``, from :func:`first_true`) of this shared set
         or of this set's row ``r``.  The index one past the end is padding: a wall or box at
         infinity (no speed, no mover), whose gaps are ``inf`` and so never decide a test or
-        attain a minimum."""
+        attain a minimum.
+
+        Parameters
+        ----------
+        walls, boxes : ndarray of int, shapes (R, W') and (R, M')
+            Per driver, the indices of the walls and of the boxes it keeps.
+        """
         rows = np.arange(len(walls))[:, None] if self.walls.ndim == 3 else None
 
-        def pick(values, filler, index):
-            if values is None:
-                return None
+        def pick(values: NDArray[_Scalar], filler: object, index: NDArray[np.intp]) -> NDArray[_Scalar]:
             axis = 0 if rows is None else 1  # the obstacles' axis
             shape = list(values.shape)
             shape[axis] = 1
@@ -252,9 +296,9 @@ class Obstacles:
             pick(self.walls, [np.inf] * 4, walls),
             pick(self.boxes, [np.inf, np.inf, 0.0], boxes),
             pick(self.speed, 0.0, boxes),
-            pick(self.velocity, [0.0, 0.0], boxes),
-            pick(self.acceleration, 0.0, boxes),
-            pick(self.agents, False, boxes),
+            None if self.velocity is None else pick(self.velocity, [0.0, 0.0], boxes),
+            None if self.acceleration is None else pick(self.acceleration, 0.0, boxes),
+            None if self.agents is None else pick(self.agents, False, boxes),
         )
 
     def per_driver(self, drivers: int) -> Obstacles:
@@ -265,27 +309,38 @@ class Obstacles:
         Per-driver sets may differ (:func:`~cosmop.control.neighbourhood.dwa_commands_near`
         gives each driver what is near it); a shorter set is padded with boxes and walls at
         infinity (:func:`~cosmop.control.geometry.per_row`), which no test or minimum sees.
+
+        Parameters
+        ----------
+        drivers : int
+            The number of drivers ``R``.
         """
         if self.walls.ndim == 3:
             return self
 
-        def each(values):
-            return None if values is None else values[None].repeat(drivers, axis=0)
+        def each(values: NDArray[_Scalar]) -> NDArray[_Scalar]:
+            return values[None].repeat(drivers, axis=0)
 
         return Obstacles(
             each(self.walls),
             each(self.boxes),
             each(self.speed),
-            each(self.velocity),
-            each(self.acceleration),
-            each(self.agents),
+            None if self.velocity is None else each(self.velocity),
+            None if self.acceleration is None else each(self.acceleration),
+            None if self.agents is None else each(self.agents),
             self.names,
         )
 
-    def rows(self, rows: np.ndarray) -> Obstacles:
-        """The per-driver sets of the drivers `rows` (obstacles made by :meth:`per_driver`)."""
+    def rows(self, rows: NDArray[np.intp]) -> Obstacles:
+        """The per-driver sets of the drivers `rows` (obstacles made by :meth:`per_driver`).
 
-        def pick(values):
+        Parameters
+        ----------
+        rows : ndarray of int
+            Indices of the drivers.
+        """
+
+        def pick(values: NDArray[_Scalar] | None) -> NDArray[_Scalar] | None:
             return None if values is None else values[rows]
 
         return Obstacles(
@@ -299,16 +354,21 @@ class Obstacles:
         )
 
     @property
-    def movers(self) -> np.ndarray:
+    def movers(self) -> NDArray[np.bool_]:
         """Which boxes are kept at the standoff: :attr:`agents`, else those that move."""
         return self.speed > 0 if self.agents is None else self.agents
 
-    def speed_bound(self, horizon) -> np.ndarray:
+    def speed_bound(self, horizon: float | NDArray[np.float64]) -> NDArray[np.float64]:
         """:math:`V_o` of every box over a stopping `horizon` (s), mm/s.
 
         :func:`~cosmop.control.safety.obstacle_speed` of the boxes' current speeds and
         accelerations, or their top speed when those are unknown.  `horizon` broadcasts against
         the boxes: a scalar gives ``(M,)``, a column ``(R, 1)`` gives ``(R, M)``.
+
+        Parameters
+        ----------
+        horizon : float or ndarray
+            The stopping horizon, s.
         """
         if self.acceleration is None or self.velocity is None or not self.boxes.shape[-2]:
             return np.broadcast_to(self.speed, np.broadcast_shapes(np.shape(horizon), self.speed.shape))
@@ -343,16 +403,16 @@ class Drivers:
         own robot.
     """
 
-    pose: np.ndarray
-    v: np.ndarray
-    half: np.ndarray
+    pose: NDArray[np.float64]
+    v: NDArray[np.float64]
+    half: NDArray[np.float64]
     limits: Limits
-    target: np.ndarray
-    stop_distance: np.ndarray
-    w: np.ndarray | None = None
-    room_cap: np.ndarray | None = None
+    target: NDArray[np.float64]
+    stop_distance: NDArray[np.float64]
+    w: NDArray[np.float64] | None = None
+    room_cap: NDArray[np.float64] | None = None
 
-    def __getitem__(self, rows) -> Drivers:
+    def __getitem__(self, rows: NDArray[np.intp] | NDArray[np.bool_]) -> Drivers:
         """The drivers `rows` (an index array or a mask)."""
         return Drivers(
             self.pose[rows],
@@ -371,8 +431,8 @@ def dwa_commands(
     obstacles: Obstacles,
     settings: DwaSettings = DwaSettings(),
     *,
-    ignore: np.ndarray | None = None,
-    grip: np.ndarray | None = None,
+    ignore: NDArray[np.bool_] | None = None,
+    grip: NDArray[np.bool_] | None = None,
 ) -> DwaCommand:
     """One cycle of the extended DWA for `R` robots at once.
 
@@ -422,7 +482,7 @@ def dwa_commands(
             W[rows],
             score[rows],
             obstacles.rows(rows),
-            None if ignore is None else skip[rows],
+            None if ignore is None or skip is None else skip[rows],
             _keep(box_gap[rows], obstacles.movers[rows], settings),
         )
         admitted = np.full((len(rows), V.shape[1]), -np.inf)  # the best escape arc alone
@@ -439,8 +499,12 @@ def dwa_commands(
 
 
 def _passive_safety(
-    drivers: Drivers, obstacles: Obstacles, wall_gap: np.ndarray, box_gap: np.ndarray, settings: DwaSettings
-) -> np.ndarray:
+    drivers: Drivers,
+    obstacles: Obstacles,
+    wall_gap: NDArray[np.float64],
+    box_gap: NDArray[np.float64],
+    settings: DwaSettings,
+) -> NDArray[np.bool_]:
     """The paper's ``safe`` for every robot against every obstacle at once, ``(R,)``.
 
     Walls and resting objects have :math:`V_o = 0`; robots and people keep the standoff, and
@@ -450,7 +514,7 @@ def _passive_safety(
     limits, v = drivers.limits.column(), drivers.v[:, None]
     # stopping_margin(v, V_o) is own + V_o * horizon, summed in that order: each part once
     own, horizon = own_margin(v, limits), stopping_horizon(v, limits)
-    safe = np.all(wall_gap > own, axis=1)  # walls stand still
+    safe: NDArray[np.bool_] = np.all(wall_gap > own, axis=1)  # walls stand still
     if obstacles.boxes.shape[-2]:
         gap = box_gap - settings.standoff * obstacles.movers
         safe &= np.all(gap > own + obstacles.speed_bound(horizon) * horizon, axis=1)
@@ -458,7 +522,11 @@ def _passive_safety(
 
 
 def _retreat(
-    drivers: Drivers, obstacles: Obstacles, box_gap: np.ndarray, unsafe: np.ndarray, settings: DwaSettings
+    drivers: Drivers,
+    obstacles: Obstacles,
+    box_gap: NDArray[np.float64],
+    unsafe: NDArray[np.bool_],
+    settings: DwaSettings,
 ) -> Drivers:
     """`drivers` with the unsafe ones inside a box's standoff aimed at a point away from it,
     and no stop distance (they leave at once)."""
@@ -480,8 +548,8 @@ def _retreat(
 
 
 def _arcs(
-    drivers: Drivers, V: np.ndarray, W: np.ndarray, settings: DwaSettings
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    drivers: Drivers, V: NDArray[np.float64], W: NDArray[np.float64], settings: DwaSettings
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """Predicted arcs: the times ``t`` (S,), positions ``(R, K, S, 2)`` and headings
     ``(R, K, S)`` at :math:`t_k = k\\,T/S`, k = 1..S, with ``(v, w)`` held."""
     xy, theta = drivers.pose[:, :2], drivers.pose[:, 2]
@@ -501,8 +569,12 @@ def _arcs(
 
 
 def _clearance(
-    drivers: Drivers, obstacles: Obstacles, ignore: np.ndarray | None, t: np.ndarray, pts: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
+    drivers: Drivers,
+    obstacles: Obstacles,
+    ignore: NDArray[np.bool_] | None,
+    t: NDArray[np.float64],
+    pts: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """The least gap along each arc to anything, and to movers alone, ``(R, K)`` each, mm.
 
     Moving boxes are extrapolated with their velocities when known (else grown by nothing:
@@ -544,12 +616,12 @@ def _clearance(
 def _far_for_the_score(
     drivers: Drivers,
     obstacles: Obstacles,
-    ignore: np.ndarray | None,
-    t: np.ndarray,
-    pts: np.ndarray,
+    ignore: NDArray[np.bool_] | None,
+    t: NDArray[np.float64],
+    pts: NDArray[np.float64],
     settings: DwaSettings,
-    gaps: tuple[np.ndarray, np.ndarray] | None = None,
-) -> tuple[Obstacles, np.ndarray | None]:
+    gaps: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
+) -> tuple[Obstacles, NDArray[np.bool_] | None]:
     """`obstacles` (and `ignore`) without the walls and boxes too far to change any arc's score.
 
     The score reads the least gap along an arc only up to the clearance cap :math:`c`, and the
@@ -598,13 +670,13 @@ def _far_for_the_score(
 def _score(
     drivers: Drivers,
     settings: DwaSettings,
-    high: np.ndarray,
-    V: np.ndarray,
-    pts: np.ndarray,
-    th: np.ndarray,
-    clear: np.ndarray,
-    mover_clear: np.ndarray,
-) -> np.ndarray:
+    high: NDArray[np.float64],
+    V: NDArray[np.float64],
+    pts: NDArray[np.float64],
+    th: NDArray[np.float64],
+    clear: NDArray[np.float64],
+    mover_clear: NDArray[np.float64],
+) -> NDArray[np.float64]:
     """Each arc's score ``(R, K)``: progress towards the target, heading towards it at the
     arc's end, room (up to the clearance cap and the personal space) and speed."""
     xy, target = drivers.pose[:, :2], drivers.target
@@ -633,10 +705,11 @@ def _score(
         + settings.speed_weight * V / np.maximum(drivers.limits.max_speed, 1.0)[:, None]
     )
     # An arc that would touch something within the horizon is taken only if every arc would.
-    return np.where(clear > 0, score, score - 1e3 + clear / 1e3)
+    scored: NDArray[np.float64] = np.where(clear > 0, score, score - 1e3 + clear / 1e3)
+    return scored
 
 
-def _keep(near: np.ndarray, movers: np.ndarray, settings: DwaSettings) -> np.ndarray:
+def _keep(near: NDArray[np.float64], movers: NDArray[np.bool_], settings: DwaSettings) -> NDArray[np.float64]:
     """Inside the standoff of a mover, an escape arc may not end closer to it than now (a few
     mm of slack per cycle, down to half the standoff, so that it can slide along); ``-inf``
     elsewhere."""
@@ -644,7 +717,14 @@ def _keep(near: np.ndarray, movers: np.ndarray, settings: DwaSettings) -> np.nda
     return np.where(movers & (near < settings.standoff), floor, -np.inf)
 
 
-def _open_retreat(xy, half, away, delta, walls, reach: float) -> np.ndarray:
+def _open_retreat(
+    xy: NDArray[np.float64],
+    half: NDArray[np.float64],
+    away: NDArray[np.float64],
+    delta: NDArray[np.float64],
+    walls: NDArray[np.float64],
+    reach: float,
+) -> NDArray[np.float64]:
     """Where to step back from the nearest box: `reach` along `away` unless a wall is in the way,
     then along the other axis (the side farther from the box first), else staying put."""
     other = np.where(away[:, :1] != 0, [[0.0, 1.0]], [[1.0, 0.0]])
@@ -659,7 +739,9 @@ def _open_retreat(xy, half, away, delta, walls, reach: float) -> np.ndarray:
     return np.where(free[rows, first][:, None], points[rows, first], xy)
 
 
-def _window(drivers: Drivers, settings: DwaSettings) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def _window(
+    drivers: Drivers, settings: DwaSettings
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     r"""The sampled arcs of the dynamic window of each robot, towards its `target`.
 
     The speeds span :math:`[v - b\varepsilon, \min(v + A\varepsilon, v_{top},
@@ -697,7 +779,7 @@ def _window(drivers: Drivers, settings: DwaSettings) -> tuple[np.ndarray, np.nda
 
 
 @lru_cache(maxsize=8)
-def _spread(start: float, count: int) -> np.ndarray:
+def _spread(start: float, count: int) -> NDArray[np.float64]:
     """``count`` evenly spaced values from `start` to 1 (the window's samples, made once)."""
     out = np.linspace(start, 1.0, count)
     out.flags.writeable = False
@@ -705,7 +787,7 @@ def _spread(start: float, count: int) -> np.ndarray:
 
 
 @lru_cache(maxsize=8)
-def _instants(horizon: float, samples: int) -> np.ndarray:
+def _instants(horizon: float, samples: int) -> NDArray[np.float64]:
     """The predicted instants :math:`k\\,T/S`, k = 1..S, of an arc (made once)."""
     out = horizon * np.arange(1, samples + 1) / samples
     out.flags.writeable = False
@@ -718,13 +800,13 @@ _ESCAPE_BATCH = 8
 
 def _best_escapes(
     drivers: Drivers,
-    V: np.ndarray,
-    W: np.ndarray,
-    score: np.ndarray,
+    V: NDArray[np.float64],
+    W: NDArray[np.float64],
+    score: NDArray[np.float64],
     obstacles: Obstacles,
-    skip: np.ndarray | None,
-    keep: np.ndarray,
-) -> tuple[np.ndarray, np.ndarray]:
+    skip: NDArray[np.bool_] | None,
+    keep: NDArray[np.float64],
+) -> tuple[NDArray[np.int64], NDArray[np.bool_]]:
     """For each unsafe driver, the best-scored arc that :func:`_escape_ok` admits: its index
     ``(U,)`` and whether there is one ``(U,)``.
 
@@ -762,13 +844,13 @@ def _best_escapes(
 
 def _far_for_escape(
     drivers: Drivers,
-    pts: np.ndarray,
-    longest: np.ndarray,
-    slack: np.ndarray,
+    pts: NDArray[np.float64],
+    longest: NDArray[np.float64],
+    slack: NDArray[np.float64],
     obstacles: Obstacles,
-    skip: np.ndarray | None,
-    keep: np.ndarray,
-) -> tuple[Obstacles, np.ndarray | None, np.ndarray]:
+    skip: NDArray[np.bool_] | None,
+    keep: NDArray[np.float64],
+) -> tuple[Obstacles, NDArray[np.bool_] | None, NDArray[np.float64]]:
     """`obstacles` (with `skip` and `keep`) without the boxes that pass every sample of every
     escape arc (:func:`_escape_ok`; `pts` ``(U, P, 2)`` its samples, `longest` ``(U,)`` the
     boxes' horizon, at least every arc's time to a stop, `slack` ``(U, K, 1)``).
@@ -794,14 +876,14 @@ def _far_for_escape(
 
 def _escape_ok(
     drivers: Drivers,
-    V: np.ndarray,
-    W: np.ndarray,
+    V: NDArray[np.float64],
+    W: NDArray[np.float64],
     obstacles: Obstacles,
-    skip: np.ndarray | None,
-    keep: np.ndarray,
+    skip: NDArray[np.bool_] | None,
+    keep: NDArray[np.float64],
     steps: int = 8,
-    longest: np.ndarray | None = None,
-) -> np.ndarray:
+    longest: NDArray[np.float64] | None = None,
+) -> NDArray[np.bool_]:
     """Whether each arc's worst case keeps clear: held for one cycle, then braking to a stop.
 
     The robot reaches speed ``V`` linearly within :math:`\\varepsilon`, then brakes with
@@ -863,4 +945,5 @@ def _escape_ok(
         ok &= fine.all(axis=(2, 3))
     # A robot that stands and stays standing (it may turn: its square does not move) cannot
     # run into anything: that is always allowed, so a robot touching a wall can turn away.
-    return ok | ((v[:, None] == 0) & (V == 0))
+    admitted: NDArray[np.bool_] = ok | ((v[:, None] == 0) & (V == 0))
+    return admitted

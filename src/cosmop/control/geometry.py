@@ -10,36 +10,61 @@ centres (any leading shape) and obstacles (last axis); units are millimetres.
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Sequence
+
 import numpy as np
+from numpy.typing import NDArray
 
 __all__ = ["box_gaps", "per_row", "point_segment_linf", "rect_gaps", "segment_array", "segment_bounds"]
 
 
-def segment_array(segments) -> np.ndarray:
-    """Segments ``[((x1, y1), (x2, y2)), ...]`` as a float array of shape ``(n, 4)``."""
+def segment_array(segments: Iterable[Sequence[Sequence[float]]]) -> NDArray[np.float64]:
+    """Segments ``[((x1, y1), (x2, y2)), ...]`` as a float array of shape ``(n, 4)``.
+
+    Parameters
+    ----------
+    segments : iterable of pairs of points
+        Each segment's two ends ``(x, y)``, mm.
+    """
     out = np.asarray([[a[0], a[1], b[0], b[1]] for a, b in segments], dtype=float)
     return out.reshape(-1, 4)
 
 
-def segment_bounds(segments: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Each segment's bounding box ``x1, y1, x2, y2`` as lower and upper corners ``(n, 2)``, mm."""
+def segment_bounds(segments: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Each segment's bounding box ``x1, y1, x2, y2`` as lower and upper corners ``(n, 2)``, mm.
+
+    Parameters
+    ----------
+    segments : ndarray, shape (n, 4)
+        Segments ``x1, y1, x2, y2`` (mm), as from :func:`segment_array`.
+    """
     ends = np.asarray(segments, dtype=float).reshape(-1, 2, 2)
     return ends.min(axis=1), ends.max(axis=1)
 
 
-def rect_gaps(lo: np.ndarray, hi: np.ndarray, lows: np.ndarray, highs: np.ndarray) -> np.ndarray:
+def rect_gaps(
+    lo: NDArray[np.float64], hi: NDArray[np.float64], lows: NDArray[np.float64], highs: NDArray[np.float64]
+) -> NDArray[np.float64]:
     """L-infinity distance from the box ``[lo, hi]`` to each box ``[lows, highs]`` (0 when they meet).
 
     It bounds from below the distance from any point of ``[lo, hi]`` to anything inside the
     other box (a wall segment lies in its bounding box, :func:`segment_bounds`).  Corners
     ``(2,)`` against boxes ``(n, 2)`` give ``(n,)``; several boxes at once, ``(G, 1, 2)``, give
     ``(G, n)``.
+
+    Parameters
+    ----------
+    lo, hi : ndarray, shape (2,) or (G, 1, 2)
+        Lower and upper corners of the box (or boxes), mm.
+    lows, highs : ndarray, shape (n, 2)
+        Lower and upper corners of the other boxes, mm.
     """
     d = np.maximum(np.maximum(lows - hi, lo - highs), 0.0)
-    return d.max(axis=-1)
+    gaps: NDArray[np.float64] = d.max(axis=-1)
+    return gaps
 
 
-def point_segment_linf(points: np.ndarray, segments: np.ndarray) -> np.ndarray:
+def point_segment_linf(points: NDArray[np.float64], segments: NDArray[np.float64]) -> NDArray[np.float64]:
     """L-infinity distance from points to segments.
 
     :math:`d_\\infty(p, [a, b]) = \\min_{t \\in [0, 1]} \\max(|a_x + t d_x - p_x|, |a_y + t d_y -
@@ -76,12 +101,19 @@ def point_segment_linf(points: np.ndarray, segments: np.ndarray) -> np.ndarray:
     return _general(points, seg)
 
 
-def per_row(obstacles: np.ndarray, point_axes: int) -> np.ndarray:
+def per_row(obstacles: NDArray[np.float64], point_axes: int) -> NDArray[np.float64]:
     """`obstacles` ``(R, m, k)`` (one set per row) shaped to broadcast against points of
     `point_axes` axes ``(R, ..., 2)`` once those gain an obstacle axis; ``(m, k)`` as it is.
 
     Sets of different sizes are padded with obstacles at infinity (every coordinate
     ``inf``, sizes 0): their gaps are ``inf``, as if they were absent.
+
+    Parameters
+    ----------
+    obstacles : ndarray, shape (m, k) or (R, m, k)
+        Segments (``k = 4``) or boxes (``k = 3``), mm; with three axes, one set per row.
+    point_axes : int
+        The number of axes of the points they will meet, the last being ``x, y``.
     """
     if obstacles.ndim == 2:
         return obstacles
@@ -89,16 +121,17 @@ def per_row(obstacles: np.ndarray, point_axes: int) -> np.ndarray:
     return obstacles.reshape(R, *(1,) * (point_axes - 2), m, k)
 
 
-def _axis_aligned(points: np.ndarray, segments: np.ndarray) -> np.ndarray:
+def _axis_aligned(points: NDArray[np.float64], segments: NDArray[np.float64]) -> NDArray[np.float64]:
     """An axis-parallel segment is a degenerate box: the larger of the two interval distances."""
     p = np.asarray(points, dtype=float)[..., None, :]
     lo = np.minimum(segments[..., :2], segments[..., 2:])
     hi = np.maximum(segments[..., :2], segments[..., 2:])
     d = np.maximum(np.maximum(lo - p, p - hi), 0.0)
-    return np.maximum(d[..., 0], d[..., 1])
+    gaps: NDArray[np.float64] = np.maximum(d[..., 0], d[..., 1])
+    return gaps
 
 
-def _general(points: np.ndarray, segments: np.ndarray) -> np.ndarray:
+def _general(points: NDArray[np.float64], segments: NDArray[np.float64]) -> NDArray[np.float64]:
     p = np.asarray(points, dtype=float)[..., None, :]
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # padding: inf - inf
         ax = segments[..., 0] - p[..., 0]
@@ -106,7 +139,7 @@ def _general(points: np.ndarray, segments: np.ndarray) -> np.ndarray:
         dx = segments[..., 2] - segments[..., 0]
         dy = segments[..., 3] - segments[..., 1]
         ax, ay = np.broadcast_arrays(ax, ay)
-        best = np.maximum(np.abs(ax), np.abs(ay))
+        best: NDArray[np.float64] = np.maximum(np.abs(ax), np.abs(ay))
         end = np.maximum(np.abs(ax + dx), np.abs(ay + dy))
         np.minimum(best, end, out=best)
         for num, den in ((-ax, dx), (-ay, dy), (ay - ax, dx - dy), (-(ax + ay), dx + dy)):
@@ -117,7 +150,9 @@ def _general(points: np.ndarray, segments: np.ndarray) -> np.ndarray:
     return best
 
 
-def box_gaps(centres: np.ndarray, half: float | np.ndarray, boxes: np.ndarray) -> np.ndarray:
+def box_gaps(
+    centres: NDArray[np.float64], half: float | NDArray[np.float64], boxes: NDArray[np.float64]
+) -> NDArray[np.float64]:
     """L-infinity gaps between squares and boxes (negative when they overlap).
 
     Parameters
@@ -137,7 +172,9 @@ def box_gaps(centres: np.ndarray, half: float | np.ndarray, boxes: np.ndarray) -
     """
     c = np.asarray(centres, dtype=float)[..., None, :]
     b = per_row(boxes, np.ndim(centres))
-    d = c[..., 0] - b[..., 0]  # the same operations as max(|dx|, |dy|) - half - k, in place
+    d: NDArray[np.float64] = (
+        c[..., 0] - b[..., 0]
+    )  # the same operations as max(|dx|, |dy|) - half - k, in place
     dy = c[..., 1] - b[..., 1]
     np.abs(d, out=d)
     np.maximum(d, np.abs(dy, out=dy), out=d)

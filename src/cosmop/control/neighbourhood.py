@@ -55,6 +55,7 @@ argument above, and an exact :attr:`~cosmop.control.dwa.DwaCommand.gap`.
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import NDArray
 
 from cosmop.control.dwa import (
     Drivers,
@@ -76,8 +77,19 @@ __all__ = ["dwa_commands_near", "reach"]
 _FEW = 32
 
 
-def reach(drivers: Drivers, obstacles: Obstacles, settings: DwaSettings) -> tuple[np.ndarray, np.ndarray]:
+def reach(
+    drivers: Drivers, obstacles: Obstacles, settings: DwaSettings
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """The gaps (mm) beyond which a wall, and a box, cannot change each driver's command.
+
+    Parameters
+    ----------
+    drivers : Drivers
+        The robots and their limits.
+    obstacles : Obstacles
+        The walls and boxes they sense (one shared set).
+    settings : DwaSettings
+        The window's horizon, clearance, personal space and standoff.
 
     Returns
     -------
@@ -101,8 +113,8 @@ def dwa_commands_near(
     obstacles: Obstacles,
     settings: DwaSettings | None = None,
     *,
-    ignore: np.ndarray | None = None,
-    grip: np.ndarray | None = None,
+    ignore: NDArray[np.bool_] | None = None,
+    grip: NDArray[np.bool_] | None = None,
     cell: float | None = None,
 ) -> DwaCommand:
     """:func:`~cosmop.control.dwa.dwa_commands`, each group of drivers against what is near it.
@@ -111,7 +123,13 @@ def dwa_commands_near(
     group's drivers get the walls and boxes within reach of any of them, and one call of the
     dynamic window serves every group (module docstring).  The commands are those of one call
     with everything.
-    Parameters as :func:`~cosmop.control.dwa.dwa_commands`.
+
+    Parameters
+    ----------
+    drivers, obstacles, settings, ignore, grip
+        As for :func:`~cosmop.control.dwa.dwa_commands` (`obstacles` one shared set).
+    cell : float, optional
+        Side of the cells that group the drivers, mm.
     """
     R, settings = len(drivers.v), settings or DwaSettings()
     if R == 0:
@@ -147,7 +165,7 @@ def dwa_commands_near(
     )
 
 
-def _cells(xy: np.ndarray, side: float) -> np.ndarray:
+def _cells(xy: NDArray[np.float64], side: float) -> NDArray[np.int64]:
     """The group of each point ``(R, 2)``: the square cell of side `side` it lies in, numbered
     in order of first appearance (a dictionary: the points are few, and sorting them is not
     needed)."""

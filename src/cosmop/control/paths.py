@@ -18,9 +18,11 @@ import heapq
 import math
 from dataclasses import dataclass
 from functools import cached_property
+from typing import Any
 
 import numpy as np
 import shapely
+from numpy.typing import NDArray
 from shapely.geometry import Polygon
 
 from cosmop.control.geometry import segment_bounds
@@ -54,7 +56,9 @@ class GlobalPath:
         return sum(math.dist(a, b) for a, b in zip(self.points, self.points[1:], strict=False))
 
     @cached_property
-    def _segments(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    def _segments(
+        self,
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
         """Each segment's start, direction and length, and the length with 1 for a zero one
         (made once: a robot asks for its look-ahead point every cycle)."""
         pts = np.asarray(self.points, dtype=float)
@@ -63,12 +67,12 @@ class GlobalPath:
         return a, d, lengths, np.where(lengths > 0, lengths, 1.0)
 
     @cached_property
-    def _projecting(self) -> tuple[np.ndarray, np.ndarray]:
+    def _projecting(self) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
         """Each segment's squared length (1 for a zero one) and whether it has a length."""
         _, _, lengths, safe_len = self._segments
         return safe_len**2, lengths > 0
 
-    def _projection(self, position: Point) -> tuple[int, np.ndarray]:
+    def _projection(self, position: Point) -> tuple[int, NDArray[np.float64]]:
         """The segment nearest `position` and, for every segment, where along it (0..1) the
         point nearest `position` lies."""
         a, d, _, _ = self._segments
@@ -82,7 +86,15 @@ class GlobalPath:
 
     def beyond(self, position: Point, distance: float) -> tuple[Point | None, tuple[Point, ...]]:
         """The point `distance` mm further along the path than `position`'s projection, and the
-        vertices after it; ``(None, ())`` when the path ends before (mm)."""
+        vertices after it; ``(None, ())`` when the path ends before (mm).
+
+        Parameters
+        ----------
+        position : (float, float)
+            Where the robot is, mm (anywhere: it is projected onto the path).
+        distance : float
+            How far beyond the projection, mm.
+        """
         if len(self.points) == 1:
             return None, ()
         a, d, lengths, _ = self._segments
@@ -103,6 +115,15 @@ class GlobalPath:
         cutting a corner would aim the robot into the obstacle the path goes around.
 
         Returns the point and the length of the path left after the projection (mm).
+
+        Parameters
+        ----------
+        position : (float, float)
+            Where the robot is, mm (anywhere: it is projected onto the path).
+        distance : float
+            The most the point lies beyond the projection, mm.
+        corner : float, default 30.0
+            How near (mm) the next vertex must be for the point to pass it.
         """
         if len(self.points) == 1:
             return self.points[0], 0.0
@@ -123,7 +144,7 @@ class GlobalPath:
         return self.points[-1], left
 
 
-def _grown(walls: np.ndarray, boxes: np.ndarray, half: float) -> list[Polygon]:
+def _grown(walls: NDArray[np.float64], boxes: NDArray[np.float64], half: float) -> list[Polygon]:
     """Obstacles grown by the robot's square of half side `half` (configuration-space obstacles)."""
     out: list[Polygon] = [swept_square((x1, y1), (x2, y2), 2.0 * half) for x1, y1, x2, y2 in walls]
     out += [square(x, y, 2.0 * (k + half)) for x, y, k in boxes]
@@ -134,8 +155,8 @@ def plan_path(
     start: Point,
     goal: Point,
     half: float,
-    walls: np.ndarray,
-    boxes: np.ndarray,
+    walls: NDArray[np.float64],
+    boxes: NDArray[np.float64],
     *,
     margin: float = 150.0,
     penalty: float = 3.0,
@@ -217,7 +238,16 @@ NEAR = 5000.0
 """How far beyond its start and goal (mm) :func:`plan_path` looks first."""
 
 
-def _route(ends, half, walls, boxes, region, margin, penalty, squeeze) -> tuple[GlobalPath | None, float]:
+def _route(
+    ends: NDArray[np.float64],
+    half: float,
+    walls: NDArray[np.float64],
+    boxes: NDArray[np.float64],
+    region: tuple[NDArray[np.float64], NDArray[np.float64]] | None,
+    margin: float,
+    penalty: float,
+    squeeze: float,
+) -> tuple[GlobalPath | None, float]:
     """The cheapest route among `walls` and `boxes` with corners inside `region` (``(lo, hi)``
     corners of a box, or ``None``: anywhere), and its cost (:func:`plan_path`)."""
     grown = shapely.unary_union(_grown(walls, boxes, half))
@@ -238,7 +268,7 @@ def _route(ends, half, walls, boxes, region, margin, penalty, squeeze) -> tuple[
 
 
 def straight_path(
-    start: Point, goal: Point, half: float, walls: np.ndarray, boxes: np.ndarray
+    start: Point, goal: Point, half: float, walls: NDArray[np.float64], boxes: NDArray[np.float64]
 ) -> GlobalPath | None:
     """The straight segment from `start` to `goal` when the robot's square can follow it.
 
@@ -249,6 +279,17 @@ def straight_path(
     a person), for :func:`plan_path` to find a way around.  The path's margin is its clearance
     to the grown obstacles, capped at :data:`CLEARANCE_CAP` (only obstacles that near are
     measured).
+
+    Parameters
+    ----------
+    start, goal : (float, float)
+        The segment's ends, the robot's centre (mm).
+    half : float
+        Half side of the robot (mm).
+    walls : ndarray, shape (n, 4)
+        Wall segments ``x1, y1, x2, y2`` (mm).
+    boxes : ndarray, shape (m, 3)
+        Resting objects, standing robots and people as ``x, y, half side`` (mm).
     """
     walls, boxes = (
         np.asarray(walls, dtype=float).reshape(-1, 4),
@@ -266,21 +307,21 @@ def straight_path(
         if shapely.intersects(_interior(grown), line):
             return None
         clearance = min(float(shapely.distance(grown.boundary, line)), CLEARANCE_CAP)
-    return GlobalPath((tuple(map(float, start)), tuple(map(float, goal))), clearance)
+    return GlobalPath(((float(start[0]), float(start[1])), (float(goal[0]), float(goal[1]))), clearance)
 
 
 CLEARANCE_CAP = 1000.0
 """The most clearance (mm) :func:`straight_path` measures."""
 
 
-def _interior(geometry):
+def _interior(geometry: Any) -> Any:
     """The open interior, shrunk by half a millimetre against round-off, prepared."""
     inner = geometry.buffer(-0.5, join_style="mitre") if not geometry.is_empty else geometry
     shapely.prepare(inner)
     return inner
 
 
-def _corners(grown, exact_inner, offset: float) -> np.ndarray:
+def _corners(grown: Any, exact_inner: Any, offset: float) -> NDArray[np.float64]:
     """Corners of the grown obstacles, pushed out by `offset`, that are outside every obstacle."""
     if grown.is_empty:
         return np.zeros((0, 2))
@@ -305,7 +346,8 @@ def _corners(grown, exact_inner, offset: float) -> np.ndarray:
     outside = ~shapely.contains_xy(grown, cand[:, 0], cand[:, 1])
     cand = cand[outside]
     inside_exact = shapely.intersects_xy(exact_inner, cand[:, 0], cand[:, 1])
-    return cand[~inside_exact]
+    corners: NDArray[np.float64] = cand[~inside_exact]
+    return corners
 
 
 class _EdgeCosts:
@@ -316,11 +358,21 @@ class _EdgeCosts:
     (:func:`plan_path`).  Evaluated for one node's edges at a time, when the search reaches it.
     """
 
-    def __init__(self, nodes, inner, boundary, margin: float, penalty: float, squeeze: float) -> None:
+    def __init__(
+        self,
+        nodes: NDArray[np.float64],
+        inner: Any,
+        boundary: Any,
+        margin: float,
+        penalty: float,
+        squeeze: float,
+    ) -> None:
         self.nodes, self.inner, self.boundary = nodes, inner, boundary
         self.margin, self.penalty, self.squeeze = margin, penalty, squeeze
 
-    def __call__(self, u: int, others: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def __call__(
+        self, u: int, others: NDArray[np.intp]
+    ) -> tuple[NDArray[np.intp], NDArray[np.float64], NDArray[np.float64]]:
         """The free edges from `u` to `others`: their far ends, costs and clearances."""
         ends = self.nodes[others]
         lines = shapely.linestrings(np.stack([np.broadcast_to(self.nodes[u], ends.shape), ends], axis=1))
@@ -336,7 +388,7 @@ class _EdgeCosts:
         return others, cost, clearance
 
 
-def _a_star(nodes: np.ndarray, costs: _EdgeCosts) -> tuple[list[int], float, float] | None:
+def _a_star(nodes: NDArray[np.float64], costs: _EdgeCosts) -> tuple[list[int], float, float] | None:
     """Cheapest route from node 0 to node 1, the least clearance along it, and its cost.
 
     A* with the straight-line distance to the goal, which never overestimates (an edge costs

@@ -38,8 +38,10 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TypeAlias
 
 import numpy as np
+from numpy.typing import NDArray
 
 from cosmop.scene import Dynamics
 
@@ -52,6 +54,10 @@ __all__ = [
     "stopping_horizon",
     "stopping_margin",
 ]
+
+
+_Real: TypeAlias = float | NDArray[np.float64]
+"""A quantity given for one robot or obstacle (float) or for a batch of them (float array)."""
 
 
 @dataclass(frozen=True)
@@ -73,15 +79,23 @@ class Limits:
         :math:`\\varepsilon`, s.
     """
 
-    max_speed: np.ndarray
-    acceleration: np.ndarray
-    braking: np.ndarray
-    turn_rate: np.ndarray
-    cycle: np.ndarray
+    max_speed: NDArray[np.float64]
+    acceleration: NDArray[np.float64]
+    braking: NDArray[np.float64]
+    turn_rate: NDArray[np.float64]
+    cycle: NDArray[np.float64]
 
     @classmethod
     def of(cls, dynamics: Sequence[Dynamics]) -> Limits:
         """The limits of robots with these `dynamics`, in order.
+
+        Parameters
+        ----------
+        dynamics : sequence of Dynamics
+            One per robot.
+
+        Examples
+        --------
 
         >>> Limits.of([Dynamics(), Dynamics(max_speed=500)]).max_speed
         array([750., 500.])
@@ -94,8 +108,9 @@ class Limits:
             cycle=np.array([d.cycle for d in dynamics], dtype=float),
         )
 
-    def __getitem__(self, rows) -> Limits:
-        """The limits of the robots `rows` (an index array, a mask or a slice)."""
+    def __getitem__(self, rows: int | slice | NDArray[np.intp] | NDArray[np.bool_]) -> Limits:
+        """The limits of the robots `rows` (an index array, a mask or a slice; one robot's index
+        gives scalar entries, which broadcast like the arrays)."""
         return Limits(*(getattr(self, name)[rows] for name in _LIMIT_FIELDS))
 
     def column(self) -> Limits:
@@ -106,7 +121,7 @@ class Limits:
 _LIMIT_FIELDS = ("max_speed", "acceleration", "braking", "turn_rate", "cycle")
 
 
-def stopping_margin(v, speed_bound, dynamics: Dynamics | Limits):
+def stopping_margin(v: _Real, speed_bound: _Real, dynamics: Dynamics | Limits) -> _Real:
     """The right-hand side of ``safe``: the gap (mm) a robot at speed `v` needs.
 
     Parameters
@@ -121,20 +136,36 @@ def stopping_margin(v, speed_bound, dynamics: Dynamics | Limits):
     return own_margin(v, dynamics) + speed_bound * stopping_horizon(v, dynamics)
 
 
-def own_margin(v, dynamics: Dynamics | Limits):
+def own_margin(v: _Real, dynamics: Dynamics | Limits) -> _Real:
     """:func:`stopping_margin` before an obstacle moves (:math:`V_o = 0`): the robot's own
-    stopping distance, mm, :math:`(A/b + 1)(A\\varepsilon^2/2 + \\varepsilon v) + v^2/2b`."""
+    stopping distance, mm, :math:`(A/b + 1)(A\\varepsilon^2/2 + \\varepsilon v) + v^2/2b`.
+
+    Parameters
+    ----------
+    v : float or ndarray
+        Translational speed now, mm/s (>= 0).
+    dynamics : Dynamics or Limits
+        :math:`A`, :math:`b`, :math:`\\varepsilon` (arrays broadcast with `v`).
+    """
     a, b, eps = dynamics.acceleration, dynamics.braking, dynamics.cycle
     return (a / b + 1.0) * (a / 2.0 * eps**2 + eps * v) + v * v / (2.0 * b)
 
 
-def stopping_horizon(v, dynamics: Dynamics | Limits):
-    """:math:`T = \\varepsilon + (v + A\\varepsilon)/b`: the latest time a robot at `v` stands still, s."""
+def stopping_horizon(v: _Real, dynamics: Dynamics | Limits) -> _Real:
+    """:math:`T = \\varepsilon + (v + A\\varepsilon)/b`: the latest time a robot at `v` stands still, s.
+
+    Parameters
+    ----------
+    v : float or ndarray
+        Translational speed now, mm/s (>= 0).
+    dynamics : Dynamics or Limits
+        :math:`A`, :math:`b`, :math:`\\varepsilon` (arrays broadcast with `v`).
+    """
     a, b, eps = dynamics.acceleration, dynamics.braking, dynamics.cycle
     return eps + (v + a * eps) / b
 
 
-def obstacle_speed(horizon, top, speed_now, acceleration):
+def obstacle_speed(horizon: _Real, top: _Real, speed_now: _Real, acceleration: _Real) -> NDArray[np.float64]:
     r"""The speed bound :math:`V_o = \min(v^{top}_o, v_o + A_o T/2)` of an obstacle over `horizon`.
 
     Parameters
@@ -150,24 +181,42 @@ def obstacle_speed(horizon, top, speed_now, acceleration):
 
     Returns
     -------
-    float or ndarray
-        A speed whose product with `horizon` bounds the obstacle's displacement, mm/s.
+    ndarray
+        A speed whose product with `horizon` bounds the obstacle's displacement, mm/s (0-d for
+        scalar arguments).
     """
     with np.errstate(invalid="ignore"):
         reach = np.asarray(speed_now) + np.asarray(acceleration) * np.asarray(horizon) / 2.0
     return np.minimum(top, np.where(np.isnan(reach), np.inf, reach))
 
 
-def is_safe(gap, v, speed_bound, dynamics: Dynamics | Limits):
-    """The paper's ``safe``: ``gap > stopping_margin(v, V)`` (elementwise)."""
+def is_safe(gap: _Real, v: _Real, speed_bound: _Real, dynamics: Dynamics | Limits) -> NDArray[np.bool_]:
+    """The paper's ``safe``: ``gap > stopping_margin(v, V)`` (elementwise).
+
+    Parameters
+    ----------
+    gap : float or ndarray
+        The gap to the obstacle (:math:`\\lVert p_r - p_o \\rVert_\\infty` in the condition), mm.
+    v, speed_bound, dynamics
+        As for :func:`stopping_margin`.
+    """
     return np.asarray(gap) > stopping_margin(v, speed_bound, dynamics)
 
 
-def admissible_speed(gap, speed_bound, dynamics: Dynamics | Limits):
+def admissible_speed(gap: _Real, speed_bound: _Real, dynamics: Dynamics | Limits) -> NDArray[np.float64]:
     """The Corollary's :math:`v_{max}`: ``safe`` holds exactly for ``0 <= v < v_max``.
 
     Negative when not even a standing robot may start (the gap is below
     :math:`(A/b + 1) A\\varepsilon^2/2 + V_o\\varepsilon(1 + A/b)`).
+
+    Parameters
+    ----------
+    gap : float or ndarray
+        The gap to the obstacle (:math:`\\lVert p_r - p_o \\rVert_\\infty` in the condition), mm.
+    speed_bound : float or ndarray
+        :math:`V_o`, the most the obstacle moves, mm/s.
+    dynamics : Dynamics or Limits
+        :math:`A`, :math:`b`, :math:`\\varepsilon` (arrays broadcast with the others).
     """
     a, b, eps = dynamics.acceleration, dynamics.braking, dynamics.cycle
     gap = np.asarray(gap, dtype=float)

@@ -618,13 +618,26 @@ class IncrementalUnrolling(_Encoding):
         return literal, self._drain()
 
     def require(self, formula: object, k: int = 0) -> list[z3.BoolRef]:
-        """The constraints asserting that ``formula`` holds at instant ``k`` (definitions included)."""
+        """The constraints asserting that ``formula`` holds at instant ``k`` (definitions included).
+
+        Parameters
+        ----------
+        formula : Formula or bool Var
+            The formula to require.
+        k : int, default 0
+            :math:`0 \\le k \\le K`.
+        """
         literal, constraints = self.encode(formula, k)
         constraints.append(literal)
         return constraints
 
     def extend(self, K: int | None = None) -> list[z3.BoolRef]:
         """Grow the horizon to ``K`` (default :math:`K+1`) and return the constraints to add.
+
+        Parameters
+        ----------
+        K : int, optional
+            The new last instant; at least the current one.
 
         Raises
         ------

@@ -55,7 +55,7 @@ __all__ = ["evaluate", "evaluate_all", "failing"]
 
 Trace = Sequence[Mapping[str, object]]
 
-_COMPARE: dict[str, Callable[[object, object], bool]] = {
+_COMPARE: dict[str, Callable[[Fraction, Fraction], bool]] = {
     "<=": operator.le,
     "<": operator.lt,
     ">=": operator.ge,
@@ -128,6 +128,13 @@ def failing(formulas: Sequence[object], trace: Trace) -> list[int]:
     One evaluation shares the work of the sub-formulas the formulas have in common, so
     testing many constraints of one specification on a plan costs little more than one.
 
+    Parameters
+    ----------
+    formulas : sequence of Formula or bool Var
+        The formulas to test.
+    trace : sequence of mapping
+        As for :func:`evaluate`.
+
     Examples
     --------
     >>> from cosmop.logic import ints
@@ -177,7 +184,7 @@ class _Evaluator:
 
     def term(self, term: Shifted | Max | Min, k: int) -> Fraction:
         if isinstance(term, Shifted):
-            return Fraction(self.value(term.var, k + term.offset))  # type: ignore[arg-type]
+            return Fraction(self.value(term.var, k + term.offset))
         left, right = self.linear(term.left, k), self.linear(term.right, k)
         return max(left, right) if isinstance(term, Max) else min(left, right)
 

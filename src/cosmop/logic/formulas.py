@@ -77,12 +77,12 @@ from __future__ import annotations
 
 import math
 import numbers
-from collections.abc import Iterable, Iterator, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass, fields
 from fractions import Fraction
 from functools import cached_property
 from itertools import combinations
-from typing import Any, Literal, TypeAlias
+from typing import TYPE_CHECKING, Any, Literal, TypeAlias, TypeVar, cast, overload
 
 __all__ = [
     "FALSE",
@@ -179,9 +179,9 @@ def to_fraction(value: object) -> Fraction:
     """
     kind = type(value)
     if kind is Fraction:  # the common case in formulas, first: immutable, so itself
-        return value  # type: ignore[return-value]
+        return cast(Fraction, value)
     if kind is int:
-        return Fraction(value)  # type: ignore[arg-type]
+        return Fraction(cast(int, value))
     if _is_bool(value):
         raise TypeError(f"expected a number, got the bool {value!r}")
     if isinstance(value, numbers.Integral):
@@ -234,22 +234,37 @@ def normalize_value(sort: str, value: object) -> Value:
 # the node machinery
 
 
-def _node(cls: type | None = None, /, *, init: bool = True) -> Any:
-    """Make ``cls`` a frozen dataclass with structural ``==`` and a cached structural hash."""
+_Class = TypeVar("_Class", bound=type)
 
-    def wrap(klass: type) -> type:
-        klass = dataclass(frozen=True, init=init)(klass)
+
+@overload
+def _node(cls: _Class, /) -> _Class: ...
+
+
+@overload
+def _node(cls: None = None, /, *, init: bool = True) -> Callable[[_Class], _Class]: ...
+
+
+def _node(cls: _Class | None = None, /, *, init: bool = True) -> _Class | Callable[[_Class], _Class]:
+    """Make ``cls`` a frozen dataclass with structural ``==`` and a cached structural hash.
+
+    The type checker does not see the generated ``__init__``: each node class declares the
+    signature it accepts under ``TYPE_CHECKING`` (the dataclass keeps generating the real one).
+    """
+
+    def wrap(klass: _Class) -> _Class:
+        klass = cast(_Class, dataclass(frozen=True, init=init)(klass))
         names = tuple(f.name for f in fields(klass))
         tag = klass.__name__
 
         def __hash__(self: Any) -> int:
-            cached = self.__dict__.get("_hash")
+            cached: int | None = self.__dict__.get("_hash")
             if cached is None:
                 cached = hash((tag, *[getattr(self, name) for name in names]))
                 object.__setattr__(self, "_hash", cached)
             return cached
 
-        klass.__hash__ = __hash__  # type: ignore[method-assign]
+        klass.__hash__ = __hash__  # type: ignore[assignment]  # the class object's hash slot, set once
         return klass
 
     return wrap if cls is None else wrap(cls)
@@ -306,11 +321,23 @@ class Expr(Node):
 
     # -- structure ----------------------------------------------------------------------------
     def next(self, k: int = 1) -> Expr:
-        """The expression :math:`k` instants later, :math:`\\bigcirc^{k} e` (every term shifted)."""
+        """The expression :math:`k` instants later, :math:`\\bigcirc^{k} e` (every term shifted).
+
+        Parameters
+        ----------
+        k : int
+            Instants ahead (negative: back).
+        """
         raise NotImplementedError
 
     def prev(self, k: int = 1) -> Expr:
-        """The expression :math:`k` instants earlier, :math:`\\bigcirc^{-k} e`."""
+        """The expression :math:`k` instants earlier, :math:`\\bigcirc^{-k} e`.
+
+        Parameters
+        ----------
+        k : int
+            Instants back (negative: ahead).
+        """
         return self.next(-_offset(k))
 
     @property
@@ -374,15 +401,33 @@ class Expr(Node):
         return _compare(self, ">", other)
 
     def eq(self, other: object) -> Formula:
-        """The atom :math:`\\mathit{self} = \\mathit{other}` (see :func:`eq`)."""
+        """The atom :math:`\\mathit{self} = \\mathit{other}` (see :func:`eq`).
+
+        Parameters
+        ----------
+        other : expression, variable or number
+            The right-hand side.
+        """
         return eq(self, other)
 
     def ne(self, other: object) -> Formula:
-        """The formula :math:`\\mathit{self} \\neq \\mathit{other}` (see :func:`ne`)."""
+        """The formula :math:`\\mathit{self} \\neq \\mathit{other}` (see :func:`ne`).
+
+        Parameters
+        ----------
+        other : expression, variable or number
+            The right-hand side.
+        """
         return ne(self, other)
 
     def between(self, low: object, high: object) -> And:
-        """The formula :math:`\\mathit{low} \\le \\mathit{self} \\le \\mathit{high}`."""
+        """The formula :math:`\\mathit{low} \\le \\mathit{self} \\le \\mathit{high}`.
+
+        Parameters
+        ----------
+        low, high : expression, variable or number
+            The bounds, both included.
+        """
         return And(_compare(self, ">=", low), _compare(self, "<=", high))
 
 
@@ -418,11 +463,16 @@ class LinExpr(Expr):
     terms: tuple[tuple[Shifted | Max | Min, Fraction], ...] = ()
     const: Fraction = Fraction(0)
 
+    if TYPE_CHECKING:
+
+        def __init__(
+            self, terms: Iterable[tuple[Shifted | Max | Min, object]] = (), const: object = Fraction(0)
+        ) -> None: ...
+
     def __post_init__(self) -> None:
         merged: dict[Shifted | Max | Min, Fraction] = {}
         for term, coefficient in self.terms:
-            kind = type(term)
-            if kind is Shifted:
+            if isinstance(term, Shifted):
                 if term.sort == "bool":
                     raise TypeError(f"the bool variable {term.var.name!r} is not an arithmetic term")
             elif not isinstance(term, (Max, Min)):
@@ -446,6 +496,13 @@ class LinExpr(Expr):
         return out
 
     def next(self, k: int = 1) -> LinExpr:
+        """The expression :math:`k` instants later (every term shifted).
+
+        Parameters
+        ----------
+        k : int
+            Instants ahead (negative: back).
+        """
         k = _offset(k)
         return LinExpr(tuple((t.next(k), c) for t, c in self.terms), self.const)
 
@@ -477,6 +534,11 @@ def _fmt_number(value: Fraction) -> str:
 
 def as_expr(value: object) -> LinExpr:
     """Coerce a number, numeric variable, term or expression to a :class:`LinExpr`.
+
+    Parameters
+    ----------
+    value : object
+        A number (read as by :func:`to_fraction`), numeric :class:`Var`, term or expression.
 
     Raises
     ------
@@ -519,7 +581,13 @@ def _scale(expr: LinExpr, factor: Fraction) -> LinExpr:
 
 
 def sum_of(items: Iterable[object]) -> LinExpr:
-    """The sum of numbers and expressions, built in one pass (linear time, unlike ``sum``)."""
+    """The sum of numbers and expressions, built in one pass (linear time, unlike ``sum``).
+
+    Parameters
+    ----------
+    items : iterable of object
+        Numbers, numeric variables, terms or expressions.
+    """
     terms: list[tuple[Shifted | Max | Min, Fraction]] = []
     const = Fraction(0)
     for item in items:
@@ -542,11 +610,22 @@ class Max(Expr):
     left: LinExpr
     right: LinExpr
 
+    if TYPE_CHECKING:
+
+        def __init__(self, left: object, right: object) -> None: ...
+
     def __post_init__(self) -> None:
         object.__setattr__(self, "left", as_expr(self.left))
         object.__setattr__(self, "right", as_expr(self.right))
 
     def next(self, k: int = 1) -> Max:
+        """The term :math:`k` instants later (both operands shifted).
+
+        Parameters
+        ----------
+        k : int
+            Instants ahead (negative: back).
+        """
         return Max(self.left.next(k), self.right.next(k))
 
     @cached_property
@@ -570,11 +649,22 @@ class Min(Expr):
     left: LinExpr
     right: LinExpr
 
+    if TYPE_CHECKING:
+
+        def __init__(self, left: object, right: object) -> None: ...
+
     def __post_init__(self) -> None:
         object.__setattr__(self, "left", as_expr(self.left))
         object.__setattr__(self, "right", as_expr(self.right))
 
     def next(self, k: int = 1) -> Min:
+        """The term :math:`k` instants later (both operands shifted).
+
+        Parameters
+        ----------
+        k : int
+            Instants ahead (negative: back).
+        """
         return Min(self.left.next(k), self.right.next(k))
 
     @cached_property
@@ -586,7 +676,13 @@ class Min(Expr):
 
 
 def maximum(first: object, *rest: object) -> LinExpr:
-    """:math:`\\max` of one or more expressions, as nested binary :class:`Max` terms."""
+    """:math:`\\max` of one or more expressions, as nested binary :class:`Max` terms.
+
+    Parameters
+    ----------
+    first, rest : object
+        The expressions (numbers, numeric variables, terms), at least one.
+    """
     result = as_expr(first)
     for item in rest:
         result = as_expr(Max(result, item))
@@ -594,7 +690,13 @@ def maximum(first: object, *rest: object) -> LinExpr:
 
 
 def minimum(first: object, *rest: object) -> LinExpr:
-    """:math:`\\min` of one or more expressions, as nested binary :class:`Min` terms."""
+    """:math:`\\min` of one or more expressions, as nested binary :class:`Min` terms.
+
+    Parameters
+    ----------
+    first, rest : object
+        The expressions (numbers, numeric variables, terms), at least one.
+    """
     result = as_expr(first)
     for item in rest:
         result = as_expr(Min(result, item))
@@ -646,6 +748,11 @@ def as_formula(value: object) -> Formula:
 
     A Boolean :class:`Var` ``p`` becomes the atom ``Shifted(p, 0)``.
 
+    Parameters
+    ----------
+    value : object
+        A Boolean :class:`Var` or :class:`Shifted`, or a formula.
+
     Raises
     ------
     TypeError
@@ -685,6 +792,10 @@ class Var(Formula, Expr):
     name: str
     sort: str
 
+    if TYPE_CHECKING:
+
+        def __init__(self, name: str, sort: str) -> None: ...
+
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
             raise ValueError(f"a variable name is a non-empty string, got {self.name!r}")
@@ -694,9 +805,23 @@ class Var(Formula, Expr):
             )
 
     def next(self, k: int = 1) -> Shifted:
+        """The term :math:`\\bigcirc^{k} x`.
+
+        Parameters
+        ----------
+        k : int
+            Instants ahead (negative: back).
+        """
         return Shifted(self, _offset(k))
 
     def prev(self, k: int = 1) -> Shifted:
+        """The term :math:`\\bigcirc^{-k} x`.
+
+        Parameters
+        ----------
+        k : int
+            Instants back (negative: ahead).
+        """
         return Shifted(self, -_offset(k))
 
     @property
@@ -724,6 +849,10 @@ class Shifted(Formula, Expr):
     var: Var
     offset: int = 0
 
+    if TYPE_CHECKING:
+
+        def __init__(self, var: Var, offset: int = 0) -> None: ...
+
     def __post_init__(self) -> None:
         if not isinstance(self.var, Var):
             raise TypeError(f"Shifted needs a Var, got {self.var!r}")
@@ -735,9 +864,23 @@ class Shifted(Formula, Expr):
         return self.var.sort
 
     def next(self, k: int = 1) -> Shifted:
+        """The same variable :math:`k` instants later.
+
+        Parameters
+        ----------
+        k : int
+            Instants ahead (negative: back).
+        """
         return Shifted(self.var, self.offset + _offset(k))
 
     def prev(self, k: int = 1) -> Shifted:
+        """The same variable :math:`k` instants earlier.
+
+        Parameters
+        ----------
+        k : int
+            Instants back (negative: ahead).
+        """
         return Shifted(self.var, self.offset - _offset(k))
 
     @property
@@ -761,6 +904,10 @@ class BoolConst(Formula):
     """
 
     value: bool
+
+    if TYPE_CHECKING:
+
+        def __init__(self, value: bool) -> None: ...
 
     def __post_init__(self) -> None:
         if not isinstance(self.value, bool):
@@ -796,6 +943,10 @@ class Compare(Formula):
     expr: LinExpr
     op: str
     const: Fraction = Fraction(0)
+
+    if TYPE_CHECKING:
+
+        def __init__(self, expr: object, op: str, const: object = Fraction(0)) -> None: ...
 
     def __post_init__(self) -> None:
         expr = as_expr(self.expr)
@@ -837,6 +988,11 @@ def eq(left: object, right: object) -> Formula:
     For arithmetic operands a :class:`Compare` ``==`` atom; when either operand is Boolean (a
     Boolean variable or any formula) the equivalence :class:`Iff`, so ``p.next().eq(p)`` says
     that ``p`` keeps its value.
+
+    Parameters
+    ----------
+    left, right : object
+        Expressions, numbers, Boolean variables or formulas.
     """
     if _is_boolean(left) or _is_boolean(right):
         return Iff(left, right)
@@ -844,7 +1000,13 @@ def eq(left: object, right: object) -> Formula:
 
 
 def ne(left: object, right: object) -> Not:
-    """The disequality :math:`\\neg(\\mathit{left} = \\mathit{right})` (see :func:`eq`)."""
+    """The disequality :math:`\\neg(\\mathit{left} = \\mathit{right})` (see :func:`eq`).
+
+    Parameters
+    ----------
+    left, right : object
+        Expressions, numbers, Boolean variables or formulas.
+    """
     return Not(eq(left, right))
 
 
@@ -859,6 +1021,10 @@ class _Unary(Formula):
     """
 
     arg: Formula
+
+    if TYPE_CHECKING:
+
+        def __init__(self, arg: object) -> None: ...
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "arg", as_formula(self.arg))
@@ -885,6 +1051,10 @@ class _Binary(Formula):
 
     left: Formula
     right: Formula
+
+    if TYPE_CHECKING:
+
+        def __init__(self, left: object, right: object) -> None: ...
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "left", as_formula(self.left))
@@ -1038,6 +1208,11 @@ def conj(formulas: Iterable[object]) -> Formula:
 
     Returns :data:`FALSE` if an argument is :data:`FALSE`, :data:`TRUE` if nothing remains, the
     single remaining formula alone, else an :class:`And`.
+
+    Parameters
+    ----------
+    formulas : iterable of object
+        Formulas or Boolean variables.
     """
     items: list[Formula] = []
     for item in formulas:
@@ -1060,6 +1235,11 @@ def disj(formulas: Iterable[object]) -> Formula:
 
     Returns :data:`TRUE` if an argument is :data:`TRUE`, :data:`FALSE` if nothing remains, the
     single remaining formula alone, else an :class:`Or`.
+
+    Parameters
+    ----------
+    formulas : iterable of object
+        Formulas or Boolean variables.
     """
     items: list[Formula] = []
     for item in formulas:
@@ -1079,7 +1259,13 @@ def disj(formulas: Iterable[object]) -> Formula:
 
 def exactly_one(formulas: Iterable[object]) -> Formula:
     """:math:`\\bigvee_i \\phi_i \\wedge \\bigwedge_{i<j} \\neg(\\phi_i \\wedge \\phi_j)` (pairwise;
-    :data:`FALSE` when empty)."""
+    :data:`FALSE` when empty).
+
+    Parameters
+    ----------
+    formulas : iterable of object
+        Formulas or Boolean variables.
+    """
     items = [as_formula(f) for f in formulas]
     at_least = disj(items)
     at_most = [Not(And(a, b)) for a, b in combinations(items, 2)]
@@ -1095,6 +1281,11 @@ def subformulas(formula: object) -> list[Formula]:
 
     Every formula appears after its children; structurally equal sub-formulas appear once.
     Iterative, so deep formulas do not hit the recursion limit.
+
+    Parameters
+    ----------
+    formula : object
+        A formula or Boolean variable.
     """
     root = as_formula(formula)
     order: list[Formula] = []
@@ -1168,7 +1359,13 @@ class Signature(Mapping[str, str]):
 
     @classmethod
     def of(cls, *objects: object) -> Signature:
-        """The variables of formulas, expressions, variables or signatures, in order of appearance."""
+        """The variables of formulas, expressions, variables or signatures, in order of appearance.
+
+        Parameters
+        ----------
+        *objects : object
+            Formulas, expressions, variables or signatures.
+        """
         found: list[Var] = []
         for obj in objects:
             if isinstance(obj, Signature):
@@ -1183,7 +1380,13 @@ class Signature(Mapping[str, str]):
         return tuple(Var(name, sort) for name, sort in self._sorts.items())
 
     def var(self, name: str) -> Var:
-        """The variable called ``name``."""
+        """The variable called ``name``.
+
+        Parameters
+        ----------
+        name : str
+            A declared variable's name.
+        """
         return Var(name, self[name])
 
     def __or__(self, other: object) -> Signature:
@@ -1212,15 +1415,33 @@ def _declare(sort: str, names: str) -> tuple[Var, ...]:
 
 
 def ints(names: str) -> tuple[Var, ...]:
-    """Integer variables from whitespace-separated names: ``i, j = ints("i j")``."""
+    """Integer variables from whitespace-separated names: ``i, j = ints("i j")``.
+
+    Parameters
+    ----------
+    names : str
+        Variable names separated by whitespace.
+    """
     return _declare("int", names)
 
 
 def reals(names: str) -> tuple[Var, ...]:
-    """Real variables from whitespace-separated names: ``(x,) = reals("x")``."""
+    """Real variables from whitespace-separated names: ``(x,) = reals("x")``.
+
+    Parameters
+    ----------
+    names : str
+        Variable names separated by whitespace.
+    """
     return _declare("real", names)
 
 
 def bools(names: str) -> tuple[Var, ...]:
-    """Boolean variables from whitespace-separated names: ``p, q = bools("p q")``."""
+    """Boolean variables from whitespace-separated names: ``p, q = bools("p q")``.
+
+    Parameters
+    ----------
+    names : str
+        Variable names separated by whitespace.
+    """
     return _declare("bool", names)

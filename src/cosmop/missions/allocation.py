@@ -36,10 +36,11 @@ step keeps an optimal alternative.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from types import MappingProxyType
 
+from cosmop.automata import DFA
 from cosmop.missions.mission import GlobalMission
 
 __all__ = [
@@ -71,12 +72,19 @@ class Alternative:
         object.__setattr__(self, "words", MappingProxyType({r: tuple(w) for r, w in self.words.items()}))
 
     def movers(self, mission: GlobalMission) -> dict[str, str]:
-        """The robot that picks each object up, by object (what ``plan.json`` records)."""
-        out = {}
+        """The robot that picks each object up, by object (what ``plan.json`` records).
+
+        Parameters
+        ----------
+        mission : GlobalMission
+            The mission whose events the words name.
+        """
+        out: dict[str, str] = {}
         for robot, word in self.words.items():
             for name in word:
                 event = mission.events[name]
                 if event.kind == "pick" and event.robot == robot:
+                    assert event.obj is not None  # a pick names its object
                     out[event.obj] = robot
         return dict(sorted(out.items()))
 
@@ -135,17 +143,20 @@ def alternatives(mission: GlobalMission, *, max_nodes: int = 200_000) -> Alterna
     >>> [alt.label() for alt in alternatives(GlobalMission.from_dfa(k)).items]
     ['R1: pick(R1,O1); R2: (nothing)', 'R1: (nothing); R2: pick(R2,O1)']
     """
+    assert mission.complete is not None  # set on construction
     factors = mission.complete.components
     robots = mission.robots
     names = sorted(mission.complete.alphabet)
     columns = [f.event_index() for f in factors]
     owners = [tuple(n for n, r in enumerate(robots) if r in mission.events[e].owners) for e in names]
     start = tuple(f.initial for f in factors)
-    empty = tuple(() for _ in robots)
+    empty: Words = tuple(() for _ in robots)
     longest = math.prod(f.n_states for f in factors) - 1
-    found: dict[tuple, None] = {}
+    found: dict[Words, None] = {}
     seen = {(start, empty)}
-    stack = [(start, empty, 0, iter(range(len(names))))]
+    stack: list[tuple[tuple[int, ...], Words, int, Iterator[int]]] = [
+        (start, empty, 0, iter(range(len(names))))
+    ]
     nodes = 1
     if all(f.marked[q] for f, q in zip(factors, start, strict=True)):
         found[empty] = None
@@ -183,6 +194,15 @@ def own_choices(found: Alternatives, robot: str, mission: GlobalMission) -> dict
     (messages are placed on one word, after the choice), is a choice that concerns no one
     else.  Only an `exhaustive` enumeration is split this way.
 
+    Parameters
+    ----------
+    found : Alternatives
+        The alternatives of the mission.
+    robot : str
+        The robot whose choices are sought.
+    mission : GlobalMission
+        The mission whose events the words name.
+
     Returns
     -------
     dict
@@ -199,10 +219,10 @@ def own_choices(found: Alternatives, robot: str, mission: GlobalMission) -> dict
     """
     if not found.exhaustive:
         return {}
-    groups: dict[tuple, list[tuple[str, ...]]] = {}
+    groups: dict[Words, list[tuple[str, ...]]] = {}
     for alt in found.items:
         groups.setdefault(others(alt, robot), []).append(alt.words[robot])
-    out = {}
+    out: dict[Words, Words] = {}
     for rest, words in groups.items():
         events = [[mission.events[e] for e in w] for w in words]
         picks = {frozenset(e.obj for e in w if e.kind == "pick") for w in events}
@@ -212,11 +232,21 @@ def own_choices(found: Alternatives, robot: str, mission: GlobalMission) -> dict
 
 
 def others(alt: Alternative, robot: str) -> Words:
-    """The words of every robot but `robot` in `alt`, in team order."""
+    """The words of every robot but `robot` in `alt`, in team order.
+
+    Parameters
+    ----------
+    alt : Alternative
+        An alternative of the team.
+    robot : str
+        The robot left out.
+    """
     return tuple(w for r, w in alt.words.items() if r != robot)
 
 
-def _step(factors, columns, state: tuple, name: str) -> tuple | None:
+def _step(
+    factors: Sequence[DFA], columns: Sequence[Mapping[str, int]], state: tuple[int, ...], name: str
+) -> tuple[int, ...] | None:
     """The factors' states after `name`, or ``None`` where a factor forbids it."""
     out = list(state)
     for i, (factor, column) in enumerate(zip(factors, columns, strict=True)):
@@ -230,7 +260,7 @@ def _step(factors, columns, state: tuple, name: str) -> tuple | None:
     return tuple(out)
 
 
-def _items(found: Mapping[tuple, None], robots: tuple[str, ...]) -> tuple[Alternative, ...]:
+def _items(found: Mapping[Words, None], robots: tuple[str, ...]) -> tuple[Alternative, ...]:
     return tuple(Alternative(dict(zip(robots, words, strict=True))) for words in found)
 
 
@@ -264,7 +294,9 @@ class Choice:
     unplannable: Mapping[tuple[str, tuple[str, ...]], str] = field(default_factory=dict)
     exhaustive: bool = True
     method: str = "every alternative costed by the robots' shortest plans"
-    costs: Mapping[tuple, int | None] = field(default_factory=dict)
+    costs: Mapping[tuple[str, str, str], int | None] | Mapping[tuple[str, tuple[str, ...]], int | None] = (
+        field(default_factory=dict)
+    )
 
 
 def choose(
@@ -290,7 +322,10 @@ def choose(
     Choice
         Ties go to the alternative found first.
     """
-    best, key, unplannable, table = None, None, {}, {}
+    best: Alternative | None = None
+    key: tuple[int, int] | None = None
+    unplannable: dict[tuple[str, tuple[str, ...]], str] = {}
+    table: dict[tuple[str, tuple[str, ...]], int | None] = {}
     for alt in found.items:
         costs = []
         for robot, word in alt.words.items():
@@ -349,10 +384,18 @@ class Assignment:
     stuck: tuple[str, ...] = ()
 
     def loads(self, costs: Mapping[tuple[str, str, str], int | None]) -> dict[str, int]:
-        """Each robot's load under `costs` (robots with nothing to do left out)."""
+        """Each robot's load under `costs` (robots with nothing to do left out).
+
+        Parameters
+        ----------
+        costs : mapping of (str, str, str) to int or None
+            :math:`c(r, o, w)` by ``(robot, object, workspace)``, as given to :func:`assign`.
+        """
         out: dict[str, int] = {}
         for obj, (robot, ws) in self.tasks.items():
-            out[robot] = out.get(robot, 0) + costs[(robot, obj, ws)]
+            cost = costs[(robot, obj, ws)]
+            assert cost is not None  # a chosen option has a cost
+            out[robot] = out.get(robot, 0) + cost
         return out
 
 
@@ -438,7 +481,9 @@ class _Search:
     exhaustive: bool
 
 
-def _branch_and_bound(order: Sequence[str], usable: Mapping[str, list], max_nodes: int) -> _Search:
+def _branch_and_bound(
+    order: Sequence[str], usable: Mapping[str, list[tuple[int, str, str]]], max_nodes: int
+) -> _Search:
     """Depth-first branch and bound over the objects in `order`, from the greedy assignment.
 
     Each object's options are tried in their rank order (`usable`); a branch is cut when its
@@ -483,7 +528,9 @@ def _branch_and_bound(order: Sequence[str], usable: Mapping[str, list], max_node
     return _Search(best, nodes, exhaustive)
 
 
-def _greedy(order: Sequence[str], usable: Mapping[str, list]) -> tuple[tuple[int, int], list[Option]]:
+def _greedy(
+    order: Sequence[str], usable: Mapping[str, list[tuple[int, str, str]]]
+) -> tuple[tuple[int, int], list[Option]]:
     """Each object in turn where it raises the makespan least: the first bound.
 
     The options are ranked (cost, seconds), so of options that raise it equally the cheapest

@@ -76,6 +76,11 @@ def blocking_word(sequences: Mapping[str, Sequence[Event]]) -> tuple[str, ...] |
     Messages are asynchronous (a responder sends and goes on; a requester waits until the
     answer has been sent), as the robots execute them: see
     :func:`cosmop.missions.team.blocking_word`.
+
+    Parameters
+    ----------
+    sequences : mapping of str to sequence of Event
+        Each robot's events, in order.
     """
     return team_blocking_word({r: [e.name for e in seq] for r, seq in sequences.items()})
 
@@ -140,17 +145,18 @@ def coordinate(
         return {r: tuple(seq) for r, seq in out.items()}
 
     preferred = {b: sorted(ps, key=rank) for b, ps in by_responder.items()}
-    candidates = [preferred]
+    candidates: list[Mapping[str, Sequence[Pair]]] = [preferred]
     alternatives = [list(itertools.permutations(ps)) for ps in preferred.values()]
     if alternatives and all(len(a) <= 24 for a in alternatives):
         for combo in itertools.islice(itertools.product(*alternatives), 1, 200):
             candidates.append(dict(zip(preferred, combo, strict=True)))
-    first_block = None
+    first_block: tuple[dict[str, tuple[Event, ...]], tuple[str, ...]] | None = None
     for orders in candidates:
         placed = place(orders)
         word = blocking_word(placed)
         if word is None:
             return Coordinated(MappingProxyType(placed), tuple(pairs), tuple(unanswered), True)
         first_block = first_block or (placed, word)
+    assert first_block is not None  # the candidates hold at least the preferred order
     placed, word = first_block
     return Coordinated(MappingProxyType(placed), tuple(pairs), tuple(unanswered), False, word)

@@ -24,6 +24,7 @@ import time
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
+from typing import Any
 
 import numpy as np
 
@@ -68,6 +69,15 @@ def factor_counterexample(modules: list[DFA], factor: DFA, log: SizeLog | None =
     :math:`u \\in P_{\\Sigma(T)}(\\|_i M_i) \\setminus T` is a shortest violation of the factor
     (the projection is computed compositionally), lifted to a word of the product that
     projects onto it; ``None`` when the factor holds.
+
+    Parameters
+    ----------
+    modules : list of DFA
+        The local missions :math:`M_i`.
+    factor : DFA
+        A factor :math:`T` of the global mission.
+    log : SizeLog, optional
+        Records every intermediate automaton.
     """
     view = project_composition(modules, factor.alphabet, log=log, minimal=False)  # only searched
     u = inclusion_counterexample(view, factor)
@@ -85,6 +95,15 @@ def separability_counterexample(
     """A word of :math:`\\|_i K^i` outside :math:`K`, or ``None`` when :math:`\\|_i K^i \\subseteq K`.
 
     Factor by factor (:func:`factor_counterexample`); the first violated factor gives the word.
+
+    Parameters
+    ----------
+    mission : Composition
+        The global mission :math:`K`, as its factors.
+    local : mapping of str to DFA
+        The local missions :math:`K^i` by robot.
+    log : SizeLog, optional
+        Records every intermediate automaton.
     """
     modules = list(local.values())
     for factor in mission.components:
@@ -141,7 +160,7 @@ class Resynthesis:
     removed: Mapping[str, tuple[Word, ...]]
     lost_events: Mapping[str, tuple[str, ...]]
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         """JSON-ready form."""
         return {
             "converged": self.converged,
@@ -240,7 +259,7 @@ class Messaging:
     rounds: int
     unordered: Mapping[str, tuple[str, ...]]
 
-    def to_dict(self) -> list[dict]:
+    def to_dict(self) -> list[dict[str, Any]]:
         """JSON-ready list: ``{"event", "sender", "receiver", "after", "before"}`` per message."""
         out, words = [], self.unordered
         for name, ((a, i), (b, j)) in self.messages:
@@ -255,6 +274,13 @@ def order_by_messages(mission: GlobalMission, local: Mapping[str, DFA]) -> Messa
 
     ``None`` when a local mission branches or no complete word of the mission interleaves the
     sequences (then only pruning or other words can help).
+
+    Parameters
+    ----------
+    mission : GlobalMission
+        The global mission, with its complete words.
+    local : mapping of str to DFA
+        The local missions by robot.
     """
     words = {}
     for robot, dfa in local.items():
@@ -262,6 +288,7 @@ def order_by_messages(mission: GlobalMission, local: Mapping[str, DFA]) -> Messa
         if seq is None:
             return None
         words[robot] = seq
+    assert mission.complete is not None  # set on construction
     result = order_words(mission.complete, words)
     if not result.feasible:
         return None
@@ -297,7 +324,7 @@ class DecompositionStats:
     mission_factors: int
     mission_factor_states: tuple[int, ...]
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         """JSON-ready form."""
         return {k: (list(v) if isinstance(v, tuple) else v) for k, v in self.__dict__.items()}
 
@@ -347,7 +374,7 @@ class Decomposition:
             return self.resynthesis.local_missions
         raise ValueError("no sound local missions: re-synthesis did not converge")
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         """JSON-ready form (``separable``, ``counterexample``, ``local_missions``, ...)."""
         return {
             "separable": self.separable,

@@ -69,7 +69,13 @@ class Handovers:
     unordered: tuple[tuple[str, tuple[str, int], tuple[str, int]], ...] = ()
 
     def to(self, robot: str) -> tuple[Handover, ...]:
-        """The hand-overs `robot` receives."""
+        """The hand-overs `robot` receives.
+
+        Parameters
+        ----------
+        robot : str
+            The receiver.
+        """
         return tuple(h for h in self.items if h.receiver == robot)
 
     def turns(self, robots: Sequence[str]) -> tuple[tuple[tuple[str, ...], tuple[Handover, ...]], ...]:
@@ -79,6 +85,11 @@ class Handovers:
         A robot is planned once every robot that hands it goods is (Kahn's algorithm); when the
         rest wait on each other in a cycle, the first hand-over among them (in `robots`' order)
         gets its spot chosen for both, and the wait is broken.
+
+        Parameters
+        ----------
+        robots : sequence of str
+            The robots to plan, in order.
         """
         waiting = {r: {h for h in self.to(r) if h.giver != r} for r in robots}
         todo, out = list(robots), []
@@ -126,6 +137,7 @@ def handovers(words: Mapping[str, Sequence[Event]]) -> Handovers:
     for robot, word in words.items():
         for i, event in enumerate(word, 1):
             if event.kind in ("pick", "drop") and event.robot == robot:
+                assert event.obj is not None  # a pick or a drop names its object
                 handling.setdefault(event.obj, []).append((robot, i, event))
     items, refused, unordered = [], [], []
     for obj, events in handling.items():

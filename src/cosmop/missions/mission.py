@@ -37,6 +37,13 @@ def sequence_automaton(events: Sequence[str], *, closed: bool = True) -> DFA:
     With ``closed=True`` (a mission) every state is marked, so the marked language is the
     prefix-closure :math:`\\overline{\\sigma_1 \\cdots \\sigma_k}`; with ``closed=False`` only
     the complete sequence is marked (used to see whether robots can all finish).
+
+    Parameters
+    ----------
+    events : sequence of str
+        The event names, in order.
+    closed : bool, default True
+        Whether every prefix is marked, or only the whole sequence.
     """
     return DFA.from_word(tuple(events), closed=closed)
 
@@ -45,8 +52,14 @@ def sequence_of(dfa: DFA) -> tuple[str, ...] | None:
     """The events of a linear DFA (one path, no branching, no cycle), or ``None``.
 
     The inverse of :func:`sequence_automaton`: a local mission that is one sequence of events.
+
+    Parameters
+    ----------
+    dfa : DFA
+        A local mission.
     """
-    q, seq, seen = dfa.initial, [], {dfa.initial}
+    q, seen = dfa.initial, {dfa.initial}
+    seq: list[str] = []
     while True:
         out = [j for j in range(dfa.n_events) if dfa.delta[q, j] >= 0]
         if not out:
@@ -88,6 +101,13 @@ def local_alphabets(events: Iterable[Event], robots: Iterable[str]) -> dict[str,
 
     A robot that owns no event gets the empty alphabet (its local mission is
     :math:`\\{\\varepsilon\\}`).
+
+    Parameters
+    ----------
+    events : iterable of Event
+        The mission's events.
+    robots : iterable of str
+        The team.
     """
     alphabets: dict[str, set[str]] = {robot: set() for robot in robots}
     for event in events:
@@ -136,10 +156,18 @@ class GlobalMission:
     @property
     def prefixes(self) -> Composition:
         r""":math:`\overline{K}`: every factor's runs that can still complete, all marked."""
+        assert self.complete is not None  # set on construction
         return Composition(tuple(prefix_closure(f) for f in self.complete.components))
 
     def is_complete_word(self, word: Sequence[str]) -> bool:
-        """Whether `word` (event names; messages ignored) is a complete word of the mission."""
+        """Whether `word` (event names; messages ignored) is a complete word of the mission.
+
+        Parameters
+        ----------
+        word : sequence of str
+            Event names, in order.
+        """
+        assert self.complete is not None  # set on construction
         known = set(self.complete.alphabet)
         if any(e not in known and not parse_event(e).is_message for e in word):
             return False
@@ -152,6 +180,7 @@ class GlobalMission:
     @property
     def completable(self) -> bool:
         """Whether every factor can reach a complete state (else no team run can complete)."""
+        assert self.complete is not None  # set on construction
         return all(bool(f.marked.any()) for f in self.complete.components)
 
     @property
@@ -161,7 +190,15 @@ class GlobalMission:
 
     @classmethod
     def from_mission(cls, mission: Mission, robots: Iterable[str]) -> GlobalMission:
-        """Build from a validated scenario :class:`~cosmop.scene.Mission`."""
+        """Build from a validated scenario :class:`~cosmop.scene.Mission`.
+
+        Parameters
+        ----------
+        mission : Mission
+            A validated scenario mission.
+        robots : iterable of str
+            The team, in scenario order.
+        """
         robots = tuple(robots)
         if mission.tasks is not None:
             events = {e.name: e for seq in mission.tasks.values() for e in seq}
@@ -202,6 +239,7 @@ class GlobalMission:
         has moved something (complete when it moved nothing, or is home; without ``return``,
         whenever it carries nothing).
         """
+        assert mission.deliveries is not None  # the caller's test
         events = {e.name: e for e in mission.events}
         prefix, complete = [], []
         for d in mission.deliveries:
@@ -228,6 +266,11 @@ class GlobalMission:
     def from_scenario(cls, scenario: Scenario) -> GlobalMission:
         """The mission of a loaded scenario, with the scene's robots as the team.
 
+        Parameters
+        ----------
+        scenario : Scenario
+            A loaded scenario with a mission.
+
         Raises
         ------
         ValueError
@@ -239,7 +282,15 @@ class GlobalMission:
 
     @classmethod
     def from_dfa(cls, dfa: DFA, robots: Iterable[str] | None = None) -> GlobalMission:
-        """Wrap an explicit DFA whose event names parse as mission events."""
+        """Wrap an explicit DFA whose event names parse as mission events.
+
+        Parameters
+        ----------
+        dfa : DFA
+            The mission automaton.
+        robots : iterable of str, optional
+            The team; by default the events' owners, sorted.
+        """
         events = {name: parse_event(name) for name in dfa.alphabet}
         team = (
             tuple(robots)
@@ -252,7 +303,15 @@ class GlobalMission:
     def from_tasks(
         cls, tasks: Mapping[str, Sequence[str]], robots: Iterable[str] | None = None
     ) -> GlobalMission:
-        """The parallel composition of one event sequence per robot (canonical event names)."""
+        """The parallel composition of one event sequence per robot (canonical event names).
+
+        Parameters
+        ----------
+        tasks : mapping of str to sequence of str
+            Each robot's events, in order.
+        robots : iterable of str, optional
+            The team; by default the robots of `tasks`.
+        """
         events = {name: parse_event(name) for seq in tasks.values() for name in seq}
         factors = tuple(sequence_automaton(list(seq)) for seq in tasks.values())
         ends = tuple(sequence_automaton(list(seq), closed=False) for seq in tasks.values())

@@ -34,6 +34,7 @@ from __future__ import annotations
 from collections import deque
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import TypeAlias
 
 from cosmop.automata import Composition
 from cosmop.errors import MissionTooLargeError
@@ -51,6 +52,11 @@ __all__ = [
 
 Edge = tuple[tuple[str, int], tuple[str, int]]
 """``((A, a), (B, b))``: B's event at index b waits for A's event at index a (0-based)."""
+
+_State: TypeAlias = tuple[tuple[int, ...], tuple[int, ...]]
+"""A team state: each robot's position in its word, and each factor's state."""
+_Moves: TypeAlias = list[tuple[int, _State | None]]
+"""The enabled moves of a state: ``(robot index, next state or None if it leaves the mission)``."""
 
 
 @dataclass(frozen=True)
@@ -79,7 +85,13 @@ class WordOrder:
 
 
 def message_edges(words: Mapping[str, Sequence[str]]) -> list[Edge]:
-    """The edges of the message events already in the words: send occurrence -> receive one."""
+    """The edges of the message events already in the words: send occurrence -> receive one.
+
+    Parameters
+    ----------
+    words : mapping of str to sequence of str
+        Each robot's word (event names).
+    """
     sends: dict[str, tuple[str, int]] = {}
     waits: dict[str, tuple[str, int]] = {}
     for robot, word in words.items():
@@ -108,13 +120,13 @@ class _Team:
         event = parse_event(name)
         return not event.is_message or event.sender == robot  # a message moves K when sent
 
-    def start(self) -> tuple:
+    def start(self) -> _State:
         return (tuple(0 for _ in self.robots), tuple(f.initial for f in self.factors))
 
-    def moves(self, state: tuple) -> list[tuple[int, tuple | None]]:
+    def moves(self, state: _State) -> _Moves:
         """Enabled moves ``(robot index, next state or None if it leaves the mission)``."""
         positions, qs = state
-        out = []
+        out: _Moves = []
         for n, p in enumerate(positions):
             if p >= len(self.words[n]):
                 continue
@@ -137,17 +149,18 @@ class _Team:
             out.append((n, None if dead else (npos, tuple(nqs))))
         return out
 
-    def complete(self, state: tuple) -> bool:
+    def complete(self, state: _State) -> bool:
         positions, qs = state
         return all(p == len(w) for p, w in zip(positions, self.words, strict=True)) and all(
             bool(f.marked[q]) for f, q in zip(self.factors, qs, strict=True)
         )
 
 
-def _explore(team: _Team, max_states: int) -> tuple[list, dict, dict]:
+def _explore(team: _Team, max_states: int) -> tuple[list[_State], dict[_State, _Moves], set[_State]]:
     """Reachable states in breadth-first order, their moves, and the good ones."""
     start = team.start()
-    order, seen, moves = [start], {start}, {}
+    order, seen = [start], {start}
+    moves: dict[_State, _Moves] = {}
     queue = deque([start])
     while queue:
         state = queue.popleft()
@@ -233,17 +246,29 @@ def order_words(
     return WordOrder(True, tuple(kept), _witness(team, order, moves, good), len(order), rounds)
 
 
-def _witness(team: _Team, order: list, moves: dict, good: set) -> tuple[str, ...]:
+def _witness(
+    team: _Team, order: list[_State], moves: Mapping[_State, _Moves], good: set[_State]
+) -> tuple[str, ...]:
     """A complete run: from the start, always a move into a good state."""
     state, word = team.start(), []
     while not team.complete(state):
-        n, state = next((n, nxt) for n, nxt in moves[state] if nxt in good)
+        n, state = next((n, nxt) for n, nxt in moves[state] if nxt is not None and nxt in good)
         word.append(team.words[n][state[0][n] - 1])
     return tuple(word)
 
 
 def reduce_edges(lengths: Mapping[str, int], fixed: Sequence[Edge], edges: Sequence[Edge]) -> list[Edge]:
-    """`edges` without those implied by program order, `fixed` and the other kept edges."""
+    """`edges` without those implied by program order, `fixed` and the other kept edges.
+
+    Parameters
+    ----------
+    lengths : mapping of str to int
+        Each robot's word length.
+    fixed : sequence of Edge
+        Edges that stay (the messages').
+    edges : sequence of Edge
+        The edges to reduce, in order.
+    """
     kept = list(edges)
     for edge in list(edges):
         rest = [e for e in kept if e != edge]
@@ -276,7 +301,13 @@ def _implied(lengths: Mapping[str, int], edges: Sequence[Edge], edge: Edge) -> b
 
 
 def message_tag(name: str) -> str:
-    """A message tag that says after which event it is sent: ``drop(R1,O1,W1)`` -> ``after_drop_O1_W1``."""
+    """A message tag that says after which event it is sent: ``drop(R1,O1,W1)`` -> ``after_drop_O1_W1``.
+
+    Parameters
+    ----------
+    name : str
+        The event's canonical name.
+    """
     event = parse_event(name)
     parts = [event.kind] + [p for p in (event.obj, event.workspace, event.tag) if p]
     return "after_" + "_".join(parts)
@@ -290,6 +321,13 @@ def with_messages(
     For an edge ``((A, a), (B, b))`` the message ``msg(A,B,tag)`` goes right after A's event
     *a* and right before B's event *b* (indices into the given words); at one place a robot's
     sends come before its waits, so that it never waits with news it could already give.
+
+    Parameters
+    ----------
+    words : mapping of str to sequence of str
+        Each robot's word (event names).
+    edges : sequence of Edge
+        The edges to turn into messages.
     """
     inserts: dict[str, list[tuple[int, int, str]]] = {r: [] for r in words}
     used: set[str] = set()

@@ -42,8 +42,10 @@ from __future__ import annotations
 import heapq
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any, TypeAlias, TypeVar
 
 import numpy as np
+from numpy.typing import NDArray
 
 __all__ = ["Link", "Node", "Precedence", "TakenBack"]
 
@@ -51,6 +53,12 @@ Node = tuple[str, int]
 """A step of a plan: ``(robot, instant)``, instants 1..K (0 is the start)."""
 
 _NEVER = -1  # the row of the source of a message nobody sends
+
+_Entry: TypeAlias = tuple[Any, ...]
+"""An entry of an undo log: ``(None, target, source)`` for a start edge linked, or ``(row,
+masks, old mask, times, old time)`` for a step's clock and time raised (the lists changed)."""
+
+_T = TypeVar("_T")
 
 
 @dataclass(frozen=True)
@@ -121,7 +129,9 @@ class Precedence:
         self.column = {r: n for n, r in enumerate(self.robots)}
         self.horizons = dict(horizons)
         sizes = [self.horizons[r] + 2 for r in self.robots]
-        self.offsets = dict(zip(self.robots, np.cumsum([0, *sizes]).tolist()[:-1], strict=True))
+        self.offsets: dict[str, int] = dict(
+            zip(self.robots, np.cumsum([0, *sizes]).tolist()[:-1], strict=True)
+        )
         self.size = sum(sizes)
         self.durations = {
             r: np.asarray(durations[r] if durations is not None else np.ones(k), dtype=float)
@@ -176,7 +186,13 @@ class Precedence:
 
     def rows(self, edge: tuple[Node, Node]) -> tuple[int, int]:
         """The rows of the start edge ``(A, i) -> (B, j)``: A's step i (:data:`_NEVER` if it
-        never completes) and B's step j."""
+        never completes) and B's step j.
+
+        Parameters
+        ----------
+        edge : (Node, Node)
+            ``((A, i), (B, j))``.
+        """
         return self._source(edge[0]), self._row(edge[1])
 
     # -- construction -------------------------------------------------------------------------
@@ -240,7 +256,7 @@ class Precedence:
                 bits[rows] = np.frombuffer(packed, dtype=np.uint8).reshape(len(rows), n)
                 flat[rows] = [times[r] for r in rows]
 
-    def _mirror_log(self, log: list) -> None:
+    def _mirror_log(self, log: list[_Entry]) -> None:
         """:meth:`_mirror` the rows an undo log changed."""
         D = self._D
         changed = [(entry[0], entry[1] is D) for entry in log if entry[0] is not None]
@@ -248,13 +264,18 @@ class Precedence:
 
     # -- adding start edges one at a time (the ordering search) ---------------------------------
 
-    def add_start(self, edge: tuple[Node, Node]) -> list:
+    def add_start(self, edge: tuple[Node, Node]) -> list[_Entry]:
         """Add the start edge ``((A, i), (B, j))`` and update clocks and times incrementally.
 
         Clocks and times only grow, so the change propagates from B's step j to the steps after
         it with maxima, each step raised once, by the steps it waits for that changed, in the
         order's topological order (:meth:`_place`).  The order must stay acyclic (check
         :meth:`would_cycle` first) and complete.  Returns an undo log for :meth:`undo`.
+
+        Parameters
+        ----------
+        edge : (Node, Node)
+            ``((A, i), (B, j))``: B starts step j once A has completed step i.
         """
         source, target = self._source(edge[0]), self._row(edge[1])
         if not self._place(source, target):
@@ -264,7 +285,7 @@ class Precedence:
         self._mirror_log(log)
         return log
 
-    def add_starts(self, edges: Sequence[tuple[Node, Node]]) -> tuple[list, list[int]]:
+    def add_starts(self, edges: Sequence[tuple[Node, Node]]) -> tuple[list[_Entry], list[int]]:
         """Add start edges in their order, each unless it closes a cycle with those before it,
         as :meth:`would_cycle` then :meth:`add_start` for each in turn would, but in one pass.
 
@@ -274,6 +295,11 @@ class Precedence:
         fixpoint of the edges taken, whatever the order they are added in, so they are those of
         one edge at a time.
 
+        Parameters
+        ----------
+        edges : sequence of (Node, Node)
+            Start edges ``((A, i), (B, j))``, in order.
+
         Returns
         -------
         log : list
@@ -281,7 +307,9 @@ class Precedence:
         refused : list of int
             The indices of the edges not added (each closes a cycle with those before it).
         """
-        log, refused, targets = [], [], set()
+        log: list[_Entry] = []
+        refused: list[int] = []
+        targets: set[int] = set()
         for n, (s, t) in enumerate(edges):
             source, target = self._source(s), self._row(t)
             if self._place(source, target):
@@ -297,7 +325,7 @@ class Precedence:
         self._mirror_log(log)
         return log, refused
 
-    def _propagate(self, log: list, pending: dict[int, tuple[list[int], list[int]]]) -> None:
+    def _propagate(self, log: list[_Entry], pending: dict[int, tuple[list[int], list[int]]]) -> None:
         """Settle the `pending` steps and every step they change, in topological order.
 
         `pending` maps a step to the changed steps it starts after and completes after; a step
@@ -340,9 +368,10 @@ class Precedence:
                 continue
             if row in last:  # "start of K+1": after the whole plan
                 _raise(log, B, S, row + 1, D[row], F[row])
-            after = succ.get(row, ())
-            if nxt[row] is not None:
-                after = [(nxt[row], False), *after]
+            after: Sequence[tuple[int, bool]] = succ.get(row, ())
+            following = nxt[row]
+            if following is not None:
+                after = [(following, False), *after]
             for then, is_done in after:
                 if then not in pending:
                     pending[then] = ([], [])
@@ -383,9 +412,9 @@ class Precedence:
             place[row] = position
         return True
 
-    def _link(self, edges: Sequence[tuple[int, int]]) -> list:
+    def _link(self, edges: Sequence[tuple[int, int]]) -> list[_Entry]:
         """Put the start `edges` (rows) in the order's tables (clocks untouched): their undo log."""
-        log: list = []
+        log: list[_Entry] = []
         for source, target in edges:
             self._into_start.setdefault(target, []).append(source)
             self._succ.setdefault(source, []).append((target, False))
@@ -414,8 +443,14 @@ class Precedence:
                 t = F[s]
         return clock, t
 
-    def undo(self, log: list) -> None:
-        """Take back an :meth:`add_start` or :meth:`add_starts` (logs are undone newest first)."""
+    def undo(self, log: list[_Entry]) -> None:
+        """Take back an :meth:`add_start` or :meth:`add_starts` (logs are undone newest first).
+
+        Parameters
+        ----------
+        log : list
+            An undo log of :meth:`add_start`, :meth:`add_starts` or :meth:`take_back`.
+        """
         for entry in reversed(log):
             if entry[0] is None:
                 self._into_start[entry[1]].pop()
@@ -425,7 +460,7 @@ class Precedence:
                 masks[row], times[row] = old, t
         self._mirror_log(log)
 
-    def take_back(self, logs: Sequence[list], edges: Sequence[tuple[Node, Node]]) -> list:
+    def take_back(self, logs: Sequence[list[_Entry]], edges: Sequence[tuple[Node, Node]]) -> list[_Entry]:
         """Remove some of the start edges that `logs` added, keeping the others where they are.
 
         `logs` are the undo logs of every :meth:`add_start` and :meth:`add_starts` since some
@@ -435,12 +470,22 @@ class Precedence:
         changed since *S* and the logs hold its value in *S*: their entries, without the links
         of the edges gone and with only the oldest value of each step, are one undo log that
         restores *S*, returned for :meth:`undo`.  The order must be complete.
+
+        Parameters
+        ----------
+        logs : sequence of list
+            The undo logs since the state *S*, oldest first.
+        edges : sequence of (Node, Node)
+            The start edges to remove.
         """
         gone: dict[tuple[int, int], int] = {}
         for s, t in edges:
             key = (self._source(s), self._row(t))
             gone[key] = gone.get(key, 0) + 1
-        links, values, seeds, D = [], {}, set(), self._D
+        links: list[_Entry] = []
+        values: dict[tuple[int, bool], _Entry] = {}
+        seeds: set[int] = set()
+        D = self._D
         for log in logs:
             if isinstance(log, _Compact):  # from an earlier take_back: its values by step
                 entries = log[: log.links]
@@ -505,6 +550,11 @@ class Precedence:
         """Whether ``first = (A, i)`` always completes before ``then = (B, j)`` starts.
 
         ``j`` may be ``K_B + 1`` (after B's plan); ``j = 0`` is the beginning (never).
+
+        Parameters
+        ----------
+        first, then : Node
+            The steps ``(A, i)`` and ``(B, j)``.
         """
         (a, i), (b, j) = first, then
         if j <= 0 or b not in self.column or a not in self.column:
@@ -514,7 +564,13 @@ class Precedence:
         return self._has(self._B, self._row(then), first)
 
     def precedes(self, first: Node, then: Node) -> bool:
-        """Whether ``first = (A, i)`` always completes before ``then = (B, j)`` completes."""
+        """Whether ``first = (A, i)`` always completes before ``then = (B, j)`` completes.
+
+        Parameters
+        ----------
+        first, then : Node
+            The steps ``(A, i)`` and ``(B, j)``.
+        """
         (a, i), (b, j) = first, then
         if a == b:
             return i <= j
@@ -522,7 +578,13 @@ class Precedence:
 
     def would_cycle(self, first: Node, then: Node) -> bool:
         """Whether the start edge ``first -> then`` closes a cycle: ``then`` must already
-        complete before ``first`` does."""
+        complete before ``first`` does.
+
+        Parameters
+        ----------
+        first, then : Node
+            The ends of the start edge.
+        """
         (a, i), (b, j) = first, then
         if a == b:
             return j <= i
@@ -530,26 +592,56 @@ class Precedence:
 
     def done_before(self, row: int) -> int:
         """The steps that always complete before the step of `row` completes (its vector clock
-        as a set of rows, one bit each; 0 for a row past a plan, ``-1``)."""
+        as a set of rows, one bit each; 0 for a row past a plan, ``-1``).
+
+        Parameters
+        ----------
+        row : int
+            A step's row (``-1``: :data:`_NEVER`).
+        """
         return self._D[row] if row >= 0 else 0
 
     def completed(self, step: Node, robot: str) -> int:
         """How many of `robot`'s steps always complete by the completion of `step` (its entry
-        in the step's vector clock)."""
+        in the step's vector clock).
+
+        Parameters
+        ----------
+        step : Node
+            The step ``(A, i)``.
+        robot : str
+            The robot whose steps are counted.
+        """
         o, k = self.offsets[robot], self.horizons[robot]
         return (self._D[self._row(step)] >> (o + 1) & ((1 << k) - 1)).bit_count()
 
-    def places(self, steps: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    def places(self, steps: NDArray[np.int64], rows: NDArray[np.int64]) -> NDArray[np.int64]:
         """Where :meth:`completes_before` reads whether the step of row ``steps[n]`` completes
         before the step of row ``rows[n]``: the bit in the flattened tables.  Rows are
         ``offsets[robot] + instant``; those of instants 0 and K+1 are in no set.  The places
-        :attr:`never` and :attr:`always` read ``False`` and ``True``."""
-        return rows * (self.done_bits.shape[1] * 8) + steps
+        :attr:`never` and :attr:`always` read ``False`` and ``True``.
 
-    def completes_before(self, at: np.ndarray, *, start: bool = False) -> np.ndarray:
+        Parameters
+        ----------
+        steps, rows : ndarray of int
+            Rows of the steps asked about and of the steps they are compared with.
+        """
+        at: NDArray[np.int64] = rows * (self.done_bits.shape[1] * 8) + steps
+        return at
+
+    def completes_before(self, at: NDArray[np.int64], *, start: bool = False) -> NDArray[np.bool_]:
         """Vectorised :meth:`precedes` (:meth:`before_start` with `start`) at the :meth:`places`
-        `at`: whether each step completes before the other completes (starts)."""
-        return (self._flat[start][at >> 3] >> (at & 7)) & 1 == 1
+        `at`: whether each step completes before the other completes (starts).
+
+        Parameters
+        ----------
+        at : ndarray of int
+            Places, from :meth:`places`.
+        start : bool, default False
+            Whether to ask about the other step's start instead of its completion.
+        """
+        found: NDArray[np.bool_] = (self._flat[start][at >> 3] >> (at & 7)) & 1 == 1
+        return found
 
     @property
     def makespan(self) -> float:
@@ -557,7 +649,13 @@ class Precedence:
         return max((self._F[o + self.horizons[r]] for r, o in self.offsets.items()), default=0.0)
 
     def start_time(self, node: Node) -> float:
-        """Earliest start of step ``(robot, k)`` (``k = K + 1``: the end of its plan)."""
+        """Earliest start of step ``(robot, k)`` (``k = K + 1``: the end of its plan).
+
+        Parameters
+        ----------
+        node : Node
+            The step ``(robot, k)``.
+        """
         return self._S[self._row(node)] if node[1] >= 1 else 0.0
 
 
@@ -590,14 +688,26 @@ class TakenBack:
         self.before: dict[int, int] = {}  # such a row -> the rows that complete before a source
 
     def take(self, source: int, target: int) -> None:
-        """Count the edge ``source -> target`` as taken back."""
+        """Count the edge ``source -> target`` as taken back.
+
+        Parameters
+        ----------
+        source, target : int
+            The edge's rows (:meth:`Precedence.rows`).
+        """
         if source != _NEVER:
             self.targets |= 1 << target
             self.before[target] = self.before.get(target, 0) | self.done[source]
 
     def may_pass(self, source: int, target: int) -> bool:
         """Whether a cycle that the edge ``source -> target`` closes may run through an edge
-        taken back."""
+        taken back.
+
+        Parameters
+        ----------
+        source, target : int
+            The edge's rows (:meth:`Precedence.rows`).
+        """
         if source == _NEVER:
             return False
         reach = self.done[source] & self.targets
@@ -609,19 +719,19 @@ class TakenBack:
         return False
 
 
-class _Compact(list):
+class _Compact(list[_Entry]):
     """An undo log of :meth:`Precedence.take_back`: its links, then one value per step (the
     oldest), also kept by step in :attr:`values`."""
 
     __slots__ = ("links", "values")
 
-    def __init__(self, links: list, values: dict) -> None:
+    def __init__(self, links: list[_Entry], values: dict[tuple[int, bool], _Entry]) -> None:
         super().__init__(links)
         self += values.values()
         self.links, self.values = len(links), values
 
 
-def _drop_last(items: list, item) -> None:
+def _drop_last(items: list[_T], item: _T) -> None:
     """Remove the last occurrence of `item` from `items`."""
     for n in range(len(items) - 1, -1, -1):
         if items[n] == item:
@@ -630,7 +740,7 @@ def _drop_last(items: list, item) -> None:
     raise ValueError(f"{item!r} is not in the list")
 
 
-def _raise(log: list, masks: list[int], times: list[float], row: int, clock: int, t: float) -> bool:
+def _raise(log: list[_Entry], masks: list[int], times: list[float], row: int, clock: int, t: float) -> bool:
     """Raise the set ``masks[row]`` to hold `clock` and ``times[row]`` to `t`; log the old
     values.  Whether anything grew (a time by more than rounding)."""
     old, new, old_t = masks[row], masks[row] | clock, times[row]

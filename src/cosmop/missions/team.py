@@ -25,6 +25,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
+from typing import TypeAlias
 
 import numpy as np
 
@@ -38,7 +39,13 @@ __all__ = ["TeamVerdict", "blocking_word", "check_words", "team_modules", "verif
 
 
 def word_links(words: Mapping[str, Sequence[str]]) -> list[Link]:
-    """The messages of the words as links between occurrences (instants 1-based)."""
+    """The messages of the words as links between occurrences (instants 1-based).
+
+    Parameters
+    ----------
+    words : mapping of str to sequence of str
+        Every robot's word (event names), messages included.
+    """
     sends: dict[str, tuple[str, int]] = {}
     waits: dict[str, tuple[str, int]] = {}
     for robot, word in words.items():
@@ -49,6 +56,7 @@ def word_links(words: Mapping[str, Sequence[str]]) -> list[Link]:
     out = []
     for name in sorted(set(sends) | set(waits)):
         event = parse_event(name)
+        assert event.sender is not None and event.receiver is not None  # a message names both
         send = sends.get(name)
         wait = waits.get(name)
         out.append(
@@ -85,7 +93,7 @@ def _module(robot: str, word: Sequence[str], *, closed: bool) -> DFA:
                 todo.append(nxt)
             row[col[name]] = states[nxt]
         rows.append(row)
-    order = sorted(states, key=states.get)
+    order = sorted(states, key=states.__getitem__)
     marked = np.array([closed or (p == len(word) and not got) for p, got in order], dtype=bool)
     delta = np.array(rows, dtype=np.int32).reshape(len(order), len(alphabet))
     return DFA(tuple(alphabet), delta, 0, marked)
@@ -96,6 +104,13 @@ def team_modules(words: Mapping[str, Sequence[str]], *, closed: bool = True) -> 
 
     With ``closed=True`` every state is marked (the words' prefixes), else only the end of the
     word (complete runs).
+
+    Parameters
+    ----------
+    words : mapping of str to sequence of str
+        Every robot's word (event names), messages included.
+    closed : bool, default True
+        Whether every state is marked, or only the end of the word.
     """
     return {robot: _module(robot, word, closed=closed) for robot, word in words.items()}
 
@@ -142,7 +157,13 @@ class TeamVerdict:
 
 
 def blocking_word(words: Mapping[str, Sequence[str]]) -> tuple[str, ...] | None:
-    """A shortest word into the team's deadlock (then the waits), or ``None`` if it cannot block."""
+    """A shortest word into the team's deadlock (then the waits), or ``None`` if it cannot block.
+
+    Parameters
+    ----------
+    words : mapping of str to sequence of str
+        Every robot's word (event names), messages included.
+    """
     precedence = Precedence({r: len(w) for r, w in words.items()}, word_links(words))
     if precedence.complete:
         return None
@@ -175,16 +196,24 @@ def verify_team(
     safety = verify(replace(mission, automaton=mission.prefixes), team_modules(words), method=method)
     if not safety.holds:
         return TeamVerdict(False, None, safety, None, safety.counterexample)
+    assert mission.complete is not None  # set on construction
     completion = verify(
         replace(mission, automaton=mission.complete), team_modules(words, closed=False), method=method
     )
     return TeamVerdict(completion.holds, None, safety, completion, completion.counterexample)
 
 
-def _factor_counterexample(factor: DFA, words: Mapping[str, Sequence[str]], precedence: Precedence):
+_State: TypeAlias = tuple[tuple[int, ...], int]
+"""A state of the search of :func:`_factor_counterexample`: each robot's occurrences done, and
+the factor's state."""
+
+
+def _factor_counterexample(
+    factor: DFA, words: Mapping[str, Sequence[str]], precedence: Precedence
+) -> tuple[str, ...] | None:
     """A run of the team whose events of the factor are not a complete word of it, or ``None``."""
     sigma = set(factor.alphabet)
-    occurrences = {}
+    occurrences: dict[str, list[tuple[int, str]]] = {}
     for robot, word in words.items():
         occ = [
             (k, name)
@@ -203,8 +232,8 @@ def _factor_counterexample(factor: DFA, words: Mapping[str, Sequence[str]], prec
         for r in robots
         for p, (kk, _) in enumerate(occurrences[r])
     }
-    start = (tuple(0 for _ in robots), factor.initial)
-    parent = {start: None}
+    start: _State = (tuple(0 for _ in robots), factor.initial)
+    parent: dict[_State, tuple[_State, str] | None] = {start: None}
     queue = [start]
     for state in queue:
         positions, q = state
@@ -228,10 +257,15 @@ def _factor_counterexample(factor: DFA, words: Mapping[str, Sequence[str]], prec
     return None
 
 
-def _trail(parent, state, robots, occurrences) -> tuple[str, ...]:
+def _trail(
+    parent: Mapping[_State, tuple[_State, str] | None],
+    state: _State,
+    robots: Sequence[str],
+    occurrences: Mapping[str, Sequence[tuple[int, str]]],
+) -> tuple[str, ...]:
     out = []
-    while parent.get(state) is not None:
-        state, name = parent[state]
+    while (step := parent.get(state)) is not None:
+        state, name = step
         out.append(name)
     return tuple(reversed(out))
 
@@ -242,11 +276,19 @@ def check_words(mission: GlobalMission, words: Mapping[str, Sequence[str]]) -> T
 
     Exact, like :func:`verify_team`; it explores, per factor of the mission, only the order
     induced on that factor's events.
+
+    Parameters
+    ----------
+    mission : GlobalMission
+        The global mission, with its complete words.
+    words : mapping of str to sequence of str
+        Every robot's word (event names), messages included.
     """
     words = {r: tuple(words.get(r, ())) for r in mission.robots} | {r: tuple(w) for r, w in words.items()}
     precedence = Precedence({r: len(w) for r, w in words.items()}, word_links(words))
     if not precedence.complete:
         return TeamVerdict(False, blocking_word(words), None, None, None)
+    assert mission.complete is not None  # set on construction
     for factor in mission.complete.components:
         word = _factor_counterexample(factor, words, precedence)
         if word is not None:

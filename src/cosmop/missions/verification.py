@@ -42,7 +42,7 @@ from __future__ import annotations
 import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -98,7 +98,7 @@ class AssumptionReport:
     equivalence_queries: int
     holds: bool
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         """JSON-ready form."""
         a = self.assumption
         return {
@@ -175,7 +175,7 @@ class Verification:
         methods = {c.method for c in self.checks}
         return methods.pop() if len(methods) == 1 else "mixed"
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         """JSON-ready form."""
         return {
             "holds": self.holds,
@@ -218,7 +218,7 @@ class _Membership:
         k_rows.append([dead] * spec.n_events)
         m1_rows = m1.delta.tolist()
 
-        def mover(event: str):
+        def mover(event: str) -> tuple[int | None, int | None]:
             """(M1 column or None, K column or None) for ``event``."""
             return m1_index.get(event), k_index.get(event)
 
@@ -227,7 +227,7 @@ class _Membership:
         self.m1_rows, self.k_rows = m1_rows, k_rows
         self.start = self._close({(m1.initial, spec.initial)})
 
-    def _step(self, pairs: set[tuple[int, int]], move) -> set[tuple[int, int]]:
+    def _step(self, pairs: set[tuple[int, int]], move: tuple[int | None, int | None]) -> set[tuple[int, int]]:
         jm, jk = move
         out = set()
         for m, k in pairs:
@@ -264,7 +264,7 @@ class _Membership:
         return self.holds(pairs)
 
 
-def _to_dfa(hypothesis, interface: Sequence[str]) -> DFA:
+def _to_dfa(hypothesis: Any, interface: Sequence[str]) -> DFA:
     """Convert an AALpy DFA hypothesis (complete, with a rejecting sink) to a minimal DFA."""
     states = list(hypothesis.states)
     ids = {s.state_id: k for k, s in enumerate(states)}
@@ -291,6 +291,7 @@ def _learn_assumption(
     oracle = _Membership(m1, spec, interface)
     sul = _membership_sul(oracle)
     teacher = _teacher(sul, oracle, m1, environment, spec, interface, log)
+    holds: bool | None
     try:
         run_Lstar(
             list(interface),
@@ -318,7 +319,7 @@ def _membership_sul(oracle: _Membership) -> SUL:
     """
     from aalpy.base import SUL
 
-    class Membership(SUL):
+    class Membership(SUL):  # type: ignore[misc]  # aalpy has no stubs
         """AALpy's view of the membership oracle: one step per interface event."""
 
         def __init__(self) -> None:
@@ -331,7 +332,7 @@ def _membership_sul(oracle: _Membership) -> SUL:
         def post(self) -> None:
             pass
 
-        def step(self, letter):
+        def step(self, letter: str | None) -> bool:
             if letter is not None:
                 self.pairs = oracle.advance(self.pairs, letter)
             return oracle.holds(self.pairs)
@@ -358,7 +359,7 @@ def _teacher(
     """
     from aalpy.base import Oracle
 
-    class Teacher(Oracle):
+    class Teacher(Oracle):  # type: ignore[misc]  # aalpy has no stubs
         def __init__(self, alphabet: list[str], sul: SUL) -> None:
             super().__init__(alphabet, sul)
             self.last: DFA | None = None
@@ -366,7 +367,7 @@ def _teacher(
             self.membership = 0
             self.equivalence = 0
 
-        def find_cex(self, hypothesis):
+        def find_cex(self, hypothesis: Any) -> Word | None:
             self.equivalence += 1
             a = log.observe(_to_dfa(hypothesis, interface))
             self.last = a
@@ -563,6 +564,7 @@ def _environment(roles: _Roles, sigma: set[str], team: _Team) -> tuple[tuple[str
     :math:`\\Sigma_A = \\Sigma_{M_2} \\cap (\\Sigma_{M_1} \\cup \\Sigma_K)`, sorted; the abstraction is
     the compositional projection of the environment's modules (the product is never built).
     """
+    assert roles.guarantor is not None  # a cluster of two robots or more has one
     m1_sigma = team.alphabets[roles.guarantor]
     env_sigma = set().union(*(team.alphabets[r] for r in roles.environment))
     interface = tuple(sorted(env_sigma & (m1_sigma | sigma)))
@@ -591,6 +593,7 @@ def _assume_guarantee(
         A violation lifted to a word of the cluster.
     """
     guarantor = roles.guarantor
+    assert guarantor is not None  # a cluster of two robots or more has one
     holds, assumption, violation, mq, eq = _learn_assumption(
         team.local[guarantor], abstraction, factor, interface, team.log, max_rounds
     )

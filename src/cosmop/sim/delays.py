@@ -87,6 +87,12 @@ class Delays:
     def parse(cls, text: str) -> Delays:
         """The delays written ``P:MIN:MAX`` (``0.01:2:10``: 1 % a second, 2 to 10 s).
 
+        Parameters
+        ----------
+        text : str
+            ``P:MIN:MAX``: the probability per robot and second, and the shortest and the longest
+            stop, s.
+
         Raises
         ------
         ValueError
@@ -131,7 +137,13 @@ class DelayDraws:
 
     def due(self, t: float) -> list[tuple[int, float]]:
         """The stops that strike by time `t` (s) and were not yet given: ``(robot index, seconds)``,
-        in order of time, then of robot."""
+        in order of time, then of robot.
+
+        Parameters
+        ----------
+        t : float
+            Time now, s.
+        """
         out: list[tuple[int, float]] = []
         d = self.delays
         while self._next <= t + _EPS:

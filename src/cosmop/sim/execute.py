@@ -38,7 +38,7 @@ from cosmop.control.geometry import box_gaps
 from cosmop.control.safety import stopping_margin
 from cosmop.docking import docking_pose, in_front
 from cosmop.events import Primitive
-from cosmop.planning.plan import Step
+from cosmop.planning.plan import Pose, Step
 from cosmop.sim.motion import HOLD, REPLANNED, brake, creep_is_safe, creep_out, drive, halt
 from cosmop.sim.world import TOUCH, Action, Agent, World
 
@@ -65,6 +65,13 @@ def decide(world: World, agent: Agent) -> Action:
     Steps that are done at once (a message sent, a drive already at its goal) are completed in
     the same cycle; a robot that has finished brakes.  A robot a delay has stopped
     (:mod:`cosmop.sim.delays`) brakes along its arc and stands, its step left as it was.
+
+    Parameters
+    ----------
+    world : World
+        The running simulation.
+    agent : Agent
+        The robot deciding.
     """
     if agent.stopped_until is not None:
         return halt(world, agent.index)
@@ -99,16 +106,26 @@ def go_to(world: World, agent: Agent, step: Step) -> Action | None:
     A waypoint from which the plan approaches a pose that touches something is reached too
     (not turned): cutting its corner would cut into what that pose touches.  A robot that
     starts off touching something creeps out first (:func:`cosmop.sim.motion.creep_out`).
+
+    Parameters
+    ----------
+    world : World
+        The running simulation.
+    agent : Agent
+        The robot executing the step.
+    step : Step
+        Its current step.
     """
     k = agent.step_index
     agent.through = False
     after = _next_drive(world, agent, k)
     last = after is None
     goal = step.robot
-    stop = last or bool(
+    stop = after is None or bool(
         world.static_gaps(agent.steps[after].robot[:2], world.robot_half[agent.index])[0]
         < world.settings.leave_gap
     )
+    origin: Pose | None
     if agent.replan_start is not None and agent.replan_start[0] == k:  # a replan's first step
         origin = agent.replan_start[1]
     else:
@@ -147,12 +164,22 @@ def pick_up(world: World, agent: Agent, step: Step) -> Action | None:
     The gripper touches the object from the docking on; a pick-up whose docking is blocked
     within ``reach`` of its pose still picks the object up.  A carried object rides on its
     robot, inside the robot's square, as in the plan model where a carried object takes no room.
+
+    Parameters
+    ----------
+    world : World
+        The running simulation.
+    agent : Agent
+        The robot executing the step.
+    step : Step
+        Its current step.
     """
     i = agent.index
     j = world.object_ids.index(step.object)
     heading = float(step.robot[2]) % 360.0
     gap = world.robot_half[i] + world.object_half[j]
-    dock = (*map(float, docking_pose(world.object_xy[j], gap, heading)), heading)
+    x, y = docking_pose(world.object_xy[j], gap, heading)
+    dock = (float(x), float(y), heading)
 
     def lift() -> None:
         world.carried_by[j] = i
@@ -168,6 +195,15 @@ def drop_off(world: World, agent: Agent, step: Step) -> Action | None:
     the robot stays where the plan has it, touching the object (a robot that waits there keeps
     the clearances the plan was ordered with), and creeps out when it next drives, so that it
     never drives along the object it touches (:func:`let_go` then frees the gripper).
+
+    Parameters
+    ----------
+    world : World
+        The running simulation.
+    agent : Agent
+        The robot executing the step.
+    step : Step
+        Its current step.
     """
     i = agent.index
     j = world.object_ids.index(step.object)
@@ -276,15 +312,21 @@ def _drop_clear(world: World, i: int, j: int, spot: np.ndarray) -> bool:
 
 
 def let_go(world: World) -> None:
-    """Free the gripper of every robot that has crept more than 1 mm off the object it dropped."""
-    held = [a for a in world.agents if a.gripped is not None and a.dock_stage is None]
-    held = [a for a in held if world.carried_by[a.gripped] < 0]  # dropped, not picked
+    """Free the gripper of every robot that has crept more than 1 mm off the object it dropped.
+
+    Parameters
+    ----------
+    world : World
+        The running simulation.
+    """
+    held = [(a, a.gripped) for a in world.agents if a.gripped is not None and a.dock_stage is None]
+    held = [(a, j) for a, j in held if world.carried_by[j] < 0]  # dropped, not picked
     if not held:
         return
-    robots, objects = [a.index for a in held], [a.gripped for a in held]
+    robots, objects = [a.index for a, _ in held], [j for _, j in held]
     boxes = np.column_stack([world.object_xy[objects], world.object_half[objects]])[:, None, :]  # one each
     gaps = box_gaps(world.pose[robots, :2], world.robot_half[robots][:, None], boxes)[:, 0]
-    for agent, gap in zip(held, gaps.tolist(), strict=True):
+    for (agent, _), gap in zip(held, gaps.tolist(), strict=True):
         if gap > 1.0:
             agent.gripped = None
 
@@ -294,7 +336,17 @@ def let_go(world: World) -> None:
 
 def wait_for_message(world: World, agent: Agent, step: Step) -> Action | None:
     """``Req``: stop and wait until the message is sent, and no robot that may move is within
-    the standoff (a waiting robot is parked: :meth:`~cosmop.sim.world.World.crowded`)."""
+    the standoff (a waiting robot is parked: :meth:`~cosmop.sim.world.World.crowded`).
+
+    Parameters
+    ----------
+    world : World
+        The running simulation.
+    agent : Agent
+        The robot executing the step.
+    step : Step
+        Its current step.
+    """
     i = agent.index
     if agent.through and step.message is not None and world.received(agent, step):
         return None  # it has come: the robot drives on through the waypoint
@@ -308,7 +360,17 @@ def wait_for_message(world: World, agent: Agent, step: Step) -> Action | None:
 def send_message(world: World, agent: Agent, step: Step) -> Action | None:
     """``Res``: stop, then send the message (:meth:`~cosmop.sim.world.World.send`); a robot
     driving through the waypoint sends it on the way (a cut where a robot leaves a place it
-    shares lies a pass tolerance beyond the place: :class:`~cosmop.planning.conflicts.ConflictSettings`)."""
+    shares lies a pass tolerance beyond the place: :class:`~cosmop.planning.conflicts.ConflictSettings`).
+
+    Parameters
+    ----------
+    world : World
+        The running simulation.
+    agent : Agent
+        The robot executing the step.
+    step : Step
+        Its current step.
+    """
     if world.v[agent.index] > 0 and not agent.through:
         return brake(world, agent.index)
     world.send(agent, step)

@@ -53,6 +53,7 @@ class Walker:
             self.target = None  # stays at the last point
 
     def _random_point(self) -> np.ndarray:
+        assert self.human.walk is not None  # a random walk has its area
         (x0, x1), (y0, y1) = self.human.walk
         for _ in range(50):
             point = np.array([self.rng.uniform(x0, x1), self.rng.uniform(y0, y1)])
@@ -68,7 +69,13 @@ class Walker:
         return bool((point_segment_linf(pts, self.walls) > self.half).all())
 
     def step(self, dt: float) -> None:
-        """Walk for `dt` seconds."""
+        """Walk for `dt` seconds.
+
+        Parameters
+        ----------
+        dt : float
+            The cycle, s.
+        """
         before = self.position.copy()
         self._walk(dt)
         self.velocity = (self.position - before) / dt

@@ -9,6 +9,7 @@ finished run's trace for robots that overlap.  Units: mm, mm/s, seconds.
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import NDArray
 
 from cosmop.control.dwa import robot_gaps
 from cosmop.scene import Scene
@@ -18,10 +19,18 @@ from cosmop.sim.world import TOUCH, World
 __all__ = ["footprint_overlaps", "monitor"]
 
 
-def monitor(world: World, moving_speed: np.ndarray) -> None:
+def monitor(world: World, moving_speed: NDArray[np.float64]) -> None:
     """Log this cycle's contacts in ``world.contacts``: a new episode for every pair that starts
     touching, marked moving if the robot's speed (`moving_speed`, mm/s) is above zero at any
-    cycle of it."""
+    cycle of it.
+
+    Parameters
+    ----------
+    world : World
+        The running simulation; its contact log is updated.
+    moving_speed : ndarray, shape (R,)
+        Each robot's speed this cycle, mm/s (:func:`~cosmop.sim.physics.integrate`).
+    """
     now = _touching(world)
     for pair in list(world.open_contacts):
         if pair not in now:
@@ -63,6 +72,15 @@ def footprint_overlaps(
 
     Returns ``(t, robot, other, depth)`` for the first instant of each overlapping pair and
     episode, depth in mm; an empty list for a run in which robots never overlap.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene that was run.
+    result : SimResult
+        The run, with its frames.
+    tolerance : float, default 1e-6
+        Overlaps no deeper than this (mm) count as touching.
     """
     pose = result.frames["pose"]
     half = np.array([scene.robots[r].size / 2.0 for r in result.robot_ids])

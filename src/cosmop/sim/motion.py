@@ -19,10 +19,12 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numpy.typing import NDArray
 
 from cosmop.control.geometry import box_gaps, point_segment_linf
 from cosmop.control.paths import GlobalPath, plan_path, straight_path
 from cosmop.control.safety import is_safe, stopping_horizon
+from cosmop.planning.plan import Pose
 from cosmop.sim.replan import replan_stalled
 from cosmop.sim.world import TOUCH, Action, Agent, World
 
@@ -60,7 +62,15 @@ REACH = 1.25
 
 
 def brake(world: World, i: int) -> Action:
-    """Robot `i`'s command to brake with :math:`-b` (the always-safe choice), not turning."""
+    """Robot `i`'s command to brake with :math:`-b` (the always-safe choice), not turning.
+
+    Parameters
+    ----------
+    world : World
+        The running simulation.
+    i : int
+        The robot's index.
+    """
     return ("move", (max(0.0, world.v[i] - world.limits.braking[i] * world.dt), 0.0))
 
 
@@ -69,12 +79,21 @@ def halt(world: World, i: int) -> Action:
 
     The arc is the one the dynamic window chose last cycle, whose braking its safety check
     covered (:mod:`cosmop.control.dwa`); standing, it stops turning too.
+
+    Parameters
+    ----------
+    world : World
+        The running simulation.
+    i : int
+        The robot's index.
     """
     v = float(world.v[i])
     return ("move", (max(0.0, v - world.limits.braking[i] * world.dt), float(world.w[i]) if v > 0 else 0.0))
 
 
-def route(world: World, i: int, goal: tuple, origin: tuple | None) -> tuple[GlobalPath, tuple | None]:
+def route(
+    world: World, i: int, goal: Pose, origin: Pose | None
+) -> tuple[GlobalPath, tuple[float, float] | None]:
     """The global path to `goal` (the plan's own segment where the robot can follow it), and
     the segment's start when the path goes back to it first (``None`` otherwise).
 
@@ -82,6 +101,17 @@ def route(world: World, i: int, goal: tuple, origin: tuple | None) -> tuple[Glob
     back onto the plan's segment at its `origin` (an intermediate waypoint passed within the
     tolerance, or a replan's rounded start, leaves the robot beside it) and along it; else
     around what now stands in the way (:func:`cosmop.control.paths.plan_path`).
+
+    Parameters
+    ----------
+    world : World
+        The running simulation.
+    i : int
+        The robot's index.
+    goal : (float, float, float)
+        The goal pose, mm, mm, degrees.
+    origin : (float, float, float) or None
+        The start of the plan's segment to `goal`, if known.
     """
     xy = world.pose[i, :2]
     here, boxes = (float(xy[0]), float(xy[1])), world.static_boxes(i, goal)
@@ -106,12 +136,28 @@ def drive(
     goal: tuple[float, float, float],
     final: bool,
     heading: bool,
-    origin: tuple | None = None,
+    origin: Pose | None = None,
 ) -> Action | None:
     """Drive towards `goal` (mm, mm, degrees); ``None`` once it is reached (and turned to, if
     `heading`).  A `final` goal is reached within ``goal_tolerance`` and the robot stops there;
     an intermediate one is passed within ``pass_tolerance``.  `origin` is the start of the
-    plan's segment to `goal` (:func:`route`)."""
+    plan's segment to `goal` (:func:`route`).
+
+    Parameters
+    ----------
+    world : World
+        The running simulation.
+    agent : Agent
+        The driving robot.
+    goal : (float, float, float)
+        The goal pose, mm, mm, degrees.
+    final : bool
+        Whether the robot stops at `goal` (else it passes it).
+    heading : bool
+        Whether it turns to the goal's heading there.
+    origin : (float, float, float), optional
+        The start of the plan's segment to `goal`.
+    """
     s = world.settings
     i = agent.index
     xy = world.pose[i, :2]
@@ -137,6 +183,7 @@ def drive(
     # the target lies beyond where the robot gets in one horizon at its top speed: a nearer one
     # would be overshot by a faster arc, so progress alone would hold the robot below its top
     reach = max(s.dwa.lookahead, REACH * world.limits.max_speed[i] * s.dwa.horizon)
+    assert agent.path is not None  # set by the drive's start
     target, left = agent.path.lookahead((float(xy[0]), float(xy[1])), reach)
     agent.path_left = left
     if left < agent.best_path_left - s.stall_progress:
@@ -152,7 +199,7 @@ def drive(
     return ("drive", (target, stop, agent.goal_clearance))
 
 
-def _start_drive(world: World, agent: Agent, goal: tuple, origin: tuple | None) -> None:
+def _start_drive(world: World, agent: Agent, goal: Pose, origin: Pose | None) -> None:
     """A new drive: its global path, and the progress and stall clocks reset."""
     s = world.settings
     i = agent.index
@@ -165,7 +212,7 @@ def _start_drive(world: World, agent: Agent, goal: tuple, origin: tuple | None) 
     agent.last_progress_t = world.t
 
 
-def _turn(world: World, i: int, goal: tuple, heading: bool) -> Action | None:
+def _turn(world: World, i: int, goal: Pose, heading: bool) -> Action | None:
     """At the goal: brake to a stop, then turn on the spot to the goal's heading (if `heading`)."""
     if world.v[i] > 0:
         return brake(world, i)
@@ -197,6 +244,15 @@ def detour(world: World, agent: Agent, goal: tuple[float, float, float]) -> None
     rejoins the path 4, 8 or 16 m further on where it can (the rest of the path is kept), and
     goes to the goal only where it cannot: on a large map, a route to a far goal is a search
     of the whole map (seconds), and round the blockers is what is needed.
+
+    Parameters
+    ----------
+    world : World
+        The running simulation.
+    agent : Agent
+        The blocked robot.
+    goal : (float, float, float)
+        Its goal pose, mm, mm, degrees.
     """
     s = world.settings
     i = agent.index
@@ -217,13 +273,14 @@ def detour(world: World, agent: Agent, goal: tuple[float, float, float]) -> None
     path = None
     # round the blockers back onto the path a little beyond them, not all the way to a far goal
     # (on a large map the search for a route to the goal spans the whole map: seconds)
+    current = agent.path
     for ahead in _REJOIN_AHEAD:
-        rejoin, rest = agent.path.beyond(xy, ahead) if agent.path is not None else (None, ())
-        if rejoin is None:
+        rejoin, rest = current.beyond(xy, ahead) if current is not None else (None, ())
+        if current is None or rejoin is None:
             break
         way = plan_path(xy, rejoin, half, world.walls, boxes)
         if way is not None:
-            path = GlobalPath(way.points + rest, min(way.margin, agent.path.margin))
+            path = GlobalPath(way.points + rest, min(way.margin, current.margin))
             break
     path = path or plan_path(xy, (goal[0], goal[1]), half, world.walls, boxes)
     if path is None:
@@ -237,7 +294,19 @@ def detour(world: World, agent: Agent, goal: tuple[float, float, float]) -> None
 
 def creep_to(world: World, agent: Agent, point: tuple[float, float], heading: float | None = None) -> Action:
     """The docking creep straight to `point`, turning to `heading` (rad; default: keep it);
-    brake first, or wait while something passes."""
+    brake first, or wait while something passes.
+
+    Parameters
+    ----------
+    world : World
+        The running simulation.
+    agent : Agent
+        The creeping robot.
+    point : (float, float)
+        Where it creeps to, mm.
+    heading : float, optional
+        The heading to turn to, rad.
+    """
     i = agent.index
     if world.v[i] > 0:
         return brake(world, i)
@@ -248,7 +317,7 @@ def creep_to(world: World, agent: Agent, point: tuple[float, float], heading: fl
     return HOLD  # something passes: wait for it
 
 
-def creep_is_safe(world: World, agent: Agent, target: tuple | None = None) -> bool:
+def creep_is_safe(world: World, agent: Agent, target: Pose | None = None) -> bool:
     """Passive safety of a slow docking creep, with the gripper's object left out.
 
     Moving obstacles (robots, people) need the paper's ``safe`` at the creep speed.  Towards a
@@ -256,6 +325,15 @@ def creep_is_safe(world: World, agent: Agent, target: tuple | None = None) -> bo
     so walls and resting objects only need to stay clear of that short segment (touching
     allowed: a docking pose may touch a wall, as the plan allows).  Without a target, the
     robot's square where it is must be safe at the creep speed from everything.
+
+    Parameters
+    ----------
+    world : World
+        The running simulation.
+    agent : Agent
+        The creeping robot.
+    target : (float, float, float), optional
+        The docking pose, mm, mm, degrees (only ``x, y`` are read).
     """
     i = agent.index
     sensed = world.with_motion(world.obstacles())
@@ -263,7 +341,9 @@ def creep_is_safe(world: World, agent: Agent, target: tuple | None = None) -> bo
     skip = {agent.id}
     if agent.gripped is not None:
         skip.add(world.object_ids[agent.gripped])
-    movers = [b for b, n in enumerate(names) if n not in skip and (speeds[b] > 0 or sensed.agents[b])]
+    agents = sensed.agents
+    assert agents is not None  # the world's obstacles say which boxes are robots or people
+    movers = [b for b, n in enumerate(names) if n not in skip and (speeds[b] > 0 or agents[b])]
     still = [b for b, n in enumerate(names) if n not in skip and b not in movers]
     dyn = world.limits[i]  # this robot's limits
     speed = world.creep_speed(i)
@@ -294,6 +374,17 @@ def creep_onto_goal(world: World, agent: Agent, goal: tuple[float, ...], dist: f
     touches something (a docking pose, a home against a wall) lies right there; within
     ``dock_tolerance`` of it (`dist`, mm) the docking creep, straight and exact, takes over
     when its way is clear (``None`` otherwise: the window drives on).
+
+    Parameters
+    ----------
+    world : World
+        The running simulation.
+    agent : Agent
+        The driving robot.
+    goal : tuple of float
+        The final pose ``x, y, ...``, mm.
+    dist : float
+        The robot's distance to it, mm.
     """
     s = world.settings
     i = agent.index
@@ -313,8 +404,16 @@ def back_onto_segment(world: World, agent: Agent) -> Action | None:
     the wall, the robot's first move along that segment runs into the corner, and the
     controller, aiming along the path, never finds the sideways move out.  The docking creep
     is that move: straight, slow, exact at the end.
+
+    Parameters
+    ----------
+    world : World
+        The running simulation.
+    agent : Agent
+        The robot, with its ``reseat_point`` and path set.
     """
     i = agent.index
+    assert agent.reseat_point is not None and agent.path is not None  # the drive found the segment
     (sx, sy), (tx, ty) = agent.reseat_point, agent.path.points[-1]
     heading = math.atan2(ty - sy, tx - sx)
     if math.dist(world.pose[i, :2], (sx, sy)) <= 1e-9 and abs(world.heading_error(i, heading)) <= 1e-9:
@@ -333,6 +432,15 @@ def creep_out(world: World, agent: Agent, goal: tuple[float, float, float]) -> A
     wall), and a controller cannot drive off along a face it touches: it first creeps straight
     out (:func:`find_way_out`, towards the goal where it can) to ``leave_gap`` from everything
     static.  ``None`` when there is nothing to leave or once out.
+
+    Parameters
+    ----------
+    world : World
+        The running simulation.
+    agent : Agent
+        The robot about to drive.
+    goal : (float, float, float)
+        The goal of its drive, mm, mm, degrees.
     """
     s = world.settings
     i = agent.index
@@ -346,12 +454,23 @@ def creep_out(world: World, agent: Agent, goal: tuple[float, float, float]) -> A
     return creep_to(world, agent, agent.way_out)
 
 
-def find_way_out(world: World, i: int, toward: np.ndarray, gap: float) -> tuple[float, float] | None:
+def find_way_out(world: World, i: int, toward: NDArray[np.float64], gap: float) -> tuple[float, float] | None:
     """The nearest point straight out from robot `i` at `gap` (mm) from everything static, or ``None``.
 
     Headings every 5 degrees and distances every millimetre up to :data:`_EXIT_REACH` are
     tried; the way to the point must not touch a wall or resting object.  Of the points within
     2 mm of the nearest, the one most towards `toward` is taken.
+
+    Parameters
+    ----------
+    world : World
+        The running simulation.
+    i : int
+        The robot's index.
+    toward : ndarray, shape (2,)
+        The point the way out should head towards, mm.
+    gap : float
+        The gap wanted from everything static, mm.
     """
     xy, half = world.pose[i, :2], float(world.robot_half[i])
     units = np.column_stack([np.cos(_EXIT_HEADINGS), np.sin(_EXIT_HEADINGS)])

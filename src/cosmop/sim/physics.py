@@ -9,10 +9,13 @@ mm, mm/s, radians and rad/s, seconds.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from functools import lru_cache
 
 import numpy as np
+from numpy.typing import NDArray
 
+from cosmop.planning.plan import Pose
 from cosmop.sim.world import World, wrap_angle
 
 __all__ = ["integrate"]
@@ -20,7 +23,9 @@ __all__ = ["integrate"]
 _SUBSTEPS = 4  # sub-steps of a cycle's arc (each at its midpoint heading)
 
 
-def integrate(world: World, v_cmd: np.ndarray, w_cmd: np.ndarray, docks: dict[int, tuple]) -> np.ndarray:
+def integrate(
+    world: World, v_cmd: NDArray[np.float64], w_cmd: NDArray[np.float64], docks: Mapping[int, Pose]
+) -> NDArray[np.float64]:
     """Move every robot for one cycle towards the speed `v_cmd`, turning at `w_cmd`.
 
     A robot slows down by braking at :math:`-b` until it reaches the commanded speed, then holds
@@ -33,6 +38,17 @@ def integrate(world: World, v_cmd: np.ndarray, w_cmd: np.ndarray, docks: dict[in
     Returns each robot's translational speed at the end of the cycle, mm/s: what the monitor
     calls moving.  A docking creep is a stop-and-go no faster than one cycle's braking, so the
     robot is at rest at the start of every docking cycle and moving until it is on the pose.
+
+    Parameters
+    ----------
+    world : World
+        The simulation; its robots' poses, speeds and distances are updated.
+    v_cmd : ndarray, shape (R,)
+        Commanded translational speeds, mm/s.
+    w_cmd : ndarray, shape (R,)
+        Commanded turn rates, rad/s.
+    docks : mapping of int to (float, float, float)
+        The docking robots' poses to creep to, ``x, y`` mm and heading in degrees.
     """
     dt = world.dt
     acc, brk = world.limits.acceleration, world.limits.braking
@@ -68,7 +84,7 @@ def integrate(world: World, v_cmd: np.ndarray, w_cmd: np.ndarray, docks: dict[in
     world.pose[:, 2] = wrap_angle(heading[-1])
     world.v = v1
     world.w = w_cmd.copy()
-    moving = v1.copy()
+    moving: NDArray[np.float64] = v1.copy()
     for i, dock in docks.items():
         moving[i] = _creep(world, i, dock)
     world.distance += np.hypot(*(world.pose[:, :2] - start).T)
@@ -76,14 +92,14 @@ def integrate(world: World, v_cmd: np.ndarray, w_cmd: np.ndarray, docks: dict[in
 
 
 @lru_cache(maxsize=4)
-def _instants(dt: float, n: int) -> np.ndarray:
+def _instants(dt: float, n: int) -> NDArray[np.float64]:
     """The sub-steps' ends in a cycle of `dt` s, ``(n + 1, 1)`` (made once)."""
     out = (np.arange(n + 1) * dt / n)[:, None]
     out.flags.writeable = False
     return out
 
 
-def _creep(world: World, i: int, dock: tuple) -> float:
+def _creep(world: World, i: int, dock: Pose) -> float:
     """The docking controller: robot `i` creeps straight towards `dock` (``x, y`` mm, heading
     deg), turning at most its turn rate, and halts exactly on it.  Returns its speed, mm/s."""
     dt = world.dt

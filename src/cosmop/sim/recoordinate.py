@@ -165,6 +165,19 @@ def recoordinate_world(
     When accepted, every robot's executor takes its new rest (``world.conflict_messages``
     gains the messages added).  Returns ``(accepted, why not, messages added)``.  The conflicts
     are found with `settings`, by default the world's (``World.conflict_settings``).
+
+    Parameters
+    ----------
+    world : World
+        The running simulation; its robots' executors take their new rests when accepted.
+    agent : Agent
+        The robot that replanned.
+    new : RobotPlan
+        Its new plan.
+    start : State
+        Where the new plan starts.
+    settings : ConflictSettings, optional
+        How conflicts are found (default: the world's).
     """
     splits = {a.id: a.split_mission(world.scenario) for a in world.agents}
     rests = {}
@@ -179,7 +192,7 @@ def recoordinate_world(
     positions = {
         oid: None
         if world.carried_by[j] >= 0 or world.shipped[j]
-        else tuple(float(v) for v in world.object_xy[j])
+        else (float(world.object_xy[j][0]), float(world.object_xy[j][1]))
         for j, oid in enumerate(world.object_ids)
     }
     result = recoordinate(

@@ -8,6 +8,8 @@ so that the pictures can say it in words.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from cosmop.control.geometry import box_gaps
@@ -34,11 +36,17 @@ class Recorder:
     """Collects the frames of a run (:meth:`record` once per cycle, :meth:`frames` at the end)."""
 
     def __init__(self) -> None:
-        self._rows: dict[str, list] = {k: [] for k in _FIELDS}
+        self._rows: dict[str, list[Any]] = {k: [] for k in _FIELDS}
         self._standing_since: dict[int, float] = {}  # robot index: when it stopped while it should move
 
     def record(self, world: World) -> None:
-        """Append the world's current state as a frame."""
+        """Append the world's current state as a frame.
+
+        Parameters
+        ----------
+        world : World
+            The running simulation.
+        """
         rows = self._rows
         rows["t"].append(world.t)
         pose = world.pose.copy()
@@ -90,7 +98,13 @@ class Recorder:
         return names[k] if k >= 0 and gaps[k] < world.settings.sense_range else None
 
     def frames(self, world: World) -> dict[str, np.ndarray]:
-        """The frames as arrays (:attr:`~cosmop.sim.result.SimResult.frames`), shaped for `world`."""
+        """The frames as arrays (:attr:`~cosmop.sim.result.SimResult.frames`), shaped for `world`.
+
+        Parameters
+        ----------
+        world : World
+            The simulation that was recorded.
+        """
         frames = {k: np.array(v) for k, v in self._rows.items()}
         n = len(frames["t"])
         frames["pose"] = frames["pose"].reshape(n, len(world.robot_ids), 3)

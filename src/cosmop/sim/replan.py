@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Sequence
+from collections.abc import Set as AbstractSet
 from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
@@ -35,7 +36,15 @@ _PERSON_ROOM = 10.0  # mm added around a sensed person (a robot gets the standof
 
 
 def sensed_scene(scene: Scene, boxes: Iterable[tuple[float, float, float]]) -> Scene:
-    """The scene with each sensed box ``(x, y, half side)`` (mm) added as four walls."""
+    """The scene with each sensed box ``(x, y, half side)`` (mm) added as four walls.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene as planned.
+    boxes : iterable of (float, float, float)
+        The sensed boxes ``x, y, half side``, mm.
+    """
     walls = list(scene.obstacles)
     for x, y, h in boxes:
         corners = [(x - h, y - h), (x + h, y - h), (x + h, y + h), (x - h, y + h)]
@@ -107,6 +116,13 @@ def replan_stalled(world: World, agent: Agent) -> None:
     Does nothing when the settings turn replanning off.  Every attempt goes to
     ``world.replan_log``; a new plan is taken only if the team-safety layer orders it with
     the others' rests (:func:`cosmop.sim.recoordinate.recoordinate_world`).
+
+    Parameters
+    ----------
+    world : World
+        The running simulation.
+    agent : Agent
+        The stalled robot.
     """
     s = world.settings
     if not s.replan:
@@ -152,7 +168,15 @@ def replan_stalled(world: World, agent: Agent) -> None:
 
 def route(agent: Agent, start: Sequence[float]) -> dict[str, Any]:
     """What `agent` does from now on, for the pictures: where it starts (mm, mm, degrees) and
-    each step left with its pose, primitive and what it is about (an object or a message)."""
+    each step left with its pose, primitive and what it is about (an object or a message).
+
+    Parameters
+    ----------
+    agent : Agent
+        The robot, with its new plan.
+    start : sequence of float
+        Where it starts, ``x, y`` mm and heading in degrees.
+    """
     steps = agent.steps[agent.step_index :]
     return {
         "from": [round(float(v), 3) for v in start],
@@ -185,13 +209,22 @@ def _sensed(world: World, agent: Agent) -> list[tuple[float, float, float]]:
     ]
 
 
-def start_state(world: World, agent: Agent, picks: set[str | None] = frozenset()) -> State:
+def start_state(world: World, agent: Agent, picks: AbstractSet[str | None] = frozenset()) -> State:
     """Where `agent` replans from: its pose and every object, rounded to integer mm and degrees.
 
     An object another robot carries, or one it has asked to be moved away (a ``Req`` step done),
     is away: not in its way.  Goods it still has to pick (`picks`) and does not carry are where
     its plan expects them: a robot that another hands them over to waits for them where the
     other puts them down (:mod:`cosmop.missions.handover`), wherever they are now.
+
+    Parameters
+    ----------
+    world : World
+        The running simulation.
+    agent : Agent
+        The robot that replans.
+    picks : set of str, optional
+        The objects it still has to pick up.
     """
     i = agent.index
     k = agent.step_index

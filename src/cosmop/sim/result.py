@@ -184,9 +184,9 @@ class SimResult:
     replans, replan_attempts : int
         Successful replans and all attempts.
     messages : tuple of Message
-    objects : Mapping[str, tuple]
+    objects : Mapping[str, (tuple of float, str or None)]
         Final ``(position (x, y), carried_by or None)`` of every object.
-    robots : Mapping[str, tuple]
+    robots : Mapping[str, ((float, float, float), float)]
         Final ``(pose (x, y, heading deg), distance_mm)`` of every robot.
     finished : Mapping[str, bool]
         Whether each robot executed its whole plan.
@@ -234,8 +234,8 @@ class SimResult:
     replans: int
     replan_attempts: int
     messages: tuple[Message, ...]
-    objects: Mapping[str, tuple]
-    robots: Mapping[str, tuple]
+    objects: Mapping[str, tuple[tuple[float, ...], str | None]]
+    robots: Mapping[str, tuple[tuple[float, float, float], float]]
     frames: Mapping[str, np.ndarray] = field(repr=False)
     finished: Mapping[str, bool] = field(default_factory=dict)
     robot_ids: tuple[str, ...] = ()
@@ -254,6 +254,13 @@ class SimResult:
         """A matplotlib figure of the run at frame `index`, by default its end: every robot's
         path driven and planned, where it stands and why, the people (the ``viz`` extra;
         :func:`cosmop.viz.draw_frame`).
+
+        Parameters
+        ----------
+        index : int, default -1
+            The frame to draw.
+        title : str, optional
+            The figure's title.
 
         Raises
         ------
@@ -368,20 +375,41 @@ class SimResult:
         )
 
     def save_summary(self, path: str | os.PathLike[str]) -> None:
-        """Write :meth:`summary` as JSON, atomically."""
+        """Write :meth:`summary` as JSON, atomically.
+
+        Parameters
+        ----------
+        path : str or path-like
+            The JSON file to write.
+        """
         write_atomic(path, json.dumps(self.summary(), indent=2) + "\n")
 
     def save_trace(self, path: str | os.PathLike[str]) -> None:
-        """Write :meth:`trace` as compact JSON, atomically (:meth:`cosmop.traces.Trace.save`)."""
+        """Write :meth:`trace` as compact JSON, atomically (:meth:`cosmop.traces.Trace.save`).
+
+        Parameters
+        ----------
+        path : str or path-like
+            The JSON file to write.
+        """
         self.trace().save(path)
 
     def objects_in_workspaces(self, scenario: Scenario, plans: PlanSet) -> dict[str, bool]:
-        """For every drop event of the plans' missions: is its object in its workspace now?"""
+        """For every drop event of the plans' missions: is its object in its workspace now?
+
+        Parameters
+        ----------
+        scenario : Scenario
+            The scenario that was run.
+        plans : PlanSet
+            The plans that were run.
+        """
         scene = plans.extend(scenario).scene
-        out = {}
+        out: dict[str, bool] = {}
         for plan in plans.robots.values():
             for event in plan.events:
                 if event.kind == "drop":
+                    assert event.obj is not None  # a drop names its object
                     position, by = self.objects[event.obj]
                     out[event.obj] = by is None and drop_holds(scene, event, position)
         return out
@@ -446,6 +474,17 @@ def frames_trace(
 
 def drop_holds(scene: Scene, event: Event, position: Sequence[float]) -> bool:
     """Whether a ``drop`` `event`'s object, lying at `position` (mm), is in the event's workspace
-    (to within 1e-6 mm: a drop lands exactly where the plan puts it)."""
+    (to within 1e-6 mm: a drop lands exactly where the plan puts it).
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene, with the event's object and workspace.
+    event : Event
+        A ``drop`` event.
+    position : sequence of float
+        Where the object lies, ``x, y`` mm.
+    """
+    assert event.obj is not None and event.workspace is not None  # a drop names both
     size = scene.objects[event.obj].size
     return scene.workspaces[event.workspace].holds(position[0], position[1], size, 1e-6)

@@ -74,7 +74,7 @@ import numpy as np
 
 from cosmop.control.dwa import Drivers, Obstacles, dwa_commands
 from cosmop.control.neighbourhood import dwa_commands_near
-from cosmop.planning.plan import Itinerary, PlanSet
+from cosmop.planning.plan import Itinerary, PlanSet, Pose
 from cosmop.planning.timing import itinerary
 from cosmop.scene import Scenario
 from cosmop.sim.execute import decide, let_go
@@ -160,7 +160,17 @@ def simulate(
 
 def time_limit(scenario: Scenario, plans: PlanSet, settings: SimSettings | None = None) -> float:
     """When a run of `plans` stops unfinished, simulated s: ``settings.max_time``, or by
-    default three times the plans' expected makespan and at least 900 s (:class:`SimSettings`)."""
+    default three times the plans' expected makespan and at least 900 s (:class:`SimSettings`).
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The scenario the plans are for.
+    plans : PlanSet
+        The plans to run.
+    settings : SimSettings, optional
+        The run's settings (default: the defaults).
+    """
     settings = settings or SimSettings()
     planned = None if settings.max_time is not None else _planned_times(plans.extend(scenario), plans)
     return _time_limit(settings, planned)
@@ -175,7 +185,13 @@ def _time_limit(settings: SimSettings, planned: Itinerary | None) -> float:
 
 def advance(world: World) -> None:
     """One control cycle of the whole world (the module docstring's steps 0 to 4); a lifelong
-    run (:mod:`cosmop.lifelong`) drives the world with it between its dispatches."""
+    run (:mod:`cosmop.lifelong`) drives the world with it between its dispatches.
+
+    Parameters
+    ----------
+    world : World
+        The running simulation, changed in place.
+    """
     _delays(world)
     # the dynamic window senses the world as it was when the cycle began: an object picked
     # up or dropped during the decisions is sensed next cycle
@@ -211,9 +227,9 @@ class _Commands:
 
     v: np.ndarray
     w: np.ndarray
-    docks: dict[int, tuple] = field(default_factory=dict)  # robot -> pose (x, y, heading deg)
+    docks: dict[int, Pose] = field(default_factory=dict)  # robot -> pose (x, y, heading deg)
     driving: list[int] = field(default_factory=list)  # robots for the dynamic window
-    targets: list[tuple] = field(default_factory=list)  # their lookahead points, mm
+    targets: list[tuple[float, float]] = field(default_factory=list)  # their lookahead points, mm
     stops: list[float] = field(default_factory=list)  # path left to a final goal (inf: none), mm
     rooms: list[float] = field(default_factory=list)  # their goals' clearance, mm
 

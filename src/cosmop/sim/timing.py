@@ -68,6 +68,17 @@ def carry_instants(
 ) -> list[int | None]:
     """The instants of `new` steps: each equal to the next unmatched `old` step keeps its instant.
 
+    Parameters
+    ----------
+    old : sequence
+        The steps before.
+    instants : sequence of int or None
+        The instant of each old step.
+    new : sequence
+        The steps after.
+
+    Examples
+    --------
     >>> carry_instants("abc", [1, 2, 3], "axbc")
     [1, None, 2, 3]
     """

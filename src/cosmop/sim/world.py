@@ -11,9 +11,11 @@ keep their heading in radians), seconds; degrees where a plan's pose is read.
 from __future__ import annotations
 
 import math
-from typing import Any
+from collections.abc import Iterable, Sequence
+from typing import Any, Literal
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from cosmop.control.dwa import Obstacles
 from cosmop.control.geometry import box_gaps, point_segment_linf, rect_gaps, segment_array, segment_bounds
@@ -22,7 +24,7 @@ from cosmop.control.safety import Limits
 from cosmop.events import MESSAGE_KINDS, Event, Primitive, parse_event, realising_step
 from cosmop.physics import TOUCH  # the one tolerance under which two squares touch
 from cosmop.planning.conflicts import ConflictSettings
-from cosmop.planning.plan import PlanSet, RobotPlan, Step
+from cosmop.planning.plan import PlanSet, Pose, RobotPlan, Step
 from cosmop.planning.realisation import event_instants
 from cosmop.scene import Scenario
 from cosmop.sim.delays import DelayDraws
@@ -40,8 +42,19 @@ Action = tuple[str, Any]
 ``("move", (v, w))`` (mm/s, rad/s) or ``("dock", (x, y, heading deg))`` for the docking creep."""
 
 
-def wrap_angle(angle: np.ndarray | float) -> np.ndarray | float:
-    """`angle` (radians) wrapped into :math:`[-\\pi, \\pi)`."""
+def wrap_angle(angle: NDArray[np.float64] | float) -> NDArray[np.float64]:
+    """`angle` (radians) wrapped into :math:`[-\\pi, \\pi)`.
+
+    Parameters
+    ----------
+    angle : float or ndarray
+        Angles, rad.
+
+    Returns
+    -------
+    ndarray
+        The same shape as `angle` (0-d for a float).
+    """
     return (np.asarray(angle) + math.pi) % (2 * math.pi) - math.pi
 
 
@@ -52,7 +65,7 @@ class Agent:
         self.id = rid
         self.index = index  # the robot's row in the world's arrays
         self.steps = list(steps)  # the plan being executed (a replan replaces the rest)
-        self.mission = mission  # the events those steps realise, messages included
+        self.mission = list(mission)  # the events those steps realise, messages included
         self.step_index = 0  # the step being executed (== len(steps): finished)
         # each step's instant in the plan the run started from (None: a replan added it)
         self.plan_instants: list[int | None] = list(range(1, len(self.steps) + 1))
@@ -62,7 +75,7 @@ class Agent:
         self.dock_stage: str | None = None  # of a pick or drop: approach, dock, handle (None: not begun)
         self.path: GlobalPath | None = None  # the global path being followed
         self.reseat_point: tuple[float, float] | None = None  # the plan's segment start to creep back to
-        self.replan_start: tuple[int, tuple] | None = None  # (step, pose): where a replan starts that step
+        self.replan_start: tuple[int, Pose] | None = None  # (step, pose): where a replan starts that step
         self.handling_left = 0.0  # seconds of gripper work left
         self.gripped: int | None = None  # the object (index) the gripper touches, not carried
         self.best_path_left = math.inf  # path left (mm) at the last progress
@@ -74,7 +87,7 @@ class Agent:
         self.through = False  # drove through its last waypoint: its messages there need no stop
         self.answers_sent: dict[str, int] = {}  # Res steps done per object
         # where it creeps out of touch before driving off: None not looked for yet, False none
-        self.way_out: tuple[float, float] | bool | None = None
+        self.way_out: tuple[float, float] | Literal[False] | None = None
         self.stopped_until: float | None = None  # a delay holds it until then, s (None: not stopped)
         self.stops: list[tuple[float, float]] = []  # the delays that struck it: (time, seconds), s
 
@@ -84,13 +97,21 @@ class Agent:
         return self._mission
 
     @mission.setter
-    def mission(self, events) -> None:
+    def mission(self, events: Iterable[Event]) -> None:
         self._mission = list(events)
         self._realising: dict[tuple[Primitive, str | None], list[Event]] = {}
 
     def realising(self, primitive: Primitive, obj: str | None) -> list[Event]:
         """The mission's events that a step `primitive` about `obj` (no message) realises, in
-        order (kept: a waiting robot asks every cycle)."""
+        order (kept: a waiting robot asks every cycle).
+
+        Parameters
+        ----------
+        primitive : Primitive
+            The step's primitive.
+        obj : str or None
+            The object the step is about.
+        """
         key = (primitive, obj)
         if key not in self._realising:
             self._realising[key] = [
@@ -109,13 +130,27 @@ class Agent:
         return self.steps[self.step_index]
 
     def stop_for(self, t: float, seconds: float) -> None:
-        """A delay strikes at time `t` (s): the robot stops for `seconds` (:mod:`cosmop.sim.delays`)."""
+        """A delay strikes at time `t` (s): the robot stops for `seconds` (:mod:`cosmop.sim.delays`).
+
+        Parameters
+        ----------
+        t : float
+            Time now, s.
+        seconds : float
+            How long the delay holds the robot, s.
+        """
         self.stopped_until = t + seconds
         self.stops.append((t, seconds))
 
     def resume(self, t: float) -> None:
         """The delay is over at time `t` (s).  The clocks of progress and of detours move on by
-        the time the robot stood, so that its own stop is not taken for a stall."""
+        the time the robot stood, so that its own stop is not taken for a stall.
+
+        Parameters
+        ----------
+        t : float
+            Time now, s.
+        """
         stood = t - self.stops[-1][0]
         self.last_progress_t += stood
         self.detour_until += stood
@@ -129,7 +164,13 @@ class Agent:
         self.way_out = None
 
     def split_mission(self, scenario: Scenario) -> tuple[list[Event], list[Event]]:
-        """The mission events done (by the completed steps) and those still to do."""
+        """The mission events done (by the completed steps) and those still to do.
+
+        Parameters
+        ----------
+        scenario : Scenario
+            The running scenario.
+        """
         plan = RobotPlan.from_steps([e.name for e in self.mission], self.steps)
         instants = event_instants(plan, self.id, scenario.scene)
         done = [
@@ -200,7 +241,9 @@ class World:
         }
         self.t = 0.0  # simulated time, s
         self._layout_key: tuple[bytes, bytes] | None = None  # what the sensed layout was made for
-        self._static_memo: dict[tuple, np.ndarray] = {}  # static_gaps by points, half and layout
+        self._static_memo: dict[
+            tuple[bytes, float, bytes, bytes], NDArray[np.float64]
+        ] = {}  # static_gaps by points, half and layout
 
     def _init_robots(self, scenario: Scenario) -> None:
         """The robots' arrays: sizes, limits, poses at rest."""
@@ -233,7 +276,13 @@ class World:
         return (self.carried_by < 0) & ~self.shipped
 
     def ship(self, obj: str) -> None:
-        """Goods delivered in a lifelong run leave the world: no longer sensed, drawn or planned."""
+        """Goods delivered in a lifelong run leave the world: no longer sensed, drawn or planned.
+
+        Parameters
+        ----------
+        obj : str
+            The object's id.
+        """
         self.shipped[self.object_ids.index(obj)] = True
 
     def people_boxes(self) -> np.ndarray:
@@ -283,13 +332,25 @@ class World:
 
     def first_robot_box(self, count: int) -> int:
         """Where the robots' boxes begin among `count` sensed boxes (:meth:`obstacles`,
-        :meth:`boxes`): after the resting objects', before the people's, in robot order."""
+        :meth:`boxes`): after the resting objects', before the people's, in robot order.
+
+        Parameters
+        ----------
+        count : int
+            The number of sensed boxes.
+        """
         return count - len(self.robot_ids) - len(self.walkers)
 
     def with_motion(self, sensed: Obstacles) -> Obstacles:
         """`sensed` with the velocities (mm/s; sensed, for prediction only) and acceleration
         limits (mm/s^2) its boxes have now: resting objects and parked robots 0, people an
-        unknown acceleration (``inf``)."""
+        unknown acceleration (``inf``).
+
+        Parameters
+        ----------
+        sensed : Obstacles
+            What :meth:`obstacles` returned this cycle.
+        """
         first = self.first_robot_box(len(sensed.names))
         robots = slice(first, first + len(self.robot_ids))
         velocity = np.zeros((len(sensed.names), 2))
@@ -308,18 +369,33 @@ class World:
     def own_boxes(self, sensed: Obstacles, robots: np.ndarray | None = None) -> np.ndarray:
         """Which box of `sensed` (of :meth:`obstacles`) is each robot itself, ``(R, n)``, or
         each of the robots `robots` only: the robots' boxes follow the resting objects', in
-        robot order."""
+        robot order.
+
+        Parameters
+        ----------
+        sensed : Obstacles
+            What :meth:`obstacles` returned this cycle.
+        robots : ndarray of int, optional
+            Indices of the robots asked about (default: all).
+        """
         rows = np.arange(len(self.robot_ids)) if robots is None else np.asarray(robots)
         first = self.first_robot_box(len(sensed.names))
         own = np.zeros((len(rows), len(sensed.names)), dtype=bool)
         own[np.arange(len(rows)), first + rows] = True
         return own
 
-    def static_gaps(self, points: np.ndarray, half: float) -> np.ndarray:
+    def static_gaps(self, points: ArrayLike, half: float) -> NDArray[np.float64]:
         """L-infinity gaps (mm) of squares of half side `half` at `points` to walls and resting objects.
 
         Answers about a few points are remembered until an object is picked up or dropped: a
         driving robot asks about the same waypoints every cycle.
+
+        Parameters
+        ----------
+        points : array_like, shape (n, 2)
+            Centres of the squares, mm.
+        half : float
+            Their half side, mm.
         """
         points = np.asarray(points, dtype=float).reshape(-1, 2)
         if len(points) > _MEMO_POINTS:
@@ -350,11 +426,18 @@ class World:
             gap = np.minimum(gap, box_gaps(points, half, self.resting_boxes()).min(axis=1))
         return gap
 
-    def static_boxes(self, robot: int, goal: tuple[float, ...] | None = None) -> np.ndarray:
+    def static_boxes(self, robot: int, goal: Sequence[float] | None = None) -> np.ndarray:
         """What the global path of robot `robot` avoids: resting objects and parked robots.
 
         A robot that waits for a message, docks, handles an object or has finished stands
         still for a while, so the others plan around it instead of queueing behind it.
+
+        Parameters
+        ----------
+        robot : int
+            The robot's index.
+        goal : sequence of float, optional
+            The robot's goal ``x, y`` (mm; more entries are ignored).
         """
         boxes = [self.resting_boxes()]
         parked = [
@@ -378,7 +461,13 @@ class World:
         return np.concatenate([b.reshape(-1, 3) for b in boxes])
 
     def gaps_to_robots(self, i: int) -> np.ndarray:
-        """L-infinity gaps (mm) of robot `i`'s square to every robot's (itself included)."""
+        """L-infinity gaps (mm) of robot `i`'s square to every robot's (itself included).
+
+        Parameters
+        ----------
+        i : int
+            The robot's index.
+        """
         return box_gaps(self.pose[i, :2], self.robot_half[i], self.robot_boxes())
 
     def object_positions(self) -> np.ndarray:
@@ -392,11 +481,26 @@ class World:
 
     def creep_speed(self, i: int) -> float:
         """Speed (mm/s) of robot `i`'s docking creep: at most ``dock_speed``, and no faster than
-        the robot stops within one cycle (so it halts exactly on its pose)."""
-        return min(self.settings.dock_speed, self.limits.braking[i] * self.dt)
+        the robot stops within one cycle (so it halts exactly on its pose).
+
+        Parameters
+        ----------
+        i : int
+            The robot's index.
+        """
+        speed: float = min(self.settings.dock_speed, self.limits.braking[i] * self.dt)
+        return speed
 
     def heading_error(self, i: int, heading: float) -> float:
-        """The turn (rad, wrapped) from robot `i`'s heading to `heading` (rad)."""
+        """The turn (rad, wrapped) from robot `i`'s heading to `heading` (rad).
+
+        Parameters
+        ----------
+        i : int
+            The robot's index.
+        heading : float
+            The heading wanted, rad.
+        """
         return float(wrap_angle(heading - self.pose[i, 2]))
 
     # -- who may move ----------------------------------------------------------------------------
@@ -420,7 +524,13 @@ class World:
         parked one whose message has not come (it cannot leave; were it to hold `i`, and its
         message wait on `i`, neither would ever move); of two other parked robots close
         together the one listed first may leave (the other keeps its promise), so that two
-        waiting robots never hold each other for ever."""
+        waiting robots never hold each other for ever.
+
+        Parameters
+        ----------
+        i : int
+            The robot's index.
+        """
         gaps = self.gaps_to_robots(i)
         gaps[i] = np.inf
         parked = self.parked()
@@ -438,28 +548,54 @@ class World:
 
     def send(self, agent: Agent, step: Step) -> None:
         """Send the message of a ``Res`` step: its ``msg``, or the next ``away`` answer about its
-        object (the k-th Res(O) answers the k-th away(O, *, sender) of the mission)."""
+        object (the k-th Res(O) answers the k-th away(O, *, sender) of the mission).
+
+        Parameters
+        ----------
+        agent : Agent
+            The sender.
+        step : Step
+            Its ``Res`` step.
+        """
         if step.message is not None:
             event = parse_event(step.message)
         else:
+            assert step.object is not None  # a Res without a message answers about its object
             answers = agent.realising(Primitive.RES, step.object)
             sent = agent.answers_sent.get(step.object, 0)
             agent.answers_sent[step.object] = sent + 1
             event = answers[min(sent, len(answers) - 1)]
+        assert event.receiver is not None  # a message event
         self.messages.append(Message(round(self.t, 6), agent.id, event.receiver, event.obj, event.name))
         self.sent_messages.add(event.name)
         self.events.append((round(self.t, 6), agent.id, event.name))
 
     def awaited(self, agent: Agent, step: Step) -> Event | None:
         """The message a ``Req`` step waits for: its ``msg``, or the first ``away`` request about
-        its object not yet answered (None when every one has been)."""
+        its object not yet answered (None when every one has been).
+
+        Parameters
+        ----------
+        agent : Agent
+            The waiting robot.
+        step : Step
+            Its ``Req`` step.
+        """
         if step.message is not None:
             return parse_event(step.message)
         pending = [e for e in agent.realising(Primitive.REQ, step.object) if e.name not in self.sent_messages]
         return pending[0] if pending else None
 
     def received(self, agent: Agent, step: Step) -> bool:
-        """Whether the message a ``Req`` step waits for has been sent."""
+        """Whether the message a ``Req`` step waits for has been sent.
+
+        Parameters
+        ----------
+        agent : Agent
+            The waiting robot.
+        step : Step
+            Its ``Req`` step.
+        """
         if step.message is not None:
             return step.message in self.sent_messages
         return any(e.name in self.sent_messages for e in agent.realising(Primitive.REQ, step.object))
@@ -475,7 +611,15 @@ class World:
         return True
 
     def log_events(self, agent: Agent, step: Step) -> None:
-        """Log the mission events a finished step realises (the executed word of the run)."""
+        """Log the mission events a finished step realises (the executed word of the run).
+
+        Parameters
+        ----------
+        agent : Agent
+            The robot.
+        step : Step
+            The step it finished.
+        """
         done = {name for _, robot, name in self.events if robot == agent.id}
         realised = (step.primitive, step.object, step.message)
         wanted = [
