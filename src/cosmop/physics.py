@@ -44,7 +44,7 @@ class Overlap:
         What it overlaps, in words (a wall with its end points, or another body).
     """
 
-    field: tuple
+    field: tuple[str | int, ...]
     body: str
     other: str
 
@@ -59,7 +59,7 @@ class _Body:
     size: float
     x: float
     y: float
-    field: tuple
+    field: tuple[str | int, ...]
 
     def words(self, units: UnitSystem) -> str:
         at = f"({shown(self.x, units):g}, {shown(self.y, units):g})"
