@@ -7,7 +7,6 @@ of a scene and the global paths all grow walls and motions by the same square.
 from __future__ import annotations
 
 from collections.abc import Iterable
-from typing import overload
 
 import numpy as np
 import shapely
@@ -19,28 +18,20 @@ from cosmop.docking import DOCKING_HEADINGS, docking_pose
 __all__ = ["docking_places", "overlap_depths", "rectangle", "square", "swept_square"]
 
 
-@overload
-def square(x: float, y: float, side: float) -> Polygon: ...
-@overload
-def square(
-    x: NDArray[np.float64], y: NDArray[np.float64], side: NDArray[np.float64]
-) -> NDArray[np.object_]: ...
-def square(
-    x: float | NDArray[np.float64], y: float | NDArray[np.float64], side: float | NDArray[np.float64]
-) -> Polygon | NDArray[np.object_]:
+def square(x: float, y: float, side: float) -> Polygon:
     """The axis-aligned square of side `side` centred at ``(x, y)`` (mm).
 
     Parameters
     ----------
-    x, y : float or numpy.ndarray of float
+    x, y : float
         The centre, mm.
-    side : float or numpy.ndarray of float
+    side : float
         The side, mm.
 
     Returns
     -------
-    shapely.Polygon or numpy.ndarray of shapely.Polygon
-        One square, or one per element when given arrays (shapely builds them all at once).
+    shapely.Polygon
+        Given arrays instead, an array of squares, one per element (shapely builds them at once).
     """
     half = side / 2.0
     return box(x - half, y - half, x + half, y + half)
