@@ -32,6 +32,10 @@ import os
 import signal
 import sys
 
+TYPE_CHECKING = False  # (typing itself is not imported at run time)
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
 EXIT_INTERRUPTED = 130
 """Exit status after Ctrl-C (128 + SIGINT)."""
 
@@ -86,7 +90,7 @@ def _flush() -> None:
         _quietly(stream.flush)
 
 
-def _quietly(action, *args) -> None:
+def _quietly(action: Callable[..., object], *args: object) -> None:
     """``action(*args)``, where a closed pipe or stream has nothing more to take (contextlib's
     ``suppress`` would load a module before the handler is in place)."""
     try:

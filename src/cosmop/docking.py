@@ -29,6 +29,16 @@ def facing(heading: float) -> tuple[int, int]:
     """The exact unit vector ``(cos h, sin h)`` of a docking heading `h` (degrees, modulo 360,
     within 1e-6).
 
+    Parameters
+    ----------
+    heading : float
+        A docking heading, degrees.
+
+    Returns
+    -------
+    tuple of int
+        ``(cos h, sin h)``, each -1, 0 or 1.
+
     Raises
     ------
     ValueError
@@ -52,6 +62,20 @@ def docking_pose(obj: Iterable[float], gap: float, heading: float) -> tuple[floa
     `gap` is the centre distance :math:`d = (l_r + l_o)/2` (mm) at which the robot's and the
     object's squares touch; the robot stands at :math:`o - d\\,(\\cos h, \\sin h)`.
 
+    Parameters
+    ----------
+    obj : iterable of float
+        The object's centre ``(x, y, ...)``, mm; further items are ignored.
+    gap : float
+        The centre distance at which the two squares touch, mm.
+    heading : float
+        The robot's docking heading, degrees (one of :data:`DOCKING_HEADINGS`, modulo 360).
+
+    Returns
+    -------
+    tuple of float
+        The robot's centre ``(x, y)``, mm.
+
     Examples
     --------
     >>> docking_pose((1000, 0), 250, 0), docking_pose((1000, 0), 250, 270)
@@ -64,7 +88,22 @@ def docking_pose(obj: Iterable[float], gap: float, heading: float) -> tuple[floa
 
 def in_front(robot: Iterable[float], gap: float, heading: float) -> tuple[float, float]:
     """Where an object lies that a robot at `robot` facing `heading` touches: the inverse of
-    :func:`docking_pose`, :math:`r + d\\,(\\cos h, \\sin h)` (mm)."""
+    :func:`docking_pose`, :math:`r + d\\,(\\cos h, \\sin h)` (mm).
+
+    Parameters
+    ----------
+    robot : iterable of float
+        The robot's centre ``(x, y, ...)``, mm; further items (a heading) are ignored.
+    gap : float
+        The centre distance at which the two squares touch, mm.
+    heading : float
+        The robot's docking heading, degrees (one of :data:`DOCKING_HEADINGS`, modulo 360).
+
+    Returns
+    -------
+    tuple of float
+        The object's centre ``(x, y)``, mm.
+    """
     x, y, *_ = robot
     ux, uy = facing(heading)
     return x + gap * ux, y + gap * uy

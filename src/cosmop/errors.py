@@ -8,6 +8,7 @@ The command line prints such errors as one line and exits with status 2.
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 from dataclasses import dataclass
 
 __all__ = [
@@ -65,14 +66,22 @@ class CosmopInputError(Exception):
     def __str__(self) -> str:
         return self._message()
 
-    def __reduce__(self):  # keyword-only arguments: teach pickle (multiprocessing) to rebuild us
+    def __reduce__(self) -> tuple[Callable[..., CosmopInputError], tuple[object, ...]]:
+        # keyword-only arguments: teach pickle (multiprocessing) to rebuild us
         return (
             _rebuild,
             (type(self), self.expected, self.file, self.field, self.line, self.column),
         )
 
 
-def _rebuild(cls, expected, file, field, line, column):
+def _rebuild(
+    cls: type[CosmopInputError],
+    expected: str,
+    file: str | None,
+    field: str | None,
+    line: int | None,
+    column: int | None,
+) -> CosmopInputError:
     return cls(expected, file=file, field=field, line=line, column=column)
 
 

@@ -175,6 +175,7 @@ class Event:
         """The robots whose alphabets contain this event: sender and receiver for a message,
         else ``{robot}``."""
         if self.kind in MESSAGE_KINDS:
+            assert self.responder is not None  # a message always has one (__post_init__)
             return frozenset((self.robot, self.responder))
         return frozenset((self.robot,))
 
@@ -284,6 +285,19 @@ def _parse_text(text: str, robot: str | None) -> Event:
 def message(sender: str, receiver: str, tag: str) -> Event:
     """The message event ``msg(sender,receiver,tag)``.
 
+    Parameters
+    ----------
+    sender, receiver : str
+        The robots that send and await the message (different ids).
+    tag : str
+        What the message is about, an id.
+
+    Returns
+    -------
+    Event
+
+    Examples
+    --------
     >>> message("R1", "R2", "after_drop_O1").name
     'msg(R1,R2,after_drop_O1)'
     """
@@ -320,6 +334,20 @@ def realising_step(event: Event, robot: str) -> tuple[Primitive, str | None, str
     ``away(O,A,B)`` and of the tag for ``msg(S,R,tag)``.  ``None`` for ``return(R)``, which a
     pose realises, not a step.
 
+    Parameters
+    ----------
+    event : Event
+        The event to realise.
+    robot : str
+        The robot whose plan holds the step (for a message: its sender or its receiver).
+
+    Returns
+    -------
+    tuple of (Primitive, str or None, str or None) or None
+        The step's primitive, the object it handles and the message's name (``msg`` only).
+
+    Examples
+    --------
     >>> realising_step(parse_event("away(O2,R1,R2)"), "R2")
     (<Primitive.RES: 'Res'>, 'O2', None)
     """

@@ -10,6 +10,7 @@ import stat
 import tempfile
 from collections.abc import Iterator
 from pathlib import Path
+from types import FrameType
 
 from cosmop.errors import CosmopInputError, OutputPathError
 
@@ -27,7 +28,7 @@ __all__ = [
 
 
 @contextlib.contextmanager
-def uninterrupted():
+def uninterrupted() -> Iterator[None]:
     """Hold Ctrl-C (SIGINT) back while the block runs; it arrives, if pressed, right after.
 
     For outputs that belong together (a run's summary and its trace): each is written
@@ -43,7 +44,7 @@ def uninterrupted():
     if threading.current_thread() is not threading.main_thread():
         yield
         return
-    pressed: list[tuple[int, object]] = []
+    pressed: list[tuple[int, FrameType | None]] = []
     old = signal.signal(signal.SIGINT, lambda number, frame: pressed.append((number, frame)))
     try:
         yield
@@ -52,7 +53,7 @@ def uninterrupted():
         if pressed:
             if callable(old):
                 old(*pressed[0])
-            elif old == signal.default_int_handler or old == signal.SIG_DFL:
+            elif old == signal.SIG_DFL:  # (Python's default handler is callable: called above)
                 raise KeyboardInterrupt
 
 

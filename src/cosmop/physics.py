@@ -44,7 +44,7 @@ class Overlap:
         What it overlaps, in words (a wall with its end points, or another body).
     """
 
-    field: tuple
+    field: tuple[str | int, ...]
     body: str
     other: str
 
@@ -59,7 +59,7 @@ class _Body:
     size: float
     x: float
     y: float
-    field: tuple
+    field: tuple[str | int, ...]
 
     def words(self, units: UnitSystem) -> str:
         at = f"({shown(self.x, units):g}, {shown(self.y, units):g})"
@@ -114,7 +114,8 @@ def overlaps(scene: Scene, *, units: UnitSystem = "mm") -> list[Overlap]:
     xy = np.array([(b.x, b.y) for b in bodies])
     found: dict[int, list[str]] = {}
     if scene.obstacles:
-        boxes = square(xy[:, 0], xy[:, 1], size - 2.0 * TOUCH)  # shapely builds them all at once
+        # arrays: shapely builds them all at once (square's types name one square)
+        boxes = square(xy[:, 0], xy[:, 1], size - 2.0 * TOUCH)  # type: ignore[arg-type]
         walls = [shapely.LineString([w.start, w.end]) for w in scene.obstacles]
         hits = shapely.STRtree(walls).query(boxes, predicate="intersects")
         for i, j in sorted(zip(hits[0].tolist(), hits[1].tolist(), strict=True)):

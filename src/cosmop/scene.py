@@ -192,8 +192,15 @@ class Workspace:
         rectangle = self.x is not None and self.y is not None
         if rectangle == (self.point is not None) or (self.x is None) != (self.y is None):
             raise ValueError(f"workspace {self.id}: give either x and y ranges, or a point")
-        if rectangle and (self.x[0] > self.x[1] or self.y[0] > self.y[1]):
-            raise ValueError(f"workspace {self.id}: ranges must be [lo, hi] with lo <= hi")
+        if rectangle:
+            x, y = self._box()
+            if x[0] > x[1] or y[0] > y[1]:
+                raise ValueError(f"workspace {self.id}: ranges must be [lo, hi] with lo <= hi")
+
+    def _box(self) -> tuple[Point, Point]:
+        # The x and y ranges of a rectangle workspace (both given: __post_init__ checks it).
+        assert self.x is not None and self.y is not None
+        return self.x, self.y
 
     @property
     def is_point(self) -> bool:
@@ -205,20 +212,31 @@ class Workspace:
         """The centre of the rectangle, or the point (mm)."""
         if self.point is not None:
             return self.point
-        return ((self.x[0] + self.x[1]) / 2.0, (self.y[0] + self.y[1]) / 2.0)
+        x, y = self._box()
+        return ((x[0] + x[1]) / 2.0, (y[0] + y[1]) / 2.0)
 
     @property
     def ranges(self) -> tuple[Point, Point]:
         """``(x range, y range)`` (mm); a point workspace gives ranges of zero width."""
         if self.point is not None:
             return (self.point[0], self.point[0]), (self.point[1], self.point[1])
-        return self.x, self.y
+        return self._box()
 
     def centres(self, size: float) -> Workspace:
         """Where the centre of a square of side `size` (mm) lies when the whole square is inside.
 
         A rectangle shrinks by ``size / 2`` on every side; a point workspace is its own answer
         (it names the object's position exactly).
+
+        Parameters
+        ----------
+        size : float
+            Side of the square, mm.
+
+        Returns
+        -------
+        Workspace
+            The workspace of allowed centres (same id).
 
         Raises
         ------
@@ -233,7 +251,8 @@ class Workspace:
         if self.point is not None:
             return self
         half = size / 2.0
-        x, y = (self.x[0] + half, self.x[1] - half), (self.y[0] + half, self.y[1] - half)
+        box_x, box_y = self._box()
+        x, y = (box_x[0] + half, box_x[1] - half), (box_y[0] + half, box_y[1] - half)
         if x[0] > x[1] or y[0] > y[1]:
             raise ValueError(f"workspace {self.id} cannot hold a square of side {size:g} mm")
         return Workspace(self.id, x=x, y=y)
@@ -242,6 +261,21 @@ class Workspace:
         """Whether a square of side `size` (mm) centred at ``(x, y)`` lies wholly inside, within
         `tol` mm (a point workspace: the centre is the point): :meth:`centres` contains it.
 
+        Parameters
+        ----------
+        x, y : float
+            The square's centre, mm.
+        size : float
+            Side of the square, mm.
+        tol : float, optional
+            Slack in mm on every side (default 0: exact).
+
+        Returns
+        -------
+        bool
+
+        Examples
+        --------
         >>> Workspace("W", x=(0, 500), y=(0, 300)).holds(460, 100, 100)
         False
         """
@@ -264,7 +298,8 @@ class Workspace:
         """
         if self.point is not None:
             return abs(x - self.point[0]) <= tol and abs(y - self.point[1]) <= tol
-        return self.x[0] - tol <= x <= self.x[1] + tol and self.y[0] - tol <= y <= self.y[1] + tol
+        box_x, box_y = self._box()
+        return box_x[0] - tol <= x <= box_x[1] + tol and box_y[0] - tol <= y <= box_y[1] + tol
 
 
 @dataclass(frozen=True)
@@ -405,7 +440,7 @@ class Scene:
 
     def blocked(
         self, half: float, slack: float = 0.5, within: tuple[float, float, float, float] | None = None
-    ):
+    ) -> Any:
         """Where the centre of an axis-aligned square of half-side `half` (mm) overlaps a wall.
 
         Each wall grown by the square exactly (the convex hull of the square at both ends),
@@ -413,6 +448,20 @@ class Scene:
         (the walls are shrunk one by one, so that gap is not closed by their union).  A shapely
         geometry (empty without walls).  Given ``within = (xmin, ymin, xmax, ymax)``, only the
         walls whose grown shape can meet that box are taken (the answer is the same inside it).
+
+        Parameters
+        ----------
+        half : float
+            Half the side of the square, mm.
+        slack : float, optional
+            How much less than the square each wall is grown by, mm (default 0.5).
+        within : tuple of float, optional
+            A box ``(xmin, ymin, xmax, ymax)``, mm, to which the answer may be limited.
+
+        Returns
+        -------
+        shapely.Geometry
+            The blocked region of centres.
         """
         import shapely
 
@@ -519,7 +568,8 @@ class Mission:
             return frozenset(event for sequence in self.tasks.values() for event in sequence)
         if self.dfa is not None:
             return frozenset(self.dfa.alphabet)
-        out = set()
+        assert self.deliveries is not None  # exactly one of the three forms is given
+        out: set[Event] = set()
         for d in self.deliveries:
             out.update(d.events())
             if self.returns:

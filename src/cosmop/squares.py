@@ -10,6 +10,7 @@ from collections.abc import Iterable
 
 import numpy as np
 import shapely
+from numpy.typing import NDArray
 from shapely import LineString, Point, Polygon, box
 
 from cosmop.docking import DOCKING_HEADINGS, docking_pose
@@ -18,7 +19,20 @@ __all__ = ["docking_places", "overlap_depths", "rectangle", "square", "swept_squ
 
 
 def square(x: float, y: float, side: float) -> Polygon:
-    """The axis-aligned square of side `side` centred at ``(x, y)`` (mm)."""
+    """The axis-aligned square of side `side` centred at ``(x, y)`` (mm).
+
+    Parameters
+    ----------
+    x, y : float
+        The centre, mm.
+    side : float
+        The side, mm.
+
+    Returns
+    -------
+    shapely.Polygon
+        Given arrays instead, an array of squares, one per element (shapely builds them at once).
+    """
     half = side / 2.0
     return box(x - half, y - half, x + half, y + half)
 
@@ -32,6 +46,20 @@ def docking_places(
 
     One place per heading: the rectangle moved by :math:`-d\\,(\\cos h, \\sin h)`, `gap` being
     :math:`d`.
+
+    Parameters
+    ----------
+    x, y : iterable of float
+        The ranges ``(lo, hi)`` of the object's centre, mm.
+    gap : float
+        The centre distance at which the robot's and the object's squares touch, mm.
+    headings : iterable of int, optional
+        The docking headings to take, degrees (default all four).
+
+    Returns
+    -------
+    list of shapely geometries
+        One point, segment or rectangle per heading, in the order of `headings`.
 
     Examples
     --------
@@ -48,7 +76,17 @@ def docking_places(
 
 def rectangle(x: Iterable[float], y: Iterable[float]) -> Point | LineString | Polygon:
     """The closed rectangle ``x[0] <= x <= x[1]``, ``y[0] <= y <= y[1]`` (mm), as a point or a
-    segment when it has no width or no height (a zero-area polygon would intersect nothing)."""
+    segment when it has no width or no height (a zero-area polygon would intersect nothing).
+
+    Parameters
+    ----------
+    x, y : iterable of float
+        The ranges ``(lo, hi)``, mm.
+
+    Returns
+    -------
+    shapely.Point, shapely.LineString or shapely.Polygon
+    """
     (x0, x1), (y0, y1) = x, y
     if x0 == x1 and y0 == y1:
         return Point(x0, y0)
@@ -79,7 +117,9 @@ def swept_square(start: Iterable[float], end: Iterable[float], side: float) -> P
     return first.union(square(x1, y1, side)).convex_hull
 
 
-def overlap_depths(shapes: np.ndarray, left: np.ndarray, right: np.ndarray) -> np.ndarray:
+def overlap_depths(
+    shapes: NDArray[np.object_], left: NDArray[np.intp], right: NDArray[np.intp]
+) -> NDArray[np.float64]:
     """How deep the pairs ``(shapes[left[n]], shapes[right[n]])`` of convex polygons overlap (mm).
 
     By the separating axis theorem, two convex polygons' interiors overlap iff their
@@ -87,6 +127,18 @@ def overlap_depths(shapes: np.ndarray, left: np.ndarray, right: np.ndarray) -> n
     those overlaps: positive when the interiors overlap, at most 0 when the polygons only touch
     or lie apart (then minus the gap along the axis that separates them).  A shape that is not a
     convex polygon without holes (within 1e-6 mm) gives its pairs NaN.
+
+    Parameters
+    ----------
+    shapes : numpy.ndarray of shapely geometries
+        The shapes, mm.
+    left, right : numpy.ndarray of int
+        Indices into `shapes`: the pairs to compare, of equal length.
+
+    Returns
+    -------
+    numpy.ndarray of float
+        One depth per pair, mm (NaN where a shape is not a convex polygon).
 
     Examples
     --------
@@ -104,12 +156,14 @@ def overlap_depths(shapes: np.ndarray, left: np.ndarray, right: np.ndarray) -> n
     return np.where(convex[left] & convex[right], depth, np.nan)
 
 
-def _convex(shapes: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def _convex(
+    shapes: NDArray[np.object_],
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_], NDArray[np.bool_]]:
     """Each shape's corners ``(m, V, 2)`` (the last repeated up to V), its edges' unit normals
     ``(m, V, 2)`` with whether each edge is real (not of zero length), and whether it is a
     convex polygon without holes (every corner on the inner side of every edge)."""
     polygon = (shapely.get_type_id(shapes) == 3) & (shapely.get_num_interior_rings(shapes) == 0)
-    rings = shapely.get_exterior_ring(np.where(polygon, shapes, None))
+    rings = shapely.get_exterior_ring(np.where(polygon, shapes, np.array(None)))
     coords, owner = shapely.get_coordinates(rings, return_index=True)
     count = np.bincount(owner, minlength=len(shapes)) - 1  # the ring closes on its first corner
     polygon &= count >= 3

@@ -63,22 +63,48 @@ _MM_PER_M = 1000.0
 
 
 def mm_from_m(value: float) -> float:
-    """Metres to millimetres, rounded to 1e-6 mm (so that 2.3 m is exactly 2300 mm)."""
+    """Metres to millimetres, rounded to 1e-6 mm (so that 2.3 m is exactly 2300 mm).
+
+    Parameters
+    ----------
+    value : float
+        A length, m.
+    """
     return round(value * _MM_PER_M, 6) + 0.0
 
 
 def m_from_mm(value: float) -> float:
-    """Millimetres to metres."""
+    """Millimetres to metres.
+
+    Parameters
+    ----------
+    value : float
+        A length, mm.
+    """
     return value / _MM_PER_M
 
 
 def shown(mm: float, units: UnitSystem) -> float:
-    """A length of the internal scene (mm) as the file wrote it (mm, or m for ``units: m``)."""
+    """A length of the internal scene (mm) as the file wrote it (mm, or m for ``units: m``).
+
+    Parameters
+    ----------
+    mm : float
+        The length, mm.
+    units : {"mm", "m"}
+        The file's units.
+    """
     return m_from_mm(mm) if units == "m" else mm
 
 
 def length_unit(units: UnitSystem) -> str:
-    """The unit lengths are written in: ``"m"`` or ``"mm"``."""
+    """The unit lengths are written in: ``"m"`` or ``"mm"``.
+
+    Parameters
+    ----------
+    units : {"mm", "m"}
+        The file's units.
+    """
     return "m" if units == "m" else "mm"
 
 
@@ -88,6 +114,15 @@ def show_number(mm: float, units: UnitSystem) -> str:
     Whole numbers without a point and in full (``800000``, never ``8e+05``), others exactly in
     mm and to 1e-9 m (a micrometre's thousandth, below the planner's grid) in metres.
 
+    Parameters
+    ----------
+    mm : float
+        The length or coordinate, mm.
+    units : {"mm", "m"}
+        The file's units.
+
+    Examples
+    --------
     >>> show_number(800000.0, "m"), show_number(1433.5, "mm"), show_number(-2000.0, "mm")
     ('800', '1433.5', '-2000')
     """
@@ -101,37 +136,83 @@ def show_number(mm: float, units: UnitSystem) -> str:
 
 def plain(value: float) -> str:
     """A number as people write it: whole ones in full (``800000``, never ``8e+05``), others to
-    six significant digits; huge and tiny ones in exponent form (``1e+300``)."""
+    six significant digits; huge and tiny ones in exponent form (``1e+300``).
+
+    Parameters
+    ----------
+    value : float
+        The number.
+    """
     if math.isfinite(value) and float(value).is_integer() and abs(value) < 1e15:
         return str(int(value))
     return f"{value:.6g}"
 
 
 def show_length(mm: float, units: UnitSystem) -> str:
-    """A length of the internal scene (mm) in the file's units, with the unit (``"0.4 m"``)."""
+    """A length of the internal scene (mm) in the file's units, with the unit (``"0.4 m"``).
+
+    Parameters
+    ----------
+    mm : float
+        The length, mm.
+    units : {"mm", "m"}
+        The file's units.
+    """
     return f"{show_number(mm, units)} {length_unit(units)}"
 
 
 def show_point(point: Iterable[float], units: UnitSystem) -> str:
-    """A point of the internal scene (mm) in the file's units: ``(0.8, 1)`` for ``(800, 1000)`` in m."""
+    """A point of the internal scene (mm) in the file's units: ``(0.8, 1)`` for ``(800, 1000)`` in m.
+
+    Parameters
+    ----------
+    point : iterable of float
+        The coordinates, mm.
+    units : {"mm", "m"}
+        The file's units.
+    """
     return "(" + ", ".join(show_number(v, units) for v in point) + ")"
 
 
 def show_angle(degrees: float, units: UnitSystem) -> str:
-    """A heading of the internal scene (degrees) in the file's units: ``90°`` or ``1.5708 rad``."""
+    """A heading of the internal scene (degrees) in the file's units: ``90°`` or ``1.5708 rad``.
+
+    Parameters
+    ----------
+    degrees : float
+        The heading, degrees.
+    units : {"mm", "m"}
+        The file's units (``"m"``: radians).
+    """
     if units == "m":
         return f"{math.radians(degrees):.6g} rad"
     return f"{show_number(degrees, 'mm')}°"
 
 
 def show_pose(pose: Sequence[float], units: UnitSystem) -> str:
-    """A pose ``(x, y, heading)`` of the internal scene in the file's units: ``(0.8, 1, 1.5708 rad)``."""
+    """A pose ``(x, y, heading)`` of the internal scene in the file's units: ``(0.8, 1, 1.5708 rad)``.
+
+    Parameters
+    ----------
+    pose : sequence of float
+        ``(x, y, heading)``: position in mm, heading in degrees.
+    units : {"mm", "m"}
+        The file's units.
+    """
     x, y, heading = pose
     return f"({show_number(x, units)}, {show_number(y, units)}, {show_angle(heading, units)})"
 
 
 def show_speed(mm_per_s: float, units: UnitSystem) -> str:
-    """A speed of the internal scene (mm/s) in the file's units, with the unit (``"0.75 m/s"``)."""
+    """A speed of the internal scene (mm/s) in the file's units, with the unit (``"0.75 m/s"``).
+
+    Parameters
+    ----------
+    mm_per_s : float
+        The speed, mm/s.
+    units : {"mm", "m"}
+        The file's units.
+    """
     return f"{show_number(mm_per_s, units)} {length_unit(units)}/s"
 
 
@@ -140,12 +221,19 @@ def _deg_from_rad(value: float) -> float:
 
 
 def rad_from_deg(value: float) -> float:
-    """Degrees to radians."""
+    """Degrees to radians.
+
+    Parameters
+    ----------
+    value : float
+        An angle, degrees.
+    """
     return math.radians(value)
 
 
-def _point(point: tuple[float, ...]) -> tuple[float, ...]:
-    return tuple(mm_from_m(v) for v in point)
+def _point(point: tuple[float, float]) -> tuple[float, float]:
+    x, y = point
+    return mm_from_m(x), mm_from_m(y)
 
 
 def _dynamics(d: Dynamics) -> Dynamics:
@@ -163,6 +251,11 @@ def default_dynamics(units: UnitSystem) -> Dynamics:
 
     A scene read in metres starts from these, so that :func:`scene_to_internal` turns them
     back into exactly the millimetre defaults.
+
+    Parameters
+    ----------
+    units : {"mm", "m"}
+        The units to express them in.
     """
     d = Dynamics()
     if units == "mm":
@@ -257,6 +350,13 @@ def localize(message: str, units: UnitSystem) -> str:
 
     The scenario's messages name units the internal way ("a positive number (side of the
     square robot, mm)"); for a file in metres they should say "m" and "radians".
+
+    Parameters
+    ----------
+    message : str
+        The message, with its units named the internal way.
+    units : {"mm", "m"}
+        The file's units.
     """
     if units != "m":
         return message

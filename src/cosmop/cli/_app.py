@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
-from typing import Annotated, Any, NoReturn
+from typing import TYPE_CHECKING, Annotated, Any, NoReturn, cast
 
 import typer
 from rich.console import Console
@@ -27,11 +27,23 @@ EXIT_INPUT_ERROR = 2
 """Exit status for bad input (also the status of command-line usage errors)."""
 
 
+if TYPE_CHECKING:
+
+    class _ClickError(Exception):
+        """What click's error base class offers us, whichever click typer uses."""
+
+        exit_code: int
+
+        def format_message(self) -> str: ...
+
+
 # click's error base class, from typer's own BadParameter (typer may bundle its own click)
-_ClickException = next(c for c in typer.BadParameter.__mro__ if c.__name__ == "ClickException")
+_ClickException = cast(
+    "type[_ClickError]", next(c for c in typer.BadParameter.__mro__ if c.__name__ == "ClickException")
+)
 
 
-def _usage_error(err: Exception) -> NoReturn:
+def _usage_error(err: _ClickError) -> NoReturn:
     """A command-line usage error (an option out of range, a missing argument, an unknown
     command) as one line naming the command and the option, with click's exit status (2).
 
@@ -55,13 +67,14 @@ class _Group(TyperGroup):
     Ctrl-C is the program's (:mod:`cosmop._entry`): KeyboardInterrupt passes through.
     """
 
-    def make_context(self, info_name, args, parent=None, **extra) -> Any:
+    # click's Context is typer's bundled one or click's own, as installed: no one public name for it
+    def make_context(self, info_name: str | None, args: list[str], parent: Any = None, **extra: Any) -> Any:
         try:  # the group's own options and arguments
             return super().make_context(info_name, args, parent=parent, **extra)
         except _ClickException as err:
             _usage_error(err)
 
-    def invoke(self, ctx: typer.Context) -> Any:
+    def invoke(self, ctx: Any) -> Any:
         try:
             return super().invoke(ctx)
         except _ClickException as err:  # a command's options and arguments, or its own checks

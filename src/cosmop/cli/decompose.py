@@ -16,9 +16,11 @@ from cosmop.automata import DFA
 from cosmop.cli._app import ScenarioArgument, load, stderr, stdout
 from cosmop.cli.words import decompose_verdict
 from cosmop.io import check_writable, write_atomic
+from cosmop.missions.decomposition import Decomposition, Resynthesis
 from cosmop.missions.decomposition import decompose as run_decompose
 from cosmop.missions.mission import GlobalMission, sequence_of
-from cosmop.missions.team import verify_team
+from cosmop.missions.team import TeamVerdict, verify_team
+from cosmop.missions.verification import Verification
 from cosmop.missions.verification import verify as run_verify
 from cosmop.scene import Scenario
 
@@ -54,8 +56,23 @@ def decompose(
     Exit status 0 when the mission is separable and the local missions are proven to satisfy it,
     1 when it is not (the counterexample and the re-synthesised local missions are shown), 2 on
     bad input.
+
+    Parameters
+    ----------
+    scenario : pathlib.Path
+        The scenario file (YAML).
+    as_json : bool
+        ``--json``: print one JSON object instead of tables.
+    method : Method
+        ``--method``: verify by assume-guarantee reasoning with L*, by direct inclusion, or
+        choose automatically.
+    dot : pathlib.Path or None
+        ``--dot``: also write each local mission as Graphviz DOT into this directory.
+    verbose : bool
+        ``--verbose``: also print the verification's statistics.
     """
     loaded = load(scenario)
+    assert loaded.mission is not None  # load() refuses a file without one
     check_writable(dot, "--dot", folder=True)
     if loaded.mission.deliveries is not None:
         _refuse_deliveries(scenario)
@@ -88,7 +105,9 @@ def _refuse_deliveries(scenario: Path) -> None:
     raise typer.Exit(1)
 
 
-def _decompose_and_verify(mission: GlobalMission, method: Method) -> tuple[Any, Any, Any]:
+def _decompose_and_verify(
+    mission: GlobalMission, method: Method
+) -> tuple[Decomposition, Verification, TeamVerdict | None]:
     """The decomposition, its verification and, for robots ordered by messages, the team's proof."""
     team = None
     with stderr().status("decomposing by natural projection ...", spinner="dots") as status:
@@ -104,7 +123,7 @@ def _decompose_and_verify(mission: GlobalMission, method: Method) -> tuple[Any, 
     return result, verification, team
 
 
-def _write_dot(dot: Path, result: Any, tell_stderr: bool) -> str:
+def _write_dot(dot: Path, result: Decomposition, tell_stderr: bool) -> str:
     """Write each local mission as ``<robot>.dot``; the file names, for the closing line."""
     dot.mkdir(parents=True, exist_ok=True)
     for robot, dfa in result.local_missions.items():
@@ -115,7 +134,9 @@ def _write_dot(dot: Path, result: Any, tell_stderr: bool) -> str:
     return names
 
 
-def _as_json(result: Any, verification: Any, team: Any, holds: bool) -> dict[str, Any]:
+def _as_json(
+    result: Decomposition, verification: Verification, team: TeamVerdict | None, holds: bool
+) -> dict[str, Any]:
     """The ``--json`` answer: the decomposition with its verification (and the team's proof)."""
     checked = verification.to_dict() | {"holds": holds}
     if team is not None:
@@ -135,7 +156,7 @@ def _sequence_text(dfa: DFA) -> str:
     return " -> ".join(seq) if seq else "(no events)"
 
 
-def _print_local_missions(console: Console, loaded: Scenario, result: Any, verbose: bool) -> None:
+def _print_local_missions(console: Console, loaded: Scenario, result: Decomposition, verbose: bool) -> None:
     """The table of local missions, separability, and what ordering or re-synthesis changed."""
     table = Table(title=Text(f"local missions of {loaded.name}"), header_style="bold")
     for column in ("robot", "events", "states", "local mission K_i = P_i(K)"):
@@ -165,7 +186,7 @@ def _print_local_missions(console: Console, loaded: Scenario, result: Any, verbo
         _print_resynthesis(console, result.resynthesis)
 
 
-def _print_resynthesis(console: Console, rs: Any) -> None:
+def _print_resynthesis(console: Console, rs: Resynthesis) -> None:
     """Whether the paper's re-synthesis converged, and each robot's lost events."""
     console.print(
         Text(
@@ -178,7 +199,9 @@ def _print_resynthesis(console: Console, rs: Any) -> None:
             console.print(Text(f"  {robot} can no longer perform: {', '.join(events)}", style="yellow"))
 
 
-def _print_verification(console: Console, v: Any, team: Any, holds: bool, verbose: bool) -> None:
+def _print_verification(
+    console: Console, v: Verification, team: TeamVerdict | None, holds: bool, verbose: bool
+) -> None:
     """The verification's verdict (statistics with ``--verbose``) and the violation, if any."""
     sizes = ", ".join(str(a.assumption.n_states if a.assumption else 0) for a in v.assumptions) or "-"
     details = (

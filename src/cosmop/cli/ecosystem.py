@@ -6,9 +6,10 @@ rules: thin functions, input errors reported by the command group as one line wi
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from enum import StrEnum
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 from rich.text import Text
@@ -17,6 +18,8 @@ from cosmop.cli._app import load, stdout
 from cosmop.io import check_writable, write_atomic
 
 if TYPE_CHECKING:
+    from cosmop.planning.plan import PlanSet
+    from cosmop.scene import Scenario, Scene
     from cosmop.traces import Trace
 
 __all__ = ["check_bag_target", "export", "import_map", "view", "write_bag_and_report"]
@@ -78,6 +81,28 @@ def import_map(
     mission); with one, a whole scenario, which is validated before it is written: the template
     as it was (comments, key order, one-line lists) with its walls replaced. Exit status 0
     written, 2 bad input (nothing written).
+
+    Parameters
+    ----------
+    map_file : pathlib.Path
+        The map: a MovingAI ``.map`` file or a ROS ``map_server`` ``.yaml`` file.
+    output : pathlib.Path
+        ``-o``: the scenario YAML to write.
+    cell_size : float or None
+        ``--cell-size``: side of a cell, mm (None: 1000 for ``.map``, the YAML's resolution).
+    origin : tuple of float or None
+        ``--origin``: the map's lower-left corner ``(x, y)``, mm (None: ``(0, 0)``, or the ROS
+        map's origin).
+    unknown : {"blocked", "free"}
+        ``--unknown``: what the unknown cells of a ROS map are.
+    walls : {"boundary", "rectangles"}
+        ``--walls``: only the edges between free and blocked cells, or every rectangle's outline.
+    units : {"mm", "m"} or None
+        ``--units``: the units to write (None: the template's, else mm).
+    template : pathlib.Path or None
+        ``--template``: a scenario to keep, comments and all, with only its walls replaced.
+    name : str or None
+        ``--name``: the scenario's name (None: the template's, else the map file's stem).
     """
     from cosmop.maps import import_map as read_map
     from cosmop.maps import scenario_text
@@ -116,7 +141,7 @@ def import_map(
     )
 
 
-def _warn_if_other_scenario(loaded, trace: Trace | None, plans) -> None:
+def _warn_if_other_scenario(loaded: Scenario, trace: Trace | None, plans: PlanSet | None) -> None:
     """A trace or plan made for another scenario (by name) is drawn anyway, with a warning."""
     for what, name in (
         ("trace", getattr(trace, "scenario", None)),
@@ -127,7 +152,13 @@ def _warn_if_other_scenario(loaded, trace: Trace | None, plans) -> None:
 
 
 def check_bag_target(bag: Path) -> None:
-    """Before any work: the ``ros`` extra is installed and the bag directory is new (else exit 2)."""
+    """Before any work: the ``ros`` extra is installed and the bag directory is new (else exit 2).
+
+    Parameters
+    ----------
+    bag : pathlib.Path
+        The bag directory to create (``--bag``).
+    """
     from cosmop.export import ros_available
 
     if not ros_available():
@@ -141,8 +172,31 @@ def check_bag_target(bag: Path) -> None:
     check_writable(bag, "--bag", folder=True)  # its folder exists and is writable
 
 
-def write_bag_and_report(scene, trace, bag: Path, plans, rate: float | None, scene_rate: float) -> None:
-    """Write the bag and print one line: where, how many messages on how many topics, how big."""
+def write_bag_and_report(
+    scene: Scene,
+    trace: Trace | Mapping[str, Any],
+    bag: Path,
+    plans: PlanSet | None,
+    rate: float | None,
+    scene_rate: float,
+) -> None:
+    """Write the bag and print one line: where, how many messages on how many topics, how big.
+
+    Parameters
+    ----------
+    scene : Scene
+        The run's scene (mm).
+    trace : Trace or Mapping
+        The run (or its ``cosmop.trace/1`` JSON).
+    bag : pathlib.Path
+        The bag directory to create.
+    plans : PlanSet or None
+        The plans executed, published as each robot's ``/<robot>/plan``.
+    rate : float or None
+        Poses and ``/tf`` per second, Hz (None: every frame of the trace).
+    scene_rate : float
+        ``/scene`` marker arrays per second, Hz.
+    """
     from cosmop.export import write_bag
 
     summary = write_bag(scene, trace, bag, plans=plans, rate=rate, scene_rate=scene_rate)
@@ -190,6 +244,21 @@ def export(
     Topics: /tf, /<robot>/pose (PoseStamped), /<robot>/plan (Path), /scene (MarkerArray: walls,
     workspaces, objects, people, robots and what they carry, message arrows) and /coordination
     (String, one JSON object per message). Exit status 0 written, 2 bad input (nothing written).
+
+    Parameters
+    ----------
+    scenario : pathlib.Path
+        The scenario file (YAML).
+    trace : pathlib.Path
+        ``--trace``: the run, a trace from ``cosmop simulate --trace`` (``cosmop.trace/1``).
+    bag : pathlib.Path
+        ``--bag``: the bag directory to create (MCAP storage).
+    plan_file : pathlib.Path or None
+        ``--plan``: the plan file executed, published as each robot's ``/<robot>/plan``.
+    rate : float or None
+        ``--rate``: poses and ``/tf`` per second, Hz (None: every frame of the trace).
+    scene_rate : float
+        ``--scene-rate``: ``/scene`` marker arrays per second, Hz.
     """
     from cosmop.planning.plan import load_plan
     from cosmop.traces import load_trace
@@ -220,6 +289,17 @@ def view(
     Open it in any browser: a time slider and a play button move the robots (labelled, with
     what they carry) and draw each message as an arrow with its time. Exit status 0 written,
     2 bad input (nothing written).
+
+    Parameters
+    ----------
+    scenario : pathlib.Path
+        The scenario file (YAML).
+    output : pathlib.Path
+        ``-o``: the HTML file to write.
+    plan_file : pathlib.Path or None
+        ``--plan``: a plan file (``cosmop.plan/1``) to draw.
+    trace : pathlib.Path or None
+        ``--trace``: a run (``cosmop.trace/1``) to play with a time slider.
     """
     from cosmop.planning.plan import load_plan
     from cosmop.traces import load_trace

@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import json
+from concurrent.futures import Executor
+from contextlib import AbstractContextManager
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 from rich.console import Console
@@ -17,6 +19,9 @@ from cosmop.io import check_writable
 from cosmop.planning.checker import check_plan
 from cosmop.planning.plan import MAX_STEPS, load_plan
 from cosmop.scene import Scenario
+
+if TYPE_CHECKING:
+    from cosmop.team.loop import TeamResult
 
 __all__ = ["SchedulerOption", "WorkersOption", "check", "check_engine", "plan", "plan_with_progress"]
 
@@ -51,6 +56,15 @@ def check(
 
     Exit status 0 when the plan is valid, 1 when it breaks a rule (every violation is listed),
     2 on bad input.
+
+    Parameters
+    ----------
+    scenario : pathlib.Path
+        The scenario file (YAML).
+    plan : pathlib.Path
+        The plan file to check (``cosmop.plan/1`` JSON).
+    as_json : bool
+        ``--json``: print the report as one JSON object instead of a table.
     """
     loaded = load(scenario)
     plans = load_plan(plan)
@@ -116,6 +130,24 @@ def plan(
     are the same.  The PNG shows where the team works (``--full-map``: the whole map) and says
     in its title whether the plans are feasible, and if not why.  Exit status 0 feasible,
     1 infeasible, 2 bad input (an unreachable scheduler included).
+
+    Parameters
+    ----------
+    scenario : pathlib.Path
+        The scenario file (YAML).
+    output : pathlib.Path
+        ``-o``: the plan file to write (``cosmop.plan/1`` JSON).
+    png : pathlib.Path or None
+        ``--png``: also draw the scene and the plans into this PNG.
+    full_map : bool
+        ``--full-map``: draw the whole map in the PNG, not only where the team works.
+    max_horizon : int or None
+        ``--max-horizon``: the longest plan tried per robot, steps (None: the planner's default).
+    workers : int or None
+        ``--workers``: local processes for the robots' syntheses (None: one per core, at most
+        one per robot).
+    scheduler : str or None
+        ``--scheduler``: the address of a Dask scheduler to run the syntheses on (None: local).
     """
     check_engine(workers, scheduler)
     loaded = load(scenario)
@@ -155,7 +187,16 @@ def _need_viz() -> None:
 
 
 def check_engine(workers: int | None, scheduler: str | None) -> None:
-    """``--workers`` counts local processes; a cluster has its own workers (usage error, 2)."""
+    """``--workers`` counts local processes; a cluster has its own workers (usage error, 2).
+
+    Parameters
+    ----------
+    workers : int or None
+        ``--workers``: local processes for the robots' syntheses (None: one per core, at most
+        one per robot).
+    scheduler : str or None
+        ``--scheduler``: the address of a Dask scheduler to run the syntheses on (None: local).
+    """
     if workers is not None and scheduler is not None:
         raise typer.BadParameter(
             "local worker processes and a Dask scheduler exclude each other: "
@@ -166,9 +207,25 @@ def check_engine(workers: int | None, scheduler: str | None) -> None:
 
 def plan_with_progress(
     loaded: Scenario, max_horizon: int | None = None, workers: int | None = None, scheduler: str | None = None
-) -> Any:
+) -> TeamResult:
     """:func:`cosmop.team.loop.plan_team` under a spinner that names each robot as it is planned;
-    in local processes, or on the Dask cluster whose scheduler is at `scheduler`."""
+    in local processes, or on the Dask cluster whose scheduler is at `scheduler`.
+
+    Parameters
+    ----------
+    loaded : Scenario
+        The scenario to plan.
+    max_horizon : int or None
+        The longest plan tried per robot, steps (None: the planner's default).
+    workers : int or None
+        Local processes for the syntheses (None: one per core, at most one per robot).
+    scheduler : str or None
+        The address of a Dask scheduler to run the syntheses on (None: local processes).
+
+    Returns
+    -------
+    cosmop.team.loop.TeamResult
+    """
     from contextlib import nullcontext
 
     from rich.progress import Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
@@ -178,7 +235,7 @@ def plan_with_progress(
     columns = (SpinnerColumn(), TextColumn("{task.description}"), TimeElapsedColumn())
     with Progress(*columns, console=stderr(), transient=True) as progress:
         task = progress.add_task("planning", total=None)
-        engine = nullcontext(None)
+        engine: AbstractContextManager[Executor | None] = nullcontext(None)
         if scheduler is not None:
             from cosmop.team.cluster import dask_executor
 
@@ -197,9 +254,10 @@ def plan_with_progress(
             )
 
 
-def _print_coordination(console: Console, result: Any) -> None:
+def _print_coordination(console: Console, result: TeamResult) -> None:
     """The formal verdict: coordination pairs, messages, conflicts ordered, and the expected finish."""
     v, safety = result.verification, result.safety
+    assert v is not None  # printed for a verified team only
     ordered = ""
     if safety is not None:
         ordered = f"{safety.conflicts} conflict(s) between plans"
@@ -225,9 +283,10 @@ def _print_coordination(console: Console, result: Any) -> None:
         )
 
 
-def _print_allocation(console: Console, result: Any) -> None:
+def _print_allocation(console: Console, result: TeamResult) -> None:
     """Which robot moves each good, and the cost of that choice."""
     choice = result.allocation
+    assert choice is not None  # printed when the mission left a choice only
     moved = ", ".join(f"{o} by {r}" for o, r in result.plans.allocation.items()) or "nothing moved"
     proof = "the best" if choice.exhaustive else "the best found within the search bound"
     console.print(
@@ -238,7 +297,7 @@ def _print_allocation(console: Console, result: Any) -> None:
     )
 
 
-def _plan_table(scenario: Scenario, result) -> Table:
+def _plan_table(scenario: Scenario, result: TeamResult) -> Table:
     """One row per robot: its plan's steps, K (the shortest plan), requests, answers, messages."""
     table = Table(title=Text(f"plans for {scenario.name}"), header_style="bold")
     for column in ("robot", "feasible", "steps", "K", "requests", "answers", "msgs out/in", "solve"):

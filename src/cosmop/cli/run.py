@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Annotated
 
@@ -14,6 +15,7 @@ from cosmop.cli.simulate import parse_delays
 from cosmop.io import check_writable, uninterrupted
 from cosmop.lifelong import Failure, FleetResult, FleetSettings, run_fleet
 from cosmop.scenario import load_orders
+from cosmop.scene import Order, Scenario
 from cosmop.sim import Delays, SimSettings
 
 __all__ = ["run"]
@@ -75,6 +77,28 @@ def run(
     Prints a live progress line, a table per robot and the totals (deliveries per hour, each
     order's wait, contacts).  Exit status 0 when no contact happened while a robot moved and no
     order was lost, 1 otherwise, 2 on bad input.
+
+    Parameters
+    ----------
+    scenario : pathlib.Path
+        The scenario file (YAML).
+    until : float
+        ``--until``: simulated seconds the run lasts.
+    orders : pathlib.Path or None
+        ``--orders``: an orders file (``orders:`` as in a scenario); None: the scenario's orders.
+    seed : int
+        ``--seed``: seeds the people's walks and the delays.
+    fail : list of Failure or None
+        ``--fail ROBOT@SECONDS``, repeatable: robots that stop for good at those times.
+    delays : Delays or None
+        ``--delays P:MIN:MAX``: every simulated second each robot stops with probability P for
+        MIN to MAX s (None: no delays).
+    summary : pathlib.Path or None
+        ``--summary``: write the summary (``cosmop.run/1`` JSON) here.
+    trace : pathlib.Path or None
+        ``--trace``: write the trace (``cosmop.trace/1`` JSON) here.
+    plot : pathlib.Path or None
+        ``--plot``: write a PNG of the orders released and delivered over time here.
     """
     loaded = load(scenario, mission=False)
     stream = load_orders(orders, loaded) if orders is not None else loaded.orders
@@ -111,7 +135,14 @@ def run(
     raise typer.Exit(0 if ok else 1)
 
 
-def _run_with_progress(loaded, stream, until, seed, settings, failures) -> FleetResult:
+def _run_with_progress(
+    loaded: Scenario,
+    stream: Sequence[Order],
+    until: float,
+    seed: int,
+    settings: SimSettings,
+    failures: Sequence[Failure],
+) -> FleetResult:
     """:func:`cosmop.lifelong.run_fleet` under a live line: time, released, delivered."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
@@ -145,7 +176,7 @@ def _robots_table(result: FleetResult) -> Table:
     )
     for column in ("robot", "delivered", "busy", "failed"):
         table.add_column(column)
-    done = {}
+    done: dict[str, int] = {}
     for order in result.orders:
         if order.delivered is not None and order.robot is not None:
             done[order.robot] = done.get(order.robot, 0) + 1

@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 from rich.table import Table
@@ -17,7 +18,7 @@ from cosmop.io import check_writable, uninterrupted
 from cosmop.planning.checker import check_plan
 from cosmop.planning.plan import PlanSet, load_plan
 from cosmop.scene import Scenario
-from cosmop.sim import Delays, SimSettings
+from cosmop.sim import Delays, SimResult, SimSettings, StepTimes
 
 if TYPE_CHECKING:
     from cosmop.traces import Trace
@@ -112,6 +113,41 @@ def simulate(
     Without ``--plan`` the team is planned first, as ``cosmop plan`` does (``--workers``,
     ``--scheduler``).  Exit status 0 when every robot finished with no contact while moving, 1
     otherwise, 2 on bad input.
+
+    Parameters
+    ----------
+    scenario : pathlib.Path
+        The scenario file (YAML).
+    plan_file : pathlib.Path or None
+        ``--plan``: the plan file to execute (``cosmop.plan/1``); None: plan the team first.
+    seed : int
+        ``--seed``: seeds the people's random walks and the delays.
+    delays : Delays or None
+        ``--delays P:MIN:MAX``: every simulated second each robot stops with probability P for
+        MIN to MAX s (None: no delays).
+    summary : pathlib.Path or None
+        ``--summary``: write the summary (``cosmop.sim/1`` JSON) here.
+    trace : pathlib.Path or None
+        ``--trace``: write the trace, every cycle (``cosmop.trace/1`` JSON), here.
+    html : pathlib.Path or None
+        ``--html``: write a web page of the run here (as ``cosmop view`` does).
+    gif, mp4 : pathlib.Path or None
+        ``--gif``, ``--mp4``: write an animation of the run here.
+    speed : float or None
+        ``--speed``: the animations' simulated seconds per second (None: they last at most 45 s).
+    size : int or None
+        ``--size``: the animations' width, pixels (None: about 790).
+    bag : pathlib.Path or None
+        ``--bag``: write a ROS 2 bag directory (MCAP) of the run here.
+    max_time : float or None
+        ``--max-time``: simulated seconds before giving up (None: three times the planned
+        makespan, at least 900 s).
+    replan : bool
+        ``--replan/--no-replan``: whether stalled robots replan their remaining mission.
+    workers : int or None
+        ``--workers``: local processes for the syntheses when the team is planned first.
+    scheduler : str or None
+        ``--scheduler``: a Dask scheduler's address for those syntheses.
     """
     check_engine(workers, scheduler)
     loaded = load(scenario)
@@ -124,13 +160,16 @@ def simulate(
     run = result.trace() if any(p is not None for p in (trace, bag, gif, mp4, html)) else None
     with uninterrupted():  # the trace and its summary: both or neither
         if trace is not None:
+            assert run is not None  # made whenever a trace is asked for
             run.save(trace)
         if summary is not None:
             result.save_summary(summary)
     if bag is not None:
+        assert run is not None
         write_bag_and_report(loaded.scene, run, bag, plans, None, 5.0)
     for path in (gif, mp4):
         if path is not None:
+            assert run is not None
             _animate(loaded, run, plans, path, speed, size)
     if html is not None:
         from cosmop.viz.web import save_html
@@ -187,7 +226,7 @@ def _plans_to_run(
     return plans
 
 
-def _run_with_progress(loaded: Scenario, plans: PlanSet, seed: int, settings: SimSettings) -> Any:
+def _run_with_progress(loaded: Scenario, plans: PlanSet, seed: int, settings: SimSettings) -> SimResult:
     """:func:`cosmop.sim.simulate` under a bar of simulated time and robots done."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
@@ -227,7 +266,7 @@ def _animate(
         save_animation(loaded.scene, run, path, plans=plans, speed=speed, size=size)
 
 
-def _robots_table(loaded: Scenario, result: Any, seed: int) -> Table:
+def _robots_table(loaded: Scenario, result: SimResult, seed: int) -> Table:
     """One row per robot: where it ended, how far it drove, whether and when it finished."""
     delays = result.delays
     title = f"simulation of {loaded.name} (seed {seed}" + (f"; delays {delays.show()})" if delays else ")")
@@ -255,14 +294,14 @@ def _robots_table(loaded: Scenario, result: Any, seed: int) -> Table:
     return table
 
 
-def _stopped(stops) -> str:
+def _stopped(stops: Sequence[tuple[float, float]]) -> str:
     """How often and how long a delay stopped a robot: ``2 times, 12.3 s`` (``-``: never)."""
     if not stops:
         return "-"
     return f"{len(stops)} time{'s' if len(stops) > 1 else ''}, {sum(s for _, s in stops):.1f} s"
 
 
-def _verdict(loaded: Scenario, result: Any, plans: PlanSet) -> str:
+def _verdict(loaded: Scenario, result: SimResult, plans: PlanSet) -> str:
     """The closing line: completed or not, times, goods in place, contacts, messages, replans."""
     delivered = result.objects_in_workspaces(loaded, plans)
     speed = result.sim_time_s / max(result.wall_time_s, 1e-9)
@@ -277,7 +316,7 @@ def _verdict(loaded: Scenario, result: Any, plans: PlanSet) -> str:
     )
 
 
-def _contacts_said(loaded: Scenario, result: Any) -> str:
+def _contacts_said(loaded: Scenario, result: SimResult) -> str:
     """The contacts in the closing line, with how many were people walking into a standing robot
     (passive safety keeps a robot from moving into anything, not people from walking into it)."""
     people = sum(1 for c in result.contacts if not c.moving and c.other in loaded.scene.humans)
@@ -285,7 +324,7 @@ def _contacts_said(loaded: Scenario, result: Any) -> str:
     return said + (f" ({people} a person walking into a standing robot)" if people else "")
 
 
-def _delays_said(result: Any) -> str:
+def _delays_said(result: SimResult) -> str:
     """The delays in the closing line: how often robots stopped and for how long in all."""
     report = result.delay_report()
     if report is None:
@@ -293,7 +332,7 @@ def _delays_said(result: Any) -> str:
     return f"; delays stopped robots {report['count']} times, {report['seconds']:.1f} s in all"
 
 
-def _done_at(rows, finished: bool) -> str:
+def _done_at(rows: Sequence[StepTimes], finished: bool) -> str:
     """When a robot ended its plan in the run, and when its itinerary expected it: ``64.7 s (46.1 s)``."""
     realised = rows[-1].realised[1] if finished and rows and rows[-1].realised else None
     planned = max((r.planned[1] for r in rows if r.planned is not None), default=None)

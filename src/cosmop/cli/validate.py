@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+
 from rich.table import Table
 from rich.text import Text
 
 from cosmop.cli._app import ScenarioArgument, load, stdout
-from cosmop.scene import Dynamics, Human, Robot, Scenario
+from cosmop.scene import Dynamics, Human, Mission, Robot, Scenario
 from cosmop.units import (
     UnitSystem,
     length_unit,
@@ -23,7 +25,13 @@ __all__ = ["validate"]
 
 def validate(scenario: ScenarioArgument) -> None:
     """Check a scenario file and summarise it: robots and their speed limits, objects,
-    workspaces, walls, people walking through, the mission and when it is complete."""
+    workspaces, walls, people walking through, the mission and when it is complete.
+
+    Parameters
+    ----------
+    scenario : pathlib.Path
+        The scenario file (YAML).
+    """
     loaded = load(scenario, mission=False)
     console = stdout()
     console.print(_summary_table(loaded))
@@ -77,6 +85,7 @@ def _summary_table(scenario: Scenario) -> Table:
         )
     else:
         deliveries = mission.deliveries
+        assert deliveries is not None  # neither tasks nor a dfa: deliveries
         choices = sum(len(d.to) * len(d.by) for d in deliveries)
         movers = sorted({r for d in deliveries for r in d.by})
         row(
@@ -100,15 +109,17 @@ def _orders(scenario: Scenario) -> str:
     )
 
 
-def _completion(mission) -> tuple[int, str]:
+def _completion(mission: Mission) -> tuple[int, str]:
     """Where the mission is complete: the count and the words for the summary's row."""
     if mission.tasks is not None:
         return len(mission.tasks), "when every robot's task list is done"
     if mission.deliveries is not None:
         home = " and every robot that moved something is home" if mission.returns else ""
         return len(mission.deliveries), f"when every object is in one of its workspaces{home}"
-    done = mission.dfa.complete_states
-    why = "the marked states" if mission.dfa.marked_given else "the states with no outgoing event"
+    dfa = mission.dfa
+    assert dfa is not None  # neither tasks nor deliveries: a dfa
+    done = dfa.complete_states
+    why = "the marked states" if dfa.marked_given else "the states with no outgoing event"
     return len(done), f"in {', '.join(done)} ({why})"
 
 
@@ -133,7 +144,7 @@ def _limit(dynamics: Dynamics, field: str, units: UnitSystem) -> str:
     return f"{plain(value)} s"
 
 
-def _dynamics(robots, units: UnitSystem) -> str:
+def _dynamics(robots: Iterable[Robot], units: UnitSystem) -> str:
     """The limits the robots drive by, one line per set of robots that share them.
 
     Parameters
@@ -157,7 +168,7 @@ def _dynamics(robots, units: UnitSystem) -> str:
     lines = []
     for dynamics, members in groups.items():
         # a limit equal to the default is shown as a default, whether or not the file wrote it
-        parts = {True: [], False: []}
+        parts: dict[bool, list[str]] = {True: [], False: []}
         for field, words in _LIMITS:
             given = getattr(dynamics, field) != getattr(default, field)
             parts[given].append(f"{words} {_limit(dynamics, field, units)}")

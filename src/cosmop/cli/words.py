@@ -6,20 +6,30 @@ sentences, and their statistics only with ``--verbose``.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
 
 from cosmop.units import UnitSystem, show_point
+
+if TYPE_CHECKING:
+    from cosmop.missions.decomposition import Decomposition
+    from cosmop.missions.team import TeamVerdict
+    from cosmop.missions.verification import Verification
+    from cosmop.planning.plan import PlanSet
 
 __all__ = ["decompose_verdict", "plan_verdict"]
 
 
-def decompose_verdict(result: Any, verification: Any, holds: bool | None = None) -> tuple[str, bool]:
+def decompose_verdict(
+    result: Decomposition, verification: Verification, holds: bool | None = None
+) -> tuple[str, bool]:
     """One sentence on what ``cosmop decompose`` found, and whether it is good news.
 
     Parameters
     ----------
     result : cosmop.missions.decomposition.Decomposition
+        The decomposition: whether the mission is separable, its messages or re-synthesis.
     verification : cosmop.missions.verification.Verification
+        Whether the local missions together satisfy the global one.
     holds : bool, optional
         The team's verdict when it differs from `verification`'s (robots ordered by messages).
     """
@@ -59,9 +69,19 @@ def decompose_verdict(result: Any, verification: Any, holds: bool | None = None)
     )
 
 
-def plan_verdict(plans: Any, verification: Any, units: UnitSystem = "mm") -> str:
+def plan_verdict(plans: PlanSet, verification: TeamVerdict | None, units: UnitSystem = "mm") -> str:
     """One sentence on what ``cosmop plan`` found (feasible plan sets only); places in `units`,
-    the scenario file's."""
+    the scenario file's.
+
+    Parameters
+    ----------
+    plans : cosmop.planning.plan.PlanSet
+        A feasible plan set: its hand-overs, messages and added tasks are told.
+    verification : cosmop.missions.team.TeamVerdict or None
+        The team's verification (None: none was made, so nothing is proven).
+    units : {"mm", "m"}, optional
+        The scenario file's units, which places are shown in.
+    """
     pairs = len(plans.coordination)
     messages = len(getattr(plans, "messages", ()))
     order = (

@@ -34,6 +34,9 @@ _GREY = (0.6, 0.6, 0.6, 0.45)
 _BROWN = (0.55, 0.27, 0.07, 1.0)
 _ORANGE = (1.0, 0.6, 0.1, 0.9)
 
+_Triple = tuple[float, float, float]  # a marker's scale, m
+_Rgba = tuple[float, float, float, float]  # a colour, each in [0, 1]
+
 
 class SceneMarkers:
     """Builds the ``/scene`` marker array of any frame of a trace.
@@ -59,7 +62,17 @@ class SceneMarkers:
 
     # -- builders ---------------------------------------------------------------------------
 
-    def _marker(self, ns: int, space: str, ident: int, kind: str, pose: Any, scale, colour, **extra) -> Any:
+    def _marker(
+        self,
+        ns: int,
+        space: str,
+        ident: int,
+        kind: str,
+        pose: Any,
+        scale: _Triple,
+        colour: _Rgba,
+        **extra: Any,
+    ) -> Any:
         t = self.ros.t
         marker_type = t["visualization_msgs/msg/Marker"]
         return marker_type(
@@ -94,7 +107,9 @@ class SceneMarkers:
     def _point(self, x_mm: float, y_mm: float, z_m: float = 0.0) -> Any:
         return self.ros.t["geometry_msgs/msg/Point"](x=m_from_mm(x_mm), y=m_from_mm(y_mm), z=z_m)
 
-    def _text(self, ns: int, space: str, ident: int, x: float, y: float, z: float, text: str, colour) -> Any:
+    def _text(
+        self, ns: int, space: str, ident: int, x: float, y: float, z: float, text: str, colour: _Rgba
+    ) -> Any:
         scale = (0.0, 0.0, _TEXT_HEIGHT)
         return self._marker(ns, space, ident, "TEXT_VIEW_FACING", self._at(x, y, z), scale, colour, text=text)
 
@@ -117,7 +132,8 @@ class SceneMarkers:
             if ws.is_point:
                 scale = (0.1, 0.1, 0.01)
             else:
-                scale = (m_from_mm(ws.x[1] - ws.x[0]), m_from_mm(ws.y[1] - ws.y[0]), 0.01)
+                x, y = ws.ranges
+                scale = (m_from_mm(x[1] - x[0]), m_from_mm(y[1] - y[0]), 0.01)
             out.append(self._marker(ns, "workspaces", k, "CUBE", self._at(cx, cy, 0.005), scale, _GREY))
             out.append(self._text(ns, "workspace_labels", k, cx, cy, 0.1, wid, _BLACK))
         return out
@@ -194,7 +210,20 @@ class SceneMarkers:
         return out
 
     def array(self, ns: int, k: int) -> Any:
-        """The ``MarkerArray`` of frame `k` of the trace, stamped `ns` nanoseconds."""
+        """The ``MarkerArray`` of frame `k` of the trace, stamped `ns` nanoseconds.
+
+        Parameters
+        ----------
+        ns : int
+            The time stamp, ns.
+        k : int
+            The frame's index in the trace.
+
+        Returns
+        -------
+        visualization_msgs/msg/MarkerArray
+            The message (a ``rosbags`` object).
+        """
         robots = self.trace.robots_at(k)
         markers = self._fixed(ns) + self._objects(ns, k, self.trace.carried_at(k))
         markers += self._robots(ns, k, robots) + self._arrows(ns, float(self.trace.t[k]), robots)

@@ -33,7 +33,7 @@ import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypedDict
 
 from cosmop.export.markers import SceneMarkers
 from cosmop.io import atomic_path
@@ -147,7 +147,9 @@ def _plan_path(ros: _Ros, scene: Scene, plans: PlanSet, rid: str, ns: int, start
     return ros.t["nav_msgs/msg/Path"](header=ros.header(ns), poses=poses)
 
 
-def _write(writer: Any, ros: _Ros, connections: dict, counts: dict, topic: str, ns: int, msg: Any) -> None:
+def _write(
+    writer: Any, ros: _Ros, connections: dict[str, Any], counts: dict[str, int], topic: str, ns: int, msg: Any
+) -> None:
     if topic not in connections:
         connections[topic] = writer.add_connection(topic, msg.__msgtype__, typestore=ros.store)
         counts[topic] = 0
@@ -155,13 +157,21 @@ def _write(writer: Any, ros: _Ros, connections: dict, counts: dict, topic: str, 
     counts[topic] += 1
 
 
+class _Options(TypedDict):
+    rate: float | None  # frames per second, None: every frame
+    scene_rate: float  # scene marker arrays per second
+    start_ns: int  # the stamp of t = 0, ns
+
+
 def _write_all(
-    writer: Any, scene: Scene, trace: Trace, plans: PlanSet | None, options: dict
+    writer: Any, scene: Scene, trace: Trace, plans: PlanSet | None, options: _Options
 ) -> dict[str, int]:
     """Write every topic of the bag from `trace`; return the number of messages per topic."""
     ros = _Ros()
     times = trace.t.tolist()
-    start_ns, connections, counts = options["start_ns"], {}, {}
+    start_ns = options["start_ns"]
+    connections: dict[str, Any] = {}  # topic -> the bag's connection (rosbags' own type)
+    counts: dict[str, int] = {}
 
     def write(topic: str, ns: int, msg: Any) -> None:
         _write(writer, ros, connections, counts, topic, ns, msg)
@@ -252,7 +262,7 @@ def write_bag(
     target = Path(path)
     if target.exists():
         raise FileExistsError(f"{target} exists; a bag is written into a new directory")
-    options = {"rate": rate, "scene_rate": scene_rate, "start_ns": round(start * 1e9)}
+    options: _Options = {"rate": rate, "scene_rate": scene_rate, "start_ns": round(start * 1e9)}
     with atomic_path(target) as bag:  # named as the target: the MCAP file is named after its folder
         writer = Writer(bag, version=8, storage_plugin=StoragePlugin.MCAP)
         writer.set_compression(CompressionMode.STORAGE, CompressionFormat.ZSTD)

@@ -66,7 +66,24 @@ def _dock(scene: Scene, order: Order, goods: Sequence[float]) -> str:
 
 def delivery_events(scene: Scene, robot: str, order: Order, goods: Sequence[float]) -> tuple[Event, ...]:
     """The mission that serves `order` by `robot`: pick the goods (lying at `goods`, mm), drop
-    them at the nearest of the order's docks, and go home."""
+    them at the nearest of the order's docks, and go home.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene (its workspaces place the docks).
+    robot : str
+        The robot that serves the order.
+    order : Order
+        The order to serve.
+    goods : sequence of float
+        Where the order's goods lie ``(x, y)``, mm.
+
+    Returns
+    -------
+    tuple of Event
+        ``pick``, ``drop`` at the nearest dock, ``return``.
+    """
     dock = _dock(scene, order, goods)
     return (
         Event("pick", robot, obj=order.object),
@@ -83,7 +100,9 @@ def choose_robot(
     Parameters
     ----------
     scene : Scene
+        The scene (its workspaces place the docks).
     order : Order
+        The order to serve.
     idle : iterable of (str, (float, float))
         The idle robots and where they stand (mm).
     goods : (float, float)

@@ -28,6 +28,7 @@ import math
 import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -70,6 +71,11 @@ class Failure:
     @classmethod
     def parse(cls, text: str) -> Failure:
         """``ROBOT@SECONDS``, e.g. ``R3@600``.
+
+        Parameters
+        ----------
+        text : str
+            The robot's id and the time it fails, s (as ``--fail`` gives them).
 
         Raises
         ------
@@ -121,8 +127,8 @@ class _Run:
     busy: dict[str, OrderState] = field(default_factory=dict)
     busy_since: dict[str, float] = field(default_factory=dict)
     busy_time: dict[str, float] = field(default_factory=dict)
-    failed: dict[str, dict] = field(default_factory=dict)
-    log: list[dict] = field(default_factory=list)
+    failed: dict[str, dict[str, Any]] = field(default_factory=dict)  # JSON records of the summary
+    log: list[dict[str, Any]] = field(default_factory=list)
     seen_events: int = 0
     delivered: int = 0
 
@@ -176,7 +182,7 @@ def run_fleet(
     recorder = Recorder()
     recorder.record(world)
     due = sorted(failures, key=lambda f: f.at)
-    released = next_dispatch = 0
+    released, next_dispatch = 0, 0.0
     for _ in range(math.ceil(fleet.until / world.dt)):
         while released < len(run.states) and run.states[released].order.at <= world.t:
             run.pool.append(run.states[released])
@@ -224,7 +230,7 @@ def _dispatch(run: _Run) -> None:
             del idle[robot]
 
 
-def _hand_over(run: _Run, agent: Agent, state: OrderState, goods: tuple[float, float]) -> bool:
+def _hand_over(run: _Run, agent: Agent, state: OrderState, goods: tuple[float, ...]) -> bool:
     """Plan `agent`'s mission for `state`'s order, order it with the others' and hand it over."""
     world, fleet = run.world, run.fleet
     scene = world.scenario.scene

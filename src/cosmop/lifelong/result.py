@@ -143,7 +143,29 @@ class FleetResult:
         failed: Mapping[str, Mapping[str, Any]],
         log: Sequence[Mapping[str, Any]],
     ) -> FleetResult:
-        """The result of a finished run (:func:`cosmop.lifelong.run_fleet` calls it)."""
+        """The result of a finished run (:func:`cosmop.lifelong.run_fleet` calls it).
+
+        Parameters
+        ----------
+        scenario : Scenario
+            The scenario that was run.
+        world : World
+            The simulation at the end of the run.
+        frames : Mapping of str to numpy.ndarray
+            The recorded frames (:meth:`cosmop.sim.recording.Recorder.frames`).
+        states : sequence of OrderState
+            What became of each order, in stream order.
+        busy : Mapping of str to float
+            Per robot, the time it served orders, s.
+        failed : Mapping of str to Mapping
+            Per failed robot, its record (``t``, ``at``, ``carrying``, ``recoordinated``, ``why``).
+        log : sequence of Mapping
+            The dispatcher's log, one record per plan handed over or refused.
+
+        Returns
+        -------
+        FleetResult
+        """
         orders = tuple(
             OrderRecord(
                 s.index, s.order.object, s.order.at, s.order.to, s.served_by, s.assigned, s.delivered, s.lost
@@ -228,7 +250,13 @@ class FleetResult:
         }
 
     def save_summary(self, path: str | os.PathLike[str]) -> None:
-        """Write :meth:`summary` as JSON, atomically."""
+        """Write :meth:`summary` as JSON, atomically.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The JSON file to write.
+        """
         write_atomic(path, json.dumps(self.summary(), indent=2) + "\n")
 
     def trace(self) -> Trace:
@@ -265,7 +293,13 @@ class FleetResult:
         return fig
 
     def save_plot(self, path: str | os.PathLike[str]) -> None:
-        """Write :meth:`plot` as a PNG, atomically."""
+        """Write :meth:`plot` as a PNG, atomically.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The PNG file to write.
+        """
         import io
 
         buffer = io.BytesIO()

@@ -24,6 +24,7 @@ Rectangles are ``(row0, col0, row1, col1)`` half-open corner indices (cells ``ro
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import NDArray
 
 from cosmop.maps.grid import OccupancyGrid
 
@@ -33,7 +34,7 @@ Rect = tuple[int, int, int, int]
 Segment = tuple[tuple[int, int], tuple[int, int]]
 
 
-def rectangle_cover(blocked: np.ndarray) -> list[Rect]:
+def rectangle_cover(blocked: NDArray[np.bool_]) -> list[Rect]:
     """Disjoint rectangles whose union is exactly the blocked cells (row-run, then grow).
 
     Parameters
@@ -68,14 +69,14 @@ def rectangle_cover(blocked: np.ndarray) -> list[Rect]:
     return rects
 
 
-def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
+def _runs(mask: NDArray[np.bool_]) -> list[tuple[int, int]]:
     """Maximal runs ``[start, stop)`` of True in a 1-D boolean array."""
     padded = np.concatenate(([False], mask, [False])).astype(np.int8)
     change = np.flatnonzero(np.diff(padded))
     return list(zip(change[::2].tolist(), change[1::2].tolist(), strict=True))
 
 
-def boundary_walls(blocked: np.ndarray) -> list[Segment]:
+def boundary_walls(blocked: NDArray[np.bool_]) -> list[Segment]:
     """The edges between free cells and blocked cells (or the outside), as maximal segments.
 
     Parameters
@@ -101,13 +102,34 @@ def boundary_walls(blocked: np.ndarray) -> list[Segment]:
 
 
 def rectangle_walls(rects: list[Rect]) -> list[Segment]:
-    """Every rectangle's four edges (shared and outer edges included)."""
+    """Every rectangle's four edges (shared and outer edges included).
+
+    Parameters
+    ----------
+    rects : list of (int, int, int, int)
+        Rectangles ``(row0, col0, row1, col1)``, half-open corner indices.
+
+    Returns
+    -------
+    list of ((int, int), (int, int))
+        Four segments between grid corners per rectangle: bottom, top, left, right.
+    """
     walls: list[Segment] = []
     for r0, c0, r1, c1 in rects:
         walls += [((r0, c0), (r0, c1)), ((r1, c0), (r1, c1)), ((r0, c0), (r1, c0)), ((r0, c1), (r1, c1))]
     return walls
 
 
-def walls_in_mm(grid: OccupancyGrid, walls: list[Segment]) -> list[tuple[tuple[float, float], ...]]:
-    """Segments between grid corners as wall segments ``((x1, y1), (x2, y2))`` in mm."""
+def walls_in_mm(
+    grid: OccupancyGrid, walls: list[Segment]
+) -> list[tuple[tuple[float, float], tuple[float, float]]]:
+    """Segments between grid corners as wall segments ``((x1, y1), (x2, y2))`` in mm.
+
+    Parameters
+    ----------
+    grid : OccupancyGrid
+        The grid the corners belong to (its origin and cell size place them).
+    walls : list of ((int, int), (int, int))
+        Segments between grid corners ``(row, col)``.
+    """
     return [(grid.point(*a), grid.point(*b)) for a, b in walls]

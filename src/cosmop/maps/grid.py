@@ -12,6 +12,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 
 from cosmop.errors import CosmopInputError
 
@@ -37,7 +38,7 @@ class OccupancyGrid:
         The lower-left corner of cell ``(0, 0)``, mm (default ``(0, 0)``).
     """
 
-    blocked: np.ndarray
+    blocked: NDArray[np.bool_]
     cell_size: float
     origin: tuple[float, float] = (0.0, 0.0)
 
@@ -58,13 +59,25 @@ class OccupancyGrid:
         return self.blocked.shape
 
     def point(self, row: int, column: int) -> tuple[float, float]:
-        """The grid corner ``(row, column)`` (a corner index, 0 to rows / columns), in mm."""
+        """The grid corner ``(row, column)`` (a corner index, 0 to rows / columns), in mm.
+
+        Parameters
+        ----------
+        row, column : int
+            The corner's indices, counted from the bottom left.
+        """
         return (
             self.origin[0] + column * self.cell_size,
             self.origin[1] + row * self.cell_size,
         )
 
     def center(self, row: int, column: int) -> tuple[float, float]:
-        """The centre of cell ``(row, column)``, mm."""
+        """The centre of cell ``(row, column)``, mm.
+
+        Parameters
+        ----------
+        row, column : int
+            The cell's indices, counted from the bottom left.
+        """
         x, y = self.point(row, column)
         return x + self.cell_size / 2, y + self.cell_size / 2

@@ -42,7 +42,7 @@ def _header_value(lines: list[str], index: int, key: str, file: str | None) -> i
 
 
 def parse_movingai(
-    text: str, cell_size: float, *, origin=(0.0, 0.0), file: str | None = None
+    text: str, cell_size: float, *, origin: tuple[float, float] = (0.0, 0.0), file: str | None = None
 ) -> OccupancyGrid:
     """Parse the text of a MovingAI ``.map`` file.
 
@@ -108,9 +108,23 @@ def parse_movingai(
 
 
 def read_movingai(
-    path: str | os.PathLike[str], cell_size: float = 1000.0, *, origin=(0.0, 0.0)
+    path: str | os.PathLike[str], cell_size: float = 1000.0, *, origin: tuple[float, float] = (0.0, 0.0)
 ) -> OccupancyGrid:
-    """Read a MovingAI ``.map`` file (see :func:`parse_movingai`); cells are 1 m by default."""
+    """Read a MovingAI ``.map`` file (see :func:`parse_movingai`); cells are 1 m by default.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The ``.map`` file.
+    cell_size : float, optional
+        Side of a cell, mm (default 1000).
+    origin : tuple of float, optional
+        Where the lower-left corner of the map goes, mm (default ``(0, 0)``).
+
+    Returns
+    -------
+    OccupancyGrid
+    """
     file = os.fspath(path)
     return parse_movingai(
         read_text(path, MapError, "a MovingAI .map file"), cell_size, origin=origin, file=file

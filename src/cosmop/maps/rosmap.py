@@ -26,6 +26,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
+from numpy.typing import NDArray
 
 from cosmop.io import read_bytes, read_text
 from cosmop.maps.grid import MapError, OccupancyGrid
@@ -34,8 +35,13 @@ from cosmop.reading import load_yaml
 __all__ = ["read_pgm", "read_ros_map"]
 
 
-def read_pgm(path: str | os.PathLike[str]) -> tuple[np.ndarray, int]:
+def read_pgm(path: str | os.PathLike[str]) -> tuple[NDArray[np.int64], int]:
     """Read a PGM image (``P5`` binary or ``P2`` ASCII).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The image file.
 
     Returns
     -------
@@ -96,7 +102,9 @@ def _number(doc: dict[str, Any], key: str, file: str, default: float | None = No
     return float(value)
 
 
-def _occupancy(pixels: np.ndarray, maxval: int, doc: dict[str, Any], file: str) -> tuple[np.ndarray, ...]:
+def _occupancy(
+    pixels: NDArray[np.int64], maxval: int, doc: dict[str, Any], file: str
+) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
     """Boolean arrays ``(occupied, free)`` of the pixels, as ``map_server`` reads them."""
     occupied_thresh = _number(doc, "occupied_thresh", file, 0.65)
     free_thresh = _number(doc, "free_thresh", file, 0.25)

@@ -12,7 +12,7 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any, Literal, cast
 
 import yaml
 
@@ -106,7 +106,7 @@ def import_map(
     return ImportedMap(file, grid, rects, walls_in_mm(grid, chosen), len(outline))
 
 
-class _Dumper(yaml.SafeDumper):
+class _Dumper(yaml.SafeDumper):  # type: ignore[misc]  # PyYAML ships no type information
     """Lists of numbers (points, walls) on one line; everything else in block style."""
 
 
@@ -220,10 +220,12 @@ def _header(imported: ImportedMap, units: str) -> list[str]:
 
 
 def _plain_yaml(data: dict[str, Any]) -> str:
-    return yaml.dump(data, Dumper=_Dumper, sort_keys=False, width=110)
+    return cast(str, yaml.dump(data, Dumper=_Dumper, sort_keys=False, width=110))
 
 
-def _keep_template(text: str, expected: dict[str, Any], walls: list, name: str | None) -> str | None:
+def _keep_template(
+    text: str, expected: dict[str, Any], walls: list[list[list[float]]], name: str | None
+) -> str | None:
     """The template's own text (comments, order, layout) with the new walls and name, or None
     when that text would not read back as `expected` (then the caller writes it plainly).
 

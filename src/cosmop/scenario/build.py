@@ -8,7 +8,7 @@ import math
 import os
 import re
 from collections import Counter
-from collections.abc import Mapping
+from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import replace
 from fractions import Fraction
 from pathlib import Path
@@ -61,7 +61,7 @@ from cosmop.scene import (
     Workspace,
 )
 from cosmop.units import (
-    SCENARIO_UNITS,
+    UnitSystem,
     default_dynamics,
     localize,
     plain,
@@ -82,7 +82,7 @@ class _Builder:
         self.file = file
         self.marks = marks or {}
         units = data.get("units") if isinstance(data, Mapping) else None
-        self.units = units if units in SCENARIO_UNITS else "mm"  # the words of its messages
+        self.units: UnitSystem = "m" if units == "m" else "mm"  # the words of its messages
 
     def position(self, path: FieldPath) -> tuple[int | None, int | None]:
         """The line and column of `path` in the file (of its nearest written parent), if known."""
@@ -187,7 +187,8 @@ class _Builder:
 
     def build_orders(self, models: list[OrderModel], scene: Scene) -> tuple[Order, ...]:
         """The orders with their ids checked against the scene, by release time (stable)."""
-        out, first = [], {}
+        out: list[Order] = []
+        first: dict[str, int] = {}
         for index, model in enumerate(models):
             path = ("orders", index)
             if model.object not in scene.objects:
@@ -213,7 +214,7 @@ class _Builder:
         return tuple(sorted(out, key=lambda order: order.at))
 
     def build_scene(self, model: SceneModel) -> Scene:
-        owner_of_id: dict[str, FieldPath] = {}
+        owner_of_id: dict[str, tuple[str, str, str]] = {}  # id -> ("scene", group, id)
         kinds = {
             "robots": "a robot",
             "objects": "an object",
@@ -275,7 +276,7 @@ class _Builder:
         and every heading is a finite number of degrees (a metres file's 1e308 radians is not)."""
         for rid, robot in scene.robots.items():
             if not math.isfinite(robot.pose[2]):
-                path = ("scene", "robots", rid, "pose", 2)
+                path: FieldPath = ("scene", "robots", rid, "pose", 2)
                 written = _written(lookup(self.data, path)[1])
                 self.fail(
                     path, f"expected a finite heading (degrees), got {written}: beyond the range of numbers"
@@ -389,10 +390,12 @@ class _Builder:
             return Mission(tasks=self.build_tasks(model.tasks, scene))
         if model.dfa is not None:
             return Mission(dfa=self.build_dfa(model.dfa, scene))
+        assert model.deliveries is not None  # exactly one of the three is given (checked above)
         return Mission(deliveries=self.build_deliveries(model.deliveries, scene), returns=bool(model.returns))
 
     def build_deliveries(self, models: list[DeliveryModel], scene: Scene) -> tuple[Delivery, ...]:
-        out, first = [], {}
+        out: list[Delivery] = []
+        first: dict[str, int] = {}
         for index, model in enumerate(models):
             path = ("mission", "deliveries", index)
             obj = model.object
@@ -468,14 +471,14 @@ class _Builder:
                         f"{event.name} is already in {robot}'s task list ({first}); every message is sent "
                         "once and awaited once",
                     )
-            for robot in (event.sender, event.receiver):
-                if robot not in places:
+            for party in (event.sender, event.receiver):
+                if party not in places:
                     other = next(iter(places))
                     role = "sent" if other == event.sender else "awaited"
-                    does = "awaits" if robot == event.receiver else "sends"
+                    does = "awaits" if party == event.receiver else "sends"
                     self.fail(
                         ("mission", "tasks", other, places[other][0]),
-                        f"{event.name} is {role} by {other}, but {robot}'s task list never {does} it; a "
+                        f"{event.name} is {role} by {other}, but {party}'s task list never {does} it; a "
                         "message is listed by both its sender and its receiver, once each",
                     )
 
@@ -612,13 +615,15 @@ class _Builder:
                 f"{_known('workspaces', scene.workspaces)}",
             )
         if event.kind == "drop":
+            assert event.obj is not None and event.workspace is not None  # a drop names both
             self.check_holds(path, scene.objects[event.obj], event.workspace, scene)
 
     def check_holds(self, path: FieldPath, obj: MovableObject, workspace: str, scene: Scene) -> None:
         """A drop's workspace can hold the object: as wide and as deep, with a place clear of walls."""
         ws, size = scene.workspaces[workspace], show_length(obj.size, self.units)
-        if not ws.is_point and min(ws.x[1] - ws.x[0], ws.y[1] - ws.y[0]) < obj.size:
-            width, depth = (show_length(hi - lo, self.units) for lo, hi in (ws.x, ws.y))
+        x_range, y_range = ws.ranges
+        if not ws.is_point and min(x_range[1] - x_range[0], y_range[1] - y_range[0]) < obj.size:
+            width, depth = (show_length(hi - lo, self.units) for lo, hi in (x_range, y_range))
             self.fail(
                 path,
                 f"workspace {workspace} ({width} x {depth}) cannot hold {obj.id} (a {size} square); "
@@ -645,7 +650,7 @@ def _known(group: str, ids: Mapping[str, Any]) -> str:
     return f"the scene's {group} are " + ", ".join(ids)
 
 
-def _planned_lengths(scene: Scene):
+def _planned_lengths(scene: Scene) -> Iterator[tuple[FieldPath, float]]:
     """``(field path, length in mm)`` of every coordinate and size the planner encodes."""
     for i, wall in enumerate(scene.obstacles):
         for j, point in enumerate((wall.start, wall.end)):
@@ -673,7 +678,7 @@ def _fits(scene: Scene, obj: MovableObject, workspace: Workspace) -> bool:
     return not places.difference(scene.blocked(obj.size / 2.0, within=places.bounds)).is_empty
 
 
-def _reachable(initial: str, transitions) -> set[str]:
+def _reachable(initial: str, transitions: Iterable[tuple[str, Event, str]]) -> set[str]:
     """The states reachable from `initial` along `transitions` ``(source, event, target)``."""
     successors: dict[str, list[str]] = {}
     for source, _, target in transitions:

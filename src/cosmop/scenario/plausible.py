@@ -75,35 +75,83 @@ class Quantity:
     magnitude: bool = False
 
     def unit(self, units: UnitSystem) -> str:
-        """The quantity's unit in a file in `units`: ``"m/s"``."""
+        """The quantity's unit in a file in `units`: ``"m/s"``.
+
+        Parameters
+        ----------
+        units : {"mm", "m"}
+            The file's units.
+        """
         return _UNIT[self.kind][units == "m"]
 
     def internal(self, value: float, units: UnitSystem) -> float:
-        """`value`, as written in a file in `units`, in mm, degrees and seconds."""
+        """`value`, as written in a file in `units`, in mm, degrees and seconds.
+
+        Parameters
+        ----------
+        value : float
+            The value as the file wrote it (in `units`).
+        units : {"mm", "m"}
+            The file's units.
+        """
         if units != "m" or self.kind == "time":
             return value
         return math.degrees(value) if self.kind in _ANGULAR else value * 1000.0
 
     def in_file(self, value: float, units: UnitSystem) -> float:
-        """`value` in mm, degrees or seconds as a file in `units` writes it."""
+        """`value` in mm, degrees or seconds as a file in `units` writes it.
+
+        Parameters
+        ----------
+        value : float
+            The value in mm, degrees or seconds.
+        units : {"mm", "m"}
+            The file's units.
+        """
         if units != "m" or self.kind == "time":
             return value
         return math.radians(value) if self.kind in _ANGULAR else value / 1000.0
 
     def within(self, value: float, bounds: tuple[float, float], units: UnitSystem) -> bool:
-        """Whether `value`, as written in a file in `units`, lies within `bounds` (internal units)."""
+        """Whether `value`, as written in a file in `units`, lies within `bounds` (internal units).
+
+        Parameters
+        ----------
+        value : float
+            The value as the file wrote it (in `units`).
+        bounds : tuple of float
+            ``(lo, hi)`` in mm, degrees and seconds.
+        units : {"mm", "m"}
+            The file's units.
+        """
         inside = self.internal(value, units)  # a metres file's 1e308 is inf here, out of every range
         lo, hi = bounds
         return lo <= (abs(inside) if self.magnitude else inside) <= hi
 
     def expected(self, bounds: tuple[float, float], units: UnitSystem) -> str:
-        """The range `bounds` in words in the file's units: ``between 0.05 and 5 m``."""
+        """The range `bounds` in words in the file's units: ``between 0.05 and 5 m``.
+
+        Parameters
+        ----------
+        bounds : tuple of float
+            ``(lo, hi)`` in mm, degrees and seconds.
+        units : {"mm", "m"}
+            The file's units.
+        """
         lo, hi = (plain(self.in_file(bound, units)) for bound in bounds)
         unit = self.unit(units)
         return f"at most {hi} {unit} either way" if self.magnitude else f"between {lo} and {hi} {unit}"
 
     def slip(self, value: float, units: UnitSystem) -> str | None:
-        """The likely slip of units when `value` would be plausible in the other units, else None."""
+        """The likely slip of units when `value` would be plausible in the other units, else None.
+
+        Parameters
+        ----------
+        value : float
+            The value as the file wrote it (in `units`).
+        units : {"mm", "m"}
+            The file's units.
+        """
         if self.kind == "time":
             return None
         other: UnitSystem = "mm" if units == "m" else "m"
@@ -160,9 +208,9 @@ def _numbers(scene: Scene) -> Iterator[tuple[FieldPath, Quantity, float]]:
         path = ("scene", "humans", hid)
         yield (*path, "size"), _SIDE_OF_PERSON, human.size
         yield (*path, "speed"), _WALKING, human.speed
-        for n, point in enumerate(human.path):
+        for n, waypoint in enumerate(human.path):
             for k in (0, 1):
-                yield (*path, "path", n, k), _COORDINATE, point[k]
+                yield (*path, "path", n, k), _COORDINATE, waypoint[k]
         for axis, bounds in zip("xy", human.walk or (), strict=False):
             for k, value in enumerate(bounds):
                 yield (*path, "walk", axis, k), _COORDINATE, value
@@ -180,6 +228,13 @@ def _dynamics(
 
 def out_of_range(scene: Scene, units: UnitSystem) -> tuple[FieldPath, str] | None:
     """The first number of `scene` (as its file wrote it, in `units`) outside its valid range.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene as the file wrote it (before :func:`cosmop.units.scene_to_internal`).
+    units : {"mm", "m"}
+        The file's units.
 
     Returns
     -------
@@ -200,6 +255,13 @@ def implausible(scene: Scene, units: UnitSystem) -> list[tuple[FieldPath, str]]:
     """Warnings on the numbers of `scene` (as its file wrote it) outside their plausible range.
 
     One per quantity: the first such field, with how many more there are.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene as the file wrote it (before :func:`cosmop.units.scene_to_internal`).
+    units : {"mm", "m"}
+        The file's units.
 
     Returns
     -------

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from types import NoneType, UnionType
-from typing import Annotated, Any, Literal, Union, get_args, get_origin
+from typing import Annotated, Any, Literal, Union, cast, get_args, get_origin
 
 from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field, field_validator
 from pydantic_core import PydanticCustomError
@@ -84,12 +84,14 @@ class _RobotModel(_Model):
     dynamics: _DynamicsModel | None = None
 
 
+_Side = Literal["west", "south", "east", "north"]
+
+
 class _ObjectModel(_Model):
     size: _Positive
     position: _Pair
-    sides: Annotated[list[Literal["west", "south", "east", "north"]], Field(min_length=1, max_length=4)] = (
-        list(SIDES)
-    )
+    # by default all four: SIDES's keys, which are exactly the names of _Side
+    sides: Annotated[list[_Side], Field(min_length=1, max_length=4)] = cast(list[_Side], list(SIDES))
 
 
 class WorkspaceModel(_Model):
@@ -267,12 +269,22 @@ def _unwrap(annotation: Any) -> Any:
 
 
 def model_at(path: FieldPath) -> type[BaseModel] | None:
-    """The pydantic model describing the mapping at `path`, if that position is a model."""
+    """The pydantic model describing the mapping at `path`, if that position is a model.
+
+    Parameters
+    ----------
+    path : tuple of str or int
+        A field's path in the scenario file: keys and list indices from the top level.
+
+    Returns
+    -------
+    type of pydantic.BaseModel or None
+    """
     annotation: Any = ScenarioModel
     for part in path:
         annotation = _unwrap(annotation)
         if isinstance(annotation, type) and issubclass(annotation, BaseModel):
-            if part not in annotation.model_fields:
+            if not isinstance(part, str) or part not in annotation.model_fields:  # (the keys are names)
                 return None
             annotation = annotation.model_fields[part].annotation
         elif get_origin(annotation) is dict:
@@ -291,7 +303,20 @@ def _describe_keys(model: type[BaseModel]) -> str:
 
 
 def expected_at(loc: FieldPath) -> tuple[FieldPath, str | None]:
-    """The field to report for an error at `loc`, and what is expected there."""
+    """The field to report for an error at `loc`, and what is expected there.
+
+    Parameters
+    ----------
+    loc : tuple of str or int
+        Where pydantic found the error: keys and list indices from the top level.
+
+    Returns
+    -------
+    path : tuple of str or int
+        `loc` or its nearest parent whose expectation is known (`loc` itself when none is).
+    expected : str or None
+        What that field expects, in words; None when nothing is known.
+    """
     for length in range(len(loc), -1, -1):
         prefix = loc[:length]
         for pattern, text in EXPECTED.items():
@@ -312,6 +337,22 @@ def _matches(pattern: str, part: str | int) -> bool:
 
 
 def lookup(data: Any, path: FieldPath) -> tuple[bool, Any]:
+    """The value at `path` in the parsed file `data`, if there is one.
+
+    Parameters
+    ----------
+    data : Any
+        The parsed file (mappings, lists and scalars).
+    path : tuple of str or int
+        Keys and list indices from the top level.
+
+    Returns
+    -------
+    found : bool
+        Whether `path` leads to a value.
+    value : Any
+        That value (None when not found).
+    """
     for part in path:
         if isinstance(data, Mapping):
             if part not in data:
@@ -323,10 +364,25 @@ def lookup(data: Any, path: FieldPath) -> tuple[bool, Any]:
 
 
 def show_points(*points: Point) -> str:
+    """Points as a message shows them: ``[[0, 0], [1, 2.5]]``.
+
+    Parameters
+    ----------
+    *points : tuple of float
+        The points ``(x, y)``, as the file wrote them.
+    """
     return "[" + ", ".join(f"[{x:g}, {y:g}]" for x, y in points) + "]"
 
 
 def show(value: Any) -> str:
+    """A value of the parsed file as a message shows it: YAML's words for null and booleans,
+    else its ``repr``, cut to 80 characters.
+
+    Parameters
+    ----------
+    value : Any
+        The value.
+    """
     if value is None:
         return "nothing (null)"
     if isinstance(value, bool):

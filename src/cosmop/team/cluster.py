@@ -101,7 +101,7 @@ def _connect(address: str, timeout: float, field: str) -> Any:
             "a Dask scheduler needs Dask on this machine: pip install 'cosmop[cluster]'", field=field
         ) from None
     try:
-        return Client(address, timeout=timeout, set_as_default=False)  # type: ignore[no-untyped-call]
+        return Client(address, timeout=timeout, set_as_default=False)  # type: ignore[no-untyped-call]  # distributed leaves Client() unannotated
     except (OSError, TimeoutError, ValueError) as err:
         raise ClusterError(
             f"expected a Dask scheduler at {address}: none answered within {timeout:g} s ({err})",

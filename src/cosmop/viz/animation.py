@@ -22,7 +22,7 @@ import math
 import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 from cosmop.io import atomic_path
 from cosmop.planning.plan import PlanSet
@@ -75,7 +75,7 @@ def _ffmpeg_exe() -> str:
         import imageio_ffmpeg
     except ImportError as exc:
         raise ImportError("MP4 animations need imageio-ffmpeg: pip install 'cosmop[video]'") from exc
-    return imageio_ffmpeg.get_ffmpeg_exe()
+    return cast(str, imageio_ffmpeg.get_ffmpeg_exe())
 
 
 # ----------------------------------------------------------------------------------------------
@@ -150,8 +150,8 @@ def _limits(scene: Scene, trace: Trace) -> tuple[float, float, float, float]:
             xs.append(obj.position[0])
             ys.append(obj.position[1])
         for ws in scene.workspaces.values():
-            xs += [ws.point[0]] if ws.point is not None else list(ws.x)
-            ys += [ws.point[1]] if ws.point is not None else list(ws.y)
+            xs += [ws.point[0]] if ws.point is not None else list(ws.ranges[0])
+            ys += [ws.point[1]] if ws.point is not None else list(ws.ranges[1])
         for group in ("robots", "humans", "objects"):
             points = trace.seen(group)
             xs += points[:, 0].tolist()
@@ -251,7 +251,7 @@ class _Animator:
         _legend(self.ax)
         self.fig.tight_layout()
         self.mm_per_pt = _mm_per_point(self.ax)
-        self.spots: dict[tuple, dict[str, tuple[float, float]]] = {}
+        self.spots: dict[tuple[tuple[str, tuple[float, float]], ...], dict[str, tuple[float, float]]] = {}
         self.moving = self._moving_artists()
         self.background: Any = None
 
@@ -261,11 +261,13 @@ class _Animator:
         self.robot_ids, self.object_ids = list(self.robots), list(self.objects)
         self.object_size = {oid: piece.size for oid, piece in self.objects.items()}
         self.object_at: dict[str, tuple[float, float] | None] = {
-            oid: tuple(scene.objects[oid].position) if oid in scene.objects else None
+            oid: (scene.objects[oid].position[0], scene.objects[oid].position[1])
+            if oid in scene.objects
+            else None
             for oid in self.object_ids
         }
         self.object_patch = {oid: piece.patch for oid, piece in self.objects.items()}
-        self.object_label = {oid: piece.label for oid, piece in self.objects.items()}
+        self.object_label: dict[str, Any] = {oid: piece.label for oid, piece in self.objects.items()}
         self.human_artists = {hid: (piece.patch, piece.label) for hid, piece in self.humans.items()}
 
     def _draw_plans(
@@ -274,7 +276,7 @@ class _Animator:
         """Each robot's planned path, dashed in its colour; the paths of its replans too, each
         from its time on.  Returns the lines of the robots that replan, with their start
         times (s): they move; the others' stay in the still background."""
-        paths: dict[str, list[tuple[float, list]]] = {}
+        paths: dict[str, list[tuple[float, list[tuple[float, float]]]]] = {}
         for rid in self.robot_ids:
             plan = plans.robots.get(rid) if plans is not None else None
             if plan is not None and rid in scene.robots:
@@ -339,7 +341,7 @@ class _Animator:
 
     def _message_arrows(
         self, messages: Sequence[Any], colours: Mapping[str, Any]
-    ) -> list[tuple[Any, Any, Mapping]]:
+    ) -> list[tuple[Any, Any, Mapping[str, Any]]]:
         """One hidden arrow and time label per message between two robots of the trace."""
         from matplotlib.patches import FancyArrowPatch
 
@@ -378,7 +380,7 @@ class _Animator:
             on = 0 <= age < self.shown and sender is not None and receiver is not None
             arrow.set_visible(on)
             text.set_visible(on)
-            if on:
+            if on and sender is not None and receiver is not None:
                 (x1, y1), (x2, y2) = sender.pose[:2], receiver.pose[:2]
                 arrow.set_positions((x1, y1), (x2, y2))
                 text.set_position(((x1 + x2) / 2, (y1 + y2) / 2))
@@ -386,9 +388,7 @@ class _Animator:
     def _object_spots(self, carried: set[str]) -> dict[str, tuple[float, float]]:
         """Where the ids of the objects on the ground go: near each, not over another id or object."""
         visible = tuple(
-            (oid, self.object_at[oid])
-            for oid in self.object_ids
-            if self.object_at[oid] and oid not in carried
+            (oid, at) for oid in self.object_ids if (at := self.object_at[oid]) and oid not in carried
         )
         if visible not in self.spots:
             boxes = [
@@ -436,7 +436,7 @@ class _Animator:
         canvas = self.fig.canvas
         if self.background is None or tuple(canvas.get_width_height(physical=True)) != tuple(frame_size):
             return None
-        return canvas.buffer_rgba()
+        return cast(memoryview, canvas.buffer_rgba())
 
     def _message_recent(self, rid: str, t: float) -> bool:
         times = self.sent[rid]
@@ -501,7 +501,7 @@ class _Animator:
         text = self.artists[rid]["why"]
         words = self._reason(rid, index) if state is not None else ""
         text.set_visible(bool(words))
-        if words:
+        if words and state is not None:
             x, y, _ = state.pose
             below = 1.1 * self.robots[rid].size / 2 + 9 * self.mm_per_pt  # under the id
             text.set_position((x, y - below))
@@ -532,7 +532,7 @@ class _Animator:
             where = self.object_at[oid]
             shown = where is not None and oid not in carried
             piece.show(shown)
-            if shown:
+            if shown and where is not None:
                 piece.move(*where)
         for oid, (x, y) in self._object_spots(carried).items():
             self.object_label[oid].set_data([x], [y])
@@ -605,7 +605,7 @@ def _mm_per_point(ax: Any) -> float:
     ax.apply_aspect()
     (x0, _), (x1, _) = ax.transData.transform([(0.0, 0.0), (1000.0, 0.0)])
     px_per_mm = abs(x1 - x0) / 1000.0 or 1.0
-    return ax.figure.dpi / 72.0 / px_per_mm
+    return cast(float, ax.figure.dpi / 72.0 / px_per_mm)
 
 
 def _writer(animation: Any, suffix: str, fps: float, animator: _Animator) -> Any:
@@ -618,7 +618,7 @@ def _writer(animation: Any, suffix: str, fps: float, animator: _Animator) -> Any
     if suffix == ".gif":
         from PIL import Image
 
-        class GifWriter(animation.PillowWriter):  # type: ignore[misc, valid-type]
+        class GifWriter(animation.PillowWriter):  # type: ignore[misc]  # `animation` is matplotlib's, passed in
             def grab_frame(self, **savefig_kwargs: Any) -> None:
                 pixels = animator.rgba(self.frame_size)
                 frames = getattr(self, "_frames", None)
@@ -632,7 +632,7 @@ def _writer(animation: Any, suffix: str, fps: float, animator: _Animator) -> Any
 
         return GifWriter(fps=fps)
 
-    class Mp4Writer(animation.FFMpegWriter):  # type: ignore[misc, valid-type]
+    class Mp4Writer(animation.FFMpegWriter):  # type: ignore[misc]  # `animation` is matplotlib's, passed in
         def grab_frame(self, **savefig_kwargs: Any) -> None:
             pixels = animator.rgba(self.frame_size)
             proc = getattr(self, "_proc", None)
@@ -725,7 +725,16 @@ def save_animation(
     return len(indices)
 
 
-def _render(matplotlib, animator, path, suffix: str, fps: float, indices, dpi: float, ffmpeg) -> None:
+def _render(
+    matplotlib: Any,
+    animator: _Animator,
+    path: str | os.PathLike[str],
+    suffix: str,
+    fps: float,
+    indices: Sequence[int],
+    dpi: float,
+    ffmpeg: str | None,
+) -> None:
     """Write the frames `indices` through the format's writer to `path`, atomically."""
     rc: dict[str, Any] = {"savefig.bbox": None}  # the writers need frames of a fixed size
     if ffmpeg is not None:

@@ -14,7 +14,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from cosmop.events import Event, EventSyntaxError, Primitive, parse_event
+from cosmop.errors import EventSyntaxError
+from cosmop.events import Event, Primitive, parse_event
 from cosmop.planning.plan import PlanMessage, PlanSet, RobotPlan
 from cosmop.scene import Scene
 from cosmop.units import length_unit, show_point
@@ -62,7 +63,18 @@ class Explainer:
     plans: PlanSet | None = None
 
     def awaits(self, name: str) -> str:
-        """Why a robot waits for the message `name` (``msg(A,B,x)`` or ``away(O,A,B)``)."""
+        """Why a robot waits for the message `name` (``msg(A,B,x)`` or ``away(O,A,B)``).
+
+        Parameters
+        ----------
+        name : str
+            The message event's canonical name.
+
+        Returns
+        -------
+        str
+            A sentence such as "waits for R2 to clear the way near W3".
+        """
         try:
             event = parse_event(name)
         except EventSyntaxError:
@@ -81,7 +93,13 @@ class Explainer:
         return f"waits for {sender}'s message {event.tag or name} (the mission's)"
 
     def yields(self, who: str) -> str:
-        """Why a robot stands for the robot or person `who` near it."""
+        """Why a robot stands for the robot or person `who` near it.
+
+        Parameters
+        ----------
+        who : str
+            The id of the robot or person it gives way to.
+        """
         if who in self.scene.humans:
             return f"waits for {who} (a person) to pass"
         return f"gives way to {who}"
@@ -111,7 +129,10 @@ class Explainer:
 
     def _sender_did(self, event: Event) -> str | None:
         """What the sender does just before it sends `event`: "drop O1 in W1", "pick up O2"."""
-        plan: RobotPlan | None = self.plans.robots.get(event.sender) if self.plans is not None else None
+        plans, sender = self.plans, event.sender
+        plan: RobotPlan | None = (
+            plans.robots.get(sender) if plans is not None and sender is not None else None
+        )
         if plan is None:
             return None
         send = next((k for k, s in enumerate(plan.steps) if s.message == event.name), None)

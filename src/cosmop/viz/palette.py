@@ -12,6 +12,7 @@ import colorsys
 from functools import lru_cache
 
 import numpy as np
+from numpy.typing import NDArray
 
 __all__ = ["TAB10", "robot_colours", "to_hex"]
 
@@ -23,16 +24,34 @@ TAB10 = (
 
 
 def _rgb(hex_colour: str) -> tuple[float, float, float]:
-    return tuple(int(hex_colour[i : i + 2], 16) / 255 for i in (1, 3, 5))
+    r, g, b = (int(hex_colour[i : i + 2], 16) / 255 for i in (1, 3, 5))
+    return r, g, b
 
 
 def to_hex(rgb: tuple[float, float, float]) -> str:
-    """``(r, g, b)`` in [0, 1] as ``#rrggbb``."""
+    """``(r, g, b)`` in [0, 1] as ``#rrggbb``.
+
+    Parameters
+    ----------
+    rgb : tuple of float
+        Red, green and blue, each in [0, 1] (clipped to it).
+    """
     return "#" + "".join(f"{round(255 * max(0.0, min(1.0, c))):02x}" for c in rgb)
 
 
-def lab(rgb: np.ndarray) -> np.ndarray:
-    """sRGB colours (``(..., 3)`` in [0, 1]) in CIELAB (D65)."""
+def lab(rgb: NDArray[np.float64]) -> NDArray[np.float64]:
+    """sRGB colours (``(..., 3)`` in [0, 1]) in CIELAB (D65).
+
+    Parameters
+    ----------
+    rgb : numpy.ndarray of float
+        Colours, shape ``(..., 3)``, each component in [0, 1].
+
+    Returns
+    -------
+    numpy.ndarray of float
+        ``L*, a*, b*`` in the same shape.
+    """
     c = np.asarray(rgb, dtype=float)
     linear = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
     m = np.array([[0.4124, 0.3576, 0.1805], [0.2126, 0.7152, 0.0722], [0.0193, 0.1192, 0.9505]])
@@ -42,7 +61,7 @@ def lab(rgb: np.ndarray) -> np.ndarray:
 
 
 @lru_cache(maxsize=1)
-def _candidates() -> tuple[np.ndarray, np.ndarray]:
+def _candidates() -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     rgb = np.array(
         [
             colorsys.hsv_to_rgb(h / 60, s, v)
@@ -66,7 +85,8 @@ def _palette(n: int) -> tuple[tuple[float, float, float], ...]:
     nearest = np.min(np.linalg.norm(lab_values[:, None, :] - lab(np.array(chosen))[None], axis=-1), axis=1)
     while len(chosen) < n:
         k = int(np.argmax(nearest))
-        chosen.append(tuple(float(v) for v in rgb[k]))
+        r, g, b = (float(v) for v in rgb[k])
+        chosen.append((r, g, b))
         nearest = np.minimum(nearest, np.linalg.norm(lab_values - lab_values[k], axis=-1))
     return tuple(chosen)
 

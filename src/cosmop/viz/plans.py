@@ -102,13 +102,14 @@ def _coordination(ax: Any, plans: PlanSet, colours: dict[str, Any]) -> list[Labe
                 if s.primitive == primitive and s.object == pair.object
             ]
             ends.append(steps[0].robot[:2] if steps else None)
-        if None in ends or ends[0] == ends[1]:
+        start, end = ends
+        if start is None or end is None or start == end:
             continue
         colour = colours.get(pair.responder, "grey")
         ax.add_patch(
             FancyArrowPatch(
-                ends[0],
-                ends[1],
+                start,
+                end,
                 arrowstyle="-|>",
                 mutation_scale=12,
                 lw=1,
@@ -118,7 +119,7 @@ def _coordination(ax: Any, plans: PlanSet, colours: dict[str, Any]) -> list[Labe
                 gid="order",
             )
         )
-        mid = ((ends[0][0] + ends[1][0]) / 2, (ends[0][1] + ends[1][1]) / 2)
+        mid = ((start[0] + end[0]) / 2, (start[1] + end[1]) / 2)
         text = f"{k}. {pair.responder}→{pair.requester}: {pair.object}"
         labels.append(Label(*mid, text, {"fontsize": 7, "color": colour}))
     return labels
@@ -140,7 +141,7 @@ def _message_ends(plans: PlanSet, event: str) -> tuple[tuple[float, float], tupl
     that sends `event` and of the receiver's step that waits for it; None if either is missing."""
     ends = []
     for rid in (parse_event(event).sender, parse_event(event).receiver):
-        plan = plans.robots.get(rid)
+        plan = plans.robots.get(rid) if rid is not None else None
         step = next((s for s in plan.steps if s.message == event), None) if plan is not None else None
         if step is None:
             return None
@@ -155,7 +156,7 @@ def _messages(ax: Any, plans: PlanSet, colours: dict[str, Any]) -> None:
 
     # hundreds of full-strength arrows would hide the map: with many, each is a faint hint
     many = len(plans.messages) > _MANY_MESSAGES
-    look = (
+    look: dict[str, Any] = (  # matplotlib keywords
         {"lw": 0.5, "alpha": 0.35, "mutation_scale": 7}
         if many
         else {"lw": 1, "alpha": 0.9, "mutation_scale": 11}
@@ -201,7 +202,9 @@ def _title(ax: Any, plans: PlanSet | None, name: str | None) -> None:
     ax.set_title("\n".join(lines), color=colour, fontsize=_TITLE_SIZE)
 
 
-def _paths(ax: Any, scene: Scene, plans: PlanSet | None, drawn: SceneArtists) -> tuple[list[Label], list]:
+def _paths(
+    ax: Any, scene: Scene, plans: PlanSet | None, drawn: SceneArtists
+) -> tuple[list[Label], list[tuple[float, float, float]]]:
     """Each plan's path through its waypoints with its primitives' marks; the labels to place
     and the squares ``(x, y, side)`` (mm) that labels must not cover."""
     labels: list[Label] = []
@@ -320,7 +323,21 @@ def save_plan_png(
     title: str | None = None,
     full_map: bool = False,
 ) -> None:
-    """Draw (:func:`draw_plan`, with the same `title` and `full_map`) and write a PNG atomically."""
+    """Draw (:func:`draw_plan`, with the same `title` and `full_map`) and write a PNG atomically.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene to draw (mm).
+    plans : PlanSet or None
+        The plans to draw over it (None: the scene alone).
+    path : str or pathlib.Path
+        The PNG file to write.
+    title : str, optional
+        The name at the head of the title (default: the plan set's scenario name).
+    full_map : bool, optional
+        Draw the whole map rather than where the team works.
+    """
     plt = _pyplot()
     fig = draw_plan(scene, plans, title=title, full_map=full_map)
     buffer = io.BytesIO()

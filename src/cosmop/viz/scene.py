@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, cast
 
 from cosmop.events import Primitive
 from cosmop.planning.plan import RobotPlan
@@ -146,7 +146,13 @@ class Piece:
     label_offset: float | None = 0.0
 
     def move(self, x: float, y: float) -> None:
-        """Centre the piece, and its id unless the caller places it, on ``(x, y)`` (mm)."""
+        """Centre the piece, and its id unless the caller places it, on ``(x, y)`` (mm).
+
+        Parameters
+        ----------
+        x, y : float
+            The new centre, mm.
+        """
         if hasattr(self.patch, "set_center"):  # a disc is placed by its centre, a square by a corner
             self.patch.set_center((x, y))
         else:
@@ -156,7 +162,13 @@ class Piece:
             self.label.set_data([x], [y + self.label_offset])
 
     def show(self, visible: bool) -> None:
-        """Show or hide the piece with its id."""
+        """Show or hide the piece with its id.
+
+        Parameters
+        ----------
+        visible : bool
+            True to show it, False to hide it.
+        """
         self.patch.set_visible(visible)
         if self.label is not None:
             self.label.set_visible(visible)
@@ -258,9 +270,10 @@ def _draw_workspaces(ax: Any, workspaces: Mapping[str, Workspace], style: SceneS
         if ws.point is not None:
             ax.plot(*ws.point, marker="x", color="grey", ms=style.cross, zorder=style.mark_layer)
         else:
-            width, height = ws.x[1] - ws.x[0], ws.y[1] - ws.y[0]
+            x, y = ws.ranges
+            width, height = x[1] - x[0], y[1] - y[0]
             area = Rectangle(
-                (ws.x[0], ws.y[0]), width, height, color="lightgrey", alpha=0.7, zorder=style.area_layer
+                (x[0], y[0]), width, height, color="lightgrey", alpha=0.7, zorder=style.area_layer
             )
             ax.add_patch(area)
         if style.placed_ids:
@@ -306,7 +319,9 @@ def _draw_robot(
 
     declared = scene.robots.get(rid)
     size = float(declared.size) if declared is not None else DEFAULT_ROBOT_SIZE
-    fill = {"fill": False} if style.robot_fill is None else {"fc": (*colour[:3], style.robot_fill)}
+    fill: dict[str, Any] = (
+        {"fill": False} if style.robot_fill is None else {"fc": (*colour[:3], style.robot_fill)}
+    )
     body = Rectangle((0, 0), size, size, ec=colour, lw=1.5, zorder=style.robot_layer, **fill)
     marker = None
     if not style.placed_ids:
@@ -345,16 +360,42 @@ def scene_legend() -> list[Any]:
 
 
 def planned_path(robot: Robot, plan: RobotPlan) -> list[tuple[float, float]]:
-    """The path a plan drives: the robot's initial position, then every GoTo's target (mm)."""
-    return [tuple(robot.pose[:2])] + [tuple(s.robot[:2]) for s in plan.steps if s.primitive == "GoTo"]
+    """The path a plan drives: the robot's initial position, then every GoTo's target (mm).
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot, at its initial pose.
+    plan : RobotPlan
+        Its plan.
+
+    Returns
+    -------
+    list of (float, float)
+    """
+    return [(robot.pose[0], robot.pose[1])] + [
+        (s.robot[0], s.robot[1]) for s in plan.steps if s.primitive == "GoTo"
+    ]
 
 
 def replanned_path(route: Mapping[str, Any]) -> list[tuple[float, float]]:
     """The path a replan drives: where it went on from, then every GoTo's target (mm); `route`
-    is a trace's ``replans[k].route`` (:attr:`cosmop.traces.Trace.replans`)."""
-    return [tuple(route["from"][:2])] + [
+    is a trace's ``replans[k].route`` (:attr:`cosmop.traces.Trace.replans`).
+
+    Parameters
+    ----------
+    route : Mapping
+        The route as the trace holds it: ``from`` (a pose) and ``steps`` (each with its
+        ``primitive`` and ``pose``), poses in mm and degrees.
+
+    Returns
+    -------
+    list of (float, float)
+    """
+    points = [tuple(route["from"][:2])] + [
         tuple(s["pose"][:2]) for s in route["steps"] if s["primitive"] == "GoTo"
     ]
+    return cast(list[tuple[float, float]], points)  # the trace's JSON: pairs of numbers
 
 
 def ids_with_trace(declared: Mapping[str, Any], trace: Trace | None, group: str) -> list[str]:

@@ -99,9 +99,8 @@ def activity_box(scene: Scene, plans: PlanSet | None) -> Box | None:
     boxes += [_square(*o.position, o.size) for oid, o in scene.objects.items() if oid in objects]
     for wid, ws in scene.workspaces.items():
         if wid in workspaces:
-            boxes.append(
-                _square(*ws.point, 0.0) if ws.point is not None else (ws.x[0], ws.y[0], ws.x[1], ws.y[1])
-            )
+            x, y = ws.ranges
+            boxes.append(_square(*ws.point, 0.0) if ws.point is not None else (x[0], y[0], x[1], y[1]))
     added = plans.added if plans is not None else ()
     boxes += [_square(*task.point, 0.0) for task in added if task.workspace in workspaces]
     return _union(boxes)

@@ -161,7 +161,7 @@ def _trace(trace: Trace, object_ids: list[str], max_frames: int) -> dict[str, An
     n = len(trace.t)
     stride = max(1, -(-n // max_frames))
     picked = list(range(0, n, stride)) if (n - 1) % stride == 0 else [*range(0, n, stride), n - 1]
-    points: dict[str, dict[str, dict[str, list]]] = {"humans": {}, "objects": {}}
+    points: dict[str, dict[str, dict[str, list[float | None]]]] = {"humans": {}, "objects": {}}
     for group, columns in points.items():
         xy = trace.positions(group)[picked]
         for j, pid in enumerate(trace.ids(group)):
@@ -174,14 +174,14 @@ def _trace(trace: Trace, object_ids: list[str], max_frames: int) -> dict[str, An
     }
 
 
-def _robot_columns(trace: Trace, picked: list[int], object_ids: list[str]) -> dict[str, dict[str, list]]:
+def _robot_columns(trace: Trace, picked: list[int], object_ids: list[str]) -> dict[str, dict[str, list[Any]]]:
     """Per robot the trace shows in the frames `picked`: x, y (mm), h (degrees), carrying, waiting.
 
     ``carrying`` is an index into `object_ids` (the scene's objects; None: nothing, or an object
     the scene does not declare).
     """
     index = {oid: k for k, oid in enumerate(object_ids)}
-    robots = {}
+    robots: dict[str, dict[str, list[Any]]] = {}  # the page's JSON: a column per key
     for i, rid in enumerate(trace.robot_ids):
         x, y, h = trace.poses[picked, i].T
         shown = (~np.isnan(x)).tolist()
@@ -204,7 +204,7 @@ def _robot_columns(trace: Trace, picked: list[int], object_ids: list[str]) -> di
     return robots
 
 
-def _why_columns(trace: Trace, picked: list[int], i: int) -> dict[str, list]:
+def _why_columns(trace: Trace, picked: list[int], i: int) -> dict[str, list[Any]]:
     """Robot `i`'s reasons to stand in the frames `picked`: ``awaits`` (a message name),
     ``yields`` (the robot or person it gives way to) and ``delayed`` (true/false), None when not."""
     out = {}
@@ -221,7 +221,9 @@ def _scene_data(scene: Scene, plans: PlanSet | None, robot_ids: list[str]) -> di
     return {
         "walls": [[*w.start, *w.end] for w in scene.obstacles],
         "workspaces": {
-            wid: {"point": list(w.point)} if w.is_point else {"x": list(w.x), "y": list(w.y)}
+            wid: {"point": list(w.point)}
+            if w.point is not None
+            else {"x": list(w.ranges[0]), "y": list(w.ranges[1])}
             for wid, w in scene.workspaces.items()
         },
         "objects": {oid: {"size": o.size, "position": list(o.position)} for oid, o in scene.objects.items()},
@@ -332,7 +334,26 @@ def save_html(
     trace: Trace | Mapping[str, Any] | None = None,
     title: str | None = None,
 ) -> int:
-    """Write :func:`render_html` to `path` atomically; return the number of bytes written."""
+    """Write :func:`render_html` to `path` atomically; return the number of bytes written.
+
+    Parameters
+    ----------
+    scene : Scene
+        Walls, workspaces, objects, robots and people (mm).
+    path : str or os.PathLike
+        The HTML file to write.
+    plans : PlanSet, optional
+        Drawn as dashed paths with their primitives.
+    trace : Trace or Mapping, optional
+        The run (a :class:`cosmop.traces.Trace` or its ``cosmop.trace/1`` JSON).
+    title : str, optional
+        Default: the plans' or trace's scenario name.
+
+    Returns
+    -------
+    int
+        The size of the file, bytes.
+    """
     text = render_html(scene, plans=plans, trace=trace, title=title)
     write_atomic(path, text)
     return len(text.encode("utf-8"))
