@@ -590,8 +590,8 @@ class Encoding:
     def targets(self, p: RobotProblem) -> tuple[str | None, ...]:
         """The objects the primitive applies to in `p` (``(None,)`` for one without object).
 
-            Parameters
-            ----------
+        Parameters
+        ----------
         p : RobotProblem
             The robot's planning problem.
         """
@@ -600,12 +600,12 @@ class Encoding:
     def parts(self, p: RobotProblem, obj: str | None) -> list[tuple[str, Formula]]:
         """Named formulas that hold whenever :math:`\\bigcirc \\pi` is this primitive on `obj`.
 
-            Parameters
-            ----------
+        Parameters
+        ----------
         p : RobotProblem
             The robot's planning problem.
-            obj : str or None
-                The object it acts on, one of :meth:`targets` (``None`` for one without object).
+        obj : str or None
+            The object it acts on, one of :meth:`targets` (``None`` for one without object).
         """
         raise NotImplementedError
 
