@@ -376,6 +376,7 @@ class _Horizon:
     Attributes
     ----------
     K : int
+        The horizon: the number of steps.
     solver : z3.Solver
         Holds the specification unrolled over instants ``0..K``.
     unrolling : Unrolling or IncrementalUnrolling
