@@ -27,7 +27,7 @@ solver, the conflict step and the exact checker, like every other plan.
 from __future__ import annotations
 
 import itertools
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -36,7 +36,7 @@ import shapely
 from cosmop.docking import docking_pose
 from cosmop.planning.plan import RobotPlan
 from cosmop.planning.reach import free_component
-from cosmop.planning.regions import wall_regions
+from cosmop.planning.regions import HalfPlane, wall_regions
 from cosmop.scene import Scene
 from cosmop.squares import rectangle, square, swept_square
 
@@ -48,6 +48,9 @@ motion margin of :data:`cosmop.planning.specification.MOTION_MARGIN`, so that no
 slide along them."""
 
 _RINGS = 40  # candidate rings around the goods (pitch: their side)
+
+_WallSides = tuple[tuple[HalfPlane, HalfPlane], ...]
+"""A wall's regions, each for a robot's square paired with the same region for a good's."""
 
 
 def place_aside(
@@ -95,7 +98,9 @@ def place_aside(
     return None
 
 
-def handover_spot(scene: Scene, obj: str, workspace: str, robots: tuple[str, ...], grid: int = 9):
+def handover_spot(
+    scene: Scene, obj: str, workspace: str, robots: tuple[str, ...], grid: int = 9
+) -> tuple[float, float] | None:
     """A spot for `obj` in `workspace` where each of `robots` can dock to it, chosen before either
     is planned (a hand-over whose giver and receiver wait on each other, :mod:`cosmop.missions.handover`).
 
@@ -105,6 +110,24 @@ def handover_spot(scene: Scene, obj: str, workspace: str, robots: tuple[str, ...
     gripper asks), and of those the one
     whose square keeps farthest from the walls and the other goods (ties: nearest the middle), so
     that both robots have the most room.  ``None`` when no spot of the grid is dockable by all.
+
+    Parameters
+    ----------
+    scene : Scene
+        Walls, robots, goods and workspaces (mm).
+    obj : str
+        The goods handed over.
+    workspace : str
+        The workspace the spot lies in.
+    robots : tuple of str
+        The robots that must dock to the goods there (giver and receiver).
+    grid : int
+        Candidate centres per axis of a rectangular workspace.
+
+    Returns
+    -------
+    tuple of float or None
+        The goods' centre at the spot (mm).
     """
     size = scene.objects[obj].size
     centres = scene.workspaces[workspace].centres(size)
@@ -138,7 +161,9 @@ def handover_spot(scene: Scene, obj: str, workspace: str, robots: tuple[str, ...
     best = max(
         (n for n in range(len(spots)) if dockable[n]),
         key=lambda n: (
-            round(float(square(*spots[n], size).distance(around)), 6) if around is not None else 0.0,
+            round(float(square(spots[n][0], spots[n][1], size).distance(around)), 6)
+            if around is not None
+            else 0.0,
             -float(np.hypot(*(spots[n] - middle))),
         ),
     )
@@ -179,6 +204,19 @@ def dock_slots(
     of up to four goods and keeping the order that packs the most.  A heuristic: the solver,
     the conflict step and the exact checker decide the plans, as for every place this module
     chooses.
+
+    Parameters
+    ----------
+    scene : Scene
+        Walls, robots, goods and workspaces (mm).
+    workspace : str
+        The workspace the goods are dropped into.
+    goods : Mapping[str, str]
+        The robot that drops each good, by object id.
+    step : float
+        The pitch of the candidate slots (mm).
+    rest : float
+        The room a docked robot keeps from the goods packed before (mm).
     """
     names = list(goods)
     candidates = {o: _dockable_slots(scene, workspace, o, goods[o], step, rest) for o in names}
@@ -222,7 +260,9 @@ def _dockable_slots(
     return np.array(rows, dtype=float).reshape(-1, 5)
 
 
-def _wall_sides(scene: Scene, robot: float, good: float, near=None) -> list[tuple]:
+def _wall_sides(
+    scene: Scene, robot: float, good: float, near: shapely.Geometry | None = None
+) -> list[_WallSides]:
     """Per wall (those meeting the geometry `near`, when given), its regions for a robot's square
     of side `robot` paired with the same regions for a good's of side `good` (mm)
     (:func:`~cosmop.planning.regions.wall_regions`)."""
@@ -233,7 +273,9 @@ def _wall_sides(scene: Scene, robot: float, good: float, near=None) -> list[tupl
     ]
 
 
-def _no_wall_between(regions: list[tuple], robot: tuple, good: tuple) -> bool:
+def _no_wall_between(
+    regions: list[_WallSides], robot: tuple[float, float], good: tuple[float, float]
+) -> bool:
     """Whether no wall comes between a robot centred at `robot` and a good at `good`: for every
     wall of :func:`_wall_sides`, both squares lie in one of its regions (the specification's
     gripper)."""
@@ -257,7 +299,14 @@ def _pack(
     return tuple(out)
 
 
-def _leaves(scene: Scene, row: np.ndarray, obj: str, rest, candidates, placed) -> tuple:
+def _leaves(
+    scene: Scene,
+    row: np.ndarray,
+    obj: str,
+    rest: Sequence[str],
+    candidates: Mapping[str, np.ndarray],
+    placed: list[tuple[float, float, float]],
+) -> tuple[int, float, float, float]:
     """How good a slot is: the dockable slots it leaves the goods still to pack, then how far
     it lies from the middle of the workspace (packing from the edges in)."""
     after = [*placed, (float(row[0]), float(row[1]), scene.objects[obj].size / 2.0)]
@@ -280,7 +329,7 @@ def _clear(rows: np.ndarray, half: float, placed: list[tuple[float, float, float
     return rows[ok]
 
 
-def _keep_off(scene: Scene, obj: str, plans: Mapping[str, RobotPlan]):
+def _keep_off(scene: Scene, obj: str, plans: Mapping[str, RobotPlan]) -> shapely.Geometry:
     """Everything the set-down goods' grown square must not overlap (one shapely geometry)."""
     parts = [shapely.LineString([w.start, w.end]) for w in scene.obstacles]
     parts += [rectangle(*ws.ranges) for ws in scene.workspaces.values()]
@@ -296,7 +345,7 @@ def _keep_off(scene: Scene, obj: str, plans: Mapping[str, RobotPlan]):
     return shapely.unary_union(parts)
 
 
-def _standing(scene: Scene, obj: str, size: float):
+def _standing(scene: Scene, obj: str, size: float) -> shapely.Geometry:
     """Robot centres whose square overlaps a wall or other goods (touching allowed)."""
     half = size / 2.0
     parts = [scene.blocked(half)]

@@ -93,6 +93,11 @@ def overlaps(a: BaseGeometry, b: BaseGeometry) -> bool:
 
     For a segment against a polygon this is ``seg.intersects(poly) and not seg.touches(poly)``:
     a segment running along the boundary, or ending on it, only touches.
+
+    Parameters
+    ----------
+    a, b : shapely geometry
+        The two shapes (mm).
     """
     return a.intersects(b) and not a.touches(b)
 
@@ -350,7 +355,7 @@ class _RobotChecker:
                 )
 
     def reach(
-        self, k: int, oid: str, robot: State, where: Iterable[float], skip: Iterable[Wall] = ()
+        self, k: int, oid: str, robot: State, where: tuple[float, float], skip: Iterable[Wall] = ()
     ) -> None:
         """The gripper must not reach through a wall: robot and object squares on its two sides."""
         x, y, _ = robot.robot
@@ -368,6 +373,7 @@ class _RobotChecker:
 
     def pickup(self, k: int, step: Step, prev: State, cur: State) -> None:
         oid = step.object
+        assert oid is not None  # Step requires the object of a primitive without a message
         self.robot_static(k, prev, cur)
         heading = self.docking(k, cur, oid, "pick-pose", "picked up")
         ox, oy = prev.objects[oid].position
@@ -375,6 +381,7 @@ class _RobotChecker:
         x, y, _ = cur.robot
         pose = None if heading is None else docking_pose((ox, oy), d, heading)
         if pose is not None and not _points_eq((x, y), pose):
+            assert heading is not None  # the pose is found only for a docking heading
             self.add(
                 k,
                 "pick-pose",
@@ -410,6 +417,7 @@ class _RobotChecker:
 
     def dropoff(self, k: int, step: Step, prev: State, cur: State) -> None:
         oid = step.object
+        assert oid is not None  # Step requires the object of a primitive without a message
         self.robot_static(k, prev, cur)
         heading = self.docking(k, cur, oid, "drop-pose", "dropped off")
         if not prev.objects[oid].carried:
@@ -430,6 +438,7 @@ class _RobotChecker:
         front = None if heading is None else in_front((x, y), d, heading)
         placed = front is not None and _points_eq(where, front)
         if front is not None and not placed:
+            assert heading is not None  # the front is found only for a docking heading
             self.add(
                 k,
                 "drop-pose",
@@ -463,6 +472,7 @@ class _RobotChecker:
 
     def req(self, k: int, step: Step, prev: State, cur: State) -> None:
         oid = step.object
+        assert oid is not None  # Step requires the object of a primitive without a message
         self.robot_static(k, prev, cur)
         self.positions_static(k, prev, cur)
         self.flags_static(k, prev, cur, "carried")
@@ -487,6 +497,7 @@ class _RobotChecker:
 
     def res(self, k: int, step: Step, prev: State, cur: State) -> None:
         oid = step.object
+        assert oid is not None  # Step requires the object of a primitive without a message
         self.robot_static(k, prev, cur)
         self.positions_static(k, prev, cur)
         self.flags_static(k, prev, cur, "carried")
@@ -505,6 +516,7 @@ class _RobotChecker:
         self.positions_static(k, prev, cur)
         self.flags_static(k, prev, cur, "carried")
         self.flags_static(k, prev, cur, "away")
+        assert step.message is not None  # (transition sends only steps with a message here)
         event = parse_event(step.message)
         role, robot = (
             ("receiver", event.receiver) if step.primitive == Primitive.REQ else ("sender", event.sender)
@@ -559,7 +571,9 @@ class _RobotChecker:
             return f"PickUp({event.obj})"
         if event.kind == "drop":
             return f"DropOff({event.obj}) that leaves {event.obj} in {event.workspace}"
-        primitive, obj, name = realising_step(event, self.robot_id)
+        realised = realising_step(event, self.robot_id)
+        assert realised is not None  # an away or msg here (a return is never asked): it has a step
+        primitive, obj, name = realised
         return f"{primitive}({obj or name})"
 
     def unmatched(self, event: Event, n: int, total: int, last: int | None, events: list[Event]) -> str:
@@ -578,6 +592,7 @@ class _RobotChecker:
                 "the events are out of order"
             )
         elif event.kind == "drop":
+            assert event.obj is not None and event.workspace is not None  # a drop names both
             for i in range(1 if last is None else last + 1, self.plan.horizon + 1):
                 step = self.plan.steps[i - 1]
                 if (
@@ -591,8 +606,8 @@ class _RobotChecker:
                         f"{_outside(self.scene, event.obj, event.workspace)}"
                     )
         elif event.kind == "return" and self.plan.horizon:
-            last = self.pose(self.states[-1].robot)
-            text += f"; the last pose is {last}: add a GoTo back to the initial pose"
+            final = self.pose(self.states[-1].robot)
+            text += f"; the last pose is {final}: add a GoTo back to the initial pose"
         remaining = [e.name for e in events[n:]]
         if remaining:
             text += f" (so {', '.join(remaining)} cannot be matched either)"
@@ -611,6 +626,7 @@ def _workspace_text(scene: Scene, wid: str) -> str:
     ws = scene.workspaces[wid]
     if ws.point is not None:
         return f"{wid} (the point {show_point(ws.point, scene.units)})"
+    assert ws.x is not None and ws.y is not None  # a rectangle
     (x0, x1), (y0, y1) = ((show_number(v, scene.units) for v in axis) for axis in (ws.x, ws.y))
     return f"{wid} (x in [{x0}, {x1}], y in [{y0}, {y1}])"
 
@@ -711,14 +727,19 @@ def check_plan(scenario: Scenario, plan: PlanSet) -> CheckReport:
             )
         )
     checked = 0
-    moved = {s.object for p in plan.robots.values() for s in p.steps if s.primitive == Primitive.PICKUP}
+    moved = {
+        s.object
+        for p in plan.robots.values()
+        for s in p.steps
+        if s.primitive == Primitive.PICKUP and s.object is not None  # (a PickUp always has one)
+    }
     for robot_id, robot_plan in plan.robots.items():
         violations.extend(check_robot_plan(scene, robot_id, robot_plan, moved=moved))
         if robot_id in scene.robots:
             checked += robot_plan.horizon
     tasks = scenario.mission.tasks if scenario.mission is not None else None
     if tasks is not None and plan.feasible:
-        added = {}
+        added: dict[str, set[Event]] = {}
         for task in plan.added:
             added.setdefault(task.robot, set()).update(task.events)
         for robot_id in sorted(set(tasks) | set(added), key=str):
@@ -824,8 +845,8 @@ def _check_coordination(plan: PlanSet) -> list[Violation]:
     for pair in plan.coordination:
         event = pair.event
         for role, robot_id in (("requester", pair.requester), ("responder", pair.responder)):
-            robot_plan = plan.robots.get(robot_id)
-            if robot_plan is None:
+            planned = plan.robots.get(robot_id)
+            if planned is None:
                 if plan.feasible:
                     violations.append(
                         Violation(
@@ -836,7 +857,7 @@ def _check_coordination(plan: PlanSet) -> list[Violation]:
                             f"but the plan has no plan for {robot_id}",
                         )
                     )
-            elif event.name not in robot_plan.mission:
+            elif event.name not in planned.mission:
                 primitive = Primitive.REQ if role == "requester" else Primitive.RES
                 violations.append(
                     Violation(

@@ -19,6 +19,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from decimal import Decimal
 from fractions import Fraction
+from typing import Any
 
 import numpy as np
 from shapely.geometry.base import BaseGeometry
@@ -26,6 +27,7 @@ from shapely.geometry.base import BaseGeometry
 from cosmop.missions.precedence import Link, Node
 from cosmop.planning.conflict_search import (
     Culprits,
+    Edge,
     Search,
     WayTable,
     backjump,
@@ -35,6 +37,9 @@ from cosmop.planning.conflict_search import (
 from cosmop.planning.conflicts import Conflict
 
 __all__ = ["order_conflicts"]
+
+_Ordered = tuple[list[tuple[Edge, Conflict]], list[Conflict]]
+"""Start edges, each with the conflict it orders, and the conflicts left unresolved."""
 
 
 def order_conflicts(
@@ -74,6 +79,26 @@ def order_conflicts(
 
     Returns the edges added (on top of `starts`), each with the conflict it orders, and the
     unresolved conflicts.
+
+    Parameters
+    ----------
+    found : sequence of Conflict
+        The conflicts between the plans (:func:`~cosmop.planning.conflicts.conflicts`).
+    horizons : Mapping[str, int]
+        Every robot's number of steps.
+    links : sequence of Link
+        The messages the plans already have.
+    starts : sequence of (Node, Node)
+        Start edges the order already has.
+    durations : Mapping[str, sequence of float]
+        Expected seconds of each robot's steps (:func:`~cosmop.planning.timing.durations`).
+    max_backtracks : int
+        Dead ends after which the search hands over to the solver.
+    fixed : Mapping[str, sequence of shapely geometry], optional
+        Each robot's places re-planning cannot move
+        (:func:`~cosmop.planning.conflicts.fixed_places`), to choose which conflict to set aside.
+    rlimit : int
+        Z3 resource limit of each scheduling call.
     """
     table = WayTable.of(found, list(horizons))
     implied, culprits = _Implied(found, table), Culprits(fixed)
@@ -108,7 +133,7 @@ def order_conflicts(
     return (better if better is not None else schedule.edges(implied.left(gone))), unresolved
 
 
-def _give_back(search: Search, culprits: Culprits, budget: int):
+def _give_back(search: Search, culprits: Culprits, budget: int) -> _Ordered | None:
     """Give back the conflicts `search` set aside that an order resolves with all the others.
 
     A conflict whose core's other members are all ordered stays set aside (its core proves it).
@@ -125,7 +150,16 @@ def _give_back(search: Search, culprits: Culprits, budget: int):
     return search.edges, search.set_aside
 
 
-def _give_up(found, horizons, links, starts, durations, max_backtracks, fixed, implied):
+def _give_up(
+    found: Sequence[Conflict],
+    horizons: Mapping[str, int],
+    links: Sequence[Link],
+    starts: Sequence[Edge],
+    durations: Mapping[str, Sequence[float]],
+    max_backtracks: int,
+    fixed: Mapping[str, Sequence[BaseGeometry]] | None,
+    implied: _Implied,
+) -> _Ordered:
     """Order what the search can, leaving each conflict it fails on unresolved (sound, not minimal)."""
     unresolved: list[Conflict] = []
     gone: set[int] = set()
@@ -157,7 +191,16 @@ class _Schedule:
     solver's work grows faster than their number.
     """
 
-    def __init__(self, found, horizons, links, starts, durations, rlimit: int, implied=None) -> None:
+    def __init__(
+        self,
+        found: Sequence[Conflict],
+        horizons: Mapping[str, int],
+        links: Sequence[Link],
+        starts: Sequence[Edge],
+        durations: Mapping[str, Sequence[float]],
+        rlimit: int,
+        implied: _Implied | None = None,
+    ) -> None:
         import z3
 
         self.ctx = ctx = z3.Context()
@@ -186,7 +229,7 @@ class _Schedule:
         self.ways = {id(c): ways_of(c) for c in found}
         self.implied = implied if implied is not None else _Implied(found)
         self.number = {id(c): n for n, c in enumerate(found)}
-        self.label: dict[int, object] = {}  # conflict -> its literal, once written
+        self.label: dict[int, Any] = {}  # conflict -> its literal (a z3 Bool), once written
         self.by_id: dict[int, Conflict] = {}  # literal -> conflict
 
     def _write(self, conflicts: Sequence[Conflict]) -> None:
@@ -233,9 +276,14 @@ class _Schedule:
                 return (a, b)
         return None
 
-    def edges(self, conflicts: Sequence[Conflict]) -> list[tuple[tuple[Node, Node], Conflict]]:
+    def edges(self, conflicts: Sequence[Conflict]) -> list[tuple[Edge, Conflict]]:
         """The way the last schedule orders each of `conflicts` (those it was asked with)."""
-        return [(self.way(c), c) for c in conflicts]
+        out: list[tuple[Edge, Conflict]] = []
+        for c in conflicts:
+            way = self.way(c)
+            assert way is not None  # the last schedule orders every conflict it was asked with
+            out.append((way, c))
+        return out
 
 
 class _Implied:
@@ -253,7 +301,7 @@ class _Implied:
         self.found = list(found)
         # every conflict's ways as (A, i, B, j), robots numbered (WayTable); each pair of robots
         # numbered in the order it first appears
-        pairs: dict[frozenset, int] = {}
+        pairs: dict[frozenset[str], int] = {}
         pair = np.array([pairs.setdefault(frozenset(c.robots), len(pairs)) for c in found], dtype=np.int64)
         table = table if table is not None else WayTable.of(found, ())
         present, ends = table.possible, table.ends
@@ -317,10 +365,11 @@ def _implications(present: np.ndarray, ends: np.ndarray) -> np.ndarray:
         & (d[..., 1] >= c[..., 1])
         & (d[..., 3] <= c[..., 3])
     )
-    return (match.any(axis=-1) | ~present[..., :, None, :]).all(axis=-1)
+    implies: np.ndarray = (match.any(axis=-1) | ~present[..., :, None, :]).all(axis=-1)
+    return implies
 
 
-def _check(solver, labels):
+def _check(solver: Any, labels: Sequence[Any]) -> Any:
     """``solver.check(*labels)`` without re-checking the sort of each label (thousands per call)."""
     import z3
 
@@ -339,11 +388,11 @@ class _Times:
     """A model's values of time variables, exactly (the eps of the order needs no rounding),
     read when first asked for."""
 
-    def __init__(self, model) -> None:
+    def __init__(self, model: Any) -> None:
         self.model = model
         self.seen: dict[int, Fraction] = {}
 
-    def __call__(self, var) -> Fraction:
+    def __call__(self, var: Any) -> Fraction:
         key = var.get_id()
         if key not in self.seen:
             value = self.model.eval(var, model_completion=True)

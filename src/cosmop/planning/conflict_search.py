@@ -14,14 +14,34 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any, Generic, Protocol, TypeVar
 
 import numpy as np
 from shapely.geometry.base import BaseGeometry
 
-from cosmop.missions.precedence import Node, Precedence, TakenBack
+from cosmop.missions.precedence import Link, Node, Precedence, TakenBack
 from cosmop.planning.conflicts import Conflict, Occupancy, detours, replan_rank
 
 __all__ = ["Culprits", "Search", "WayTable", "backjump", "both_ways", "depth_first", "way_table", "ways_of"]
+
+Edge = tuple[Node, Node]
+"""A start edge ``((A, i), (B, j))``: B starts step *j* once A has completed step *i*."""
+
+_Team = tuple[Mapping[str, int], Sequence[Link], Sequence[Edge], Mapping[str, Sequence[float]]]
+"""``(horizons, links, starts, durations)``: the plans' order before any conflict is ordered."""
+
+_Reason = frozenset[int] | bool | None
+"""Why an entry of the trail was taken: ``None`` a choice, ``True`` forced by its cycle, or the
+set of the dead end that forced it."""
+
+_Taken = tuple[int, Edge, _Reason]
+"""A conflict, the start edge that orders it, and why."""
+
+
+class _Implications(Protocol):
+    """Which conflicts imply which (:class:`cosmop.planning.conflict_order._Implied`)."""
+
+    def among(self, conflicts: Sequence[Conflict]) -> tuple[np.ndarray, np.ndarray]: ...
 
 
 class Search:
@@ -59,7 +79,12 @@ class Search:
     """
 
     def __init__(
-        self, found: Sequence[Conflict], implied, team, culprits: Culprits, table: WayTable | None = None
+        self,
+        found: Sequence[Conflict],
+        implied: _Implications,
+        team: _Team,
+        culprits: Culprits,
+        table: WayTable | None = None,
     ) -> None:
         horizons, links, starts, durations = team
         self.found, self.culprits = found, culprits
@@ -67,11 +92,11 @@ class Search:
         self.precedence = Precedence(horizons, links, starts, durations)
         self.sides = _Sides(found, self.precedence, table)
         self.at: dict[int, int] = {}  # conflict -> its place in the trail
-        self.graph = _Graph(self.precedence, links, starts, self.at)
+        self.graph: _Graph[int] = _Graph(self.precedence, links, starts, self.at)
         self.stronger, self.weaker = implied.among(found)
         # (conflict, edge, undo log, reason): None for a choice, True when forced by its cycle,
         # or the set of a dead end when forced by it
-        self.trail: list[tuple[int, tuple[Node, Node], list, object]] = []
+        self.trail: list[_Entry] = []
         self.aside = np.zeros(len(found), dtype=bool)
         self.hidden = np.zeros(len(found), dtype=bool)
         self.every = self.live = np.arange(len(found))  # the conflicts not known to be ordered yet
@@ -79,16 +104,23 @@ class Search:
         self.cores: dict[int, list[Conflict]] = {}  # id of each conflict set aside -> its core
 
     @property
-    def edges(self) -> list[tuple[tuple[Node, Node], Conflict]]:
+    def edges(self) -> list[tuple[Edge, Conflict]]:
         """The start edges taken, each with the conflict it orders."""
         return [(edge, self.found[i]) for i, edge, _, _ in self.trail]
 
     @property
     def set_aside(self) -> list[Conflict]:
         """The conflicts set aside, each with its core in :attr:`cores`."""
-        return [self.found[i] for i in np.flatnonzero(self.aside)]
+        return [self.found[int(i)] for i in np.flatnonzero(self.aside)]
 
     def is_aside(self, conflict: Conflict) -> bool:
+        """Whether `conflict` is set aside.
+
+        Parameters
+        ----------
+        conflict : Conflict
+            One of the conflicts searched.
+        """
         return bool(self.aside[self.number[id(conflict)]])
 
     def run(self, budget: int, back: int | None = None) -> bool | None:
@@ -96,6 +128,13 @@ class Search:
 
         With `back` (a conflict given back), a core sets aside `back` itself (every core found
         contains it, the others being ordered): then ``False`` once the rest is ordered again.
+
+        Parameters
+        ----------
+        budget : int
+            Dead ends after which the search gives up.
+        back : int, optional
+            The index of a conflict given back.
         """
         dead_ends, kept = 0, True
         while True:
@@ -118,7 +157,7 @@ class Search:
             side = dict(zip(live[at].tolist(), ways[at, 1].tolist(), strict=True))  # the way left
             # the hardest to re-plan first: the likely culprits come last, the least to take back
             order = sorted(side, key=lambda i: -self.culprits.rank(self.found[i]))
-            self._take_forced([(i, self.sides.edges[i][int(side[i])]) for i in order])
+            self._take_forced([(i, self.sides.way(i, int(side[i]))) for i in order])
             if len(at):
                 continue
             pool = live[open_]
@@ -135,7 +174,8 @@ class Search:
         one conflict of each is set aside (a core that holds one set aside already waits for the
         next round); then the order is taken back once, to the earliest place any of them needs.
         """
-        places, gone = [], set()
+        places: list[int] = []
+        gone: set[int] = set()
         for s in stuck:
             core, choices = self._dead_end_set(s)
             if self.aside[list(core)].any():
@@ -182,7 +222,15 @@ class Search:
     def give_back(self, conflict: Conflict, budget: int) -> bool | None:
         """Search on with `conflict` no longer set aside: ``True`` when it is ordered with the
         rest, ``False`` when a core keeps it aside (:attr:`cores` has the new one), ``None``
-        past `budget` dead ends."""
+        past `budget` dead ends.
+
+        Parameters
+        ----------
+        conflict : Conflict
+            A conflict set aside.
+        budget : int
+            Dead ends after which the search gives up.
+        """
         i = self.number[id(conflict)]
         self.aside[i] = False
         self._hide()
@@ -200,17 +248,17 @@ class Search:
         self.hidden[:] = False
         self.hidden[self.weaker[~self.aside[self.stronger]]] = True
 
-    def _take(self, i: int, edge, reason, log=None) -> None:
+    def _take(self, i: int, edge: Edge, reason: _Reason, log: list[Any] | _Batch | None = None) -> None:
         self.at[i] = len(self.trail)
         self.trail.append((i, edge, self.precedence.add_start(edge) if log is None else log, reason))
         self.graph.push(edge, i)
 
-    def _take_forced(self, forced: list[tuple[int, tuple[Node, Node]]]) -> None:
+    def _take_forced(self, forced: list[tuple[int, Edge]]) -> None:
         """Take the forced ways, in order, each unless the ones before it close its cycle (it
         is then stuck, and seen so next round)."""
         self._take_batch([(i, edge, True) for i, edge in forced])
 
-    def _take_batch(self, entries: list[tuple[int, tuple[Node, Node], object]], prefix: bool = False) -> None:
+    def _take_batch(self, entries: list[_Taken], prefix: bool = False) -> None:
         """Take ``(conflict, edge, reason)`` entries in order, each unless the ones before it
         close its cycle: in one pass (:meth:`~cosmop.missions.precedence.Precedence.add_starts`),
         taken back as one.  With `prefix`, only those before the first that closes a cycle
@@ -232,7 +280,7 @@ class Search:
         for i, edge, reason in taken:
             self._take(i, edge, reason, batch)
 
-    def _retract(self, place: int, gone: set[int], first=None) -> None:
+    def _retract(self, place: int, gone: set[int], first: _Taken | None = None) -> None:
         """Take back the trail from `place` on with the conflicts `gone` (set aside, or a choice
         that takes its other way: `first`, the entry that takes it), keeping every entry whose
         reason does not need what goes (:meth:`_needing`).
@@ -259,7 +307,7 @@ class Search:
             self._take(*first)
         self._take_batch(kept[place - start :], prefix=True)
 
-    def _needing(self, place: int, gone: set[int]) -> tuple[int, list, set[int]]:
+    def _needing(self, place: int, gone: set[int]) -> tuple[int, list[_Taken], set[int]]:
         """Which entries from `place` on need the conflicts `gone`: ``(start, kept, dropped)``,
         the entries from `start` (`place`, or where the batch it falls in starts) that stay as
         ``(conflict, edge, reason)`` and the conflicts of those that go.
@@ -271,7 +319,8 @@ class Search:
         """
         log = self.trail[place][2] if place < len(self.trail) else None
         start = log.start if isinstance(log, _Batch) else place  # a batch goes back whole
-        through, dropped, kept = TakenBack(self.precedence), set(gone), []
+        through, dropped = TakenBack(self.precedence), set(gone)
+        kept: list[_Taken] = []
         for n, (i, edge, _, reason) in enumerate(self.trail[start:], start):
             if n < place:
                 needs = False
@@ -288,7 +337,7 @@ class Search:
                 kept.append((i, edge, reason))
         return start, kept, dropped
 
-    def _drop(self, start: int, kept: list, dropped: set[int]) -> None:
+    def _drop(self, start: int, kept: list[_Taken], dropped: set[int]) -> None:
         """Remove the entries of `dropped` from the trail from `start` on; the rest, `kept`,
         stay in place as one batch."""
         tail = self.trail[start:]
@@ -336,32 +385,56 @@ class _Batch:
 
     start: int
     size: int
-    log: list
+    log: list[Any]
 
 
-def backjump(found, implied, team, culprits, budget: int):
-    """:class:`Search` run once: ``(edges, set aside, cores)``, ``edges`` ``None`` past `budget`."""
+_Entry = tuple[int, Edge, list[Any] | _Batch, _Reason]
+"""An entry of the search's trail: a conflict, its edge, the order's undo log (or the batch it
+was added in), and why it was taken."""
+
+
+def backjump(
+    found: Sequence[Conflict], implied: _Implications, team: _Team, culprits: Culprits, budget: int
+) -> tuple[list[tuple[Edge, Conflict]] | None, list[Conflict], dict[int, list[Conflict]]]:
+    """:class:`Search` run once: ``(edges, set aside, cores)``, ``edges`` ``None`` past `budget`.
+
+    Parameters
+    ----------
+    found : sequence of Conflict
+        The conflicts to order.
+    implied : _Implied
+        Which of them imply which (:class:`cosmop.planning.conflict_order._Implied`).
+    team : tuple
+        ``(horizons, links, starts, durations)``: the plans' order before any conflict's.
+    culprits : Culprits
+        Which conflict of a core to set aside.
+    budget : int
+        Dead ends after which the search gives up.
+    """
     search = Search(found, implied, team, culprits)
     done = search.run(budget)
     return (search.edges if done else None), search.set_aside, search.cores
 
 
-def _in(i: int, reason) -> bool:
+def _in(i: int, reason: _Reason) -> bool:
     return isinstance(reason, frozenset) and i in reason
 
 
-def _core(stuck: int, sides: _Sides, graph: _Graph, trail: list, at: Mapping[int, int]) -> set[int]:
+def _core(
+    stuck: int, sides: _Sides, graph: _Graph[int], trail: list[_Entry], at: Mapping[int, int]
+) -> set[int]:
     """`stuck` and every conflict its dead end follows from (:class:`Search`): the conflicts on
     the cycles that close its ways, and, for each of those forced, on the cycle its other way
     closes (or the dead end's set that forced it), back to the choices and the base order."""
 
-    def cycle(edge, before: int) -> list[int]:
+    def cycle(edge: Edge, before: int) -> list[int]:
         path = graph.path(*edge, before=before)
         if path is None:  # the clocks said the edge closes a cycle
             raise AssertionError(f"no cycle through {edge}: the clocks and the graph disagree")
         return path
 
-    core, traced, todo = {stuck}, {stuck}, []
+    core, traced = {stuck}, {stuck}
+    todo: list[int] = []
     for edge in sides.edges[stuck]:
         if edge is not None:
             todo += cycle(edge, len(trail))
@@ -376,7 +449,7 @@ def _core(stuck: int, sides: _Sides, graph: _Graph, trail: list, at: Mapping[int
             core |= reason
         elif reason is True:
             for n in sides.others(i, chosen):
-                todo += cycle(sides.edges[i][n], at[i])
+                todo += cycle(sides.way(i, n), at[i])
     return core
 
 
@@ -391,23 +464,44 @@ class Culprits:
 
     def __init__(self, fixed: Mapping[str, Sequence[BaseGeometry]] | None) -> None:
         self.fixed = fixed or {}
-        self.movers: set[str] = set()  # the robots of the conflicts set aside so far
+        self.movers: set[str | None] = set()  # the robots of the conflicts set aside so far
         self._rank: dict[int, int] = {}
         self._mover: dict[int, str | None] = {}
 
     def rank(self, conflict: Conflict) -> int:
+        """The conflict's :func:`~cosmop.planning.conflicts.replan_rank` (lower: re-planned first).
+
+        Parameters
+        ----------
+        conflict : Conflict
+            A conflict between the plans.
+        """
         if id(conflict) not in self._rank:
             self._rank[id(conflict)] = replan_rank(conflict, self.fixed)
         return self._rank[id(conflict)]
 
     def mover(self, conflict: Conflict) -> str | None:
-        """The robot re-planned around `conflict` (its best detour), if any."""
+        """The robot re-planned around `conflict` (its best detour), if any.
+
+        Parameters
+        ----------
+        conflict : Conflict
+            A conflict between the plans.
+        """
         if id(conflict) not in self._mover:
             self._mover[id(conflict)] = next((robot for robot, _ in detours(conflict, self.fixed)), None)
         return self._mover[id(conflict)]
 
     def pick(self, core: Sequence[Conflict], keep: bool = True) -> Conflict:
-        """The culprit of `core`; with `keep`, its robot counts as re-planned from now on."""
+        """The culprit of `core`; with `keep`, its robot counts as re-planned from now on.
+
+        Parameters
+        ----------
+        core : sequence of Conflict
+            Conflicts no order resolves together (not empty).
+        keep : bool
+            Count the culprit's robot as re-planned.
+        """
         n = {id(c): k for k, c in enumerate(core)}
         worst = min(core, key=lambda c: (self.rank(c), self.mover(c) not in self.movers, n[id(c)]))
         if keep:
@@ -415,7 +509,10 @@ class Culprits:
         return worst
 
 
-class _Graph:
+_Label = TypeVar("_Label")
+
+
+class _Graph(Generic[_Label]):
     """Which step completes before which: program order, messages and given start edges, and
     start edges pushed (and popped, or removed) in order, each labelled with what it orders.
 
@@ -424,9 +521,15 @@ class _Graph:
     caller), :meth:`path` can stop at a place; the clocks must then be those of an order that
     holds every edge pushed."""
 
-    def __init__(self, precedence: Precedence, links, starts, at: Mapping | None = None) -> None:
+    def __init__(
+        self,
+        precedence: Precedence,
+        links: Sequence[Link],
+        starts: Sequence[Edge],
+        at: Mapping[_Label, int] | None = None,
+    ) -> None:
         self.precedence, self.at = precedence, at
-        self.succ: dict[int, list[tuple[int, object]]] = {}  # row -> (next row, label)
+        self.succ: dict[int, list[tuple[int, _Label | None]]] = {}  # row -> (next row, label)
         for robot, k in precedence.horizons.items():
             o = precedence.offsets[robot]
             for i in range(1, k):
@@ -436,20 +539,20 @@ class _Graph:
                 self._add(((link.sender, link.send), (link.receiver, link.wait)), None)
         for edge in starts:
             self._add(edge, None)
-        self.pushed: list[tuple[int, int, object]] = []  # (source, target, label) pushed
+        self.pushed: list[tuple[int, int, _Label | None]] = []  # (source, target, label) pushed
 
-    def _add(self, edge: tuple[Node, Node], label) -> tuple[int, int, object]:
+    def _add(self, edge: Edge, label: _Label | None) -> tuple[int, int, _Label | None]:
         source, target = self.precedence.rows(edge)
         self.succ.setdefault(source, []).append((target, label))
         return source, target, label
 
-    def push(self, edge: tuple[Node, Node], label) -> None:
+    def push(self, edge: Edge, label: _Label) -> None:
         self.pushed.append(self._add(edge, label))
 
     def pop(self) -> None:
         self.succ[self.pushed.pop()[0]].pop()
 
-    def remove(self, start: int, labels: set) -> None:
+    def remove(self, start: int, labels: set[_Label]) -> None:
         """Take out the edges pushed from place `start` on whose labels are in `labels` (a
         label names one edge pushed)."""
         tail = self.pushed[start:]
@@ -457,7 +560,7 @@ class _Graph:
             self.succ[source] = [edge for edge in self.succ[source] if edge[1] not in labels]
         self.pushed[start:] = [edge for edge in tail if edge[2] not in labels]
 
-    def path(self, source: Node, target: Node, before: int | None = None) -> list | None:
+    def path(self, source: Node, target: Node, before: int | None = None) -> list[_Label] | None:
         """The labels on a shortest path from `target` to `source` -- the cycle the start edge
         ``source -> target`` would close -- through the edges pushed before place `before`
         (default: all); ``None`` if there is none."""
@@ -466,7 +569,7 @@ class _Graph:
         if not on_way >> start & 1:
             return None
         at = self.at if before is not None else None
-        parent: dict[int, tuple[int, object] | None] = {start: None}
+        parent: dict[int, tuple[int, _Label | None] | None] = {start: None}
         queue = [start]
         for row in queue:
             if row == end:
@@ -474,14 +577,15 @@ class _Graph:
             for nxt, label in self.succ.get(row, ()):
                 if not on_way >> nxt & 1 or nxt in parent:
                     continue
-                if label is None or at is None or at[label] < before:
+                if label is None or at is None or before is None or at[label] < before:
                     parent[nxt] = (row, label)
                     queue.append(nxt)
         if end not in parent:
             return None
-        out, row = [], end
-        while parent[row] is not None:
-            row, label = parent[row]
+        out: list[_Label] = []
+        row = end
+        while (step := parent[row]) is not None:
+            row, label = step
             if label is not None:
                 out.append(label)
         return out
@@ -505,7 +609,8 @@ class _Sides:
         end = np.array([precedence.horizons[r] + 1 for r in precedence.robots], dtype=np.int64)
 
         def row(robot: np.ndarray, k: np.ndarray) -> np.ndarray:  # instants clamped to 0..K+1
-            return offset[robot] + np.clip(k, 0, end[robot])
+            rows: np.ndarray = offset[robot] + np.clip(k, 0, end[robot])
+            return rows
 
         # where each occupancy's expected start is read (0 when it holds from the beginning)
         column = precedence.column
@@ -535,29 +640,38 @@ class _Sides:
         x_source = np.where(x_k > end[ends[..., 0]] - 1, -1, x_row)
         self.rows = np.stack([x_source, y_row], axis=-1).tolist()
 
-    def others(self, i: int, taken: tuple[Node, Node]) -> list[int]:
+    def way(self, i: int, n: int) -> Edge:
+        """Side `n` of conflict `i`, one that exists."""
+        edge = self.edges[i][n]
+        assert edge is not None  # (asked only of a possible side)
+        return edge
+
+    def others(self, i: int, taken: Edge) -> list[int]:
         """The sides of conflict `i` that exist other than the way `taken`."""
         return [n for n, edge in enumerate(self.edges[i]) if edge is not None and edge != taken]
 
-    def other_way(self, i: int, taken: tuple[Node, Node]) -> tuple[Node, Node]:
+    def other_way(self, i: int, taken: Edge) -> Edge:
         """The start edge of conflict `i`'s way other than `taken` (it has two)."""
-        return self.edges[i][self.others(i, taken)[0]]
+        return self.way(i, self.others(i, taken)[0])
 
     def holds(self, precedence: Precedence, rows: np.ndarray | None = None) -> np.ndarray:
         """(n, 2): whether each side (of the conflicts `rows`, default all) is already implied."""
-        rows = slice(None) if rows is None else rows
-        return precedence.completes_before(self.hold_at[rows], start=True)
+        which = slice(None) if rows is None else rows
+        held: np.ndarray = precedence.completes_before(self.hold_at[which], start=True)
+        return held
 
     def expected_start(self, precedence: Precedence, rows: np.ndarray) -> np.ndarray:
         """The expected start of the earlier occupancy of each conflict in `rows`, s."""
         started = np.where(self.from_start[rows], 0.0, precedence.started_flat[self.first_row[rows]])
-        return started.min(axis=1)
+        earliest: np.ndarray = started.min(axis=1)
+        return earliest
 
     def ways(self, precedence: Precedence, rows: np.ndarray | None = None) -> np.ndarray:
         """(n, 2): whether each side (of the conflicts `rows`, default all) can still be added
         without closing a cycle."""
-        rows = slice(None) if rows is None else rows
-        return ~precedence.completes_before(self.cycle_at[rows])
+        which = slice(None) if rows is None else rows
+        free: np.ndarray = ~precedence.completes_before(self.cycle_at[which])
+        return free
 
 
 @dataclass(frozen=True)
@@ -567,7 +681,7 @@ class WayTable:
 
     Attributes
     ----------
-    edges : list
+    edges : list of list of (Edge or None)
         Per conflict, its two ways as start edges (``None`` where a way is not possible).
     possible : numpy.ndarray
         ``(n, 2)`` bool: which ways exist.
@@ -575,21 +689,37 @@ class WayTable:
         ``(n, 2, 4)`` int: each way as ``(A, i, B, j)``, the robots numbered.
     """
 
-    edges: list
+    edges: list[list[Edge | None]]
     possible: np.ndarray
     ends: np.ndarray
 
     @classmethod
     def of(cls, found: Sequence[Conflict], robots: Sequence[str]) -> WayTable:
-        """The table of `found`, the robots numbered in the order of `robots` (then as met)."""
+        """The table of `found`, the robots numbered in the order of `robots` (then as met).
+
+        Parameters
+        ----------
+        found : sequence of Conflict
+            The conflicts.
+        robots : sequence of str
+            Robot ids, numbered in this order.
+        """
         edges = [both_ways(c) for c in found]
         return cls(edges, *way_table(edges, {r: n for n, r in enumerate(robots)}))
 
 
-def way_table(ways: Sequence[list], number: dict[str, int]) -> tuple[np.ndarray, np.ndarray]:
+def way_table(ways: Sequence[Sequence[Edge | None]], number: dict[str, int]) -> tuple[np.ndarray, np.ndarray]:
     """Every conflict's two ways (:func:`both_ways`) as arrays: whether each exists ``(n, 2)``,
     and each as ``(A, i, B, j)`` ``(n, 2, 4)``, the robots numbered by `number` (robots it
-    lacks are added, numbered in the order they come)."""
+    lacks are added, numbered in the order they come).
+
+    Parameters
+    ----------
+    ways : sequence of sequence of (Edge or None)
+        Each conflict's two ways.
+    number : dict of str to int
+        The robots' numbers (updated).
+    """
     table = []
     for pair in ways:
         for way in pair:
@@ -603,21 +733,41 @@ def way_table(ways: Sequence[list], number: dict[str, int]) -> tuple[np.ndarray,
     return possible.reshape(len(ways), 2), ends
 
 
-def both_ways(conflict: Conflict) -> list[tuple[Node, Node] | None]:
+def both_ways(conflict: Conflict) -> list[Edge | None]:
     """The conflict's two ways as start edges, ``a`` first then ``b`` first: "x before y" for x
-    that ends and y that does not hold its place from the beginning (else ``None``)."""
+    that ends and y that does not hold its place from the beginning (else ``None``).
+
+    Parameters
+    ----------
+    conflict : Conflict
+        A conflict between the plans.
+    """
     return [
         (x.last, y.first) if x.last is not None and y.first is not None and y.first[1] >= 1 else None
         for x, y in ((conflict.a, conflict.b), (conflict.b, conflict.a))
     ]
 
 
-def ways_of(conflict: Conflict) -> list[tuple[Node, Node]]:
-    """The start edges that can order `conflict` (its possible :func:`both_ways`)."""
+def ways_of(conflict: Conflict) -> list[Edge]:
+    """The start edges that can order `conflict` (its possible :func:`both_ways`).
+
+    Parameters
+    ----------
+    conflict : Conflict
+        A conflict between the plans.
+    """
     return [edge for edge in both_ways(conflict) if edge is not None]
 
 
-def depth_first(found, horizons, links, starts, durations, max_backtracks, fixed):
+def depth_first(
+    found: Sequence[Conflict],
+    horizons: Mapping[str, int],
+    links: Sequence[Link],
+    starts: Sequence[Edge],
+    durations: Mapping[str, Sequence[float]],
+    max_backtracks: int,
+    fixed: Mapping[str, Sequence[BaseGeometry]] | None,
+) -> tuple[list[tuple[Edge, Conflict]], Conflict | None]:
     """Depth-first search for edges ordering every conflict; ``(edges, None)`` or ``([], culprit)``.
 
     At every point the open conflicts are checked forward: one that has no way left to be
@@ -626,18 +776,37 @@ def depth_first(found, horizons, links, starts, durations, max_backtracks, fixed
     to start first, the way that keeps the team's expected makespan lower.  The culprit is the
     conflict without a way at the deepest dead end.  The order is updated incrementally and
     taken back on backtracking (:meth:`~cosmop.missions.precedence.Precedence.add_start`).
+
+    Parameters
+    ----------
+    found : sequence of Conflict
+        The conflicts to order.
+    horizons : Mapping[str, int]
+        Every robot's number of steps.
+    links : sequence of Link
+        The messages the plans already have.
+    starts : sequence of (Node, Node)
+        Start edges the order already has.
+    durations : Mapping[str, sequence of float]
+        Expected seconds of each robot's steps.
+    max_backtracks : int
+        Dead ends after which the search gives up.
+    fixed : Mapping[str, sequence of shapely geometry] or None
+        Each robot's places re-planning cannot move
+        (:func:`~cosmop.planning.conflicts.fixed_places`).
     """
     precedence = Precedence(horizons, links, starts, durations)
     sides = _Sides(found, precedence)
-    chosen: list[tuple[tuple[Node, Node], Conflict, list]] = []
-    stack: list[tuple[int, list[tuple[Node, Node]], Conflict]] = []  # (depth, untried, conflict)
-    backtracks, deepest, culprit = 0, -1, None
+    chosen: list[tuple[Edge, Conflict, list[Any]]] = []
+    stack: list[tuple[int, list[Edge], Conflict]] = []  # (depth, untried, conflict)
+    backtracks, deepest = 0, -1
+    culprit: Conflict | None = None
     while True:
         open_ = ~sides.holds(precedence).any(axis=1)
         if not open_.any():
             return [(edge, conflict) for edge, conflict, _ in chosen], None
         counts = np.where(open_, sides.ways(precedence).sum(axis=1), -1)
-        stuck = [found[i] for i in np.flatnonzero(counts == 0)]
+        stuck = [found[int(i)] for i in np.flatnonzero(counts == 0)]
         if stuck:
             if len(chosen) > deepest:
                 edges = [(e, c) for e, c, _ in chosen]
@@ -664,7 +833,7 @@ def depth_first(found, horizons, links, starts, durations, max_backtracks, fixed
         chosen.append((options[0], conflict, precedence.add_start(options[0])))
 
 
-def _options(conflict: Conflict, precedence: Precedence) -> list:
+def _options(conflict: Conflict, precedence: Precedence) -> list[Edge]:
     """The ways left to order `conflict`, best first: the occupancy expected to begin first goes
     first (the robot that gets there first), and of two expected at once the way that keeps the
     team's expected makespan lower."""
@@ -680,7 +849,7 @@ _AT_ONCE = 1e-6
 """Seconds within which two occupancies count as expected to begin at once."""
 
 
-def _first_of(conflict: Conflict, options: list) -> list[Occupancy]:
+def _first_of(conflict: Conflict, options: list[Edge]) -> list[Occupancy]:
     """The occupancy that goes first in each of `options` (start edges of `conflict`)."""
     a, b = conflict.a, conflict.b
     return [a if (a.last, b.first) == edge else b for edge in options]
@@ -690,14 +859,21 @@ def _start(x: Occupancy, precedence: Precedence) -> float:
     return 0.0 if x.first is None else precedence.start_time(x.first)
 
 
-def _makespan_with(precedence: Precedence, edge: tuple[Node, Node]) -> float:
+def _makespan_with(precedence: Precedence, edge: Edge) -> float:
     log = precedence.add_start(edge)
     makespan = precedence.makespan
     precedence.undo(log)
     return makespan
 
 
-def _culprit(stuck: Conflict, precedence: Precedence, links, starts, chosen, fixed) -> Conflict:
+def _culprit(
+    stuck: Conflict,
+    precedence: Precedence,
+    links: Sequence[Link],
+    starts: Sequence[Edge],
+    chosen: Sequence[tuple[Edge, Conflict]],
+    fixed: Mapping[str, Sequence[BaseGeometry]] | None,
+) -> Conflict:
     """The conflict to re-plan around when `stuck` has no way to be ordered.
 
     If `stuck` itself cannot be re-planned (two robots standing where their goods require), the
@@ -705,7 +881,7 @@ def _culprit(stuck: Conflict, precedence: Precedence, links, starts, chosen, fix
     """
     if replan_rank(stuck, fixed) < 3:
         return stuck
-    graph = _Graph(precedence, links, starts)
+    graph: _Graph[Conflict] = _Graph(precedence, links, starts)
     for edge, conflict in chosen:
         graph.push(edge, conflict)
     on_cycles: list[Conflict] = []
@@ -715,11 +891,11 @@ def _culprit(stuck: Conflict, precedence: Precedence, links, starts, chosen, fix
     return best if replan_rank(best, fixed) < 3 else stuck
 
 
-def _ways(conflict: Conflict, precedence: Precedence) -> list[tuple[Node, Node]]:
+def _ways(conflict: Conflict, precedence: Precedence) -> list[Edge]:
     """The start edges that can order `conflict`, the one expected to happen first first."""
     a, b = conflict.a, conflict.b
     options = sorted(((a, b), (b, a)), key=lambda xy: (_start(xy[0], precedence), _start(xy[1], precedence)))
-    out = []
+    out: list[Edge] = []
     for x, y in options:
         if x.last is None or y.first is None:
             continue  # x never ends, or y holds its place from the beginning

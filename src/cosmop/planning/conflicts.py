@@ -160,7 +160,13 @@ class Occupancy:
     def accounts_for(self, other: Occupancy) -> bool:
         """Whether this occupancy and `other` never need an order: they are the same robot's,
         or both goods', or a robot's whose own plan keeps clear of the goods at rest at every
-        instant it spans (its model has them lying there, :func:`_unseen`)."""
+        instant it spans (its model has them lying there, :func:`_unseen`).
+
+        Parameters
+        ----------
+        other : Occupancy
+            Another occupancy of the team.
+        """
         if not self.parties & other.parties:
             return False
         goods, robot = (self, other) if other.states is not None else (other, self)
@@ -190,7 +196,8 @@ class Conflict:
         shared = self.a.region.intersection(self.b.region)
         if shared.is_empty:
             shared = self.a.region
-        return tuple(float(v) for v in shared.bounds)
+        x_min, y_min, x_max, y_max = (float(v) for v in shared.bounds)
+        return x_min, y_min, x_max, y_max
 
     @property
     def robots(self) -> tuple[str, ...]:
@@ -347,7 +354,7 @@ def _resting(
     return Occupancy(
         oid,
         parties,
-        square(*position, size),
+        square(position[0], position[1], size),
         first,
         last,
         f"{oid} resting at {show_point(position, units)} {where}",
@@ -423,12 +430,37 @@ def occupancies(
 
     `starts` gives the robots' states at the start when it is not the scenario (mid-run), and
     `positions` where the objects are then (``None``: carried).
+
+    Parameters
+    ----------
+    scene : Scene
+        The scenario: robots' sizes and start poses, objects.
+    plans : Mapping[str, RobotPlan]
+        Every robot's plan, by id.
+    precedence : Precedence
+        The order the plans' messages impose on their steps.
+    settings : ConflictSettings, optional
+        How far robots keep apart (default :class:`ConflictSettings`).
+    starts : Mapping[str, State], optional
+        The robots' states at the start, by id, when it is not the scenario.
+    positions : Mapping[str, (float, float) or None], optional
+        Where objects are at the start (mm; ``None``: carried), by default the scene's.
+
+    Returns
+    -------
+    tuple of (list of Occupancy, list of str)
+        The occupancies, and problems with how the objects are handled, in words.
     """
     settings = settings or ConflictSettings()
     grow = settings.clearance
     out: list[Occupancy] = []
     models: dict[str, list[State]] = {}
-    moved = {s.object for plan in plans.values() for s in plan.steps if s.primitive == Primitive.PICKUP}
+    moved = {
+        s.object
+        for plan in plans.values()
+        for s in plan.steps
+        if s.primitive == Primitive.PICKUP and s.object is not None  # (a PickUp always has one)
+    }
     for robot, plan in plans.items():
         start = (starts or {}).get(robot) or initial_state(scene, robot, plan, moved)
         models[robot] = [start, *(step.state for step in plan.steps)]
@@ -447,6 +479,13 @@ def conflicts(items: Sequence[Occupancy], clearance: float | None = None) -> lis
     regions were grown by: two robots that start closer than that keep only their start gap
     where one stands at its start and the other stands at or drives off its own
     (:func:`_given_gap`).
+
+    Parameters
+    ----------
+    items : sequence of Occupancy
+        The team's occupancies (:func:`occupancies`).
+    clearance : float, optional
+        The clearance the robots' regions were grown by (mm).
     """
     if not items:
         return []
@@ -485,9 +524,11 @@ def _given_gap(a: Occupancy, b: Occupancy, clearance: float) -> bool:
     gap = max(bx0 - ax1, ax0 - bx1, by0 - ay1, ay0 - by1)
     if gap >= clearance:
         return False
-    shapes = [
-        (o.body if o.is_drive else o.start).buffer(max(gap, 0.0) / 2, join_style="mitre") for o in (a, b)
-    ]
+    shapes = []
+    for o in (a, b):
+        shape = o.body if o.is_drive else o.start
+        assert shape is not None  # a drive has its body, and both have their start
+        shapes.append(shape.buffer(max(gap, 0.0) / 2, join_style="mitre"))
     return not _overlap(_geometries(shapes), [0], [1])[0]
 
 
@@ -503,7 +544,8 @@ def _overlap(shapes: np.ndarray, first: list[int], second: list[int]) -> list[bo
     if unsure.any():
         a, b = shapes[first_[unsure]], shapes[second_[unsure]]
         overlap[unsure] = shapely.area(shapely.intersection(a, b)) > 1e-9
-    return overlap.tolist()
+    result: list[bool] = overlap.tolist()
+    return result
 
 
 def _geometries(shapes: list[BaseGeometry]) -> np.ndarray:
@@ -514,7 +556,15 @@ def _geometries(shapes: list[BaseGeometry]) -> np.ndarray:
 
 
 def is_ordered(conflict: Conflict, precedence: Precedence) -> bool:
-    """Whether one occupancy always ends before the other starts."""
+    """Whether one occupancy always ends before the other starts.
+
+    Parameters
+    ----------
+    conflict : Conflict
+        The two occupancies.
+    precedence : Precedence
+        The order the plans' messages impose on their steps.
+    """
     a, b = conflict.a, conflict.b
     return _before(a, b, precedence) or _before(b, a, precedence)
 
@@ -530,6 +580,14 @@ def detours(conflict: Conflict, fixed: Mapping[str, Sequence[BaseGeometry]]) -> 
     meets something staying for good) or dropped goods (moved by the robot that drops them).
     Avoiding the other side must leave the mover's fixed places -- its start, the poses it picks
     from, its home, given in `fixed` by robot (regions already grown) -- free.
+
+    Parameters
+    ----------
+    conflict : Conflict
+        The unresolved conflict.
+    fixed : Mapping[str, sequence of shapely geometry]
+        Each robot's places re-planning cannot move (its start, pick poses, home), regions
+        already grown (:func:`fixed_places`).
     """
     return [(robot, keep) for _, robot, keep in ranked_detours(conflict, fixed)]
 
@@ -538,8 +596,17 @@ def ranked_detours(
     conflict: Conflict, fixed: Mapping[str, Sequence[BaseGeometry]]
 ) -> list[tuple[int, str, Occupancy]]:
     """:func:`detours` with each way's rank: 0 a drive around something staying for good, 1 a
-    drive around something passing, 2 goods dropped elsewhere."""
-    out = []
+    drive around something passing, 2 goods dropped elsewhere.
+
+    Parameters
+    ----------
+    conflict : Conflict
+        The unresolved conflict.
+    fixed : Mapping[str, sequence of shapely geometry]
+        Each robot's places re-planning cannot move (its start, pick poses, home), regions
+        already grown (:func:`fixed_places`).
+    """
+    out: list[tuple[int, str, Occupancy]] = []
     for mover, keep in ((conflict.a, conflict.b), (conflict.b, conflict.a)):
         if not mover.movable or mover.first is None:
             continue
@@ -553,7 +620,13 @@ def ranked_detours(
 
 
 def fixed_places(items: Sequence[Occupancy]) -> dict[str, list[BaseGeometry]]:
-    """Every robot's places that re-planning cannot move (start, pick poses, home), by robot."""
+    """Every robot's places that re-planning cannot move (start, pick poses, home), by robot.
+
+    Parameters
+    ----------
+    items : sequence of Occupancy
+        The team's occupancies (:func:`occupancies`).
+    """
     out: dict[str, list[BaseGeometry]] = {}
     for item in items:
         if not item.movable and item.what in item.parties:
@@ -563,7 +636,15 @@ def fixed_places(items: Sequence[Occupancy]) -> dict[str, list[BaseGeometry]]:
 
 def replan_rank(conflict: Conflict, fixed: Mapping[str, Sequence[BaseGeometry]] | None = None) -> int:
     """Rank of a conflict as a culprit to re-plan (lower first): a drive against something that
-    stays for good, then any detour, then none (two robots standing where their goods require)."""
+    stays for good, then any detour, then none (two robots standing where their goods require).
+
+    Parameters
+    ----------
+    conflict : Conflict
+        The conflict.
+    fixed : Mapping[str, sequence of shapely geometry], optional
+        Each robot's places re-planning cannot move (:func:`fixed_places`); none by default.
+    """
     options = detours(conflict, fixed or {})
     if not options:
         return 3

@@ -106,7 +106,17 @@ def _messages(plan: PlanSet, plans: Mapping[str, RobotPlan]) -> list[Violation]:
 def check_team(
     scenario: Scenario, plan: PlanSet, settings: ConflictSettings | None = None
 ) -> list[Violation]:
-    """The violations of the team-level rules (module docstring) by a feasible plan set."""
+    """The violations of the team-level rules (module docstring) by a feasible plan set.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The scenario the plans are for (scene and global mission).
+    plan : PlanSet
+        The plan file: every robot's plan, the messages list, the itinerary if any.
+    settings : ConflictSettings, optional
+        How conflicts are found (default :class:`~cosmop.planning.conflicts.ConflictSettings`).
+    """
     scene = scenario.scene
     plans = {r: p for r, p in plan.robots.items() if r in scene.robots}
     violations = _messages(plan, plans)

@@ -22,6 +22,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 import shapely
+from numpy.typing import ArrayLike
 from shapely import Polygon
 from shapely.geometry.base import BaseGeometry
 
@@ -35,6 +36,9 @@ HEAD_ON = math.cos(math.radians(135.0))
 (they run within 45 degrees of opposite ways)."""
 
 Segment = tuple[tuple[float, float], tuple[float, float]]
+
+_Wall = tuple[np.ndarray, np.ndarray]
+"""A wall's end points as arrays (mm)."""
 
 
 def lanes(
@@ -85,6 +89,7 @@ def lanes(
     if da is None or db is None or float(da @ db) > HEAD_ON:
         return None
     u = _unit((0.0, 0.0), da - db)
+    assert u is not None  # head-on drives point different ways
     centre = np.asarray(shared.centroid.coords[0])
     reach = 2.0 * (scene.robots[a].size + scene.robots[b].size) + clearance
     walls = [(np.asarray(w.start, float), np.asarray(w.end, float)) for w in scene.obstacles]
@@ -113,14 +118,16 @@ def lanes(
     return keep
 
 
-def _unit(p: Sequence[float], q: Sequence[float]) -> np.ndarray | None:
+def _unit(p: ArrayLike, q: ArrayLike) -> np.ndarray | None:
     """The unit vector from `p` to `q` (``None`` when they coincide)."""
     d = np.asarray(q, float) - np.asarray(p, float)
     length = float(np.hypot(*d))
     return d / length if length > 1e-9 else None
 
 
-def _hits(walls, origin: np.ndarray, direction: np.ndarray, reach: float) -> list[tuple[float, int]]:
+def _hits(
+    walls: Sequence[_Wall], origin: np.ndarray, direction: np.ndarray, reach: float
+) -> list[tuple[float, int]]:
     """``(distance, wall index)`` of every wall the ray from `origin` along `direction` meets
     within `reach` mm."""
     out = []
@@ -137,7 +144,7 @@ def _hits(walls, origin: np.ndarray, direction: np.ndarray, reach: float) -> lis
     return out
 
 
-def _along_wall(walls, centre: np.ndarray, u: np.ndarray, reach: float) -> np.ndarray:
+def _along_wall(walls: Sequence[_Wall], centre: np.ndarray, u: np.ndarray, reach: float) -> np.ndarray:
     """The lanes' direction: along the nearest wall across `u` from `centre` when it runs
     within 45 degrees of `u` (an aisle's side), else `u` itself."""
     n = np.array([-u[1], u[0]])
@@ -150,7 +157,14 @@ def _along_wall(walls, centre: np.ndarray, u: np.ndarray, reach: float) -> np.nd
     return u
 
 
-def _free_width(walls, centre, u, n, span: tuple[float, float], reach: float) -> tuple[float, float]:
+def _free_width(
+    walls: Sequence[_Wall],
+    centre: np.ndarray,
+    u: np.ndarray,
+    n: np.ndarray,
+    span: tuple[float, float],
+    reach: float,
+) -> tuple[float, float]:
     """How far across (along `n`, from `centre`) the place is free on each side, the least over
     its two ends and its middle (at most `reach` mm each way): ``(-below, above)``."""
     below = above = reach
@@ -161,7 +175,9 @@ def _free_width(walls, centre, u, n, span: tuple[float, float], reach: float) ->
     return -below, above
 
 
-def _upper(a: str, b: str, drives, centre, n, da) -> str:
+def _upper(
+    a: str, b: str, drives: Mapping[str, Segment], centre: np.ndarray, n: np.ndarray, da: np.ndarray
+) -> str:
     """Which robot takes the side towards `n`: the one whose drive lies more that way; when
     neither does, the one whose right that is (each keeps right)."""
     offset = {r: float((np.add(*map(np.asarray, drives[r])) / 2.0 - centre) @ n) for r in (a, b)}
@@ -171,7 +187,9 @@ def _upper(a: str, b: str, drives, centre, n, da) -> str:
     return a if float(right_of_a @ n) > 0 else b
 
 
-def _rectangle(centre, u, n, along: tuple[float, float], across: tuple[float, float]) -> Polygon:
+def _rectangle(
+    centre: np.ndarray, u: np.ndarray, n: np.ndarray, along: tuple[float, float], across: tuple[float, float]
+) -> Polygon:
     """The rectangle of points ``centre + s u + t n`` with `s` in `along` and `t` in `across`."""
     corners = [centre + s * u + t * n for s, t in ((along[0], across[0]), (along[1], across[0]))]
     corners += [centre + s * u + t * n for s, t in ((along[1], across[1]), (along[0], across[1]))]

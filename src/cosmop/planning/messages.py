@@ -19,6 +19,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import replace
+from typing import Any
 
 from cosmop.events import Event, Primitive, message, parse_event
 from cosmop.missions.precedence import Node
@@ -43,7 +44,13 @@ Insert = tuple[int, int, str]
 
 
 def strip_messages(mission: Sequence[Event]) -> tuple[Event, ...]:
-    """The mission without its ``msg`` events (what the solver plans; ``away`` stays)."""
+    """The mission without its ``msg`` events (what the solver plans; ``away`` stays).
+
+    Parameters
+    ----------
+    mission : sequence of Event
+        A robot's mission.
+    """
     return tuple(e for e in mission if e.kind != "msg")
 
 
@@ -54,6 +61,11 @@ def answer_early(plan: RobotPlan) -> RobotPlan:
     put it after some drives, which keeps the requester waiting (and can close a wait cycle
     with robots those drives must pass).  Moved forward it takes the pose and objects of the
     step it now follows; the order of the plan's mission events is unchanged.
+
+    Parameters
+    ----------
+    plan : RobotPlan
+        The robot's plan.
     """
     out: list[Step] = []
     for step in plan.steps:
@@ -81,8 +93,17 @@ def wait_early(scene: Scene, robot: str, plan: RobotPlan) -> RobotPlan:
     the goods stands in the way of the very robot it waits for.  Requests are moved before the
     drive when the reordered plan still passes the exact checker (the drive then meets fewer
     objects: the requested ones are away); otherwise the plan is kept.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene the plan is checked in.
+    robot : str
+        The robot's id.
+    plan : RobotPlan
+        The robot's plan.
     """
-    actions: list[tuple] = [
+    actions: list[tuple[str, Any]] = [
         (Primitive.GOTO, st.robot) if st.primitive == Primitive.GOTO else (st.primitive, st.object)
         for st in plan.steps
     ]
@@ -119,6 +140,18 @@ def split_drives(
     drive is over.  Drives are halved until short enough, so the new waypoints are exact
     (dyadic fractions of integer coordinates).  A cut is made only where ``roomy(x, y)`` (a
     robot may have to wait there for a message: not in a narrow passage).
+
+    Parameters
+    ----------
+    plan : RobotPlan
+        The robot's plan.
+    start : sequence of float
+        The robot's pose at instant 0, ``(x, y, heading)`` (mm, degrees).
+    max_length : float
+        The longest drive kept whole (mm).
+    roomy : callable, optional
+        ``roomy(x, y)``: whether a robot centred at ``(x, y)`` (mm) may wait there; by default
+        everywhere.
     """
     out: list[Step] = []
     pose = tuple(start)
@@ -157,6 +190,18 @@ def cut_drives(
     rounded to a multiple of :data:`CUT_GRAIN` of the way (an exact point of the segment for
     coordinates on the micrometre grid), and a cut is made only where ``roomy(x, y)`` (a robot
     may wait there for a message: not in a narrow passage).
+
+    Parameters
+    ----------
+    plan : RobotPlan
+        The robot's plan.
+    start : sequence of float
+        The robot's pose at instant 0, ``(x, y, heading)`` (mm, degrees).
+    cuts : Mapping[int, sequence of float]
+        The fractions of its way (between 0 and 1) at which GoTo step *k* is cut, by *k*.
+    roomy : callable, optional
+        ``roomy(x, y)``: whether a robot centred at ``(x, y)`` (mm) may wait there; by default
+        everywhere.
     """
     out: list[Step] = []
     pose = tuple(start)
@@ -190,6 +235,13 @@ def merge_drives(plan: RobotPlan, waypoints: set[tuple[float, float]]) -> RobotP
     `waypoints` (the plan's own, before splitting): the joined drive sweeps exactly what the two
     pieces swept, and nothing waits or is sent between them, so every order between robots
     stays as it was.
+
+    Parameters
+    ----------
+    plan : RobotPlan
+        The robot's plan.
+    waypoints : set of (float, float)
+        The points ``(x, y)`` (mm) the plan's drives ended at before splitting.
     """
     out: list[Step] = []
     for step in plan.steps:
@@ -218,8 +270,11 @@ def insert_steps(
     Parameters
     ----------
     scene : Scene
+        The scene (the robot's initial state when `start` is not given).
     robot : str
+        The robot's id.
     plan : RobotPlan
+        The robot's plan.
     inserts : sequence of Insert
         Where each message goes: after instant *p* (0 = before the first step).
     start : State, optional
@@ -270,6 +325,19 @@ def place_mission_messages(
     A message the robot sends goes right after the step that realises the mission event before
     it (at the start if there is none); a message it waits for goes right before the step that
     realises the event after it (at the end if there is none).
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene (the robot's initial state when `start` is not given).
+    robot : str
+        The robot's id.
+    plan : RobotPlan
+        The robot's plan.
+    mission : sequence of Event
+        The robot's mission, its ``msg`` events included, in order.
+    start : State, optional
+        Instant 0 when it is not the scenario.
     """
     if not any(e.kind == "msg" for e in mission):
         return plan
@@ -287,8 +355,9 @@ def place_mission_messages(
         else:
             nxt = instants[seen] if seen < len(instants) else None
             p = plan.horizon if nxt is None else max(nxt - 1, 0)
-            if seen > 0 and instants[seen - 1] is not None:
-                p = max(p, instants[seen - 1])
+            before = instants[seen - 1] if seen > 0 else None
+            if before is not None:
+                p = max(p, before)
             inserts.append((p, 1, event.name))
     new, _ = insert_steps(scene, robot, plan, inserts, start, [e.name for e in mission])
     return new
@@ -306,6 +375,21 @@ def place_edges(
 
     Returns the new plans and, per message, ``(event name, old edge, edge in new instants)``;
     the new edge ``((A, i'), (B, j'))`` names A's ``Res`` and B's ``Req`` steps.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene (the robots' initial states when `starts` does not give them).
+    plans : Mapping[str, RobotPlan]
+        Every robot's plan, by id.
+    edges : sequence of (Node, Node)
+        The start edges ``((A, i), (B, j))``: B may start step *j* once A has completed step *i*.
+    tag : str
+        The messages' tags are this followed by a number.
+    used : set of str, optional
+        Message names already taken; the new ones are added to it.
+    starts : Mapping[str, State], optional
+        The robots' states at instant 0, by id, when it is not the scenario.
     """
     used = set() if used is None else used
     inserts: dict[str, list[Insert]] = {r: [] for r in plans}
@@ -320,14 +404,17 @@ def place_edges(
         inserts[a].append((i, 0, name))
         inserts[b].append((j - 1, 1, name))
         names.append(name)
-    out, moved = {}, {}
+    out: dict[str, RobotPlan] = {}
+    moved: dict[str, dict[int, int]] = {}
     for robot, plan in plans.items():
         start = (starts or {}).get(robot)
         out[robot], moved[robot] = insert_steps(scene, robot, plan, inserts[robot], start)
-    placed = []
+    placed: list[tuple[str, tuple[Node, Node], tuple[Node, Node]]] = []
     for name, edge in zip(names, edges, strict=True):
         event = parse_event(name)
-        send = next(k for k, s in enumerate(out[event.sender].steps, 1) if s.message == name)
-        wait = next(k for k, s in enumerate(out[event.receiver].steps, 1) if s.message == name)
-        placed.append((name, edge, ((event.sender, send), (event.receiver, wait))))
+        sender, receiver = event.sender, event.receiver
+        assert sender is not None and receiver is not None  # a message has both
+        send = next(k for k, s in enumerate(out[sender].steps, 1) if s.message == name)
+        wait = next(k for k, s in enumerate(out[receiver].steps, 1) if s.message == name)
+        placed.append((name, edge, ((sender, send), (receiver, wait))))
     return out, placed

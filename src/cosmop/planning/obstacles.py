@@ -45,10 +45,12 @@ from __future__ import annotations
 import re
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
+from fractions import Fraction
 from typing import Any
 
 import numpy as np
 import shapely
+from numpy.typing import NDArray
 
 from cosmop.events import Event, Primitive
 from cosmop.logic import Formula, conj, failing, to_fraction
@@ -80,6 +82,11 @@ def obstacle_of(name: str) -> str | None:
     A wall is two obstacles: ``"wall 3"`` to drives and ``"wall 3 while handling"`` to picks
     and drops (they concern different instants and places); an object is one, ``"object O2"``.
 
+    Parameters
+    ----------
+    name : str
+        The name of a part of a robot's specification.
+
     Examples
     --------
     >>> obstacle_of("wall 3 [[0, 0], [1, 0]]"), obstacle_of("gripper clear of wall 3")
@@ -105,6 +112,7 @@ class Geometry:
     Parameters
     ----------
     p : RobotProblem
+        The robot's planning problem.
     events : sequence of Event, optional
         The events planned (default the problem's mission), as for
         :func:`~cosmop.planning.specification.specification`.
@@ -143,7 +151,13 @@ class Geometry:
         self.admitted = 0
 
     def broken(self, trace: Sequence[Mapping[str, Any]]) -> list[str]:
-        """The obstacles not yet held whose parts the plan `trace` breaks (exact evaluation)."""
+        """The obstacles not yet held whose parts the plan `trace` breaks (exact evaluation).
+
+        Parameters
+        ----------
+        trace : sequence of Mapping[str, Any]
+            The plan: the value of each variable of the specification at instants 0..K.
+        """
         if self._sides is None:
             return []
         near = self._sides.unsure(self._waiting, trace)
@@ -153,7 +167,13 @@ class Geometry:
         return [k for k in broken if _base(k) == k or _base(k) not in broken]
 
     def admit(self, keys: Sequence[str]) -> Formula:
-        """Move the obstacles `keys` into the solver's share: their parts, to assert."""
+        """Move the obstacles `keys` into the solver's share: their parts, to assert.
+
+        Parameters
+        ----------
+        keys : sequence of str
+            Obstacles not yet held (:func:`obstacle_of` names).
+        """
         self._write([k for k in keys if k not in self._written])
         added = conj(self._written.pop(k) for k in keys)
         admitted = set(keys)
@@ -196,7 +216,7 @@ class _Sides:
         self._p = p
         side, margin = p.side, p.margin
         goods = {o: to_fraction(p.scene.objects[o].size) for o in p.own_objects}
-        planes: dict[str, list] = {}
+        planes: dict[str, list[list[tuple[Fraction, Fraction, Any]]]] = {}
         self._roles: dict[str, int] = {}  # 0: a wall to drives, 1: to picks and drops, 2: an object
         self._handling = {a.code for a in p.actions if a.primitive in (Primitive.PICKUP, Primitive.DROPOFF)}
         for i, w in enumerate(p.scene.obstacles):
@@ -275,11 +295,11 @@ class _Sides:
         for b, o in enumerate(self._goods, start=1):
             goods &= _clear(rows[:, b], [tuple(float(v) for v in p.obj(o).read(trace[j])[:2]) for j in at])
         clear = np.where(role == 0, robot_all, np.where(role == 1, robot_handling & goods, robot_all & goods))
-        ok = clear.any(axis=1)
+        ok = np.asarray(clear.any(axis=1))
         ends = np.array([_base(k) != k for k in keys])
         if ends.any():  # the stronger part differs only for starts past an end, near a side
-            rows = [self._row[k] for k, stronger in zip(keys, ends, strict=True) if stronger]
-            ok[ends] |= _passes_ends(self._touching[rows], robot, self._margin)
+            stronger_rows = [self._row[k] for k, stronger in zip(keys, ends, strict=True) if stronger]
+            ok[ends] |= _passes_ends(self._touching[stronger_rows], robot, self._margin)
         return ok
 
 
@@ -287,7 +307,9 @@ _SIDE_AND_END = np.array([(0, 2), (0, 3), (1, 2), (1, 3), (2, 0), (2, 1), (3, 0)
 """Each side of an obstacle with each of its neighbours (sides 0, 1 and 2, 3 are opposite)."""
 
 
-def _passes_ends(sides: np.ndarray, robot: Sequence[tuple[float, float]], margin: float) -> np.ndarray:
+def _passes_ends(
+    sides: NDArray[np.float64], robot: Sequence[tuple[float, float]], margin: float
+) -> NDArray[np.bool_]:
     """Per obstacle (`sides`: obstacles x 4 x abc, touching, scaled as in :class:`_Sides`),
     whether every motion of `robot` surely meets what
     :func:`~cosmop.planning.specification.past_its_ends` adds to the obstacle's own part.
@@ -311,16 +333,18 @@ def _passes_ends(sides: np.ndarray, robot: Sequence[tuple[float, float]], margin
     fine = (v >= passing) & (g >= passing)
     for rate, margins in PAST_AN_END:
         fine |= (towards <= rate * gain - (rate + 1) * _GAP) & (g >= margins * margin + _GAP)
-    return ~(leaves & ~fine).any(axis=(1, 2))
+    passes: NDArray[np.bool_] = ~(leaves & ~fine).any(axis=(1, 2))
+    return passes
 
 
-def _clear(planes: np.ndarray, points: Sequence[tuple[float, float]]) -> np.ndarray:
+def _clear(planes: NDArray[np.float64], points: Sequence[tuple[float, ...]]) -> NDArray[np.bool_]:
     """Per obstacle and side (`planes`: obstacles x 4 x abc), whether every point lies on it."""
     if not points:
         return np.ones(planes.shape[:2], dtype=bool)
     xy = np.asarray(points)
     value = planes[..., 0, None] * xy[:, 0] + planes[..., 1, None] * xy[:, 1]
-    return (value >= planes[..., 2, None] + _GAP).all(axis=-1)
+    on_it: NDArray[np.bool_] = (value >= planes[..., 2, None] + _GAP).all(axis=-1)
+    return on_it
 
 
 def _near_route(p: RobotProblem) -> set[str]:
@@ -339,6 +363,7 @@ def _near_route(p: RobotProblem) -> set[str]:
         places.append((p.at_start(o)[0],) * 2)
         for e in p.mission:
             if e.kind == "drop" and e.obj == o:
+                assert e.workspace is not None  # a drop names its workspace
                 (x0, x1), (y0, y1) = scene.workspaces[e.workspace].centres(scene.objects[o].size).ranges
                 places.append(((x0, y0), (x1, y1)))
     corners = robot + [q for place in places for q in place]
@@ -347,9 +372,11 @@ def _near_route(p: RobotProblem) -> set[str]:
     boxes = [shapely.box(a[0] - grow, a[1] - grow, b[0] + grow, b[1] + grow) for a, b in places]
     handling = shapely.union_all(boxes)
     walls = shapely.linestrings([[w.start, w.end] for w in scene.obstacles]) if scene.obstacles else []
-    near = {wall_key(i) for i in np.flatnonzero(shapely.intersects(route, walls))} if len(walls) else set()
+    near = (
+        {wall_key(int(i)) for i in np.flatnonzero(shapely.intersects(route, walls))} if len(walls) else set()
+    )
     if len(walls) and not handling.is_empty:
-        near |= {wall_key(i, handling=True) for i in np.flatnonzero(shapely.intersects(handling, walls))}
+        near |= {wall_key(int(i), handling=True) for i in np.flatnonzero(shapely.intersects(handling, walls))}
     for o, ob in scene.objects.items():
         if route.intersects(shapely.Point(*p.at_start(o)[0]).buffer(ob.size, cap_style="square")):
             near.add(object_key(o))

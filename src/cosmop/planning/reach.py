@@ -43,7 +43,9 @@ def unreachable(
     Parameters
     ----------
     scene : Scene
+        The scene: walls, objects and workspaces.
     robot : str
+        The robot's id.
     events : sequence of Event
         Its mission (messages and requests are ignored).
     start : tuple of float, optional
@@ -65,6 +67,7 @@ def unreachable(
     for i, event in enumerate(events, 1):
         if event.kind not in ("pick", "drop"):
             continue
+        assert event.obj is not None  # picks and drops name their object
         d = (body.size + scene.objects[event.obj].size) / 2.0
         if event.kind == "pick":
             obj = scene.objects[event.obj]
@@ -75,6 +78,7 @@ def unreachable(
             )
             what = f"its pick poses on the sides tried: {sides}"
         else:
+            assert event.workspace is not None  # a drop names its workspace
             obj = scene.objects[event.obj]
             centres = scene.workspaces[event.workspace].centres(obj.size)
             where = shapely.union_all(docking_places(*centres.ranges, d, obj.headings))
@@ -88,17 +92,30 @@ def unreachable(
     return None
 
 
-def free_component(scene: Scene, half: float, start: tuple[float, float]):
+def free_component(scene: Scene, half: float, start: tuple[float, float]) -> shapely.Polygon | None:
     """The centres of a square of half-side `half` (mm) that overlaps no wall, connected to `start`.
 
     A shapely polygon (objects ignored; touching allowed), or ``None`` when `start` itself is
     inside a wall.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene whose walls block the square.
+    half : float
+        The square's half-side (mm).
+    start : (float, float)
+        A centre in the component wanted (mm).
     """
     blocked = scene.blocked(half, _SLACK)
     # a frame around everything: walls, objects, workspaces and the start
     points = [start, *(o.position for o in scene.objects.values())]
     for ws in scene.workspaces.values():
-        points += [ws.point] if ws.is_point else [(ws.x[0], ws.y[0]), (ws.x[1], ws.y[1])]
+        if ws.point is not None:
+            points += [ws.point]
+        else:
+            assert ws.x is not None and ws.y is not None  # a rectangle
+            points += [(ws.x[0], ws.y[0]), (ws.x[1], ws.y[1])]
     lo_x, lo_y, hi_x, hi_y = shapely.MultiPoint(points).union(blocked).bounds
     margin = 4 * half + 1000.0
     frame = shapely.box(lo_x - margin, lo_y - margin, hi_x + margin, hi_y + margin)

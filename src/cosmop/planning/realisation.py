@@ -41,13 +41,25 @@ TOLERANCE = 1e-6
 
 
 def angles_equal(a: float, b: float) -> bool:
-    """Whether two headings (degrees) agree within :data:`TOLERANCE`, modulo 360."""
+    """Whether two headings (degrees) agree within :data:`TOLERANCE`, modulo 360.
+
+    Parameters
+    ----------
+    a, b : float
+        The headings (degrees).
+    """
     diff = (a - b) % 360.0
     return min(diff, 360.0 - diff) <= TOLERANCE
 
 
 def at_pose(pose: Sequence[float], home: Sequence[float]) -> bool:
-    """Whether two poses ``(x, y, heading)`` agree within :data:`TOLERANCE`."""
+    """Whether two poses ``(x, y, heading)`` agree within :data:`TOLERANCE`.
+
+    Parameters
+    ----------
+    pose, home : sequence of float
+        The poses ``(x, y, heading)`` (mm, degrees).
+    """
     return (
         abs(pose[0] - home[0]) <= TOLERANCE
         and abs(pose[1] - home[1]) <= TOLERANCE
@@ -58,7 +70,23 @@ def at_pose(pose: Sequence[float], home: Sequence[float]) -> bool:
 def holds_at(
     event: Event, robot: str, plan: RobotPlan, states: Sequence[State], scene: Scene, i: int
 ) -> bool:
-    """Whether `event` holds at instant `i` of `robot`'s `plan` (`states` are instants 0..K)."""
+    """Whether `event` holds at instant `i` of `robot`'s `plan` (`states` are instants 0..K).
+
+    Parameters
+    ----------
+    event : Event
+        The mission event.
+    robot : str
+        The robot whose plan it is.
+    plan : RobotPlan
+        The plan.
+    states : sequence of State
+        The plan's states at instants 0..K.
+    scene : Scene
+        The scene (initial poses, object sizes, workspaces).
+    i : int
+        The instant, ``0 <= i <= K``.
+    """
     if event.kind == "return":
         return at_pose(states[i].robot, scene.robots[robot].pose)
     if i == 0:
@@ -68,6 +96,7 @@ def holds_at(
     if wanted is None or (step.primitive, step.object, step.message) != wanted:
         return False
     if event.kind == "drop":
+        assert event.obj is not None and event.workspace is not None  # a drop names both
         obj = step.objects.get(event.obj)
         size = scene.objects[event.obj].size
         return obj is not None and scene.workspaces[event.workspace].holds(*obj.position, size, TOLERANCE)
@@ -86,8 +115,11 @@ def event_instants(
     Parameters
     ----------
     plan : RobotPlan
+        The plan.
     robot : str
+        The robot whose plan it is.
     scene : Scene
+        The scene (initial poses, object sizes, workspaces).
     events : sequence of Event, optional
         The events to realise (default: the plan's mission).
     start : State, optional
@@ -102,7 +134,7 @@ def event_instants(
     events = plan.events if events is None else tuple(events)
     states = [start or initial_state(scene, robot, plan, scene.objects), *(s.state for s in plan.steps)]
     out: list[int | None] = []
-    last = None
+    last: int | None = None
     for event in events:
         after = 0 if last is None else last + (0 if event.kind == "return" else 1)
         found = next(
@@ -130,7 +162,7 @@ def _message_steps(robot: str, plan: RobotPlan) -> list[tuple[int, Step, Event |
     ``away`` event of O in the mission with the robot in that role (``None`` when none is left).
     """
     pending = [e for e in _events(plan) if e.kind == "away"]
-    out = []
+    out: list[tuple[int, Step, Event | None]] = []
     for k, step in enumerate(plan.steps, 1):
         if step.primitive not in (Primitive.REQ, Primitive.RES):
             continue
@@ -150,6 +182,11 @@ def unanswered_requests(plans: Mapping[str, RobotPlan]) -> list[tuple[str, int, 
 
     No robot's plan answers such a request (an answer is an ``away`` event of both missions),
     so in joint execution the robot would wait there for ever.
+
+    Parameters
+    ----------
+    plans : Mapping[str, RobotPlan]
+        Every robot's plan, by robot id.
     """
     return [
         (robot, k, str(step.object))
@@ -164,6 +201,11 @@ def unsent_answers(plans: Mapping[str, RobotPlan]) -> list[tuple[str, int, str]]
 
     Such an answer tells nobody anything: every request it could answer is answered already
     (messages match one to one), so the plan does something its mission does not ask for.
+
+    Parameters
+    ----------
+    plans : Mapping[str, RobotPlan]
+        Every robot's plan, by robot id.
     """
     return [
         (robot, k, str(step.object))
@@ -178,6 +220,11 @@ def repeated_messages(plans: Mapping[str, RobotPlan]) -> list[tuple[str, int, st
     or sends a ``msg`` an earlier step of the same plan already awaits or sends.
 
     A message is sent once and awaited once; :func:`message_links` matches the first of each.
+
+    Parameters
+    ----------
+    plans : Mapping[str, RobotPlan]
+        Every robot's plan, by robot id.
     """
     out = []
     for robot, plan in plans.items():
@@ -198,6 +245,11 @@ def message_links(plans: Mapping[str, RobotPlan]) -> list[Link]:
     A ``msg`` is matched through the ``message`` of its ``Req`` and ``Res`` steps.  An
     ``away(O,A,B)`` is awaited by A's ``Req(O)`` and sent by B's ``Res(O)``: the *k*-th
     ``Res(O)`` of B's plan sends the *k*-th ``away(O,*,B)`` of B's mission.
+
+    Parameters
+    ----------
+    plans : Mapping[str, RobotPlan]
+        Every robot's plan, by robot id.
     """
     sends: dict[str, tuple[str, int]] = {}
     waits: dict[str, tuple[str, int]] = {}
@@ -209,14 +261,16 @@ def message_links(plans: Mapping[str, RobotPlan]) -> list[Link]:
     out = []
     for name in sorted(set(sends) | set(waits)):
         event = parse_event(name)
+        sender, receiver = event.sender, event.receiver
+        assert sender is not None and receiver is not None  # a message has both
         send, wait = sends.get(name), waits.get(name)
         out.append(
             Link(
                 name,
-                event.sender,
-                send[1] if send is not None and send[0] == event.sender else None,
-                event.receiver,
-                wait[1] if wait is not None and wait[0] == event.receiver else None,
+                sender,
+                send[1] if send is not None and send[0] == sender else None,
+                receiver,
+                wait[1] if wait is not None and wait[0] == receiver else None,
             )
         )
     return out
@@ -230,6 +284,17 @@ def request_phases(
 
     These are the requests :func:`cosmop.missions.coordination.coordinate` turns into
     request/response pairs.
+
+    Parameters
+    ----------
+    plan : RobotPlan
+        The plan.
+    robot : str
+        The robot whose plan it is.
+    scene : Scene
+        The scene (initial poses, object sizes, workspaces).
+    events : sequence of Event
+        The mission events, in order.
     """
     instants = event_instants(plan, robot, scene, events)
     out = []

@@ -34,6 +34,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from fractions import Fraction
+from typing import Any
 
 
 @dataclass(frozen=True)
@@ -54,7 +55,13 @@ class HalfPlane:
     label: str = ""
 
     def contains(self, x: float, y: float) -> bool:
-        """Whether the centre ``(x, y)`` lies in the half-plane (exact for rational input)."""
+        """Whether the centre ``(x, y)`` lies in the half-plane (exact for rational input).
+
+        Parameters
+        ----------
+        x, y : float
+            The robot centre (mm).
+        """
         return Fraction(x) * self.a + Fraction(y) * self.b >= self.c
 
 
@@ -64,7 +71,7 @@ def _support(vx: Fraction, vy: Fraction, half: Fraction) -> Fraction:
 
 
 def wall_regions(
-    start: tuple[float, float], end: tuple[float, float], side: float, name: str = "wall"
+    start: tuple[float, float], end: tuple[float, float], side: float | Fraction, name: str = "wall"
 ) -> tuple[HalfPlane, HalfPlane, HalfPlane, HalfPlane]:
     """The four regions around a wall segment for a square robot of side ``side``.
 
@@ -72,7 +79,7 @@ def wall_regions(
     ----------
     start, end : (float, float)
         The wall's end points :math:`p \\ne q` (mm).
-    side : float
+    side : float or Fraction
         The robot's side length (mm).
     name : str
         Used in the labels.
@@ -99,7 +106,11 @@ def wall_regions(
     )
 
 
-def square_sides(ox, oy, d):
+_Side = tuple[Fraction, Fraction, Any]
+"""One side ``(a, b, c)`` of :func:`square_sides`: ``a``, ``b`` exact, ``c`` a number or a solver term."""
+
+
+def square_sides(ox: Any, oy: Any, d: Any) -> tuple[_Side, _Side, _Side, _Side]:
     """The four sides of an axis-aligned square obstacle at centre distance `d`, as ``(a, b, c)``.
 
     ``a x + b y >= c`` holds for centres ``(x, y)`` at least `d` left of, right of, below or
@@ -107,6 +118,18 @@ def square_sides(ox, oy, d):
     exact (``Fraction``); `ox`, `oy` and `d` may be numbers or solver terms, so the
     specification (where an object's position is a variable) and :func:`object_regions` build
     the same half-planes.
+
+    Parameters
+    ----------
+    ox, oy : Fraction, float or z3 arithmetic term
+        The obstacle's centre (mm).
+    d : Fraction, float or z3 arithmetic term
+        The least distance of a robot centre from it along either axis (mm).
+
+    Returns
+    -------
+    tuple of (Fraction, Fraction, term)
+        ``(left, right, below, above)``.
     """
     one, zero = Fraction(1), Fraction(0)
     return ((-one, zero, d - ox), (one, zero, ox + d), (zero, -one, d - oy), (zero, one, oy + d))
@@ -120,10 +143,25 @@ def object_regions(
     ``(left, right, below, above)`` of the object with clearance
     :math:`d = (l_b + l_r)/2`: e.g. left is :math:`x \\le o_x - d`.  A straight motion whose
     two end centres lie in one of them never overlaps the object (touching allowed).
+
+    Parameters
+    ----------
+    position : (float, float)
+        The object's centre (mm).
+    object_side, robot_side : float
+        The object's and the robot's side lengths (mm).
+    name : str
+        Used in the labels.
+
+    Returns
+    -------
+    tuple of HalfPlane
+        ``(left, right, below, above)``.
     """
     ox, oy = Fraction(position[0]), Fraction(position[1])
     d = (Fraction(object_side) + Fraction(robot_side)) / 2
     labels = (f"left of {name}", f"right of {name}", f"below {name}", f"above {name}")
-    return tuple(
+    left, right, below, above = (
         HalfPlane(a, b, c, label) for (a, b, c), label in zip(square_sides(ox, oy, d), labels, strict=True)
     )
+    return left, right, below, above

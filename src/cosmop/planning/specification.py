@@ -50,6 +50,7 @@ from types import MappingProxyType
 from typing import Any
 
 import shapely
+from shapely.geometry.base import BaseGeometry
 
 from cosmop.automata import DFA
 from cosmop.docking import facing
@@ -58,6 +59,7 @@ from cosmop.logic import (
     FALSE,
     TRUE,
     Always,
+    Expr,
     Formula,
     Implies,
     Next,
@@ -71,10 +73,13 @@ from cosmop.logic import (
 )
 from cosmop.planning.plan import State
 from cosmop.planning.regions import HalfPlane, square_sides, wall_regions
-from cosmop.scene import Scene, Workspace
+from cosmop.scene import Scene, Wall, Workspace
 from cosmop.squares import docking_places
 
 NONE = 0
+
+_Term = Expr | Fraction
+"""An arithmetic term of the specification: a solver variable's expression, or an exact number."""
 
 
 def _num(value: float) -> Fraction:
@@ -90,10 +95,19 @@ def position_sort(scene: Scene, start: State | None = None, spots: Iterable[tupl
     `start` state, where the robot and the objects are in it, and the `spots` drops are pinned
     to.  When all of those are whole millimetres, integers lose no plan; otherwise (an object
     of side 101 mm, a good at x = 0.5 mm) positions are exact rationals, so that no plan is lost to rounding.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene (robots, objects, workspaces; mm).
+    start : State, optional
+        Instant 0 when it is not the scenario.
+    spots : iterable of (float, float)
+        The centres (mm) drops are pinned to.
     """
     numbers = [v for r in scene.robots.values() for v in (r.size / 2, *r.pose[:2])]
     numbers += [v for o in scene.objects.values() for v in (o.size / 2, *o.position)]
-    numbers += [v for w in scene.workspaces.values() if w.is_point for v in w.point]
+    numbers += [v for w in scene.workspaces.values() if w.point is not None for v in w.point]
     if start is not None:  # a plan from a given state (mid-run) starts exactly there
         numbers += [*start.robot[:2], *(v for o in start.objects.values() for v in o.position)]
     numbers += [v for spot in spots for v in spot]
@@ -111,6 +125,15 @@ def heading_sort(scene: Scene, robot: str, start: State | None = None) -> str:
     lose no plan; otherwise (a ROS file's -1.5708 rad, which is -90.000210459 degrees, or
     45.5 degrees) the heading is an exact rational, so that the plan starts and ends exactly
     at the given headings.  Other robots' headings never enter this robot's problem.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene (the robot's pose, degrees).
+    robot : str
+        The robot's id.
+    start : State, optional
+        Instant 0 when it is not the scenario.
     """
     headings = [scene.robots[robot].pose[2], *([start.robot[2]] if start is not None else [])]
     return "int" if all(_num(h).denominator == 1 for h in headings) else "real"
@@ -144,6 +167,15 @@ class ObjectVars:
 
     @classmethod
     def named(cls, obj: str, sort: str = "int") -> ObjectVars:
+        """Fresh variables for every field of `obj`.
+
+        Parameters
+        ----------
+        obj : str
+            The object's id (the variables are ``obj.x``, ``obj.y``, ``obj.p``, ``obj.a``).
+        sort : {"int", "real"}
+            The sort of the position variables (:func:`position_sort`).
+        """
         return cls(
             Var(f"{obj}.x", sort), Var(f"{obj}.y", sort), Var(f"{obj}.p", "bool"), Var(f"{obj}.a", "bool")
         )
@@ -154,11 +186,19 @@ class ObjectVars:
         return _negated(self.carried) & _negated(self.away)
 
     def read(self, state: Mapping[str, Any]) -> tuple[Any, Any, bool, bool]:
-        """``(x, y, carried, away)`` in a state of the trace (values for the fixed fields)."""
-        return tuple(
+        """``(x, y, carried, away)`` in a state of the trace (values for the fixed fields).
+
+        Parameters
+        ----------
+        state : Mapping[str, Any]
+            One instant of a trace: each variable's value, by name.
+        """
+        values: list[Any] = [
             state[v.name] if isinstance(v, Var) else (v if isinstance(v, Fraction) else v == TRUE)
             for v in (self.x, self.y, self.carried, self.away)
-        )
+        ]
+        x, y, carried, away = values
+        return x, y, carried, away
 
 
 def _negated(flag: Var | Formula) -> Formula:
@@ -181,12 +221,26 @@ def wall_key(i: int, handling: bool = False) -> str:
     ``"wall 3 while handling"`` to picks and drops (the gripper, the good set down).
 
     The names of the specification's parts are built from these keys, and
-    :func:`cosmop.planning.obstacles.obstacle_of` reads them back."""
+    :func:`cosmop.planning.obstacles.obstacle_of` reads them back.
+
+    Parameters
+    ----------
+    i : int
+        The wall's index in the scene's obstacles.
+    handling : bool
+        The wall to picks and drops, not to drives.
+    """
     return f"wall {i} while handling" if handling else f"wall {i}"
 
 
 def object_key(obj: str) -> str:
-    """The name of object `obj` as an obstacle: ``"object O2"``."""
+    """The name of object `obj` as an obstacle: ``"object O2"``.
+
+    Parameters
+    ----------
+    obj : str
+        The object's id.
+    """
     return f"object {obj}"
 
 
@@ -195,7 +249,13 @@ def past_its_ends(key: str) -> str:
     departures from past its ends pass them clear (:data:`PAST_AN_END`), ``"wall 3 past its ends"``.
 
     It implies the obstacle's own GoTo part, and costs the solver more: lazy geometry
-    (:mod:`cosmop.planning.obstacles`) adds it only for the obstacles a plan passes too close."""
+    (:mod:`cosmop.planning.obstacles`) adds it only for the obstacles a plan passes too close.
+
+    Parameters
+    ----------
+    key : str
+        The obstacle (:func:`wall_key` to drives, or :func:`object_key`).
+    """
     return f"{key} past its ends"
 
 
@@ -203,7 +263,7 @@ def past_its_ends(key: str) -> str:
 class Action:
     """A primitive applied to an object (``None`` for GoTo), with its code in :math:`\\pi`."""
 
-    primitive: str
+    primitive: Primitive
     obj: str | None
     code: int
 
@@ -215,7 +275,9 @@ class RobotProblem:
     Parameters
     ----------
     scene : Scene
+        The scene (walls, robots, objects, workspaces; mm).
     robot : str
+        The robot's id.
     mission : tuple of Event
         The local mission as a sequence of events (pick, drop, return, away).
     requests : bool
@@ -284,7 +346,7 @@ class RobotProblem:
         object.__setattr__(self, "mission", tuple(self.mission))
         primitives = ENCODINGS if self.primitives is None else self.primitives
         object.__setattr__(self, "primitives", MappingProxyType(dict(primitives)))
-        acts = [(prim.name, obj) for prim in self.primitives.values() for obj in prim.targets(self)]
+        acts = [(prim.name, obj) for prim in primitives.values() for obj in prim.targets(self)]
         object.__setattr__(self, "actions", tuple(Action(name, o, i + 1) for i, (name, o) in enumerate(acts)))
         object.__setattr__(self, "sort", position_sort(self.scene, self.start, (s for _, s in self.spots)))
         object.__setattr__(self, "heading_sort", heading_sort(self.scene, self.robot, self.start))
@@ -300,7 +362,7 @@ class RobotProblem:
         """
         handled = set(self.own_objects)
         asked = {a.obj for a in self.actions if a.primitive == Primitive.REQ}
-        out = {}
+        out: dict[str, ObjectVars] = {}
         for o in self.scene.objects:
             position, carried, away = self.at_start(o)
             v = ObjectVars.named(o, self.sort)
@@ -358,12 +420,24 @@ class RobotProblem:
         return Var("event", "int")
 
     def written(self, key: str) -> bool:
-        """Whether the parts of obstacle `key` are written (:attr:`obstacles`)."""
+        """Whether the parts of obstacle `key` are written (:attr:`obstacles`).
+
+        Parameters
+        ----------
+        key : str
+            An obstacle (:func:`wall_key`, :func:`object_key`, :func:`past_its_ends`).
+        """
         return self.obstacles is None or key in self.obstacles
 
-    def walls(self, handling: bool = False) -> list[tuple[int, Any]]:
+    def walls(self, handling: bool = False) -> list[tuple[int, Wall]]:
         """``(index, wall)`` of the walls whose parts for drives (or for picks and drops, when
-        `handling`) are written (:attr:`obstacles`)."""
+        `handling`) are written (:attr:`obstacles`).
+
+        Parameters
+        ----------
+        handling : bool
+            The walls to picks and drops, not to drives.
+        """
         return [(i, w) for i, w in enumerate(self.scene.obstacles) if self.written(wall_key(i, handling))]
 
     def obstacle_objects(self) -> list[str]:
@@ -371,7 +445,13 @@ class RobotProblem:
         return [o for o in self.scene.objects if self.written(object_key(o))]
 
     def at_start(self, obj: str) -> tuple[tuple[float, float], bool, bool]:
-        """``(position, carried, away)`` of `obj` at instant 0: in `start`, else the scenario's."""
+        """``(position, carried, away)`` of `obj` at instant 0: in `start`, else the scenario's.
+
+        Parameters
+        ----------
+        obj : str
+            The object's id.
+        """
         known = self.start.objects.get(obj) if self.start is not None else None
         if known is None:
             return self.scene.objects[obj].position, False, False
@@ -379,14 +459,27 @@ class RobotProblem:
 
     def drop_centres(self, event: Event) -> Workspace:
         """Where the drop `event` may put its object's centre: the workspace's
-        :meth:`~cosmop.scene.Workspace.centres`, or the one spot it is pinned to (:attr:`spots`)."""
+        :meth:`~cosmop.scene.Workspace.centres`, or the one spot it is pinned to (:attr:`spots`).
+
+        Parameters
+        ----------
+        event : Event
+            A drop event of the mission.
+        """
+        assert event.obj is not None and event.workspace is not None  # a drop names both
         for pinned, spot in self.spots:
             if pinned == event:
                 return Workspace(event.workspace, point=spot)
         return self.scene.workspaces[event.workspace].centres(self.scene.objects[event.obj].size)
 
     def obj(self, obj: str) -> ObjectVars:
-        """The terms of `obj` (:class:`ObjectVars`; fixed fields are values)."""
+        """The terms of `obj` (:class:`ObjectVars`; fixed fields are values).
+
+        Parameters
+        ----------
+        obj : str
+            The object's id.
+        """
         return self.objects[obj]
 
     @property
@@ -394,18 +487,41 @@ class RobotProblem:
         return _num(self.scene.robots[self.robot].size)
 
     def code(self, primitive: str, obj: str | None = None) -> int | None:
-        """Code of an action in :math:`\\pi`, or ``None`` if the robot may not take it."""
+        """Code of an action in :math:`\\pi`, or ``None`` if the robot may not take it.
+
+        Parameters
+        ----------
+        primitive : str
+            The primitive (a :class:`~cosmop.events.Primitive`).
+        obj : str, optional
+            The object it acts on (``None`` for GoTo).
+        """
         for a in self.actions:
             if a.primitive == primitive and a.obj == obj:
                 return a.code
         return None
 
     def is_action(self, primitive: str, obj: str | None = None) -> Formula:
+        """:math:`\\pi` is the action, or false if the robot may not take it.
+
+        Parameters
+        ----------
+        primitive : str
+            The primitive (a :class:`~cosmop.events.Primitive`).
+        obj : str, optional
+            The object it acts on (``None`` for GoTo).
+        """
         code = self.code(primitive, obj)
         return self.pi.eq(code) if code is not None else FALSE
 
     def requests_except(self, obj: str | None) -> Formula:
-        """:math:`\\pi` is GoTo or a request for an object other than ``obj``."""
+        """:math:`\\pi` is GoTo or a request for an object other than ``obj``.
+
+        Parameters
+        ----------
+        obj : str or None
+            The object not to request (``None``: every request is allowed).
+        """
         return disj(
             [
                 self.pi.eq(a.code)
@@ -415,27 +531,35 @@ class RobotProblem:
         )
 
     def clearance(self, obj: str) -> Fraction:
-        """:math:`d = (l_b + l_r)/2`, the centre distance when robot and object touch."""
+        """:math:`d = (l_b + l_r)/2`, the centre distance when robot and object touch.
+
+        Parameters
+        ----------
+        obj : str
+            The object's id.
+        """
         return (_num(self.scene.objects[obj].size) + self.side) / 2
 
 
-def _less(term, amount: Fraction):
+def _less(term: _Term, amount: Fraction) -> _Term:
     """``term - amount``, leaving `term` as it is when `amount` is zero (a smaller formula)."""
     return term if amount == 0 else term - amount
 
 
-def _docking_poses(p: RobotProblem, obj: str, ox, oy, d: Fraction) -> list[tuple[int, Any, Any]]:
+def _docking_poses(
+    p: RobotProblem, obj: str, ox: _Term, oy: _Term, d: Fraction
+) -> list[tuple[int, _Term, _Term]]:
     """``(h, x, y)``: the robot centre that faces `obj` at ``(ox, oy)`` from heading ``h``, touching
     it, :math:`(o_x, o_y) - d\\,(\\cos h, \\sin h)`, for each of the object's docking headings
     (:attr:`~cosmop.scene.MovableObject.headings`); exact terms."""
-    out = []
+    out: list[tuple[int, _Term, _Term]] = []
     for heading in p.scene.objects[obj].headings:
         ux, uy = facing(heading)
         out.append((heading, _less(ox, d * ux), _less(oy, d * uy)))
     return out
 
 
-def _docked(p: RobotProblem, obj: str, ox, oy, d: Fraction) -> Formula:
+def _docked(p: RobotProblem, obj: str, ox: _Term, oy: _Term, d: Fraction) -> Formula:
     """The robot faces `obj` at ``(ox, oy)`` square on, from one of its sides, touching it:
     :math:`\\bigvee_h \\alpha = h \\wedge (x, y)` is the pose of :func:`_docking_poses`."""
     return disj(p.h.eq(h) & p.x.eq(x) & p.y.eq(y) for h, x, y in _docking_poses(p, obj, ox, oy, d))
@@ -446,7 +570,7 @@ def _static(*terms: Any) -> Formula:
     return conj(v.next().eq(v) if v.sort != "bool" else eq(v.next(), v) for v in terms if isinstance(v, Var))
 
 
-def _half_plane(h: HalfPlane, x, y) -> Formula:
+def _half_plane(h: HalfPlane, x: Expr, y: Expr) -> Formula:
     return h.a * x + h.b * y >= h.c
 
 
@@ -464,20 +588,36 @@ class Encoding:
     name: Primitive
 
     def targets(self, p: RobotProblem) -> tuple[str | None, ...]:
+        """The objects the primitive applies to in `p` (``(None,)`` for one without object).
+
+        Parameters
+        ----------
+        p : RobotProblem
+            The robot's planning problem.
+        """
         raise NotImplementedError
 
     def parts(self, p: RobotProblem, obj: str | None) -> list[tuple[str, Formula]]:
+        """Named formulas that hold whenever :math:`\\bigcirc \\pi` is this primitive on `obj`.
+
+        Parameters
+        ----------
+        p : RobotProblem
+            The robot's planning problem.
+        obj : str or None
+            The object it acts on, one of :meth:`targets` (``None`` for one without object).
+        """
         raise NotImplementedError
 
 
-def _gripper_clear(p: RobotProblem, obj: str, ox, oy) -> list[tuple[str, Formula]]:
+def _gripper_clear(p: RobotProblem, obj: str, ox: Expr, oy: Expr) -> list[tuple[str, Formula]]:
     """Robot and object squares in one region of every wall: no wall between them (the gripper).
 
     The regions of one wall computed for the two sizes are the same half-planes shifted by each
     square's support, so both squares in the i-th of them put their union on one side.
     """
     side = _num(p.scene.objects[obj].size)
-    out = []
+    out: list[tuple[str, Formula]] = []
     for i, wall in p.walls(handling=True):
         pairs = zip(
             wall_regions(wall.start, wall.end, p.side), wall_regions(wall.start, wall.end, side), strict=True
@@ -499,14 +639,14 @@ and puts another down on its other side (or picks one up there) is wedged: every
 slides along a face it touches.  A millimetre of room lets it leave without touching."""
 
 
-def _handling_room(p: RobotProblem, obj: str, places: list | None) -> list[tuple[str, Formula]]:
+def _handling_room(p: RobotProblem, obj: str, places: list[BaseGeometry] | None) -> list[tuple[str, Formula]]:
     """The robot keeps :data:`HANDLING_CLEARANCE` from every resting object but `obj`.
 
     `places` are where the robot's centre can be while handling `obj` (shapely geometries;
     ``None``: anywhere).  An object this robot never moves rests where it started: when it is
     far from every such place its constraint always holds, and is left out (a smaller formula).
     """
-    out = []
+    out: list[tuple[str, Formula]] = []
     for o in p.obstacle_objects():
         if o == obj:
             continue
@@ -534,10 +674,10 @@ def _resting(p: RobotProblem, o: str) -> tuple[float, float] | None:
     return p.scene.objects[o].position
 
 
-def _drop_places(p: RobotProblem, obj: str) -> list | None:
+def _drop_places(p: RobotProblem, obj: str) -> list[BaseGeometry] | None:
     """Robot centres that drop `obj` in one of the mission's workspaces for it (``None``: any)."""
     d = float(p.clearance(obj))
-    places = []
+    places: list[BaseGeometry] = []
     for e in p.mission:
         if e.kind == "drop" and e.obj == obj:
             ws = p.drop_centres(e)
@@ -545,7 +685,7 @@ def _drop_places(p: RobotProblem, obj: str) -> list | None:
     return places or None
 
 
-def _pick_places(p: RobotProblem, obj: str) -> list | None:
+def _pick_places(p: RobotProblem, obj: str) -> list[BaseGeometry] | None:
     """Robot centres that pick `obj` up: facing where it starts or is dropped, from any side."""
     at = _resting(p, obj)
     if at is None:
@@ -559,10 +699,10 @@ def _robot_static(p: RobotProblem) -> Formula:
     return _static(p.x, p.y, p.h)
 
 
-def _objects_static(p: RobotProblem, *, carried=True, skip: str | None = None) -> Formula:
+def _objects_static(p: RobotProblem, *, carried: bool = True, skip: str | None = None) -> Formula:
     """Every object but `skip` keeps its position (and carried flag).  ``away`` flags have one
     frame axiom each instead (:func:`away_frames`): only a request changes one."""
-    out = []
+    out: list[Var | Fraction | Formula] = []
     for o in p.scene.objects:
         if o == skip:
             continue
@@ -578,11 +718,19 @@ def away_frames(p: RobotProblem) -> list[tuple[str, Formula]]:
 
     The same as every other primitive keeping :math:`a_o` in its effect, written once per good
     instead of once per primitive and good (with N goods to request, N squared terms per
-    instant)."""
-    out = []
+    instant).
+
+    Parameters
+    ----------
+    p : RobotProblem
+        The robot's planning problem.
+    """
+    out: list[tuple[str, Formula]] = []
     for a in p.actions:
-        if a.primitive == Primitive.REQ and isinstance(p.obj(a.obj).away, Var):
-            flag = p.obj(a.obj).away
+        if a.primitive != Primitive.REQ or a.obj is None:
+            continue
+        flag = p.obj(a.obj).away
+        if isinstance(flag, Var):
             kept = Always(Implies(Next(TRUE), eq(flag.next(), flag) | Next(p.pi.eq(a.code))))
             out.append((f"{a.obj} goes away only on request", kept))
     return out
@@ -607,15 +755,15 @@ class _Face:
 
     a: Fraction
     b: Fraction
-    c: Any
+    c: _Term
 
-    def holds(self, x, y) -> Formula:
+    def holds(self, x: Expr, y: Expr) -> Formula:
         return self.a * x + self.b * y >= self.c
 
-    def away(self, dx, dy):
+    def away(self, dx: Expr, dy: Expr) -> Expr:
         return self.a * dx + self.b * dy
 
-    def along(self, dx, dy):
+    def along(self, dx: Expr, dy: Expr) -> Expr:
         return self.a * dy - self.b * dx
 
 
@@ -639,16 +787,20 @@ side's, weighted by the rates they change at: at least ``k / (r + 1)`` margins, 
 briefly, and the executor first creeps out of a start that close)."""
 
 
-def _level(face: _Face, far: _Face, x, y, share) -> Formula:
+def _level(face: _Face, far: _Face, x: Expr, y: Expr, share: Fraction | int) -> Formula:
     """The robot centre :math:`(x, y)` is at least `share` margins inside `face` (`far` at one)."""
     return face.a * x + face.b * y >= (1 - share) * face.c + share * far.c
 
 
-def _past_an_end(side: tuple[_Face, _Face], end: tuple[_Face, _Face], x, y, dx, dy, gain) -> Formula:
+def _past_an_end(
+    side: tuple[_Face, _Face], end: tuple[_Face, _Face], x: Expr, y: Expr, dx: Expr, dy: Expr, gain: Expr
+) -> Formula:
     """The departure from `side` at :math:`(x, y)` by :math:`(dx, dy)`, gaining `gain` on it,
     passes the neighbouring side `end` (each: touching and at the margin) clear (:data:`PASSING`)."""
     towards = -end[0].away(dx, dy)  # how much nearer the end the motion comes
-    out = [end[0].a * x + end[0].b * y <= end[0].c]  # abreast of the obstacle, or beyond this end
+    out: list[Formula] = [
+        end[0].a * x + end[0].b * y <= end[0].c
+    ]  # abreast of the obstacle, or beyond this end
     out.append(_level(*side, x, y, PASSING) & _level(*end, x, y, PASSING))
     for rate, margins in PAST_AN_END:
         slope = towards <= rate * gain
@@ -657,7 +809,7 @@ def _past_an_end(side: tuple[_Face, _Face], end: tuple[_Face, _Face], x, y, dx, 
 
 
 @lru_cache(maxsize=16384)  # robots of one size share their walls' formulas (pure, hashable)
-def _apart(x, y, faces: tuple[tuple[_Face, _Face], ...], ends: bool = False) -> Formula:
+def _apart(x: Var, y: Var, faces: tuple[tuple[_Face, _Face], ...], ends: bool = False) -> Formula:
     """A straight motion from :math:`(x, y)` to :math:`\\bigcirc(x, y)` clear of one obstacle.
 
     `faces` pairs each side on which a square touching the obstacle may lie with the same side
@@ -672,7 +824,7 @@ def _apart(x, y, faces: tuple[tuple[_Face, _Face], ...], ends: bool = False) -> 
     """
     nx, ny = x.next(), y.next()
     dx, dy = nx - x, ny - y
-    out = []
+    out: list[Formula] = []
     for k, (touch, far) in enumerate(faces):
         if far is touch:
             out.append(touch.holds(x, y) & touch.holds(nx, ny))
@@ -688,7 +840,7 @@ def _apart(x, y, faces: tuple[tuple[_Face, _Face], ...], ends: bool = False) -> 
     return disj(out)
 
 
-def _wall_sides(p: RobotProblem, wall, name: str) -> tuple[tuple[_Face, _Face], ...]:
+def _wall_sides(p: RobotProblem, wall: Wall, name: str) -> tuple[tuple[_Face, _Face], ...]:
     """The four sides of a wall for the robot's square, touching and at the margin."""
     touching = [_Face(h.a, h.b, h.c) for h in wall_regions(wall.start, wall.end, p.side, name)]
     if not p.margin:
@@ -715,10 +867,10 @@ class GoTo(Encoding):
 
     name = Primitive.GOTO
 
-    def targets(self, p):
+    def targets(self, p: RobotProblem) -> tuple[str | None, ...]:
         return (None,)
 
-    def parts(self, p, obj):
+    def parts(self, p: RobotProblem, obj: str | None) -> list[tuple[str, Formula]]:
         x, y = p.x, p.y
         out = [("GoTo keeps the objects", _objects_static(p))]
         for i, wall in enumerate(p.scene.obstacles):
@@ -746,11 +898,13 @@ class PickUp(Encoding):
 
     name = Primitive.PICKUP
 
-    def targets(self, p):
+    def targets(self, p: RobotProblem) -> tuple[str | None, ...]:
         return p.own_objects
 
-    def parts(self, p, obj):
+    def parts(self, p: RobotProblem, obj: str | None) -> list[tuple[str, Formula]]:
+        assert obj is not None  # PickUp acts on an object
         v, d = p.obj(obj), p.clearance(obj)
+        assert isinstance(v.x, Var) and isinstance(v.y, Var)  # its own goods: their position varies
         now = [_negated(p.obj(o).carried) for o in p.scene.objects]
         later = [(_later if o == obj else _released)(p.obj(o).carried) for o in p.scene.objects]
         carry = conj(now + later)
@@ -765,11 +919,13 @@ class DropOff(Encoding):
 
     name = Primitive.DROPOFF
 
-    def targets(self, p):
+    def targets(self, p: RobotProblem) -> tuple[str | None, ...]:
         return p.own_objects
 
-    def parts(self, p, obj):
+    def parts(self, p: RobotProblem, obj: str | None) -> list[tuple[str, Formula]]:
+        assert obj is not None  # DropOff acts on an object
         v, d = p.obj(obj), p.clearance(obj)
+        assert isinstance(v.x, Var) and isinstance(v.y, Var)  # its own goods: their position varies
         held = conj(p.obj(o).carried if o == obj else _negated(p.obj(o).carried) for o in p.scene.objects)
         released = conj(_released(p.obj(o).carried) for o in p.scene.objects)
         place = _docked(p, obj, v.x.next(), v.y.next(), d)
@@ -807,13 +963,15 @@ class Req(Encoding):
 
     name = Primitive.REQ
 
-    def targets(self, p):
+    def targets(self, p: RobotProblem) -> tuple[str | None, ...]:
         if not p.requests:
             return ()
         return tuple(o for o in p.scene.objects if o not in p.own_objects and o not in p.unrequestable)
 
-    def parts(self, p, obj):
+    def parts(self, p: RobotProblem, obj: str | None) -> list[tuple[str, Formula]]:
+        assert obj is not None  # Req acts on an object
         v, d, side = p.obj(obj), p.clearance(obj), p.side
+        assert isinstance(v.away, Var)  # a good it may request: its away flag varies
         flags = ~v.away & v.away.next() & _objects_static(p)
         room = [  # clear of every pose that picks it: the helper picks from a side of its choosing
             disj([p.x <= px - side, p.x >= px + side, p.y <= py - side, p.y >= py + side])
@@ -827,10 +985,11 @@ class Res(Encoding):
 
     name = Primitive.RES
 
-    def targets(self, p):
+    def targets(self, p: RobotProblem) -> tuple[str | None, ...]:
         return p.answered_objects
 
-    def parts(self, p, obj):
+    def parts(self, p: RobotProblem, obj: str | None) -> list[tuple[str, Formula]]:
+        assert obj is not None  # Res acts on an object
         return [(f"Res {obj}", _robot_static(p) & _objects_static(p) & p.obj(obj).carried)]
 
 
@@ -848,14 +1007,19 @@ def _goal(p: RobotProblem, event: Event) -> tuple[Formula, Formula]:
         return p.requests_except(None), home & (p.requests_except(None) | p.pi.eq(NONE))
     if event.kind not in ("pick", "drop", "away"):
         raise ValueError(f"unknown event kind {event.kind!r}")
-    primitive, obj, _ = realising_step(event, p.robot)
+    realised = realising_step(event, p.robot)
+    assert realised is not None  # a pick, drop or away is realised by a step
+    primitive, obj, _ = realised
     goal = p.is_action(primitive, obj)
     if event.kind == "drop":  # and the object inside the workspace
+        assert event.obj is not None  # a drop names its object
         v = p.obj(event.obj)
         ws = p.drop_centres(event)
         if ws.point is not None:
+            assert isinstance(v.x, Var) and isinstance(v.y, Var)  # its own goods: their position varies
             inside = v.x.eq(_num(ws.point[0])) & v.y.eq(_num(ws.point[1]))
         else:
+            assert ws.x is not None and ws.y is not None  # a rectangle
             inside = conj(
                 [v.x >= _num(ws.x[0]), v.x <= _num(ws.x[1]), v.y >= _num(ws.y[0]), v.y <= _num(ws.y[1])]
             )
@@ -864,7 +1028,15 @@ def _goal(p: RobotProblem, event: Event) -> tuple[Formula, Formula]:
 
 
 def mission_formula(p: RobotProblem, events: Sequence[Event] | None = None) -> Formula:
-    """The local mission as nested until, ending the trace at its last event."""
+    """The local mission as nested until, ending the trace at its last event.
+
+    Parameters
+    ----------
+    p : RobotProblem
+        The robot's planning problem.
+    events : sequence of Event, optional
+        The events, in order (default the problem's mission).
+    """
     events = p.mission if events is None else tuple(events)
     if not events:
         return Not(Next(TRUE))
@@ -893,6 +1065,11 @@ def automaton_parts(p: RobotProblem) -> list[tuple[str, Formula]]:
 
     So the events the plan performs, in order, form a word that takes the automaton to a
     marked state; no other PickUp, DropOff or Res is possible (they are mission events only).
+
+    Parameters
+    ----------
+    p : RobotProblem
+        The robot's planning problem.
     """
     dfa = p.automaton
     assert dfa is not None
@@ -925,6 +1102,11 @@ def initial_state(p: RobotProblem) -> Formula:
 
     With ``p.start`` (a replan mid-mission) instant 0 is that state instead.  Fields that are
     fixed values (:meth:`RobotProblem.obj`) already hold them and need no constraint.
+
+    Parameters
+    ----------
+    p : RobotProblem
+        The robot's planning problem.
     """
     x0, y0, h0 = p.start.robot if p.start is not None else p.scene.robots[p.robot].pose
     parts = [p.x.eq(_num(x0)), p.y.eq(_num(y0)), p.h.eq(_num(h0)), p.pi.eq(NONE)]
@@ -944,14 +1126,23 @@ def specification(p: RobotProblem, events: Sequence[Event] | None = None) -> lis
     """The named parts of :math:`\\phi_{\\mathcal{P}}(\\mathcal{M}) \\wedge \\phi_{K}` for one robot.
 
     Every part holds at instant 0 of a plan; their conjunction is the whole specification.
+
+    Parameters
+    ----------
+    p : RobotProblem
+        The robot's planning problem.
+    events : sequence of Event, optional
+        The events to plan, in order (default the problem's mission, or its automaton).
     """
     codes = [a.code for a in p.actions]
+    primitives = p.primitives
+    assert primitives is not None  # set by RobotProblem
     parts: list[tuple[str, Formula]] = [
         ("initial state", initial_state(p)),
         ("one primitive per step", Always(Implies(Next(TRUE), Next(disj(p.pi.eq(c) for c in codes))))),
     ]
     for action in p.actions:
-        for name, effect in p.primitives[action.primitive].parts(p, action.obj):
+        for name, effect in primitives[action.primitive].parts(p, action.obj):
             parts.append((name, Always(Implies(Next(p.pi.eq(action.code)), effect))))
     parts += away_frames(p)
     if p.automaton is not None and events is None:
@@ -961,11 +1152,31 @@ def specification(p: RobotProblem, events: Sequence[Event] | None = None) -> lis
 
 
 def request_codes(p: RobotProblem) -> dict[int, str]:
-    """Codes of the Req actions, with their objects."""
+    """Codes of the Req actions, with their objects.
+
+    Parameters
+    ----------
+    p : RobotProblem
+        The robot's planning problem.
+    """
     return {a.code: a.obj for a in p.actions if a.primitive == Primitive.REQ and a.obj is not None}
 
 
 def decode(p: RobotProblem, code: int) -> Action:
+    """The action whose code in :math:`\\pi` is `code`.
+
+    Parameters
+    ----------
+    p : RobotProblem
+        The robot's planning problem.
+    code : int
+        A value of :math:`\\pi` (not :data:`NONE`).
+
+    Raises
+    ------
+    ValueError
+        If no action of `p` has that code.
+    """
     for a in p.actions:
         if a.code == code:
             return a
@@ -973,6 +1184,13 @@ def decode(p: RobotProblem, code: int) -> Action:
 
 
 def events_of(mission: Iterable[Event | str]) -> tuple[Event, ...]:
+    """`mission` as events (names are parsed).
+
+    Parameters
+    ----------
+    mission : iterable of Event or str
+        Events, or their names (``pick(R1,O1)``, ...).
+    """
     from cosmop.events import parse_event
 
     return tuple(e if isinstance(e, Event) else parse_event(e) for e in mission)

@@ -32,8 +32,9 @@ from __future__ import annotations
 
 import re
 import time
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
+from fractions import Fraction
 from typing import Any
 
 import numpy as np
@@ -43,7 +44,7 @@ from cosmop.automata import DFA
 from cosmop.automata.operations import project, trim
 from cosmop.events import MESSAGE_KINDS, Event, Primitive, parse_event
 from cosmop.io import collector_paused
-from cosmop.logic import IncrementalUnrolling, Signature, Unrolling, assert_all, conj, to_fraction
+from cosmop.logic import Formula, IncrementalUnrolling, Signature, Unrolling, assert_all, conj, to_fraction
 from cosmop.planning.messages import answer_early, place_mission_messages, strip_messages, wait_early
 from cosmop.planning.obstacles import Geometry, obstacle_of
 from cosmop.planning.plan import ObjectState, RobotPlan, State, Step
@@ -69,7 +70,9 @@ class Synthesis:
     Attributes
     ----------
     robot : str
+        The robot's id.
     feasible : bool
+        Whether a plan was found.
     plan : RobotPlan or None
         The shortest plan (fewest requests among the shortest).
     horizon : int or None
@@ -81,6 +84,7 @@ class Synthesis:
     blocking : tuple of str
         Names of the specification parts in the unsat core (walls, objects, ...).
     solve_s : float
+        Seconds the synthesis took.
     checks : int
         Solver calls made.
     unsat_horizons : tuple of int
@@ -114,7 +118,7 @@ def _solver(rlimit: int, ctx: z3.Context) -> z3.Solver:
     return s
 
 
-def _value(v) -> float:
+def _value(v: Any) -> float:
     f = float(v)
     return int(f) if f.is_integer() else f
 
@@ -126,12 +130,14 @@ def _plan(
     word = p.mission
     if p.automaton is not None:  # the events the steps perform, in order
         word = tuple(p.mission[int(s["event"]) - 1] for s in trace if int(s["event"]) > 0)
-    steps, requested = [], []
+    steps: list[Step] = []
+    requested: list[str] = []
     for state in trace[1:]:
         action = decode(p, int(state["pi"]))
         if action.primitive == Primitive.REQ:
+            assert action.obj is not None  # a request names its object
             requested.append(action.obj)
-        objects = {}
+        objects: dict[str, ObjectState] = {}
         for o in p.scene.objects:
             x, y, carried, away = p.obj(o).read(state)
             objects[o] = ObjectState((_value(x), _value(y)), bool(carried), bool(away))
@@ -173,7 +179,7 @@ def synthesize(
     start: State | None = None,
     explain: bool = True,
     unrequestable: frozenset[str] = frozenset(),
-    margin: float = MOTION_MARGIN,
+    margin: float | Fraction = MOTION_MARGIN,
     lazy: bool = True,
     spots: tuple[tuple[Event, tuple[float, float]], ...] = (),
     min_horizon: int = 0,
@@ -183,7 +189,9 @@ def synthesize(
     Parameters
     ----------
     scene : Scene
+        The scene (walls, robots, objects, workspaces; mm).
     robot : str
+        The robot's id.
     mission : iterable of Event or str, or DFA
         The local mission: a sequence of events, or a DFA over the robot's events whose
         marked words are the ways it may complete (a branching mission; the plan performs
@@ -204,7 +212,7 @@ def synthesize(
         ``reason``); a replan that only needs yes or no skips it.
     unrequestable : frozenset of str
         Objects the plan may not request.
-    margin : float
+    margin : float or Fraction
         mm a motion keeps from walls and resting objects between its ends
         (:data:`~cosmop.planning.specification.MOTION_MARGIN`; 0 allows sliding along them).
     lazy : bool
@@ -344,7 +352,7 @@ def _problem(
     requests: bool,
     start: State | None,
     unrequestable: frozenset[str],
-    margin: float,
+    margin: float | Fraction,
     spots: tuple[tuple[Event, tuple[float, float]], ...] = (),
 ) -> RobotProblem:
     """The solver's problem for the events of `m` (options as in :func:`synthesize`)."""
@@ -368,6 +376,7 @@ class _Horizon:
     Attributes
     ----------
     K : int
+        The horizon: the number of steps.
     solver : z3.Solver
         Holds the specification unrolled over instants ``0..K``.
     unrolling : Unrolling or IncrementalUnrolling
@@ -381,7 +390,7 @@ class _Horizon:
     unrolling: Unrolling | IncrementalUnrolling
     assumptions: tuple[z3.BoolRef, ...]
 
-    def add(self, formula) -> None:
+    def add(self, formula: Formula) -> None:
         """Assert `formula` (at instant 0) from now on, at this horizon and every later one."""
         if isinstance(self.unrolling, IncrementalUnrolling):
             assert_all(self.solver, self.unrolling.require(formula))
@@ -647,6 +656,7 @@ def _explain(p: RobotProblem, events: tuple[Event, ...], K: int, rlimit: int) ->
     head = f"{p.robot} cannot reach {event.name} (event {i} of its mission) within {K} steps"
     reason = _because(head, _as_written(p.scene, blocking), K)
     if event.kind in ("pick", "drop") and blocking:
+        assert event.obj is not None  # picks and drops name their object
         sides = p.scene.objects[event.obj].sides
         reason += f" (sides of {event.obj} tried: {', '.join(sides)})"
     return reason, blocking or ()
@@ -661,9 +671,11 @@ def _as_written(scene: Scene, blocking: tuple[str, ...] | None) -> tuple[str, ..
     if not blocking:
         return blocking
 
-    def name(match: re.Match) -> str:
+    def name(match: re.Match[str]) -> str:
         label = scene.obstacles[int(match.group(1))].label
-        return match.group(0) if label is None else label + match.group("rest")
+        whole: str = match.group(0)
+        rest: str = match.group("rest")
+        return whole if label is None else label + rest
 
     return tuple(dict.fromkeys(_WALL_PART.sub(name, part) for part in blocking))
 
@@ -678,7 +690,9 @@ def _because(head: str, blocking: tuple[str, ...] | None, K: int) -> str:
     return f"{head}; blocked by: {what}"
 
 
-def _core(p: RobotProblem, parts: list[tuple[str, object]], K: int, rlimit: int) -> tuple[str, ...] | None:
+def _core(
+    p: RobotProblem, parts: Sequence[tuple[str, Formula]], K: int, rlimit: int
+) -> tuple[str, ...] | None:
     """A minimal set of obstacle parts of `parts` that leaves no plan of ``K`` steps.
 
     Every other part (the initial state, the primitives' effects, the mission) is asserted;
@@ -716,7 +730,7 @@ def _core(p: RobotProblem, parts: list[tuple[str, object]], K: int, rlimit: int)
     return tuple(names[str(c)] for c in core)
 
 
-def _in_order(guards: list, core) -> list:
+def _in_order(guards: list[Any], core: Any) -> list[Any]:
     """The guards that are in `core`, in the order of `guards` (a deterministic answer)."""
     kept = {str(c) for c in core}
     return [g for g in guards if str(g) in kept]

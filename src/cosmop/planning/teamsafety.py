@@ -18,10 +18,11 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
 import shapely
+from shapely.geometry.base import BaseGeometry
 
 from cosmop.events import Primitive, parse_event
 from cosmop.io import collector_paused
@@ -45,6 +46,25 @@ from cosmop.scene import Scene
 from cosmop.squares import swept_square
 
 __all__ = ["TeamSafety", "Wait", "make_team_safe"]
+
+_Drive = tuple[tuple[float, float], tuple[float, float]]
+"""The centres (mm) at the two ends of a drive."""
+
+_Order = tuple[tuple[Node, Node], Conflict]
+"""A start edge chosen for a conflict, with the conflict."""
+
+_Placed = tuple[str, tuple[Node, Node], tuple[Node, Node]]
+"""A message placed for a start edge: its name, the edge, and the edge in the new instants."""
+
+_Context = tuple[
+    Scene,
+    ConflictSettings,
+    Mapping[str, State] | None,
+    Mapping[str, tuple[float, float] | None] | None,
+    str | None,
+    set[str] | None,
+]
+"""What every ordering attempt shares: ``(scene, settings, starts, positions, about, used)``."""
 
 
 @dataclass(frozen=True)
@@ -104,7 +124,7 @@ class TeamSafety:
         with every message.
     time_s : float
         Seconds this took.
-    fixed : Mapping[str, list]
+    fixed : Mapping[str, list of shapely geometry]
         Every robot's places that re-planning cannot move (to choose detours).
     chosen : int
         Orders the search chose (one per conflict it ordered, before the implied ones are
@@ -124,7 +144,7 @@ class TeamSafety:
     makespan_alone: float
     makespan: float
     time_s: float
-    fixed: Mapping[str, list] = field(default_factory=dict, repr=False)
+    fixed: Mapping[str, list[BaseGeometry]] = field(default_factory=dict, repr=False)
     chosen: int = 0
     flipped: int = 0
     waits: tuple[Wait, ...] = ()
@@ -133,15 +153,19 @@ class TeamSafety:
     def safe(self) -> bool:
         return not self.unresolved
 
-    def detours(self, conflict: Conflict) -> list:
+    def detours(self, conflict: Conflict) -> list[tuple[int, str, Occupancy]]:
         """Who can be re-planned around `conflict`, best first, each with its rank
-        (:func:`~cosmop.planning.conflicts.ranked_detours`): ``(rank, robot, what to avoid)``."""
+        (:func:`~cosmop.planning.conflicts.ranked_detours`): ``(rank, robot, what to avoid)``.
+
+        Parameters
+        ----------
+        conflict : Conflict
+            A conflict between the plans (one of :attr:`unresolved`).
+        """
         return ranked_detours(conflict, self.fixed)
 
 
-def _reduce(
-    horizons: Mapping[str, int], links: Sequence[Link], chosen: Sequence[tuple[tuple[Node, Node], Conflict]]
-) -> list[tuple[tuple[Node, Node], Conflict]]:
+def _reduce(horizons: Mapping[str, int], links: Sequence[Link], chosen: Sequence[_Order]) -> list[_Order]:
     """Drop every edge that the program order, the messages and the other kept edges imply.
 
     The edge ``(A, i) -> start of (B, j)`` is implied when, without it, a path leads from A's
@@ -183,7 +207,14 @@ def _reduce(
     return [item for n, item in enumerate(chosen) if n not in dropped]
 
 
-def _implied(order: Precedence, horizons, links_out, starts, source: Node, target: Node) -> bool:
+def _implied(
+    order: Precedence,
+    horizons: Mapping[str, int],
+    links_out: Mapping[Node, list[Node]],
+    starts: Mapping[Node, list[Node]],
+    source: Node,
+    target: Node,
+) -> bool:
     """Whether `source` completes before `target` starts by a way that leaves it through its
     next step, a message it sends or a kept edge in `starts` (:func:`_reduce`)."""
     (r, k), (robot, j) = source, target
@@ -212,9 +243,11 @@ def make_team_safe(
     Parameters
     ----------
     scene : Scene
+        The scenario's scene (walls, robots, objects).
     plans : Mapping[str, RobotPlan]
         Every robot's plan, sound alone, with the messages it already has (no deadlock).
     settings : ConflictSettings, optional
+        How conflicts are found (default :class:`~cosmop.planning.conflicts.ConflictSettings`).
     used : set of str, optional
         Message names already taken (new ones avoid them; the set is updated).
     starts : Mapping[str, State], optional
@@ -239,7 +272,7 @@ def make_team_safe(
         )
         for r, p in plans.items()
     }
-    context = (scene, settings, starts, positions, about, used)
+    context: _Context = (scene, settings, starts, positions, about, used)
     uncut = frozenset() if settings.cut else frozenset(plans)
     # each robot's cuts depend on the others' whole drives only: made once, undone robot by robot
     cut = _cut_where_shared(scene, plans, settings, starts, positions, walls) if settings.cut else plans
@@ -259,7 +292,9 @@ def make_team_safe(
     return replace(best, time_s=time.perf_counter() - t0)
 
 
-def _order(context, plans: Mapping[str, RobotPlan], waypoints) -> TeamSafety:
+def _order(
+    context: _Context, plans: Mapping[str, RobotPlan], waypoints: Mapping[str, set[tuple[float, float]]]
+) -> TeamSafety:
     """One ordering of every conflict between `plans` (already cut; `waypoints` are the
     robots' own, where pieces are joined again after), its time not yet set."""
     scene, settings, starts, positions, about, used = context
@@ -305,9 +340,11 @@ def _order(context, plans: Mapping[str, RobotPlan], waypoints) -> TeamSafety:
     )
 
 
-def _drive_ends(scene: Scene, plans: Mapping[str, RobotPlan], starts) -> dict[Node, tuple]:
+def _drive_ends(
+    scene: Scene, plans: Mapping[str, RobotPlan], starts: Mapping[str, State] | None
+) -> dict[Node, _Drive]:
     """The centres at the two ends of every GoTo step of `plans`: ``(robot, k) -> (p, q)``."""
-    out = {}
+    out: dict[Node, _Drive] = {}
     for robot, plan in plans.items():
         pose = start_pose(scene, robot, starts)
         for k, step in enumerate(plan.steps, 1):
@@ -317,7 +354,13 @@ def _drive_ends(scene: Scene, plans: Mapping[str, RobotPlan], starts) -> dict[No
     return out
 
 
-def _waits(plans, order: Precedence, placed, kept, ends: Mapping[Node, tuple]) -> tuple[Wait, ...]:
+def _waits(
+    plans: Mapping[str, RobotPlan],
+    order: Precedence,
+    placed: Sequence[_Placed],
+    kept: Sequence[_Order],
+    ends: Mapping[Node, _Drive],
+) -> tuple[Wait, ...]:
     """Each conflict message's wait in `order` (the final plans' itinerary), longest first.
 
     `placed` and `kept` pair each message with its conflict (`plans` wait for it at their
@@ -327,14 +370,19 @@ def _waits(plans, order: Precedence, placed, kept, ends: Mapping[Node, tuple]) -
     critical = _critical_waits(plans, order)
     out = []
     for (name, _, _), ((first_step, _), conflict) in zip(placed, kept, strict=True):
-        robot = parse_event(name).receiver
+        robot, other = parse_event(name).receiver, parse_event(name).sender
+        assert robot is not None and other is not None  # a message has both
         k = next(k for k, s in enumerate(plans[robot].steps, 1) if s.message == name)
         first, then = (conflict.a, conflict.b) if conflict.a.last == first_step else (conflict.b, conflict.a)
         seconds = float(order.finish[robot][k] - order.finish[robot][k - 1])
-        drives = None
-        if first.first is not None and first.first == first.last and then.first == then.last:
+        drives: tuple[_Drive, ...] | None = None
+        if (
+            first.first is not None
+            and first.first == first.last
+            and then.first is not None
+            and then.first == then.last
+        ):
             drives = (ends[first.first], ends[then.first])
-        other = parse_event(name).sender
         out.append(Wait(seconds, robot, other, name, conflict, first, then, drives, (robot, k) in critical))
     return tuple(sorted(out, key=lambda w: (-w.seconds, w.message)))
 
@@ -346,19 +394,19 @@ def _critical_waits(plans: Mapping[str, RobotPlan], order: Precedence) -> set[No
         return set()
     senders = {(link.receiver, link.wait): (link.sender, link.send) for link in message_links(plans)}
     robot = max(plans, key=lambda r: (order.finish[r][plans[r].horizon], r))
-    k, out = plans[robot].horizon, set()
+    k, out = plans[robot].horizon, set[Node]()
     while k >= 1:
         source = senders.get((robot, k))
         waited = order.finish[robot][k] > order.finish[robot][k - 1] + 1e-9
         if source is not None and source[1] is not None and waited:
             out.add((robot, k))
-            robot, k = source
+            robot, k = source[0], source[1]
             continue
         k -= 1
     return out
 
 
-def _flipped(chosen, alone: Precedence) -> int:
+def _flipped(chosen: Sequence[_Order], alone: Precedence) -> int:
     """How many of the `chosen` orders let go first the occupancy the robots' own itineraries
     (`alone`: no conflict ordered) expect to begin later: where the search departed from time."""
     out = 0
@@ -369,7 +417,14 @@ def _flipped(chosen, alone: Precedence) -> int:
     return out
 
 
-def _cut_where_shared(scene, plans, settings, starts, positions, walls) -> dict[str, RobotPlan]:
+def _cut_where_shared(
+    scene: Scene,
+    plans: Mapping[str, RobotPlan],
+    settings: ConflictSettings,
+    starts: Mapping[str, State] | None,
+    positions: Mapping[str, tuple[float, float] | None] | None,
+    walls: BaseGeometry | None,
+) -> dict[str, RobotPlan]:
     """Every drive cut where it enters and where it leaves a place another robot uses.
 
     A conflict then holds only the piece of the drive inside the shared place, so the robot
@@ -380,7 +435,7 @@ def _cut_where_shared(scene, plans, settings, starts, positions, walls) -> dict[
     precedence = Precedence({r: p.horizon for r, p in plans.items()}, message_links(plans))
     items, _ = occupancies(scene, plans, precedence, settings, starts, positions)
     tree = shapely.STRtree([item.region for item in items])
-    out = {}
+    out: dict[str, RobotPlan] = {}
     for robot, plan in plans.items():
         grown = scene.robots[robot].size + settings.clearance
         poses = [start_pose(scene, robot, starts), *(step.robot for step in plan.steps)]
@@ -399,7 +454,9 @@ def _cut_where_shared(scene, plans, settings, starts, positions, walls) -> dict[
     return out
 
 
-def _entry_exit(p, q, half: float, region, passing: float) -> tuple[float, ...]:
+def _entry_exit(
+    p: Sequence[float], q: Sequence[float], half: float, region: BaseGeometry, passing: float
+) -> tuple[float, ...]:
     """Where a square of half side `half` moving from `p` to `q` starts and stops overlapping the
     convex `region`: fractions of the way in (0, 1), rounded outwards to the cut grain; the
     exit lies `passing` mm beyond (:attr:`~cosmop.planning.conflicts.ConflictSettings.passing`)."""
@@ -431,7 +488,9 @@ def _spaced(cuts: list[float], gap: float) -> list[float]:
     return out
 
 
-def _roomy(walls, scene: Scene, robot: str, room: float):
+def _roomy(
+    walls: BaseGeometry | None, scene: Scene, robot: str, room: float
+) -> Callable[[float, float], bool]:
     """Whether the robot's square at ``(x, y)`` keeps `room` (mm) from every wall (`walls`, the
     scene's obstacles as one geometry, or ``None``)."""
     half = scene.robots[robot].size / 2.0 + room
@@ -445,6 +504,7 @@ def _roomy(walls, scene: Scene, robot: str, room: float):
 def _protects(plans: Mapping[str, RobotPlan], name: str, conflict: Conflict) -> str:
     event = parse_event(name)
     a, b = event.sender, event.receiver
+    assert a is not None and b is not None  # a message has both
     send = next(k for k, s in enumerate(plans[a].steps, 1) if s.message == name)
     wait = next(k for k, s in enumerate(plans[b].steps, 1) if s.message == name)
     cleared = plans[a].steps[send - 2].label if send >= 2 else "its start"

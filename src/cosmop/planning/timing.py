@@ -26,7 +26,7 @@ The estimates order events; they are not a promise.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 from cosmop.events import Primitive
@@ -60,13 +60,28 @@ class ExecutionModel:
 
 
 def turn_time(angle_deg: float, dynamics: Dynamics) -> float:
-    """Seconds to turn on the spot by `angle_deg` degrees (the shorter way round)."""
+    """Seconds to turn on the spot by `angle_deg` degrees (the shorter way round).
+
+    Parameters
+    ----------
+    angle_deg : float
+        The turn (degrees, any sign and size).
+    dynamics : Dynamics
+        The robot's limits (its turn rate).
+    """
     angle = abs((angle_deg + 180.0) % 360.0 - 180.0)
     return angle / dynamics.turn_rate
 
 
 def drive_time(distance: float, dynamics: Dynamics) -> float:
     """Seconds to drive `distance` mm in a straight line from standstill to standstill.
+
+    Parameters
+    ----------
+    distance : float
+        The length of the drive (mm).
+    dynamics : Dynamics
+        The robot's limits (top speed, acceleration, braking).
 
     >>> round(drive_time(1500.0, Dynamics(max_speed=750, acceleration=300, braking=500)), 3)
     4.0
@@ -94,6 +109,10 @@ def _goto_time(start: tuple[float, ...], end: tuple[float, ...], dynamics: Dynam
     )
 
 
+_Piece = tuple[int, tuple[float, ...], tuple[float, ...]]
+"""A piece of one straight drive: the step's index, the pose it starts from and the one it ends at."""
+
+
 def step_durations(
     plan: RobotPlan,
     start: tuple[float, float, float],
@@ -105,19 +124,22 @@ def step_durations(
     Parameters
     ----------
     plan : RobotPlan
+        The plan.
     start : tuple of float
         The pose at instant 0 ``(x, y, heading)``, mm and degrees.
     dynamics : Dynamics
         The robot's limits.
     model : ExecutionModel, optional
+        The times of PickUp and DropOff (default :class:`ExecutionModel`).
 
     Returns
     -------
     list of float
     """
     model = model or ExecutionModel()
-    out, pose = [], tuple(start)
-    run: list[tuple[int, tuple, tuple]] = []  # pieces of one straight drive: (index, from, to)
+    out: list[float] = []
+    pose = tuple(start)
+    run: list[_Piece] = []  # pieces of one straight drive: (index, from, to)
     for step in plan.steps:
         if step.primitive == Primitive.GOTO and run and not _collinear(run[-1][1], run[-1][2], step.robot):
             _close(run, out, dynamics)
@@ -136,7 +158,7 @@ def step_durations(
     return out
 
 
-def _collinear(a: tuple, b: tuple, c: tuple) -> bool:
+def _collinear(a: Sequence[float], b: Sequence[float], c: Sequence[float]) -> bool:
     """Whether going on from `b` to `c` continues the drive from `a` to `b` (within 1 degree)."""
     u = (b[0] - a[0], b[1] - a[1])
     v = (c[0] - b[0], c[1] - b[1])
@@ -146,7 +168,7 @@ def _collinear(a: tuple, b: tuple, c: tuple) -> bool:
     return (u[0] * v[0] + u[1] * v[1]) / (nu * nv) >= math.cos(math.radians(1.0))
 
 
-def _close(run: list, out: list[float], dynamics: Dynamics) -> None:
+def _close(run: list[_Piece], out: list[float], dynamics: Dynamics) -> None:
     """Share the time of one straight drive among its pieces, by length."""
     if not run:
         return
@@ -160,7 +182,17 @@ def _close(run: list, out: list[float], dynamics: Dynamics) -> None:
 def start_pose(
     scene: Scene, robot: str, starts: Mapping[str, State] | None = None
 ) -> tuple[float, float, float]:
-    """Where `robot` starts: its state in `starts`, else the scenario's pose (mm, degrees)."""
+    """Where `robot` starts: its state in `starts`, else the scenario's pose (mm, degrees).
+
+    Parameters
+    ----------
+    scene : Scene
+        The scenario.
+    robot : str
+        The robot's id.
+    starts : Mapping[str, State], optional
+        Where robots start, by id, if not at the scenario's poses.
+    """
     state = (starts or {}).get(robot)
     return state.robot if state is not None else scene.robots[robot].pose
 
@@ -171,7 +203,19 @@ def durations(
     model: ExecutionModel | None = None,
     starts: Mapping[str, State] | None = None,
 ) -> dict[str, list[float]]:
-    """Expected seconds of every step of every plan (:func:`step_durations`), by robot."""
+    """Expected seconds of every step of every plan (:func:`step_durations`), by robot.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scenario (start poses, each robot's dynamics).
+    plans : Mapping[str, RobotPlan]
+        Every robot's plan, by id.
+    model : ExecutionModel, optional
+        The times of PickUp and DropOff (default :class:`ExecutionModel`).
+    starts : Mapping[str, State], optional
+        Where robots start, by id, if not at the scenario's poses.
+    """
     return {
         r: step_durations(p, start_pose(scene, r, starts), scene.robots[r].dynamics, model)
         for r, p in plans.items()
@@ -197,9 +241,11 @@ def itinerary(
     Parameters
     ----------
     scene : Scene
+        The scenario (start poses, each robot's dynamics).
     plans : Mapping[str, RobotPlan]
         Every robot's plan; their messages must not deadlock.
     model : ExecutionModel, optional
+        The times of PickUp and DropOff (default :class:`ExecutionModel`).
     starts : Mapping[str, State], optional
         Where robots start, if not at the scenario's poses.
 
