@@ -239,6 +239,21 @@ class Planner:
     phases : dict of str to float
         Seconds per phase of the loop; the planner adds the synthesis time to
         ``phases["synthesize"]``.
+
+    Attributes
+    ----------
+    forbidden : dict of str to frozenset of str
+        Per robot, the goods it may not request.
+    added : list of AddedTask
+        Goods moved aside; their places extend the scenario.
+    obstacles : dict of str to tuple of Wall
+        Per robot, walls around the space others keep.
+    placed : dict of str to dict
+        Hand-overs: per receiver, goods it finds where the giver drops them, ``{goods: (x, y)}`` mm.
+    spots : dict of str to dict
+        Hand-overs and shared docks: per robot, drops held to a spot, ``{drop event: (x, y)}`` mm.
+    cache : dict
+        Every answer, by question (:meth:`key`).
     """
 
     scenario: Scenario
@@ -247,18 +262,12 @@ class Planner:
     max_horizon: int | None = None
     rlimit: int = DEFAULT_RLIMIT
     phases: dict[str, float] = field(default_factory=lambda: {"synthesize": 0.0})
-    forbidden: dict[str, frozenset[str]] = field(default_factory=dict)
-    """Per robot, the goods it may not request."""
-    added: list[AddedTask] = field(default_factory=list)
-    """Goods moved aside; their places extend the scenario."""
-    obstacles: dict[str, tuple[Wall, ...]] = field(default_factory=dict)
-    """Per robot, walls around the space others keep."""
-    placed: dict[str, dict[str, tuple[float, float]]] = field(default_factory=dict)
-    """Hand-overs: per receiver, goods it finds where the giver drops them (mm)."""
-    spots: dict[str, dict[Event, tuple[float, float]]] = field(default_factory=dict)
-    """Hand-overs and shared docks: per robot, drops held to a spot (mm)."""
-    cache: dict[tuple[Hashable, ...], Synthesis] = field(default_factory=dict)
-    """Every answer, by question (:meth:`key`)."""
+    forbidden: dict[str, frozenset[str]] = field(default_factory=dict, init=False)
+    added: list[AddedTask] = field(default_factory=list, init=False)
+    obstacles: dict[str, tuple[Wall, ...]] = field(default_factory=dict, init=False)
+    placed: dict[str, dict[str, tuple[float, float]]] = field(default_factory=dict, init=False)
+    spots: dict[str, dict[Event, tuple[float, float]]] = field(default_factory=dict, init=False)
+    cache: dict[tuple[Hashable, ...], Synthesis] = field(default_factory=dict, init=False)
 
     def restrictions(self) -> Restrictions:
         """The forbidden requests and added walls now, to :meth:`restore` after a trial."""
