@@ -323,7 +323,7 @@ def _plan_messages(plans: Mapping[str, RobotPlan], notes: Mapping[str, tuple[str
     out = []
     for robot, plan in plans.items():
         for name in plan.mission:
-            if name in notes and name.startswith("msg(") and name.split(",")[0][4:] == robot:
+            if name in notes and (event := parse_event(name)).kind == "msg" and event.sender == robot:
                 kind, text = notes[name]
                 out.append(PlanMessage(name, kind, text))
     return out
