@@ -99,7 +99,12 @@ def place_aside(
 
 
 def handover_spot(
-    scene: Scene, obj: str, workspace: str, robots: tuple[str, ...], grid: int = 9
+    scene: Scene,
+    obj: str,
+    workspace: str,
+    robots: tuple[str, ...],
+    grid: int = 9,
+    avoid: shapely.Geometry | None = None,
 ) -> tuple[float, float] | None:
     """A spot for `obj` in `workspace` where each of `robots` can dock to it, chosen before either
     is planned (a hand-over whose giver and receiver wait on each other, :mod:`cosmop.missions.handover`).
@@ -123,6 +128,8 @@ def handover_spot(
         The robots that must dock to the goods there (giver and receiver).
     grid : int
         Candidate centres per axis of a rectangular workspace.
+    avoid : shapely geometry, optional
+        Where the goods' square must not lie (mm): places other robots keep for good.
 
     Returns
     -------
@@ -138,6 +145,8 @@ def handover_spot(
         xs, ys = np.meshgrid(np.linspace(x0, x1, grid), np.linspace(y0, y1, grid))
         spots = np.column_stack([xs.ravel(), ys.ravel()])
     dockable = np.ones(len(spots), dtype=bool)
+    if avoid is not None:
+        dockable &= ~shapely.intersects(shapely.box(*(spots - size / 2).T, *(spots + size / 2).T), avoid)
     for robot in robots:
         body = scene.robots[robot]
         reach = free_component(scene, body.size / 2.0, body.pose[:2])

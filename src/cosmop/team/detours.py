@@ -14,15 +14,19 @@ import time
 from collections.abc import Hashable, Iterable, Mapping
 from dataclasses import dataclass
 
+import shapely
+
 from cosmop.events import Event
+from cosmop.planning.aside import handover_spot
 from cosmop.planning.conflicts import Conflict, ConflictSettings, Occupancy
 from cosmop.planning.lanes import lanes
 from cosmop.planning.plan import RobotPlan
 from cosmop.planning.synthesis import Synthesis
 from cosmop.planning.teamsafety import TeamSafety, Wait, make_team_safe
 from cosmop.scene import Scene, Wall
-from cosmop.team.planner import Planner, Window
+from cosmop.team.planner import Planner, Window, goods_at
 from cosmop.team.walls import walls_around
+from cosmop.units import show_point
 
 __all__ = ["MIN_WAIT", "TRIAL_STEPS", "MadeSafe", "make_safe", "shorten_waits"]
 
@@ -108,6 +112,11 @@ def make_safe(
         best, since = (left, 0) if best is None or left < best else (best, since + 1)
         last = since >= max_rounds or n == max_total
         stuck = [c for c in safety.unresolved if not safety.detours(c)]
+        moved = _drop_elsewhere(stuck, safety, current, planner, settings) if stuck and not last else {}
+        if moved:  # goods that rested in the way for good lie elsewhere now: order the new plans
+            results.update({robot: result for robot, (result, _) in moved.items()})
+            replans.extend(why for _, why in moved.values())
+            continue
         if stuck or last:
             conflict = (stuck or list(safety.unresolved))[0]
             why = f"no order or re-plan keeps {' and '.join(conflict.robots)} apart: {conflict.describe()}"
@@ -131,6 +140,49 @@ def make_safe(
             return MadeSafe(results, safety, tuple(replans), reasons)
         results.update(fresh)
     return MadeSafe(results, safety, tuple(replans))
+
+
+def _drop_elsewhere(
+    stuck: Iterable[Conflict],
+    safety: TeamSafety,
+    current: Mapping[str, tuple[Event, ...]],
+    planner: Planner,
+    settings: ConflictSettings,
+) -> dict[str, tuple[Synthesis, str]]:
+    """Goods that would rest for good where another robot stands for good, dropped elsewhere.
+
+    Walls cannot settle such a conflict when the robot that drops the goods must itself pass
+    through the other's place (to pick them, say): instead the drop is pinned to another spot
+    of its workspace, one the robot can dock to whose square keeps the clearance from the other
+    side and from every other robot's fixed places (:func:`cosmop.planning.aside.handover_spot`
+    with `avoid`), and the robot is re-planned.  Returns, per robot re-planned, its synthesis and
+    why; a robot whose re-plan fails keeps its plan and its drop.
+    """
+    scene = planner.scenario.scene
+    out: dict[str, tuple[Synthesis, str]] = {}
+    for conflict in stuck:
+        for goods, other in ((conflict.a, conflict.b), (conflict.b, conflict.a)):
+            if goods.what not in scene.objects or not goods.movable or goods.first is None:
+                continue
+            robot = goods.first[0]
+            drops = [e for e in current[robot] if e.kind == "drop" and e.obj == goods.what]
+            if robot in out or len(drops) != 1 or drops[0].workspace is None:
+                continue
+            keep = [other.region] + [g for r, places in safety.fixed.items() if r != robot for g in places]
+            avoid = shapely.unary_union(keep).buffer(settings.clearance, join_style="mitre")
+            own = goods_at(scene, planner.placed.get(robot, {}))
+            spot = handover_spot(own, goods.what, drops[0].workspace, (robot,), avoid=avoid)
+            if spot is None:
+                continue
+            saved = dict(planner.spots.get(robot, {}))
+            planner.spots.setdefault(robot, {})[drops[0]] = spot
+            result = planner.run({robot: current[robot]})[robot]
+            if result.feasible:
+                where = show_point(spot, scene.units)
+                out[robot] = (result, f"{robot} drops {goods.what} at {where} instead: {conflict.describe()}")
+                break
+            planner.spots[robot] = saved
+    return out
 
 
 def _team_safe(planner: Planner, plans: Mapping[str, RobotPlan], settings: ConflictSettings) -> TeamSafety:
