@@ -19,7 +19,8 @@ from cosmop.cli import app
 from cosmop.errors import CosmopInputError
 from cosmop.pipeline import plan_team
 from cosmop.planning.checker import check_plan
-from cosmop.planning.plan import Itinerary, PlanError, PlanSet, load_plan
+from cosmop.planning.plan_file import PlanError, load_plan
+from cosmop.planning.plan_types import Itinerary, PlanSet
 from cosmop.planning.realisation import message_links
 from cosmop.planning.timing import durations, itinerary
 from cosmop.scenario import load_scenario

@@ -313,7 +313,7 @@ def test_a_standing_robot_says_why_and_a_replan_redraws_its_path(big_map):
 def test_a_metres_file_is_shown_in_metres_on_the_page():
     from dataclasses import replace
 
-    from cosmop.planning.plan import load_plan
+    from cosmop.planning.plan_file import load_plan
     from cosmop.scenario import load_scenario
 
     plans = load_plan(Path(__file__).resolve().parent / "data" / "plan_2x2.json")

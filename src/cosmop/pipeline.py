@@ -48,7 +48,7 @@ from cosmop.planning.aside import ROOM, dock_slots, handover_spot, place_aside
 from cosmop.planning.checker import CheckReport, check_plan
 from cosmop.planning.conflicts import ConflictSettings
 from cosmop.planning.lanes import lanes
-from cosmop.planning.plan import MAX_STEPS, AddedTask, Coordination, PlanMessage, PlanSet, RobotPlan
+from cosmop.planning.plan_types import MAX_STEPS, AddedTask, Coordination, PlanMessage, PlanSet, RobotPlan
 from cosmop.planning.realisation import request_phases
 from cosmop.planning.synthesis import DEFAULT_RLIMIT, Synthesis, synthesize
 from cosmop.planning.teamsafety import TeamSafety, make_team_safe

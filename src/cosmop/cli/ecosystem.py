@@ -191,7 +191,7 @@ def export(
     workspaces, objects, people, robots and what they carry, message arrows) and /coordination
     (String, one JSON object per message). Exit status 0 written, 2 bad input (nothing written).
     """
-    from cosmop.planning.plan import load_plan
+    from cosmop.planning.plan_file import load_plan
     from cosmop.traces import load_trace
 
     loaded = load(scenario, mission=False)
@@ -221,7 +221,7 @@ def view(
     what they carry) and draw each message as an arrow with its time. Exit status 0 written,
     2 bad input (nothing written).
     """
-    from cosmop.planning.plan import load_plan
+    from cosmop.planning.plan_file import load_plan
     from cosmop.traces import load_trace
     from cosmop.viz.web import save_html
 

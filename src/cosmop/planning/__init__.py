@@ -20,22 +20,19 @@ from cosmop.planning.checker import (
     square,
     swept_square,
 )
-from cosmop.planning.plan import (
+from cosmop.planning.plan_file import PlanError, load_plan
+from cosmop.planning.plan_types import (
     OBJECT_PRIMITIVES,
     PLAN_FORMAT,
     PRIMITIVES,
     Coordination,
     ObjectState,
-    PlanError,
     PlanSet,
     RobotPlan,
     State,
     Step,
-    initial_state,
-    load_plan,
-    plan_from_actions,
-    successor,
 )
+from cosmop.planning.primitive_effects import initial_state, plan_from_actions, successor
 
 __all__ = [
     "OBJECT_PRIMITIVES",

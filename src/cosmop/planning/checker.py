@@ -64,7 +64,8 @@ from cosmop.docking import DOCKING_HEADINGS, docking_pose, in_front
 from cosmop.errors import EventSyntaxError
 from cosmop.events import Event, Primitive, parse_event, realising_step
 from cosmop.planning.joint import check_team
-from cosmop.planning.plan import PlanSet, RobotPlan, State, Step, initial_state
+from cosmop.planning.plan_types import PlanSet, RobotPlan, State, Step
+from cosmop.planning.primitive_effects import initial_state
 from cosmop.planning.realisation import TOLERANCE, angles_equal, at_pose, event_instants, holds_at
 from cosmop.planning.report import RULES, CheckReport, Violation
 from cosmop.scene import Scenario, Scene, Wall

@@ -19,7 +19,7 @@ import numpy as np
 from cosmop.control.dwa import DwaSettings
 from cosmop.events import Event
 from cosmop.io import write_atomic
-from cosmop.planning.plan import PRIMITIVES, PlanSet
+from cosmop.planning.plan_types import PRIMITIVES, PlanSet
 from cosmop.scene import Scenario, Scene
 from cosmop.sim.delays import Delays
 from cosmop.sim.timing import StepTimes

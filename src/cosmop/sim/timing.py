@@ -17,7 +17,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from cosmop.planning.plan import Itinerary
+from cosmop.planning.plan_types import Itinerary
 
 __all__ = ["StepTimes", "carry_instants", "step_times"]
 

@@ -15,7 +15,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from cosmop.events import Event, EventSyntaxError, Primitive, parse_event
-from cosmop.planning.plan import PlanMessage, PlanSet, RobotPlan
+from cosmop.planning.plan_types import PlanMessage, PlanSet, RobotPlan
 from cosmop.scene import Scene
 from cosmop.units import length_unit, show_point
 
