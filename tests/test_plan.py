@@ -459,7 +459,8 @@ def test_from_dict_without_a_file() -> None:
         ("", "the file is empty", None),
         (
             "[1, 2]",
-            "expected a JSON object with keys format, scenario, feasible, robots (a cosmop.plan/1 file), got [1, 2]",
+            "expected a JSON object with keys format, scenario, feasible, robots (a cosmop.plan/1 file), "
+            "got [1, 2]",
             None,
         ),
         # a value the parser refuses: the field and its line are named

@@ -495,6 +495,7 @@ def _members(text: str, at: int, skip: Callable[[int], int | None]) -> Iterator[
     position, index = _space_end(text, at + 1), 0
     if text.startswith(close, position):
         return
+    part: str | int
     while True:
         first, part = position, index
         if close == "}":
@@ -606,9 +607,10 @@ def json_position(text: str, path: FieldPath) -> tuple[int, int] | None:
     for part in path:
         if not text.startswith(("{", "["), at):
             return None
-        at = next((start for key, _, start in _members(text, at, skip) if key == part), None)
-        if at is None:
+        found = next((start for key, _, start in _members(text, at, skip) if key == part), None)
+        if found is None:
             return None
+        at = found
     return _line_and_column(text, at)
 
 
@@ -977,7 +979,7 @@ class Structure:
             fields = _fields(annotation)
             origin = get_origin(annotation)
             if fields is not None:
-                if part not in fields:
+                if not isinstance(part, str) or part not in fields:
                     return None
                 annotation = fields[part][0]
             elif origin is dict:

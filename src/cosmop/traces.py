@@ -29,7 +29,7 @@ import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from types import MappingProxyType
-from typing import Annotated, Any, Literal, NotRequired
+from typing import Annotated, Any, Literal, NotRequired, cast, overload
 
 import numpy as np
 from pydantic import Field
@@ -211,8 +211,8 @@ def _check(data: Any, file: str | None, text: str | None) -> dict[str, Any]:
         problem = f"expected {EXPECTED[('format',)]}, got {show(data['format'])}"
         raise STRUCTURE.fail(("format",), problem, file, text)
     STRUCTURE.validate(data, file, text)
-    if (problem := check_units_field(data.get("units"))) is not None:
-        raise STRUCTURE.fail(("units",), problem, file, text)
+    if (units_problem := check_units_field(data.get("units"))) is not None:
+        raise STRUCTURE.fail(("units",), units_problem, file, text)
     return dict(data)
 
 
@@ -371,7 +371,7 @@ class Trace:
             if value is None:
                 continue
             # A read-only view: the trace cannot change its arrays, and the caller's stay as they are.
-            array = np.asarray(value, dtype=dtype).view()
+            array: np.ndarray = np.asarray(value, dtype=dtype).view()
             shape = (len(t),) if ids is None else (len(t), len(getattr(self, ids)), *tail)
             if array.shape != shape:
                 raise ValueError(f"Trace.{name} must have the shape {shape}, got {array.shape}")
@@ -383,20 +383,47 @@ class Trace:
     # -- reading -----------------------------------------------------------------------------
 
     def ids(self, group: str) -> tuple[str, ...]:
-        """The ids of ``"robots"``, ``"humans"`` or ``"objects"``, in the order of their arrays."""
+        """The ids of ``"robots"``, ``"humans"`` or ``"objects"``, in the order of their arrays.
+
+        Parameters
+        ----------
+        group : {"robots", "humans", "objects"}
+            Which things.
+        """
         return {"robots": self.robot_ids, "humans": self.human_ids, "objects": self.object_ids}[group]
 
     def positions(self, group: str) -> np.ndarray:
-        """Positions ``(x, y)`` (mm) of ``"robots"``, ``"humans"`` or ``"objects"``: shape (n, N, 2)."""
-        return self.poses[:, :, :2] if group == "robots" else getattr(self, group)
+        """Positions ``(x, y)`` (mm) of ``"robots"``, ``"humans"`` or ``"objects"``: shape (n, N, 2).
+
+        Parameters
+        ----------
+        group : {"robots", "humans", "objects"}
+            Which things.
+        """
+        return self.poses[:, :, :2] if group == "robots" else cast(np.ndarray, getattr(self, group))
 
     def seen(self, group: str, every: int = 1) -> np.ndarray:
-        """Every position (mm) of `group` that a frame shows, every `every`-th frame: shape (m, 2)."""
+        """Every position (mm) of `group` that a frame shows, every `every`-th frame: shape (m, 2).
+
+        Parameters
+        ----------
+        group : {"robots", "humans", "objects"}
+            Which things.
+        every : int
+            Take every `every`-th frame (1: all).
+        """
         points = self.positions(group)[::every].reshape(-1, 2)
-        return points[~np.isnan(points[:, 0])]
+        shown: np.ndarray = points[~np.isnan(points[:, 0])]  # numpy types a masked index as Any
+        return shown
 
     def robots_at(self, k: int) -> dict[str, RobotState]:
-        """The robots frame `k` shows, in the order of :attr:`robot_ids`."""
+        """The robots frame `k` shows, in the order of :attr:`robot_ids`.
+
+        Parameters
+        ----------
+        k : int
+            The frame's index.
+        """
         poses = self.poses[k].tolist()
         carrying = self.carrying[k].tolist() if self.carrying is not None else [-1] * len(poses)
         waiting = self.waiting[k].tolist() if self.waiting is not None else [False] * len(poses)
@@ -407,12 +434,26 @@ class Trace:
         }
 
     def points_at(self, group: str, k: int) -> dict[str, tuple[float, float]]:
-        """Where frame `k` shows the ``"humans"`` or the ``"objects"`` (mm), by id."""
+        """Where frame `k` shows the ``"humans"`` or the ``"objects"`` (mm), by id.
+
+        Parameters
+        ----------
+        group : {"humans", "objects"}
+            Which things.
+        k : int
+            The frame's index.
+        """
         points = self.positions(group)[k].tolist()
         return {pid: (x, y) for pid, (x, y) in zip(self.ids(group), points, strict=True) if not math.isnan(x)}
 
     def carried_at(self, k: int) -> dict[str, str]:
-        """The objects carried in frame `k`: the carrier's id by object id."""
+        """The objects carried in frame `k`: the carrier's id by object id.
+
+        Parameters
+        ----------
+        k : int
+            The frame's index.
+        """
         return {s.carrying: rid for rid, s in self.robots_at(k).items() if s.carrying is not None}
 
     # -- the file -----------------------------------------------------------------------------
@@ -422,10 +463,11 @@ class Trace:
         return replace(
             self,
             t=_rounded(self.t, _TIME_DIGITS),
-            **{
-                name: _rounded(getattr(self, name), _LENGTH_DIGITS)
-                for name in ("poses", "v", "w", "humans", "objects")
-            },
+            poses=_rounded(self.poses, _LENGTH_DIGITS),
+            v=_rounded(self.v, _LENGTH_DIGITS),
+            w=_rounded(self.w, _LENGTH_DIGITS),
+            humans=_rounded(self.humans, _LENGTH_DIGITS),
+            objects=_rounded(self.objects, _LENGTH_DIGITS),
         )
 
     def to_json(self) -> dict[str, Any]:
@@ -471,6 +513,7 @@ class Trace:
                 self.awaits, self.yields_to,
             )
         )  # fmt: skip
+        assert poses is not None  # every trace has poses
         columns = {"pose": poses.tolist()}
         for key, array, to_json in (
             ("v", v, None),
@@ -551,7 +594,7 @@ class Trace:
             columns["primitive"] = _indices(columns["primitive"], index, len(robot_ids))
         human_ids = _first_seen(frames, "humans")
         return cls(
-            t=[float(frame["t"]) for frame in frames],
+            t=np.array([float(frame["t"]) for frame in frames], dtype=float),
             robot_ids=robot_ids,
             primitive_names=names,
             human_ids=human_ids,
@@ -572,6 +615,11 @@ class Trace:
         The frames are turned into JSON a block at a time, so that a long run is never all in
         memory as Python objects (a 50-robot run's 11,000 frames took some 500 MiB that way);
         the file's bytes are those of ``json.dumps(to_json())``.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The destination; its directory must exist.
         """
         exact = self.rounded()
         with (
@@ -597,6 +645,12 @@ def _compact(value: Any) -> str:
     return json.dumps(value, separators=(",", ":"))
 
 
+@overload
+def _rounded(values: np.ndarray, digits: int) -> np.ndarray: ...
+@overload
+def _rounded(values: None, digits: int) -> None: ...
+@overload
+def _rounded(values: np.ndarray | None, digits: int) -> np.ndarray | None: ...
 def _rounded(values: np.ndarray | None, digits: int) -> np.ndarray | None:
     """`values` rounded to `digits` decimals exactly as Python's :func:`round` rounds each float.
 

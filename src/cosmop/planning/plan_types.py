@@ -231,7 +231,7 @@ class Step:
         carried = [oid for oid, s in self.objects.items() if s.carried]
         if carried:
             notes.append("carrying " + ", ".join(carried))
-        if self.primitive == Primitive.DROPOFF and self.object in self.objects:
+        if self.primitive == Primitive.DROPOFF and self.object is not None and self.object in self.objects:
             notes.append(f"{self.object} at {_point(self.objects[self.object].position)}")
         away = [oid for oid, s in self.objects.items() if s.away]
         if away:
@@ -284,9 +284,18 @@ class RobotPlan:
 
     @classmethod
     def from_steps(cls, mission: Iterable[str | Event], steps: Iterable[Step]) -> RobotPlan:
-        """A plan whose horizon is the number of `steps`."""
+        """A plan whose horizon is the number of `steps`.
+
+        Parameters
+        ----------
+        mission : iterable of str or Event
+            The events the plan realises.
+        steps : iterable of Step
+            Instants 1 to K.
+        """
         steps = tuple(steps)
-        return cls(tuple(mission), len(steps), steps)
+        names = tuple(item.name if isinstance(item, Event) else item for item in mission)
+        return cls(names, len(steps), steps)
 
     @property
     def events(self) -> tuple[Event, ...]:
@@ -334,7 +343,13 @@ class RobotPlan:
 
     def to_text(self, times: Iterable[tuple[float, float]] | None = None) -> str:
         """The plan for people: one line per step, ``k  primitive  robot (x, y, heading°)  notes``,
-        with the step's expected ``start-end`` seconds after `k` when `times` are given."""
+        with the step's expected ``start-end`` seconds after `k` when `times` are given.
+
+        Parameters
+        ----------
+        times : iterable of (float, float), optional
+            Each step's expected ``(start, end)``, s (:attr:`Itinerary.times`).
+        """
         width = len(str(self.horizon))
         slots = [f"{a:7.1f}-{b:<7.1f}s  " for a, b in times] if times is not None else [""] * self.horizon
         return "\n".join(
@@ -400,12 +415,16 @@ class PlanMessage:
     @property
     def sender(self) -> str:
         """The robot that sends the message."""
-        return parse_event(self.event).sender
+        sender = parse_event(self.event).sender
+        assert sender is not None  # a msg event names its sender
+        return sender
 
     @property
     def receiver(self) -> str:
         """The robot that waits for it."""
-        return parse_event(self.event).receiver
+        receiver = parse_event(self.event).receiver
+        assert receiver is not None  # a msg event names its receiver
+        return receiver
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON form: ``{"event", "sender", "receiver", "kind", "protects"[, "place"]}``."""
@@ -520,13 +539,27 @@ class Itinerary:
         object.__setattr__(self, "times", MappingProxyType(times))
 
     def slot(self, robot: str, k: int) -> tuple[float, float]:
-        """``(start, end)`` of `robot`'s instant `k` (1..K), s."""
+        """``(start, end)`` of `robot`'s instant `k` (1..K), s.
+
+        Parameters
+        ----------
+        robot : str
+            The robot's id.
+        k : int
+            The instant, 1 to K.
+        """
         if not 1 <= k <= len(self.times[robot]):
             raise IndexError(f"{robot} has no instant {k}")
         return self.times[robot][k - 1]
 
     def end(self, robot: str) -> float:
-        """When `robot` is expected to have done its whole plan, s (0 for an empty plan)."""
+        """When `robot` is expected to have done its whole plan, s (0 for an empty plan).
+
+        Parameters
+        ----------
+        robot : str
+            The robot's id.
+        """
         slots = self.times[robot]
         return slots[-1][1] if slots else 0.0
 
@@ -629,6 +662,11 @@ class PlanSet:
         """`scenario` with the places of the added tasks as point workspaces.
 
         A place whose id the scenario already has is left out: the checker names that clash.
+
+        Parameters
+        ----------
+        scenario : Scenario
+            The scenario the plans are for.
         """
         scene = scenario.scene
         new = {t.workspace: Workspace(t.workspace, point=t.point) for t in self.added}

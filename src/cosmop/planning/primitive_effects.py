@@ -16,7 +16,7 @@ from typing import Any
 
 from cosmop.docking import in_front
 from cosmop.events import Event, Primitive
-from cosmop.planning.plan_types import ObjectState, Pose, RobotPlan, State, Step
+from cosmop.planning.plan_types import PRIMITIVES, ObjectState, Pose, RobotPlan, State, Step
 from cosmop.scene import Scene
 
 __all__ = ["Action", "initial_state", "plan_from_actions", "successor"]
@@ -64,7 +64,7 @@ def initial_state(
     steps = plan.steps if isinstance(plan, RobotPlan) else tuple(plan or ())
     if steps:
         if moved is None:
-            moved = {s.object for s in steps if s.primitive == Primitive.PICKUP}
+            moved = {s.object for s in steps if s.primitive == Primitive.PICKUP and s.object is not None}
         first = steps[0].objects
         for oid in moved:
             if oid in objects and oid in first:
@@ -111,22 +111,27 @@ def successor(
     -------
     Step
     """
+    if primitive not in PRIMITIVES:  # as Step says it
+        raise ValueError(f"unknown primitive {primitive!r}; expected one of {', '.join(PRIMITIVES)}")
+    kind = Primitive(primitive)
     robot = state.robot
     objects = dict(state.objects)
-    if primitive == Primitive.GOTO:
+    if kind == Primitive.GOTO:
         if to is None:
             raise ValueError("GoTo needs a target pose `to`")
         robot = to
     elif to is not None:
         raise ValueError(f"{primitive} does not move the robot; give no target pose")
-    elif primitive == Primitive.PICKUP:
+    elif obj is None:  # as Step says it
+        raise ValueError(f"{primitive} needs the object it acts on")
+    elif kind == Primitive.PICKUP:
         objects[obj] = ObjectState(objects[obj].position, carried=True, away=objects[obj].away)
-    elif primitive == Primitive.DROPOFF:
+    elif kind == Primitive.DROPOFF:
         gap = (scene.robots[robot_id].size + scene.objects[obj].size) / 2.0
         objects[obj] = ObjectState(_ahead(robot, gap), carried=False, away=objects[obj].away)
-    elif primitive == Primitive.REQ:
+    elif kind == Primitive.REQ:
         objects[obj] = ObjectState(objects[obj].position, carried=objects[obj].carried, away=True)
-    return Step(primitive, obj, robot, objects)
+    return Step(kind, obj, robot, objects)
 
 
 def _ahead(pose: Pose, gap: float) -> tuple[float, float]:
