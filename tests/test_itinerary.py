@@ -118,11 +118,15 @@ def _untimed(robot):
 @pytest.mark.parametrize(
     ("edit", "field", "words"),
     [
-        (_drop("end"), "robots.R1.steps[2]", "missing field 'end'"),
+        (_drop("end"), "robots.R1.steps[2].end", "missing required key 'end': expected a time (s)"),
         (_set("R1", 2, "end", 0.5), "robots.R1.steps[2].end", ">= the step's start"),
         (_set("R1", 3, "start", 1.0), "robots.R1.steps[3].start", "when the step before ends"),
         (_set("R1", 0, "start", -1), "robots.R1.steps[0].start", ">= 0"),
-        (_set("R1", 0, "start", "soon"), "robots.R1.steps[0].start", "expected a number"),
+        (
+            _set("R1", 0, "start", "soon"),
+            "robots.R1.steps[0].start",
+            "expected a time in seconds (the step's expected start), got 'soon'",
+        ),
         (_untimed("R2"), "robots.R2.steps", "as the other robots' steps have them"),
     ],
 )

@@ -63,7 +63,7 @@ def test_cli_view_writes_the_page_and_rejects_bad_input(tmp_path):
     bad = runner.invoke(
         app, ["view", str(EXAMPLE), "--trace", str(tmp_path / "bad.json"), "-o", str(tmp_path / "x.html")]
     )
-    assert bad.exit_code == 2 and "bad.json: format: expected 'cosmop.trace/1'" in bad.stderr
+    assert bad.exit_code == 2 and "bad.json: format: missing required key 'format'" in bad.stderr
     assert not (tmp_path / "x.html").exists()
 
 

@@ -19,6 +19,12 @@ every anchored value is known when it closes, so an alias adds that size without
 The YAML dialect is close to YAML 1.2's core schema: only ``true``/``false`` are booleans
 (``yes``, ``no``, ``on``, ``off``, ``y``, ``n`` stay text), integers are decimal, dates stay
 text, and a key repeated inside one mapping is an error instead of silently overriding.
+
+Once parsed, a file is checked against its format's :class:`Structure`: pydantic models (or
+TypedDicts) of the format and, per field, what it expects in words.  The first wrong field in
+the file's order is one line, ``<file>: <field>: expected <what>, got <what>`` (with its line
+and column when the JSON text is at hand); the plan files (:mod:`cosmop.planning.plan_file`)
+and the traces (:mod:`cosmop.traces`) are read so.
 """
 
 from __future__ import annotations
