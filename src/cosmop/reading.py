@@ -822,7 +822,14 @@ class Structure:
         self.root = root
         self.expected = dict(expected)
         self.error = error
-        self.adapter: TypeAdapter[Any] = TypeAdapter(root)
+        self._adapter: TypeAdapter[Any] | None = None  # built when first used: importing stays quick
+
+    @property
+    def adapter(self) -> TypeAdapter[Any]:
+        """The pydantic validator of the root type."""
+        if self._adapter is None:
+            self._adapter = TypeAdapter(self.root)
+        return self._adapter
 
     def validate(self, data: Any, file: str | None = None, text: str | None = None) -> Any:
         """`data` validated as the root type; the first wrong field in file order fails.
