@@ -750,6 +750,8 @@ def first_in_data(errors: Sequence[ErrorDetails], data: Any) -> ErrorDetails:
     def where(loc: tuple[int | str, ...]) -> tuple[int, ...]:
         out, node = [], data
         for part in loc:
+            if part == "[key]":  # a mapping's key: where its entry is
+                break
             if isinstance(node, Mapping):
                 order = orders.get(id(node))
                 if order is None:
