@@ -91,7 +91,7 @@ def child(workload: str, plans_dir: str) -> dict:
         t0 = time.perf_counter()
         plans = plan_team(sc).plans
         return {"s": time.perf_counter() - t0, "out": _digest(plans.to_dict())}
-    from cosmop.planning.plan import load_plan
+    from cosmop.planning.plan_file import load_plan
     from cosmop.sim import simulate
 
     if workload == "simulate":

@@ -6,7 +6,8 @@ from __future__ import annotations
 from functools import lru_cache
 from pathlib import Path
 
-from cosmop.planning.plan import Coordination, PlanSet, plan_from_actions
+from cosmop.planning.plan_types import Coordination, PlanSet
+from cosmop.planning.primitive_effects import plan_from_actions
 from cosmop.scenario import load_scenario
 from cosmop.scene import Scenario
 from handmade_plans import R1_ACTIONS, R1_MISSION, R2_RES_ACTIONS, R2_RES_MISSION

@@ -15,7 +15,9 @@ from shapely import LineString
 from cosmop.events import parse_event
 from cosmop.planning.aside import ROOM, place_aside
 from cosmop.planning.checker import check_plan
-from cosmop.planning.plan import AddedTask, PlanError, PlanSet, load_plan, plan_from_actions
+from cosmop.planning.plan_file import PlanError, load_plan
+from cosmop.planning.plan_types import AddedTask, PlanSet
+from cosmop.planning.primitive_effects import plan_from_actions
 from cosmop.scenario import parse_scenario
 from cosmop.sim.simulation import simulate
 from cosmop.squares import square, swept_square

@@ -32,7 +32,7 @@ from cosmop.planning import (
     square,
     swept_square,
 )
-from cosmop.planning.plan import PlanMessage
+from cosmop.planning.plan_types import PlanMessage
 from cosmop.planning.teamsafety import make_team_safe
 from cosmop.scenario import load_scenario, parse_scenario
 

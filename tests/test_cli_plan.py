@@ -10,7 +10,7 @@ from typer.testing import CliRunner
 
 from cosmop.cli import app
 from cosmop.planning.checker import check_plan
-from cosmop.planning.plan import load_plan
+from cosmop.planning.plan_file import load_plan
 from cosmop.scenario import load_scenario
 
 ROOT = Path(__file__).resolve().parents[1]

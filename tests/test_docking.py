@@ -13,7 +13,7 @@ import pytest
 from cosmop.docking import SIDES, docking_pose, facing, in_front
 from cosmop.errors import ScenarioError
 from cosmop.planning.checker import check_robot_plan
-from cosmop.planning.plan import PlanSet
+from cosmop.planning.plan_types import PlanSet
 from cosmop.planning.synthesis import synthesize
 from cosmop.scenario import parse_scenario
 from cosmop.sim.simulation import SimSettings, simulate

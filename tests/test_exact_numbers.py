@@ -14,7 +14,8 @@ import pytest
 
 from cosmop.errors import ScenarioError
 from cosmop.planning.checker import check_robot_plan
-from cosmop.planning.plan import State, initial_state
+from cosmop.planning.plan_types import State
+from cosmop.planning.primitive_effects import initial_state
 from cosmop.planning.specification import position_sort
 from cosmop.planning.synthesis import synthesize
 from cosmop.scenario import load_scenario

@@ -18,7 +18,7 @@ def test_import_cosmop_loads_nothing_until_a_verb_is_used():
 
 
 def test_the_result_types_are_the_layers_own():
-    from cosmop.planning.plan import PlanSet
+    from cosmop.planning.plan_types import PlanSet
     from cosmop.planning.report import CheckReport
     from cosmop.scene import Scenario
     from cosmop.sim import SimResult

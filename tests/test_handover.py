@@ -12,7 +12,8 @@ from cosmop.errors import ScenarioError
 from cosmop.events import Primitive, parse_event
 from cosmop.missions.handover import handovers
 from cosmop.planning.checker import check_plan
-from cosmop.planning.plan import PlanMessage, PlanSet, RobotPlan, Step, plan_from_actions
+from cosmop.planning.plan_types import PlanMessage, PlanSet, RobotPlan, Step
+from cosmop.planning.primitive_effects import plan_from_actions
 from cosmop.planning.synthesis import synthesize
 from cosmop.scenario import load_scenario, parse_scenario
 from cosmop.team.loop import plan_team

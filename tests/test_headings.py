@@ -19,7 +19,9 @@ from typer.testing import CliRunner
 from cosmop.cli import app
 from cosmop.errors import ScenarioError
 from cosmop.planning.checker import check_plan, check_robot_plan
-from cosmop.planning.plan import State, initial_state, load_plan
+from cosmop.planning.plan_file import load_plan
+from cosmop.planning.plan_types import State
+from cosmop.planning.primitive_effects import initial_state
 from cosmop.planning.specification import RobotProblem, heading_sort
 from cosmop.planning.synthesis import synthesize
 from cosmop.scenario import load_scenario

@@ -26,7 +26,8 @@ from typer.testing import CliRunner
 from cosmop.cli import app
 from cosmop.errors import CosmopInputError, ScenarioError
 from cosmop.planning.checker import check_plan
-from cosmop.planning.plan import MAX_STEPS, PlanError, PlanSet, load_plan
+from cosmop.planning.plan_file import PlanError, load_plan
+from cosmop.planning.plan_types import MAX_STEPS, PlanSet
 from cosmop.planning.synthesis import synthesize
 from cosmop.reading import (
     MAX_DEPTH,

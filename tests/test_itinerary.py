@@ -18,7 +18,8 @@ from typer.testing import CliRunner
 from cosmop.cli import app
 from cosmop.errors import CosmopInputError
 from cosmop.planning.checker import check_plan
-from cosmop.planning.plan import Itinerary, PlanError, PlanSet, load_plan
+from cosmop.planning.plan_file import PlanError, load_plan
+from cosmop.planning.plan_types import Itinerary, PlanSet
 from cosmop.planning.realisation import message_links
 from cosmop.planning.timing import durations, itinerary
 from cosmop.scenario import load_scenario
@@ -117,11 +118,15 @@ def _untimed(robot):
 @pytest.mark.parametrize(
     ("edit", "field", "words"),
     [
-        (_drop("end"), "robots.R1.steps[2]", "missing field 'end'"),
+        (_drop("end"), "robots.R1.steps[2].end", "missing required key 'end': expected a time (s)"),
         (_set("R1", 2, "end", 0.5), "robots.R1.steps[2].end", ">= the step's start"),
         (_set("R1", 3, "start", 1.0), "robots.R1.steps[3].start", "when the step before ends"),
         (_set("R1", 0, "start", -1), "robots.R1.steps[0].start", ">= 0"),
-        (_set("R1", 0, "start", "soon"), "robots.R1.steps[0].start", "expected a number"),
+        (
+            _set("R1", 0, "start", "soon"),
+            "robots.R1.steps[0].start",
+            "expected a time in seconds (the step's expected start), got 'soon'",
+        ),
         (_untimed("R2"), "robots.R2.steps", "as the other robots' steps have them"),
     ],
 )

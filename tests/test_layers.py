@@ -107,7 +107,7 @@ def test_an_upward_import_is_seen() -> None:
         "from ..viz import plans\n"
         "from cosmop import cli\n"
     )
-    found = _upward(source, "cosmop.planning.plan")
+    found = _upward(source, "cosmop.planning.plan_types")
     assert [line.split(":")[0] for line in found] == ["line 3", "line 4", "line 5"]
     assert _upward(source, "cosmop.lifelong.fleet") == [
         "line 5: cosmop.lifelong.fleet (layer 7) imports cosmop.cli (layer 8)"

@@ -19,7 +19,7 @@ from cosmop.automata import DFA
 from cosmop.planning import obstacles
 from cosmop.planning.checker import check_robot_plan
 from cosmop.planning.obstacles import obstacle_of
-from cosmop.planning.plan import State
+from cosmop.planning.plan_types import State
 from cosmop.planning.synthesis import synthesize
 from cosmop.scenario import load_scenario, parse_scenario
 from rooms import branching_words, room, shelves

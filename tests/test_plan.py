@@ -248,55 +248,179 @@ def _set(data: dict[str, Any], path: tuple, value: Any) -> None:
 _DELETE = object()
 _STEP = ("robots", "R1", "steps")
 
+_NUMBER = "expected a finite number, got"
+_ID = "([A-Za-z_][A-Za-z0-9_-]*)"
+
+# the field, then the start of the message after it (the whole of it, but for long event errors)
 BAD_FILES = [
-    (("format",), "cosmop.plan/2", "format", "unknown format 'cosmop.plan/2'; expected 'cosmop.plan/1'"),
-    (("format",), _DELETE, None, "missing field 'format'"),
-    (("feasible",), "true", "feasible", "expected true or false, got a string 'true'"),
-    (("feasible",), False, "reason", "an infeasible plan needs a reason"),
-    (("robots",), [], "robots", "expected a JSON object of plans by robot id, got a list"),
-    ((*_STEP, 3, "primitive"), "Goto", "robots.R1.steps[3].primitive", "unknown primitive a string 'Goto'"),
-    ((*_STEP, 2, "object"), None, "robots.R1.steps[2].object", "PickUp needs the id of the object"),
-    ((*_STEP, 2, "object"), _DELETE, "robots.R1.steps[2].object", "PickUp needs the id of the object"),
-    ((*_STEP, 0, "object"), _DELETE, "robots.R1.steps[0].object", "Req needs the id of the object"),
-    ((*_STEP, 1, "object"), "O1", "robots.R1.steps[1].object", "GoTo acts on no object; expected null"),
+    (
+        ("format",),
+        "cosmop.plan/2",
+        "format",
+        "expected 'cosmop.plan/1', the plan file format, got 'cosmop.plan/2'",
+    ),
+    (
+        ("format",),
+        _DELETE,
+        "format",
+        "missing required key 'format': expected 'cosmop.plan/1', the plan file format",
+    ),
+    (("feasible",), "true", "feasible", "expected true or false (whether a plan was found), got 'true'"),
+    (
+        ("feasible",),
+        False,
+        "reason",
+        "expected a reason a person can act on (the plan is infeasible), got nothing",
+    ),
+    (
+        ("robots",),
+        [],
+        "robots",
+        "expected a mapping from robot ids to plans {mission, horizon, steps}, got []",
+    ),
+    (
+        (*_STEP, 3, "primitive"),
+        "Goto",
+        "robots.R1.steps[3].primitive",
+        "expected one of GoTo, PickUp, DropOff, Req, Res, got 'Goto'",
+    ),
+    (
+        (*_STEP, 2, "object"),
+        None,
+        "robots.R1.steps[2].object",
+        "expected the id of the object PickUp acts on, got nothing (null)",
+    ),
+    (
+        (*_STEP, 2, "object"),
+        _DELETE,
+        "robots.R1.steps[2].object",
+        "expected the id of the object PickUp acts on, got nothing",
+    ),
+    (
+        (*_STEP, 0, "object"),
+        _DELETE,
+        "robots.R1.steps[0].object",
+        "expected the id of the object Req acts on, got nothing",
+    ),
+    (
+        (*_STEP, 1, "object"),
+        "O1",
+        "robots.R1.steps[1].object",
+        "expected null (GoTo acts on no object), got 'O1'",
+    ),
     (
         (*_STEP, 2, "object"),
         "O9",
         "robots.R1.steps[2].object",
-        "'O9' is not among the step's objects (O1, O2)",
+        "expected one of the step's objects (O1, O2), got 'O9'",
     ),
-    (("robots", "R1", "horizon"), 6, "robots.R1.horizon", "the horizon is 6 but there are 7 steps"),
-    (("robots", "R1", "horizon"), 7.0, "robots.R1.horizon", "expected a non-negative integer"),
-    (("robots", "R1", "horizon"), True, "robots.R1.horizon", "expected a non-negative integer"),
-    ((*_STEP, 0, "robot"), [1, 2], "robots.R1.steps[0].robot", "expected a list [x, y, heading]"),
-    ((*_STEP, 0, "robot"), "here", "robots.R1.steps[0].robot", "expected a list [x, y, heading]"),
-    ((*_STEP, 0, "robot", 2), None, "robots.R1.steps[0].robot[2]", "expected a number, got null"),
-    ((*_STEP, 0, "robot", 0), True, "robots.R1.steps[0].robot[0]", "expected a number, got a boolean"),
+    (("robots", "R1", "horizon"), 6, "robots.R1.horizon", "expected the number of steps, 7, got 6"),
+    (
+        ("robots", "R1", "horizon"),
+        7.0,
+        "robots.R1.horizon",
+        "expected the number of steps, an integer >= 0, got 7.0",
+    ),
+    (
+        ("robots", "R1", "horizon"),
+        True,
+        "robots.R1.horizon",
+        "expected the number of steps, an integer >= 0, got true",
+    ),
+    (
+        (*_STEP, 0, "robot"),
+        [1, 2],
+        "robots.R1.steps[0].robot",
+        "expected a list [x, y, heading] (mm, mm, degrees), got [1, 2]",
+    ),
+    (
+        (*_STEP, 0, "robot"),
+        "here",
+        "robots.R1.steps[0].robot",
+        "expected a list [x, y, heading] (mm, mm, degrees), got 'here'",
+    ),
+    ((*_STEP, 0, "robot", 2), None, "robots.R1.steps[0].robot[2]", f"{_NUMBER} nothing (null)"),
+    ((*_STEP, 0, "robot", 0), True, "robots.R1.steps[0].robot[0]", f"{_NUMBER} true"),
     (
         (*_STEP, 4, "objects", "O1", "position"),
         [1],
         "robots.R1.steps[4].objects.O1.position",
-        "expected a list [x, y] (mm), got 1 number(s)",
+        "expected a list [x, y] (mm), got [1]",
     ),
     (
         (*_STEP, 4, "objects", "O1", "carried"),
         "yes",
         "robots.R1.steps[4].objects.O1.carried",
-        "true or false",
+        "expected true or false (whether this robot carries it), got 'yes'",
     ),
-    ((*_STEP, 4, "objects", "O1", "away"), _DELETE, "robots.R1.steps[4].objects.O1", "missing field 'away'"),
-    ((*_STEP, 4, "objects"), [], "robots.R1.steps[4].objects", "expected a JSON object of object states"),
-    ((*_STEP, 0, "colour"), "red", "robots.R1.steps[0].colour", "unknown field 'colour'"),
-    ((*_STEP, 0), "GoTo", "robots.R1.steps[0]", "expected a JSON object, got a string 'GoTo'"),
-    (("robots", "R1", "steps"), {}, "robots.R1.steps", "expected a list of steps"),
-    (("robots", "R1", "mission", 1), "grab(R1,O1)", "robots.R1.mission[1]", "unknown event kind 'grab'"),
-    (("robots", "R1", "mission", 1), 7, "robots.R1.mission[1]", "expected an event such as 'pick(R1,O1)'"),
-    (("robots", "R1", "mission"), "pick(R1,O1)", "robots.R1.mission", "expected a list of events"),
-    (("robots", "R1", "extra"), 1, "robots.R1.extra", "unknown field 'extra'"),
-    (("robots", "R1 x"), {}, "robots['R1 x']", "is not a valid robot id"),
-    (("coordination",), {}, "coordination", "expected a list"),
-    (("coordination", 0, "responder"), "R1", "coordination[0].responder", "must differ from the requester"),
-    (("coordination", 0, "object"), _DELETE, "coordination[0]", "missing field 'object'"),
+    (
+        (*_STEP, 4, "objects", "O1", "away"),
+        _DELETE,
+        "robots.R1.steps[4].objects.O1.away",
+        "missing required key 'away': expected true or false (whether another robot has moved it away)",
+    ),
+    (
+        (*_STEP, 4, "objects"),
+        [],
+        "robots.R1.steps[4].objects",
+        "expected a mapping from object ids to states {position, carried, away}, got []",
+    ),
+    (
+        (*_STEP, 0, "colour"),
+        "red",
+        "robots.R1.steps[0].colour",
+        "unknown key 'colour'; expected one of: primitive, object, message, start, end, robot, objects",
+    ),
+    (
+        (*_STEP, 0),
+        "GoTo",
+        "robots.R1.steps[0]",
+        "expected a step {primitive, object, robot, objects}, got 'GoTo'",
+    ),
+    (("robots", "R1", "steps"), {}, "robots.R1.steps", "expected a list of at most 1,000 steps, got {}"),
+    (
+        ("robots", "R1", "mission", 1),
+        "grab(R1,O1)",
+        "robots.R1.mission[1]",
+        "invalid event 'grab(R1,O1)': unknown event kind 'grab'; accepted forms: pick(R,O);",
+    ),
+    (
+        ("robots", "R1", "mission", 1),
+        7,
+        "robots.R1.mission[1]",
+        "expected an event such as 'pick(R1,O1)' (text), got 7",
+    ),
+    (
+        ("robots", "R1", "mission"),
+        "pick(R1,O1)",
+        "robots.R1.mission",
+        "expected a list of events such as 'pick(R1,O1)', got 'pick(R1,O1)'",
+    ),
+    (
+        ("robots", "R1", "extra"),
+        1,
+        "robots.R1.extra",
+        "unknown key 'extra'; expected one of: mission, horizon, steps",
+    ),
+    (("robots", "R1 x"), {}, "robots['R1 x']", f"expected a robot id {_ID}, got 'R1 x'"),
+    (
+        ("coordination",),
+        {},
+        "coordination",
+        "expected a list of pairs {object, requester, responder}, got {}",
+    ),
+    (
+        ("coordination", 0, "responder"),
+        "R1",
+        "coordination[0].responder",
+        "expected a robot other than the requester 'R1', got 'R1'",
+    ),
+    (
+        ("coordination", 0, "object"),
+        _DELETE,
+        "coordination[0].object",
+        f"missing required key 'object': expected an object id {_ID}",
+    ),
 ]
 
 
@@ -313,9 +437,9 @@ def test_bad_plan_files_name_file_field_and_expectation(
     err = info.value
     assert isinstance(err, CosmopInputError)
     assert (err.file, err.field) == (str(file), field)
-    assert fragment in err.expected
-    prefix = f"{file}: {field}: " if field else f"{file}: "
-    assert str(err).startswith(prefix)
+    assert err.expected.startswith(fragment)
+    (line,) = str(err).splitlines()  # one line: the file, the field, what was expected and found
+    assert line.startswith(f"{file}: {field}: {fragment}")
 
 
 def test_from_dict_without_a_file() -> None:
@@ -324,8 +448,7 @@ def test_from_dict_without_a_file() -> None:
     with pytest.raises(PlanError) as info:
         PlanSet.from_dict(data)
     assert str(info.value) == (
-        "robots.R1.steps[3].primitive: unknown primitive a string 'Fly'; "
-        "expected one of GoTo, PickUp, DropOff, Req, Res"
+        "robots.R1.steps[3].primitive: expected one of GoTo, PickUp, DropOff, Req, Res, got 'Fly'"
     )
 
 
@@ -334,7 +457,12 @@ def test_from_dict_without_a_file() -> None:
     [
         ('{"format": "cosmop.plan/1",\n "scenario": }', "invalid JSON: Expecting value", 2),
         ("", "the file is empty", None),
-        ("[1, 2]", "expected a JSON object, got a list", None),
+        (
+            "[1, 2]",
+            "expected a JSON object with keys format, scenario, feasible, robots (a cosmop.plan/1 file), "
+            "got [1, 2]",
+            None,
+        ),
         # a value the parser refuses: the field and its line are named
         ('{"format": "cosmop.plan/1",\n "format": "x"}', "format: invalid JSON: duplicate key 'format'", 2),
         ('{"a": NaN}', "a: invalid JSON: NaN is not a number", 1),

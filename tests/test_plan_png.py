@@ -6,7 +6,8 @@ from __future__ import annotations
 import pytest
 
 pytest.importorskip("matplotlib")
-from cosmop.planning.plan import PlanMessage, PlanSet, RobotPlan, Step, plan_from_actions
+from cosmop.planning.plan_types import PlanMessage, PlanSet, RobotPlan, Step
+from cosmop.planning.primitive_effects import plan_from_actions
 from cosmop.scenario import parse_scenario
 from cosmop.viz import draw_plan
 from cosmop.viz.labels import Label, place_labels

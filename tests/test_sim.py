@@ -386,7 +386,8 @@ def test_robot_stopped_beside_its_waypoint_creeps_back_onto_the_segment():
     # robot starts 14 mm below the drive's start, within the tolerance of its first waypoint:
     # the straight way from where it stands runs into the block's corner, so it must first
     # creep back onto the segment -- aiming along the path, it would stand there for ever.
-    from cosmop.planning.plan import PlanSet, plan_from_actions
+    from cosmop.planning.plan_types import PlanSet
+    from cosmop.planning.primitive_effects import plan_from_actions
     from cosmop.scenario import parse_scenario
 
     box = [[-2000, -1500], [0, -1500], [0, 0], [-2000, 0]]

@@ -19,7 +19,7 @@ from cosmop.events import message, parse_event
 from cosmop.missions.mission import GlobalMission
 from cosmop.missions.precedence import Precedence
 from cosmop.planning.conflicts import conflicts, is_ordered, occupancies
-from cosmop.planning.plan import load_plan
+from cosmop.planning.plan_file import load_plan
 from cosmop.planning.realisation import message_links
 from cosmop.scenario import load_scenario, parse_scenario
 from cosmop.sim import simulate
@@ -175,7 +175,7 @@ def test_a_replan_mid_run_is_ordered_again(corridor):
 
 
 def _initial(scenario, robot):
-    from cosmop.planning.plan import initial_state
+    from cosmop.planning.primitive_effects import initial_state
 
     return initial_state(scenario.scene, robot)
 

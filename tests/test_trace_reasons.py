@@ -10,7 +10,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from cosmop.planning.plan import PlanMessage
+from cosmop.planning.plan_types import PlanMessage
 from cosmop.scenario import load_scenario
 from cosmop.traces import Trace, TraceError, load_trace
 from cosmop.viz.explain import Explainer, waiting_words
@@ -55,7 +55,7 @@ def test_reasons_and_replans_survive_the_file_and_are_left_out_when_null(tmp_pat
         (lambda d: d["frames"][0]["robots"]["R1"].update(awaits=3), "frames[0].robots.R1.awaits"),
         (lambda d: d["frames"][1]["robots"]["R2"].update(yields_to=[]), "frames[1].robots.R2.yields_to"),
         (lambda d: d.update(replans={}), "replans"),
-        (lambda d: d.update(replans=[{"t": 1, "robot": "R1"}]), "replans[0]"),
+        (lambda d: d.update(replans=[{"t": 1, "robot": "R1"}]), "replans[0].route"),
         (
             lambda d: d.update(replans=[{"t": 1, "robot": "R1", "route": {"from": [0, 0], "steps": []}}]),
             "replans[0].route.from",
@@ -66,7 +66,7 @@ def test_reasons_and_replans_survive_the_file_and_are_left_out_when_null(tmp_pat
                     {"t": 1, "robot": "R1", "route": {"from": [0, 0, 0], "steps": [{"pose": [0, 0, 0]}]}}
                 ]
             ),
-            "replans[0].route.steps[0]",
+            "replans[0].route.steps[0].primitive",
         ),
     ],
 )

@@ -63,7 +63,7 @@ def test_cli_view_writes_the_page_and_rejects_bad_input(tmp_path):
     bad = runner.invoke(
         app, ["view", str(EXAMPLE), "--trace", str(tmp_path / "bad.json"), "-o", str(tmp_path / "x.html")]
     )
-    assert bad.exit_code == 2 and "bad.json: format: expected 'cosmop.trace/1'" in bad.stderr
+    assert bad.exit_code == 2 and "bad.json: format: missing required key 'format'" in bad.stderr
     assert not (tmp_path / "x.html").exists()
 
 
@@ -313,7 +313,7 @@ def test_a_standing_robot_says_why_and_a_replan_redraws_its_path(big_map):
 def test_a_metres_file_is_shown_in_metres_on_the_page():
     from dataclasses import replace
 
-    from cosmop.planning.plan import load_plan
+    from cosmop.planning.plan_file import load_plan
     from cosmop.scenario import load_scenario
 
     plans = load_plan(Path(__file__).resolve().parent / "data" / "plan_2x2.json")

@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from cosmop.planning.checker import CheckReport
-    from cosmop.planning.plan import PlanSet
+    from cosmop.planning.plan_types import PlanSet
     from cosmop.scene import Scenario
     from cosmop.sim import SimResult, SimSettings
     from cosmop.team.loop import TeamResult
@@ -49,7 +49,7 @@ __all__ = [
 # the result types, imported when first named (``cosmop.PlanSet``)
 _TYPES = {
     "CheckReport": "cosmop.planning.checker",
-    "PlanSet": "cosmop.planning.plan",
+    "PlanSet": "cosmop.planning.plan_types",
     "Scenario": "cosmop.scene",
     "SimResult": "cosmop.sim",
     "TeamResult": "cosmop.team.loop",

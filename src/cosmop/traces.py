@@ -15,7 +15,10 @@ keys are kept as they are, so new kinds of message pass through) and ``replans``
 none: each accepted replan's ``t``, ``robot`` and ``route``, where the robot went on from and
 the steps it had left).  A robot state leaves out ``awaits`` (the message it waits for) and
 ``yields_to`` (the robot or person it gives way to) when they are null.  :func:`check_trace`
-checks that shape and names the first field that is wrong.
+checks that shape (the TypedDicts below, :data:`STRUCTURE`) and names, in one line, the file,
+the first field that is wrong, what was expected there and what it is::
+
+    run.json: frames[3].robots.R1.v: expected a speed (mm/s), got 'fast' (line 1, column 512)
 """
 
 from __future__ import annotations
@@ -26,20 +29,30 @@ import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from types import MappingProxyType
-from typing import Any
+from typing import Annotated, Any, Literal, NotRequired, cast, overload
 
 import numpy as np
+from pydantic import Field
+from typing_extensions import TypedDict
 
 from cosmop.errors import CosmopInputError
 from cosmop.io import atomic_path, collector_paused, read_text
-from cosmop.reading import load_json
+from cosmop.reading import Structure, load_json, show
 from cosmop.units import INTERNAL_UNITS, check_units_field
 
 __all__ = [
+    "STRUCTURE",
     "TRACE_FORMAT",
+    "FrameModel",
+    "MessageModel",
+    "ReplanModel",
     "RobotState",
+    "RobotStateModel",
+    "RouteModel",
+    "RouteStepModel",
     "Trace",
     "TraceError",
+    "TraceFileModel",
     "as_trace",
     "check_trace",
     "load_trace",
@@ -64,114 +77,166 @@ def _is_number(value: Any) -> bool:
     return isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
 
 
-def _is_name(value: Any) -> bool:
-    return value is None or isinstance(value, str)
+# ----------------------------------------------------------------------------------------------
+# The file's structure
+# ----------------------------------------------------------------------------------------------
+# TypedDicts, not models: a long run has millions of robot states, and pydantic validates a dict
+# in less than half the time of a model instance.  Keys a mapping has beyond these are let
+# through (a trace written by a newer or another tool may say more).
+
+_Number = Annotated[float, Field(strict=True, allow_inf_nan=False)]
+_Text = Annotated[str, Field(strict=True)]
+_Flag = Annotated[bool, Field(strict=True)]
+_Pose = tuple[_Number, _Number, _Number]
+_Point = tuple[_Number, _Number]
 
 
-_STATE_KEYS = {  # the optional keys of a robot's state in a frame: a test and what it expects
-    "v": (_is_number, "a speed (mm/s)"),
-    "w": (_is_number, "a turning rate (deg/s)"),
-    "carrying": (_is_name, "the id of the object carried, or null"),
-    "primitive": (_is_name, "the name of a primitive, or null"),
-    "waiting": (lambda value: isinstance(value, bool), "true or false"),
-    "delayed": (lambda value: isinstance(value, bool), "true or false"),
-    "awaits": (_is_name, "the name of the message the robot waits for, or null"),
-    "yields_to": (_is_name, "the id of the robot or person the robot gives way to, or null"),
+class RobotStateModel(TypedDict):
+    """A robot in a frame: its pose, and what the trace says about it besides."""
+
+    pose: _Pose
+    v: NotRequired[_Number]
+    w: NotRequired[_Number]
+    carrying: NotRequired[_Text | None]
+    primitive: NotRequired[_Text | None]
+    waiting: NotRequired[_Flag]
+    delayed: NotRequired[_Flag]
+    awaits: NotRequired[_Text | None]
+    yields_to: NotRequired[_Text | None]
+
+
+class FrameModel(TypedDict):
+    """A frame: its time (s), and where the robots, people and objects are."""
+
+    t: _Number
+    robots: NotRequired[dict[str, RobotStateModel]]
+    humans: NotRequired[dict[str, _Point]]
+    objects: NotRequired[dict[str, _Point]]
+
+
+MessageModel = TypedDict("MessageModel", {"t": _Number, "from": _Text, "to": _Text})
+"""A message: its time (s), sender and receiver (other keys pass through as they are)."""
+
+
+class RouteStepModel(TypedDict):
+    """A step of a replanned route."""
+
+    pose: _Pose
+    primitive: _Text
+    about: NotRequired[_Text | None]
+
+
+RouteModel = TypedDict("RouteModel", {"from": _Pose, "steps": list[RouteStepModel]})
+"""A replanned route: the pose the robot went on from, and the steps it had left."""
+
+
+class ReplanModel(TypedDict):
+    """An accepted replan: its time (s), the robot and its route."""
+
+    t: _Number
+    robot: _Text
+    route: RouteModel
+
+
+class TraceFileModel(TypedDict):
+    """The whole trace file."""
+
+    format: Literal["cosmop.trace/1"]  # TRACE_FORMAT
+    scenario: NotRequired[_Text | None]
+    units: NotRequired[Any]  # cosmop.units.check_units_field says what it must be
+    dt: NotRequired[Annotated[float, Field(strict=True, allow_inf_nan=False, gt=0)]]
+    frames: Annotated[list[FrameModel], Field(min_length=1)]
+    messages: NotRequired[list[MessageModel]]
+    replans: NotRequired[list[ReplanModel]]
+
+
+_POSE = "[x, y, heading] (mm, mm, degrees)"
+_ROBOT = ("frames", "#", "robots", "*")
+_STEP = ("replans", "#", "route", "steps", "#")
+
+EXPECTED: dict[tuple[str, ...], str] = {
+    (): f"a JSON object with keys format, frames (a {TRACE_FORMAT} file)",
+    ("format",): f"{TRACE_FORMAT!r}, the trace file format",
+    ("scenario",): "the scenario's name (text), or null",
+    ("dt",): "the cycle in seconds (a positive number)",
+    ("frames",): "a non-empty list of frames",
+    ("frames", "#"): "a frame {t, robots, humans, objects}",
+    ("frames", "#", "t"): "the frame's time t (s), a finite number",
+    ("frames", "#", "robots"): "a mapping of robot states by id",
+    _ROBOT: "a robot state {pose, v, w, carrying, primitive, waiting, delayed, awaits, yields_to}",
+    (*_ROBOT, "pose"): _POSE,
+    (*_ROBOT, "pose", "#"): "a finite number",
+    (*_ROBOT, "v"): "a speed (mm/s)",
+    (*_ROBOT, "w"): "a turning rate (deg/s)",
+    (*_ROBOT, "carrying"): "the id of the object carried, or null",
+    (*_ROBOT, "primitive"): "the name of a primitive, or null",
+    (*_ROBOT, "waiting"): "true or false",
+    (*_ROBOT, "delayed"): "true or false",
+    (*_ROBOT, "awaits"): "the name of the message the robot waits for, or null",
+    (*_ROBOT, "yields_to"): "the id of the robot or person the robot gives way to, or null",
+    **{("frames", "#", group): "a mapping of positions [x, y] (mm) by id" for group in ("humans", "objects")},
+    **{("frames", "#", group, "*"): "a position [x, y] (mm)" for group in ("humans", "objects")},
+    **{("frames", "#", group, "*", "#"): "a finite number (mm)" for group in ("humans", "objects")},
+    ("messages",): "a list of messages",
+    ("messages", "#"): "a message {t, from, to, ...}",
+    ("messages", "#", "t"): "the message's time t (s), a finite number",
+    ("messages", "#", "from"): "the id of the robot that sent it",
+    ("messages", "#", "to"): "the id of the robot it was sent to",
+    ("replans",): "a list of replans",
+    ("replans", "#"): "a replan {t, robot, route}",
+    ("replans", "#", "t"): "the replan's time t (s), a finite number",
+    ("replans", "#", "robot"): "the id of the robot replanned",
+    ("replans", "#", "route"): "a route {from, steps}",
+    ("replans", "#", "route", "from"): _POSE,
+    ("replans", "#", "route", "from", "#"): "a finite number",
+    ("replans", "#", "route", "steps"): "a list of steps",
+    _STEP: "a step {pose, primitive, about}",
+    (*_STEP, "pose"): _POSE,
+    (*_STEP, "pose", "#"): "a finite number",
+    (*_STEP, "primitive"): "the name of a primitive",
+    (*_STEP, "about"): "the object or message the step is about, or null",
 }
+"""What each field of a trace file expects, in words (patterns as :class:`cosmop.reading.Structure`'s)."""
+
+STRUCTURE = Structure(TraceFileModel, EXPECTED, TraceError)
+"""The trace file's structure: its TypedDicts, its words, and :class:`TraceError`."""
+
+_STATE_KEYS = frozenset(RobotStateModel.__annotations__) - {"pose"}  # all but the pose: optional
 _SPARSE_KEYS = ("awaits", "yields_to")  # written only where not null: most robots wait for nothing
 
 
-def _check_frame(frame: Any, k: int, fail) -> None:
-    if not isinstance(frame, Mapping) or not _is_number(frame.get("t")):
-        fail(f"frames[{k}]", "a mapping with a time t (s)")
-    robots = frame.get("robots", {})
-    if not isinstance(robots, Mapping):
-        fail(f"frames[{k}].robots", "a mapping of robot states by id")
-    for rid, state in robots.items():
-        pose = state.get("pose") if isinstance(state, Mapping) else None
-        if not (isinstance(pose, list) and len(pose) == 3 and all(_is_number(v) for v in pose)):
-            fail(f"frames[{k}].robots.{rid}.pose", "[x, y, heading] (mm, mm, degrees)")
-        for key, (test, expected) in _STATE_KEYS.items():
-            if key in state and not test(state[key]):
-                fail(f"frames[{k}].robots.{rid}.{key}", expected)
-    for group in ("humans", "objects"):
-        points = frame.get(group, {})
-        if not isinstance(points, Mapping) or not all(
-            isinstance(p, list) and len(p) == 2 and all(_is_number(v) for v in p) for p in points.values()
-        ):
-            fail(f"frames[{k}].{group}", "a mapping of positions [x, y] (mm) by id")
+def _check(data: Any, file: str | None, text: str | None) -> dict[str, Any]:
+    """`data` as a dict once its shape is checked (the file's `text`, if given, for the line)."""
+    if isinstance(data, Mapping) and "format" in data and data["format"] != TRACE_FORMAT:
+        problem = f"expected {EXPECTED[('format',)]}, got {show(data['format'])}"
+        raise STRUCTURE.fail(("format",), problem, file, text)
+    STRUCTURE.validate(data, file, text)
+    if (units_problem := check_units_field(data.get("units"))) is not None:
+        raise STRUCTURE.fail(("units",), units_problem, file, text)
+    return dict(data)
 
 
 def check_trace(data: Any, file: str | os.PathLike[str] | None = None) -> dict[str, Any]:
     """Check the shape of a parsed trace and return it.
 
+    Parameters
+    ----------
+    data : Any
+        The parsed ``cosmop.trace/1`` JSON.
+    file : str or os.PathLike, optional
+        The file it came from, for the error.
+
+    Returns
+    -------
+    dict
+        `data` (a shallow copy), its values as they are.
+
     Raises
     ------
     TraceError
-        Naming the file, the first wrong field and what was expected there.
+        In one line: the file, the first wrong field, what was expected there and what it is.
     """
-    where = None if file is None else os.fspath(file)
-
-    def fail(field: str, expected: str) -> None:
-        raise TraceError(f"expected {expected}", file=where, field=field)
-
-    if not isinstance(data, Mapping):
-        fail("format", f"a JSON object in the {TRACE_FORMAT} format")
-    if data.get("format") != TRACE_FORMAT:
-        fail("format", f"{TRACE_FORMAT!r}, got {data.get('format')!r}")
-    if (problem := check_units_field(data.get("units"))) is not None:
-        raise TraceError(problem, file=where, field="units")
-    frames = data.get("frames")
-    if not isinstance(frames, list) or not frames:
-        fail("frames", "a non-empty list of frames")
-    for k, frame in enumerate(frames):
-        _check_frame(frame, k, fail)
-    if "dt" in data and not (_is_number(data["dt"]) and data["dt"] > 0):
-        fail("dt", "the cycle in seconds (a positive number)")
-    messages = data.get("messages", [])
-    if not isinstance(messages, list):
-        fail("messages", "a list of messages")
-    for k, message in enumerate(messages):
-        if not (isinstance(message, Mapping) and _is_number(message.get("t"))):
-            fail(f"messages[{k}]", "a mapping with a time t (s), from and to")
-        if not (isinstance(message.get("from"), str) and isinstance(message.get("to"), str)):
-            fail(f"messages[{k}]", "a mapping with the robot ids from and to")
-    _check_replans(data.get("replans", []), fail)
-    return dict(data)
-
-
-def _check_replans(replans: Any, fail) -> None:
-    """The ``replans`` list: each a time, a robot and a route (``from`` a pose, ``steps``)."""
-    if not isinstance(replans, list):
-        fail("replans", "a list of replans")
-    for k, entry in enumerate(replans):
-        route = entry.get("route") if isinstance(entry, Mapping) else None
-        if not (
-            isinstance(entry, Mapping)
-            and _is_number(entry.get("t"))
-            and isinstance(entry.get("robot"), str)
-            and isinstance(route, Mapping)
-        ):
-            fail(f"replans[{k}]", "a mapping with a time t (s), a robot id and its route")
-        start = route.get("from")
-        if not (isinstance(start, list) and len(start) == 3 and all(_is_number(v) for v in start)):
-            fail(f"replans[{k}].route.from", "[x, y, heading] (mm, mm, degrees)")
-        steps = route.get("steps")
-        if not isinstance(steps, list):
-            fail(f"replans[{k}].route.steps", "a list of steps")
-        for j, step in enumerate(steps):
-            pose = step.get("pose") if isinstance(step, Mapping) else None
-            if not (
-                isinstance(pose, list)
-                and len(pose) == 3
-                and all(_is_number(v) for v in pose)
-                and isinstance(step.get("primitive"), str)
-                and _is_name(step.get("about"))
-            ):
-                fail(
-                    f"replans[{k}].route.steps[{j}]",
-                    "a pose [x, y, heading], a primitive and what it is about",
-                )
+    return _check(data, None if file is None else os.fspath(file), None)
 
 
 @dataclass(frozen=True)
@@ -306,7 +371,7 @@ class Trace:
             if value is None:
                 continue
             # A read-only view: the trace cannot change its arrays, and the caller's stay as they are.
-            array = np.asarray(value, dtype=dtype).view()
+            array: np.ndarray = np.asarray(value, dtype=dtype).view()
             shape = (len(t),) if ids is None else (len(t), len(getattr(self, ids)), *tail)
             if array.shape != shape:
                 raise ValueError(f"Trace.{name} must have the shape {shape}, got {array.shape}")
@@ -318,20 +383,47 @@ class Trace:
     # -- reading -----------------------------------------------------------------------------
 
     def ids(self, group: str) -> tuple[str, ...]:
-        """The ids of ``"robots"``, ``"humans"`` or ``"objects"``, in the order of their arrays."""
+        """The ids of ``"robots"``, ``"humans"`` or ``"objects"``, in the order of their arrays.
+
+        Parameters
+        ----------
+        group : {"robots", "humans", "objects"}
+            Which things.
+        """
         return {"robots": self.robot_ids, "humans": self.human_ids, "objects": self.object_ids}[group]
 
     def positions(self, group: str) -> np.ndarray:
-        """Positions ``(x, y)`` (mm) of ``"robots"``, ``"humans"`` or ``"objects"``: shape (n, N, 2)."""
-        return self.poses[:, :, :2] if group == "robots" else getattr(self, group)
+        """Positions ``(x, y)`` (mm) of ``"robots"``, ``"humans"`` or ``"objects"``: shape (n, N, 2).
+
+        Parameters
+        ----------
+        group : {"robots", "humans", "objects"}
+            Which things.
+        """
+        return self.poses[:, :, :2] if group == "robots" else cast(np.ndarray, getattr(self, group))
 
     def seen(self, group: str, every: int = 1) -> np.ndarray:
-        """Every position (mm) of `group` that a frame shows, every `every`-th frame: shape (m, 2)."""
+        """Every position (mm) of `group` that a frame shows, every `every`-th frame: shape (m, 2).
+
+        Parameters
+        ----------
+        group : {"robots", "humans", "objects"}
+            Which things.
+        every : int
+            Take every `every`-th frame (1: all).
+        """
         points = self.positions(group)[::every].reshape(-1, 2)
-        return points[~np.isnan(points[:, 0])]
+        shown: np.ndarray = points[~np.isnan(points[:, 0])]  # numpy types a masked index as Any
+        return shown
 
     def robots_at(self, k: int) -> dict[str, RobotState]:
-        """The robots frame `k` shows, in the order of :attr:`robot_ids`."""
+        """The robots frame `k` shows, in the order of :attr:`robot_ids`.
+
+        Parameters
+        ----------
+        k : int
+            The frame's index.
+        """
         poses = self.poses[k].tolist()
         carrying = self.carrying[k].tolist() if self.carrying is not None else [-1] * len(poses)
         waiting = self.waiting[k].tolist() if self.waiting is not None else [False] * len(poses)
@@ -342,12 +434,26 @@ class Trace:
         }
 
     def points_at(self, group: str, k: int) -> dict[str, tuple[float, float]]:
-        """Where frame `k` shows the ``"humans"`` or the ``"objects"`` (mm), by id."""
+        """Where frame `k` shows the ``"humans"`` or the ``"objects"`` (mm), by id.
+
+        Parameters
+        ----------
+        group : {"humans", "objects"}
+            Which things.
+        k : int
+            The frame's index.
+        """
         points = self.positions(group)[k].tolist()
         return {pid: (x, y) for pid, (x, y) in zip(self.ids(group), points, strict=True) if not math.isnan(x)}
 
     def carried_at(self, k: int) -> dict[str, str]:
-        """The objects carried in frame `k`: the carrier's id by object id."""
+        """The objects carried in frame `k`: the carrier's id by object id.
+
+        Parameters
+        ----------
+        k : int
+            The frame's index.
+        """
         return {s.carrying: rid for rid, s in self.robots_at(k).items() if s.carrying is not None}
 
     # -- the file -----------------------------------------------------------------------------
@@ -357,10 +463,11 @@ class Trace:
         return replace(
             self,
             t=_rounded(self.t, _TIME_DIGITS),
-            **{
-                name: _rounded(getattr(self, name), _LENGTH_DIGITS)
-                for name in ("poses", "v", "w", "humans", "objects")
-            },
+            poses=_rounded(self.poses, _LENGTH_DIGITS),
+            v=_rounded(self.v, _LENGTH_DIGITS),
+            w=_rounded(self.w, _LENGTH_DIGITS),
+            humans=_rounded(self.humans, _LENGTH_DIGITS),
+            objects=_rounded(self.objects, _LENGTH_DIGITS),
         )
 
     def to_json(self) -> dict[str, Any]:
@@ -406,6 +513,7 @@ class Trace:
                 self.awaits, self.yields_to,
             )
         )  # fmt: skip
+        assert poses is not None  # every trace has poses
         columns = {"pose": poses.tolist()}
         for key, array, to_json in (
             ("v", v, None),
@@ -449,12 +557,27 @@ class Trace:
         robot state has (``v``, ``w``, ``carrying``, ``primitive``, ``waiting``, ``delayed``,
         ``awaits``, ``yields_to``) give None.
 
+        Parameters
+        ----------
+        data : Any
+            The parsed JSON.
+        file : str or os.PathLike, optional
+            The file it came from, for the error.
+
+        Returns
+        -------
+        Trace
+
         Raises
         ------
         TraceError
-            Naming `file`, the first wrong field and what was expected there.
+            Naming `file`, the first wrong field, what was expected there and what it is.
         """
-        checked = check_trace(data, file)
+        return cls._from_checked(check_trace(data, file))
+
+    @classmethod
+    def _from_checked(cls, checked: Mapping[str, Any]) -> Trace:
+        """The trace of a parsed file whose shape is checked."""
         frames = checked["frames"]
         robot_ids = _first_seen(frames, "robots")
         columns = _robot_columns(frames, robot_ids)
@@ -471,7 +594,7 @@ class Trace:
             columns["primitive"] = _indices(columns["primitive"], index, len(robot_ids))
         human_ids = _first_seen(frames, "humans")
         return cls(
-            t=[float(frame["t"]) for frame in frames],
+            t=np.array([float(frame["t"]) for frame in frames], dtype=float),
             robot_ids=robot_ids,
             primitive_names=names,
             human_ids=human_ids,
@@ -492,6 +615,11 @@ class Trace:
         The frames are turned into JSON a block at a time, so that a long run is never all in
         memory as Python objects (a 50-robot run's 11,000 frames took some 500 MiB that way);
         the file's bytes are those of ``json.dumps(to_json())``.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The destination; its directory must exist.
         """
         exact = self.rounded()
         with (
@@ -517,6 +645,12 @@ def _compact(value: Any) -> str:
     return json.dumps(value, separators=(",", ":"))
 
 
+@overload
+def _rounded(values: np.ndarray, digits: int) -> np.ndarray: ...
+@overload
+def _rounded(values: None, digits: int) -> None: ...
+@overload
+def _rounded(values: np.ndarray | None, digits: int) -> np.ndarray | None: ...
 def _rounded(values: np.ndarray | None, digits: int) -> np.ndarray | None:
     """`values` rounded to `digits` decimals exactly as Python's :func:`round` rounds each float.
 
@@ -574,7 +708,7 @@ def _robot_columns(frames: Sequence[Mapping[str, Any]], robot_ids: Sequence[str]
         for rid, state in frame.get("robots", {}).items():
             i = index[rid]
             columns["poses"][k, i] = state["pose"]
-            for key in _STATE_KEYS.keys() & state.keys():
+            for key in _STATE_KEYS & state.keys():
                 columns[key][k][i] = state[key]
                 given.add(key)
     return {key: value for key, value in columns.items() if key == "poses" or key in given}
@@ -600,6 +734,15 @@ def as_trace(trace: Trace | Mapping[str, Any]) -> Trace:
 
     What the public functions that read traces call first, so that they take either.
 
+    Parameters
+    ----------
+    trace : Trace or Mapping
+        A trace, or a parsed trace file.
+
+    Returns
+    -------
+    Trace
+
     Raises
     ------
     TraceError
@@ -611,20 +754,36 @@ def as_trace(trace: Trace | Mapping[str, Any]) -> Trace:
 def load_trace(path: str | os.PathLike[str]) -> Trace:
     """Read a ``cosmop.trace/1`` file as a :class:`Trace` (checked by :func:`check_trace`).
 
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The trace file.
+
+    Returns
+    -------
+    Trace
+
     Raises
     ------
     TraceError
         If the file cannot be read or parsed, naming it, or does not have the trace's shape,
-        naming it and the first wrong field.
+        naming it, the first wrong field (and its line and column), what was expected there and
+        what it is.
     """
     file = os.fspath(path)
     text = read_text(path, TraceError, "a trace file")
-    return Trace.from_json(load_json(text, file, TraceError), file)
+    return Trace._from_checked(_check(load_json(text, file, TraceError), file, text))
 
 
 def message_label(message: Mapping[str, Any]) -> str:
     """A short text for a message of any kind: its object, else its event (a ``msg``'s tag), kind or
-    type, else "message"."""
+    type, else "message".
+
+    Parameters
+    ----------
+    message : Mapping
+        A message of a trace (:attr:`Trace.messages`).
+    """
     for key in ("object", "event", "kind", "type"):
         value = message.get(key)
         if isinstance(value, str):

@@ -18,7 +18,7 @@ from cosmop.cli._app import load, stdout
 from cosmop.io import check_writable, write_atomic
 
 if TYPE_CHECKING:
-    from cosmop.planning.plan import PlanSet
+    from cosmop.planning.plan_types import PlanSet
     from cosmop.scene import Scenario, Scene
     from cosmop.traces import Trace
 
@@ -260,7 +260,7 @@ def export(
     scene_rate : float
         ``--scene-rate``: ``/scene`` marker arrays per second, Hz.
     """
-    from cosmop.planning.plan import load_plan
+    from cosmop.planning.plan_file import load_plan
     from cosmop.traces import load_trace
 
     loaded = load(scenario, mission=False)
@@ -301,7 +301,7 @@ def view(
     trace : pathlib.Path or None
         ``--trace``: a run (``cosmop.trace/1``) to play with a time slider.
     """
-    from cosmop.planning.plan import load_plan
+    from cosmop.planning.plan_file import load_plan
     from cosmop.traces import load_trace
     from cosmop.viz.web import save_html
 

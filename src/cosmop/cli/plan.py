@@ -17,7 +17,8 @@ from cosmop.cli._app import EXIT_INPUT_ERROR, ScenarioArgument, load, stderr, st
 from cosmop.cli.words import plan_verdict
 from cosmop.io import check_writable
 from cosmop.planning.checker import check_plan
-from cosmop.planning.plan import MAX_STEPS, load_plan
+from cosmop.planning.plan_file import load_plan
+from cosmop.planning.plan_types import MAX_STEPS
 from cosmop.scene import Scenario
 
 if TYPE_CHECKING:

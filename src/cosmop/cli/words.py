@@ -14,7 +14,7 @@ if TYPE_CHECKING:
     from cosmop.missions.decomposition import Decomposition
     from cosmop.missions.team import TeamVerdict
     from cosmop.missions.verification import Verification
-    from cosmop.planning.plan import PlanSet
+    from cosmop.planning.plan_types import PlanSet
 
 __all__ = ["decompose_verdict", "plan_verdict"]
 
@@ -75,7 +75,7 @@ def plan_verdict(plans: PlanSet, verification: TeamVerdict | None, units: UnitSy
 
     Parameters
     ----------
-    plans : cosmop.planning.plan.PlanSet
+    plans : cosmop.planning.plan_types.PlanSet
         A feasible plan set: its hand-overs, messages and added tasks are told.
     verification : cosmop.missions.team.TeamVerdict or None
         The team's verification (None: none was made, so nothing is proven).

@@ -42,7 +42,7 @@ from cosmop.units import m_from_mm
 from cosmop.viz.scene import ids_with_trace
 
 if TYPE_CHECKING:
-    from cosmop.planning.plan import PlanSet
+    from cosmop.planning.plan_types import PlanSet
     from cosmop.scene import Scene
 
 __all__ = ["BagSummary", "ros_available", "write_bag"]

@@ -36,7 +36,7 @@ from cosmop.events import parse_event
 from cosmop.lifelong.dispatch import OrderState, choose_robot, delivery_events
 from cosmop.lifelong.result import FleetResult
 from cosmop.planning.conflicts import ConflictSettings
-from cosmop.planning.plan import PlanSet, RobotPlan
+from cosmop.planning.plan_types import PlanSet, RobotPlan
 from cosmop.scene import Order, Scenario
 from cosmop.sim.recoordinate import recoordinate_world
 from cosmop.sim.recording import Recorder

@@ -2,8 +2,9 @@
 
 A robot's plan is a sequence of the paper's motion primitives -- ``GoTo``, ``PickUp``,
 ``DropOff``, ``Req`` (request an object away, ``?ObjAway``) and ``Res`` (answer that it has been
-moved, ``!ObjAway``) -- with the state after each one (:mod:`cosmop.planning.plan`, the plan
-file ``cosmop.plan/1``). :func:`check_plan` decides exactly, with shapely geometry and without
+moved, ``!ObjAway``) -- with the state after each one (:mod:`cosmop.planning.plan_types`; what
+each primitive does to the state, :mod:`cosmop.planning.primitive_effects`; the plan file
+``cosmop.plan/1``, :mod:`cosmop.planning.plan_file`). :func:`check_plan` decides exactly, with shapely geometry and without
 any SMT encoding, whether a plan is sound for its scene and realises its mission
 (:mod:`cosmop.planning.checker`). :mod:`cosmop.planning.regions` holds the sound GoTo region
 constraints used by the bounded encoding. Units are millimetres and degrees throughout.
@@ -20,22 +21,19 @@ from cosmop.planning.checker import (
     square,
     swept_square,
 )
-from cosmop.planning.plan import (
+from cosmop.planning.plan_file import PlanError, load_plan
+from cosmop.planning.plan_types import (
     OBJECT_PRIMITIVES,
     PLAN_FORMAT,
     PRIMITIVES,
     Coordination,
     ObjectState,
-    PlanError,
     PlanSet,
     RobotPlan,
     State,
     Step,
-    initial_state,
-    load_plan,
-    plan_from_actions,
-    successor,
 )
+from cosmop.planning.primitive_effects import initial_state, plan_from_actions, successor
 
 __all__ = [
     "OBJECT_PRIMITIVES",

@@ -34,7 +34,7 @@ import numpy as np
 import shapely
 
 from cosmop.docking import docking_pose
-from cosmop.planning.plan import RobotPlan
+from cosmop.planning.plan_types import RobotPlan
 from cosmop.planning.reach import free_component
 from cosmop.planning.regions import HalfPlane, wall_regions
 from cosmop.scene import Scene

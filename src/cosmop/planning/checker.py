@@ -1,6 +1,6 @@
 """The exact plan checker: is a plan sound for its scene and mission?
 
-This module checks a :class:`~cosmop.planning.plan.PlanSet` against the scenario with exact
+This module checks a :class:`~cosmop.planning.plan_types.PlanSet` against the scenario with exact
 geometry (shapely 2 predicates on the double coordinates), independently of any SMT encoding,
 so that a synthesised plan can be trusted -- or a hand-made plan debugged.
 
@@ -64,7 +64,8 @@ from cosmop.docking import DOCKING_HEADINGS, docking_pose, in_front
 from cosmop.errors import EventSyntaxError
 from cosmop.events import Event, Primitive, parse_event, realising_step
 from cosmop.planning.joint import check_team
-from cosmop.planning.plan import PlanSet, RobotPlan, State, Step, initial_state
+from cosmop.planning.plan_types import PlanSet, RobotPlan, State, Step
+from cosmop.planning.primitive_effects import initial_state
 from cosmop.planning.realisation import TOLERANCE, angles_equal, at_pose, event_instants, holds_at
 from cosmop.planning.report import RULES, CheckReport, Violation
 from cosmop.scene import Scenario, Scene, Wall
@@ -653,7 +654,7 @@ def check_robot_plan(
         ``return`` still means the scenario's initial pose.
     moved : collection of str, optional
         Goods the team moves: the plan may know them elsewhere than the scenario at instant 0
-        (:func:`~cosmop.planning.plan.initial_state`; the team's checker verifies where they
+        (:func:`~cosmop.planning.primitive_effects.initial_state`; the team's checker verifies where they
         really are).  By default the goods the plan picks up.
 
     Returns

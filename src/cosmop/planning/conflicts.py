@@ -41,7 +41,8 @@ from shapely.geometry.base import BaseGeometry
 
 from cosmop.events import Primitive
 from cosmop.missions.precedence import Node, Precedence
-from cosmop.planning.plan import RobotPlan, State, initial_state
+from cosmop.planning.plan_types import RobotPlan, State
+from cosmop.planning.primitive_effects import initial_state
 from cosmop.planning.realisation import TOLERANCE, at_pose
 from cosmop.scene import Scene
 from cosmop.squares import overlap_depths, square, swept_square

@@ -26,7 +26,7 @@ from cosmop.missions.mission import GlobalMission
 from cosmop.missions.precedence import Link, Precedence
 from cosmop.missions.team import check_words
 from cosmop.planning.conflicts import ConflictSettings, conflicts, is_ordered, occupancies
-from cosmop.planning.plan import PlanSet, RobotPlan
+from cosmop.planning.plan_types import PlanSet, RobotPlan
 from cosmop.planning.realisation import message_links, repeated_messages, unanswered_requests, unsent_answers
 from cosmop.planning.report import Violation
 from cosmop.scene import Scenario

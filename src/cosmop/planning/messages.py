@@ -24,7 +24,8 @@ from typing import Any
 from cosmop.events import Event, Primitive, message, parse_event
 from cosmop.missions.precedence import Node
 from cosmop.planning.checker import check_robot_plan
-from cosmop.planning.plan import RobotPlan, State, Step, initial_state, plan_from_actions
+from cosmop.planning.plan_types import RobotPlan, State, Step
+from cosmop.planning.primitive_effects import initial_state, plan_from_actions
 from cosmop.planning.realisation import event_instants
 from cosmop.scene import Scene
 

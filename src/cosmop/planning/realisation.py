@@ -23,7 +23,8 @@ from collections.abc import Mapping, Sequence
 from cosmop.errors import EventSyntaxError
 from cosmop.events import Event, Primitive, parse_event, realising_step
 from cosmop.missions.precedence import Link
-from cosmop.planning.plan import RobotPlan, State, Step, initial_state
+from cosmop.planning.plan_types import RobotPlan, State, Step
+from cosmop.planning.primitive_effects import initial_state
 from cosmop.scene import Scene
 
 __all__ = [

@@ -71,7 +71,7 @@ from cosmop.logic import (
     eq,
     to_fraction,
 )
-from cosmop.planning.plan import State
+from cosmop.planning.plan_types import State
 from cosmop.planning.regions import HalfPlane, square_sides, wall_regions
 from cosmop.scene import Scene, Wall, Workspace
 from cosmop.squares import docking_places

@@ -47,7 +47,7 @@ from cosmop.io import collector_paused
 from cosmop.logic import Formula, IncrementalUnrolling, Signature, Unrolling, assert_all, conj, to_fraction
 from cosmop.planning.messages import answer_early, place_mission_messages, strip_messages, wait_early
 from cosmop.planning.obstacles import Geometry, obstacle_of
-from cosmop.planning.plan import ObjectState, RobotPlan, State, Step
+from cosmop.planning.plan_types import ObjectState, RobotPlan, State, Step
 from cosmop.planning.reach import unreachable
 from cosmop.planning.specification import (
     MOTION_MARGIN,

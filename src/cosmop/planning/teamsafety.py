@@ -39,7 +39,7 @@ from cosmop.planning.conflicts import (
     ranked_detours,
 )
 from cosmop.planning.messages import CUT_GRAIN, cut_drives, merge_drives, place_edges, split_drives
-from cosmop.planning.plan import PlanMessage, RobotPlan, State
+from cosmop.planning.plan_types import PlanMessage, RobotPlan, State
 from cosmop.planning.realisation import message_links
 from cosmop.planning.timing import durations, start_pose
 from cosmop.scene import Scene

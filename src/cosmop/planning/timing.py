@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 from cosmop.events import Primitive
 from cosmop.missions.precedence import Precedence
-from cosmop.planning.plan import Itinerary, RobotPlan, State
+from cosmop.planning.plan_types import Itinerary, RobotPlan, State
 from cosmop.planning.realisation import message_links
 from cosmop.scene import Dynamics, Scene
 

@@ -38,7 +38,7 @@ from cosmop.control.geometry import box_gaps
 from cosmop.control.safety import stopping_margin
 from cosmop.docking import docking_pose, in_front
 from cosmop.events import Primitive
-from cosmop.planning.plan import Pose, Step
+from cosmop.planning.plan_types import Pose, Step
 from cosmop.sim.motion import HOLD, REPLANNED, brake, creep_is_safe, creep_out, drive, halt
 from cosmop.sim.world import TOUCH, Action, Agent, World
 

@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 from cosmop.control.geometry import box_gaps, point_segment_linf
 from cosmop.control.paths import GlobalPath, plan_path, straight_path
 from cosmop.control.safety import is_safe, stopping_horizon
-from cosmop.planning.plan import Pose
+from cosmop.planning.plan_types import Pose
 from cosmop.sim.replan import replan_stalled
 from cosmop.sim.world import TOUCH, Action, Agent, World
 

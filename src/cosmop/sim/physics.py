@@ -15,7 +15,7 @@ from functools import lru_cache
 import numpy as np
 from numpy.typing import NDArray
 
-from cosmop.planning.plan import Pose
+from cosmop.planning.plan_types import Pose
 from cosmop.sim.world import World, wrap_angle
 
 __all__ = ["integrate"]

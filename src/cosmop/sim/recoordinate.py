@@ -26,7 +26,8 @@ from typing import TYPE_CHECKING
 
 from cosmop.events import Event, Primitive, parse_event
 from cosmop.planning.conflicts import ConflictSettings
-from cosmop.planning.plan import PlanMessage, RobotPlan, State, Step, initial_state
+from cosmop.planning.plan_types import PlanMessage, RobotPlan, State, Step
+from cosmop.planning.primitive_effects import initial_state
 from cosmop.planning.teamsafety import make_team_safe
 from cosmop.scene import Scene
 from cosmop.sim.timing import carry_instants

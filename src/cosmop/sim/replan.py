@@ -23,7 +23,8 @@ from cosmop.control.geometry import box_gaps
 from cosmop.events import Event, Primitive
 from cosmop.planning.checker import check_robot_plan
 from cosmop.planning.conflicts import ConflictSettings
-from cosmop.planning.plan import ObjectState, RobotPlan, State, initial_state
+from cosmop.planning.plan_types import ObjectState, RobotPlan, State
+from cosmop.planning.primitive_effects import initial_state
 from cosmop.scene import Scene, Wall
 from cosmop.sim.recoordinate import recoordinate_world
 

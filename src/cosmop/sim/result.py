@@ -19,7 +19,7 @@ import numpy as np
 from cosmop.control.dwa import DwaSettings
 from cosmop.events import Event
 from cosmop.io import write_atomic
-from cosmop.planning.plan import PRIMITIVES, PlanSet
+from cosmop.planning.plan_types import PRIMITIVES, PlanSet
 from cosmop.scene import Scenario, Scene
 from cosmop.sim.delays import Delays
 from cosmop.sim.timing import StepTimes
@@ -209,7 +209,7 @@ class SimResult:
         received).
     added : tuple of str
         The events of the tasks the planner added (:attr:`PlanSet.added
-        <cosmop.planning.plan.PlanSet.added>`): goods moved out of a robot's way.
+        <cosmop.planning.plan_types.PlanSet.added>`): goods moved out of a robot's way.
     steps : Mapping[str, tuple of StepTimes]
         Every robot's steps with their planned (the plan set's itinerary) and realised start
         and end (:mod:`cosmop.sim.timing`).

@@ -74,7 +74,7 @@ import numpy as np
 
 from cosmop.control.dwa import Drivers, Obstacles, dwa_commands
 from cosmop.control.neighbourhood import dwa_commands_near
-from cosmop.planning.plan import Itinerary, PlanSet, Pose
+from cosmop.planning.plan_types import Itinerary, PlanSet, Pose
 from cosmop.planning.timing import itinerary
 from cosmop.scene import Scenario
 from cosmop.sim.execute import decide, let_go

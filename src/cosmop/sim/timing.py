@@ -1,6 +1,6 @@
 """Planned against realised: when each step of a run was expected, and when it happened.
 
-A plan set's itinerary (:class:`~cosmop.planning.plan.Itinerary`) says when every step is
+A plan set's itinerary (:class:`~cosmop.planning.plan_types.Itinerary`) says when every step is
 expected to start and end.  The simulator logs, per robot, every step it completes with the
 cycle it started and the cycle it ended (a step starts when the robot's previous one ends;
 instant 0 at time 0), and which instant of the *original* plan it was.  Re-planning replaces
@@ -17,7 +17,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from cosmop.planning.plan import Itinerary
+from cosmop.planning.plan_types import Itinerary
 
 __all__ = ["StepTimes", "carry_instants", "step_times"]
 

@@ -24,7 +24,7 @@ from cosmop.control.safety import Limits
 from cosmop.events import MESSAGE_KINDS, Event, Primitive, parse_event, realising_step
 from cosmop.physics import TOUCH  # the one tolerance under which two squares touch
 from cosmop.planning.conflicts import ConflictSettings
-from cosmop.planning.plan import PlanSet, Pose, RobotPlan, Step
+from cosmop.planning.plan_types import PlanSet, Pose, RobotPlan, Step
 from cosmop.planning.realisation import event_instants
 from cosmop.scene import Scenario
 from cosmop.sim.delays import DelayDraws

@@ -20,7 +20,7 @@ from cosmop.events import Event
 from cosmop.planning.aside import handover_spot
 from cosmop.planning.conflicts import Conflict, ConflictSettings, Occupancy
 from cosmop.planning.lanes import lanes
-from cosmop.planning.plan import RobotPlan
+from cosmop.planning.plan_types import RobotPlan
 from cosmop.planning.synthesis import Synthesis
 from cosmop.planning.teamsafety import TeamSafety, Wait, make_team_safe
 from cosmop.scene import Scene, Wall

@@ -14,7 +14,7 @@ from collections.abc import Mapping
 from cosmop.events import Event, Primitive
 from cosmop.missions.handover import Handover, Handovers
 from cosmop.planning.aside import dock_slots, handover_spot
-from cosmop.planning.plan import RobotPlan
+from cosmop.planning.plan_types import RobotPlan
 from cosmop.planning.synthesis import Synthesis
 from cosmop.scene import Workspace
 from cosmop.team.planner import Planner, goods_at

@@ -38,7 +38,7 @@ from cosmop.missions.mission import GlobalMission, sequence_of
 from cosmop.missions.team import TeamVerdict, check_words
 from cosmop.planning.checker import CheckReport, check_plan
 from cosmop.planning.conflicts import ConflictSettings
-from cosmop.planning.plan import Coordination, PlanMessage, PlanSet, RobotPlan
+from cosmop.planning.plan_types import Coordination, PlanMessage, PlanSet, RobotPlan
 from cosmop.planning.synthesis import DEFAULT_RLIMIT, Synthesis
 from cosmop.planning.teamsafety import TeamSafety
 from cosmop.planning.timing import itinerary

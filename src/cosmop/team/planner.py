@@ -22,7 +22,7 @@ from cosmop.automata import DFA
 from cosmop.events import Event, parse_event
 from cosmop.io import uninterrupted
 from cosmop.missions.handover import Handover
-from cosmop.planning.plan import MAX_STEPS, AddedTask
+from cosmop.planning.plan_types import MAX_STEPS, AddedTask
 from cosmop.planning.synthesis import DEFAULT_RLIMIT, Synthesis, synthesize
 from cosmop.scene import Scenario, Scene, Wall
 
@@ -227,7 +227,7 @@ class Planner:
     ----------
     scenario : Scenario
         The scenario planned; it grows the places where goods are set aside
-        (:class:`~cosmop.planning.plan.AddedTask`).
+        (:class:`~cosmop.planning.plan_types.AddedTask`).
     executor : concurrent.futures.Executor, optional
         Where to run syntheses (worker processes, a Dask cluster); ``None`` runs them here.
     on_robot : callable, optional

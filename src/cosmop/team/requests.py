@@ -21,7 +21,7 @@ from cosmop.missions.coordination import Coordinated, coordinate
 from cosmop.missions.team import blocking_word
 from cosmop.planning.aside import ROOM, place_aside
 from cosmop.planning.conflicts import ConflictSettings
-from cosmop.planning.plan import MAX_STEPS, AddedTask, PlanSet, RobotPlan
+from cosmop.planning.plan_types import MAX_STEPS, AddedTask, PlanSet, RobotPlan
 from cosmop.planning.realisation import request_phases
 from cosmop.planning.synthesis import Synthesis
 from cosmop.squares import square

@@ -25,7 +25,7 @@ from pathlib import Path
 from typing import Any, cast
 
 from cosmop.io import atomic_path
-from cosmop.planning.plan import PlanSet
+from cosmop.planning.plan_types import PlanSet
 from cosmop.scene import Scene
 from cosmop.traces import RobotState, Trace, as_trace, message_label
 from cosmop.viz.explain import Explainer, waiting_words

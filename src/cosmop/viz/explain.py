@@ -3,7 +3,7 @@
 A robot of a simulated run stands for one of three reasons the trace records
 (:class:`cosmop.traces.Trace`): it waits for a message (``awaits``), it gives way to a robot or
 a person its controller will not come closer to (``yields_to``), or a delay has stopped it
-(``delayed``).  The plan file says why each message exists (:class:`cosmop.planning.plan.PlanMessage`:
+(``delayed``).  The plan file says why each message exists (:class:`cosmop.planning.plan_types.PlanMessage`:
 its kind, what it protects and the place two robots share); :func:`waiting_words` turns that
 into a sentence a newcomer reads without knowing the formal terms, "waits for R2 to clear the
 way near W3", in the scenario file's units.  The web viewer and the animations write these
@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 from cosmop.errors import EventSyntaxError
 from cosmop.events import Event, Primitive, parse_event
-from cosmop.planning.plan import PlanMessage, PlanSet, RobotPlan
+from cosmop.planning.plan_types import PlanMessage, PlanSet, RobotPlan
 from cosmop.scene import Scene
 from cosmop.units import length_unit, show_point
 

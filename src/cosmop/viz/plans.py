@@ -19,7 +19,7 @@ from typing import Any
 
 from cosmop.events import parse_event
 from cosmop.io import write_atomic
-from cosmop.planning.plan import MESSAGE_PRIMITIVES, PlanSet, RobotPlan
+from cosmop.planning.plan_types import MESSAGE_PRIMITIVES, PlanSet, RobotPlan
 from cosmop.scene import Scene
 from cosmop.viz.labels import Label, place_labels
 from cosmop.viz.scene import (

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from typing import Any, cast
 
 from cosmop.events import Primitive
-from cosmop.planning.plan import RobotPlan
+from cosmop.planning.plan_types import RobotPlan
 from cosmop.scene import Robot, Scene, Workspace
 from cosmop.traces import Trace
 from cosmop.viz.labels import Label, text_marker

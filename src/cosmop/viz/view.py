@@ -13,7 +13,7 @@ import re
 from collections.abc import Iterable
 
 from cosmop.events import ID_PATTERN, Primitive
-from cosmop.planning.plan import PlanSet
+from cosmop.planning.plan_types import PlanSet
 from cosmop.scene import Scene
 from cosmop.viz.scene import DEFAULT_ROBOT_SIZE
 

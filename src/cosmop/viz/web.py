@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 
 from cosmop.io import write_atomic
-from cosmop.planning.plan import PlanSet
+from cosmop.planning.plan_types import PlanSet
 from cosmop.scene import Scene
 from cosmop.traces import Trace, as_trace, message_label
 from cosmop.units import UnitSystem
