@@ -106,7 +106,10 @@ def test_bad_plan_file_exits_2_naming_file_and_field(tmp_path: Path) -> None:
     assert result.stdout == ""
     lines = result.stderr.splitlines()
     assert len(lines) == 1
-    assert lines[0].startswith(f"error: {path}: robots.R1.steps[3].primitive: unknown primitive")
+    assert lines[0].startswith(
+        f"error: {path}: robots.R1.steps[3].primitive: expected one of GoTo, PickUp, DropOff, Req, Res, "
+        "got 'Teleport'"
+    )
     assert "Traceback" not in result.output
 
 
@@ -118,7 +121,7 @@ def test_horizon_mismatch_exits_2(tmp_path: Path) -> None:
     write_atomic(path, json.dumps(data))
     result = runner.invoke(app, ["check", str(EXAMPLE), str(path)])
     assert result.exit_code == 2
-    assert f"error: {path}: robots.R2.horizon: the horizon is 6 but there are {steps} steps" in result.stderr
+    assert f"error: {path}: robots.R2.horizon: expected the number of steps, {steps}, got 6" in result.stderr
 
 
 def test_wrong_format_exits_2(tmp_path: Path) -> None:
@@ -127,7 +130,8 @@ def test_wrong_format_exits_2(tmp_path: Path) -> None:
     result = runner.invoke(app, ["check", str(EXAMPLE), str(path)])
     assert result.exit_code == 2
     assert result.stderr.strip() == (
-        f"error: {path}: format: unknown format 'cosmop.plan/0'; expected 'cosmop.plan/1' (line 1, column 12)"
+        f"error: {path}: format: expected 'cosmop.plan/1', the plan file format, got 'cosmop.plan/0' "
+        "(line 1, column 12)"
     )
 
 
