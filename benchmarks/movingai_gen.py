@@ -23,7 +23,7 @@ import tempfile
 from pathlib import Path
 
 from _harness import generator_main
-from cosmop.maps.scene import import_map
+from cosmop.maps.to_scenario import import_map
 
 ROWS, COLS, DOCK, BLOCK_W, BLOCK_H, BLOCKS_X, BLOCKS_Y = 63, 161, 25, 10, 2, 10, 20
 CELL, ROBOT, GOOD = 1000, 500, 200

@@ -19,10 +19,10 @@ import numpy as np
 import pytest
 import shapely
 
-from cosmop.missions.precedence import Link, Precedence, TakenBack
+from cosmop.missions.precedence import Link, Precedence, RetractedEdges
 from cosmop.planning import conflict_order
-from cosmop.planning.conflict_order import _Implied, _Schedule, order_conflicts
-from cosmop.planning.conflict_search import Culprits, Search, backjump, ways_of
+from cosmop.planning.conflict_order import _Dominance, _Schedule, order_conflicts
+from cosmop.planning.conflict_search import CorrectionSetPicker, Search, backjump, possible_orientations
 from cosmop.planning.conflicts import Conflict, Occupancy, is_ordered
 from cosmop.planning.teamsafety import _reduce
 
@@ -93,7 +93,8 @@ def test_a_choice_that_ends_in_a_dead_end_is_taken_back(monkeypatch):
     found, horizons, starts, durations = _tangle()
     found = found[:2]  # A-B and C-D: B first orders both
     team = (horizons, [], starts, durations)
-    assert backjump(found, _Implied(found), team, Culprits(None), 0)[0] is None  # A first is a dead end
+    # A first is a dead end
+    assert backjump(found, _Dominance(found), team, CorrectionSetPicker(None), 0)[0] is None
     monkeypatch.setattr(conflict_order, "_Schedule", _no_solver)
     chosen, unresolved = order_conflicts(found, horizons, [], starts, durations)
     assert unresolved == []
@@ -105,7 +106,7 @@ def test_a_core_found_through_a_choice_taken_back_is_a_core(monkeypatch):
     # B first, forced by the dead end of A first, leaves E-F no way: the core is all three
     found, horizons, starts, durations = _tangle()
     team = (horizons, [], starts, durations)
-    _, aside, cores = backjump(found, _Implied(found), team, Culprits(None), 5)
+    _, aside, cores = backjump(found, _Dominance(found), team, CorrectionSetPicker(None), 5)
     assert [sorted(map(found.index, core)) for core in cores.values()] == [[0, 1, 2]]
     schedule = _Schedule(found, horizons, [], starts, durations, 200_000_000)
     assert schedule.solve(cores[id(aside[0])]) is not None
@@ -199,11 +200,11 @@ def _args(seed):
 @pytest.mark.parametrize("seed", range(6))
 def test_an_implied_conflict_is_ordered_by_every_way_of_the_one_that_implies_it(seed):
     found, horizons, durations = _team(seed, robots=3, steps=8, conflicts=40)
-    implied = _Implied(found)
+    implied = _Dominance(found)
     pairs = [(stronger, c) for c in found for stronger in implied.by(c)]
     assert pairs  # the sample has conflicts that imply others
     for stronger, weaker in pairs:
-        for edge in ways_of(stronger):
+        for edge in possible_orientations(stronger):
             precedence = Precedence(horizons, (), [edge], durations)
             if precedence.complete:
                 assert is_ordered(weaker, precedence), (stronger, weaker, edge)
@@ -255,7 +256,7 @@ def test_the_cores_the_search_finds_are_cores():
     for seed in range(24):
         found, horizons, durations = _team(seed)
         team = (horizons, [], [], durations)
-        _, aside, found_cores = backjump(found, _Implied(found), team, Culprits(None), 200)
+        _, aside, found_cores = backjump(found, _Dominance(found), team, CorrectionSetPicker(None), 200)
         assert set(found_cores) == {id(c) for c in aside}
         schedule = _Schedule(found, horizons, [], [], durations, 200_000_000)
         for core in found_cores.values():
@@ -343,7 +344,7 @@ def _assert_trail_holds(search: Search, horizons, durations) -> None:
     assert search.at == {i: n for n, (i, _, _, _) in enumerate(search.trail)}
     assert [pushed[:2] for pushed in search.graph.pushed] == [search.precedence.rows(e) for e in edges]
     for n, (i, edge, _, reason) in enumerate(search.trail):
-        for other in search.sides.edges[i] if reason is True else ():
+        for other in search.orientations.edges[i] if reason is True else ():
             if other is not None and other != edge and other[0][0] != other[1][0]:
                 assert search.graph.path(*other, before=n) is not None, (n, other)
 
@@ -374,7 +375,7 @@ def test_the_order_the_search_keeps_is_always_that_of_its_trail(seed, robots, co
 
     monkeypatch.setattr(Search, "_back_to", checked_back_to)
     monkeypatch.setattr(Search, "_retract", checked_retract)
-    search = Search(found, _Implied(found), (horizons, [], [], durations), Culprits(None))
+    search = Search(found, _Dominance(found), (horizons, [], [], durations), CorrectionSetPicker(None))
     assert search.run(budget=200) is not None
     for conflict in list(search.set_aside):
         search.give_back(conflict, budget=200)
@@ -403,10 +404,10 @@ def test_a_choice_kept_after_a_flip_that_lost_its_other_way_counts_as_forced():
         _conflict(("A", 1, 4), ("B", 1, 2)),  # 3: A4 -> B1 closes one with 1, B2 -> A1 one with 2
     ]
     horizons, durations = {"A": 4, "B": 4}, {"A": [1.0] * 4, "B": [1.0] * 4}
-    search = Search(found, _Implied(found), (horizons, [], [], durations), Culprits(None))
+    search = Search(found, _Dominance(found), (horizons, [], [], durations), CorrectionSetPicker(None))
     for i in range(3):
-        search._take(i, search.sides.edges[i][0], None)
-    assert search.precedence.would_cycle(*search.sides.edges[2][1])
+        search._take(i, search.orientations.edges[i][0], None)
+    assert search.precedence.would_cycle(*search.orientations.edges[2][1])
     core, choices = search._dead_end_set(3)
     assert core == {0, 1, 2, 3}
     assert sorted(choices) == [0, 1]
@@ -416,7 +417,7 @@ def test_a_choice_kept_after_a_flip_that_lost_its_other_way_counts_as_forced():
 
 @pytest.mark.parametrize("seed", range(8))
 def test_start_edges_taken_back_from_the_middle_leave_the_order_of_the_rest(seed):
-    # a dead end keeps in place what does not need the edges that go (Precedence.take_back):
+    # a dead end keeps in place what does not need the edges that go (Precedence.retract):
     # the order must be that of the edges left, built from scratch, and the one undo log it
     # returns must restore the order before the first of them, also after a second take-back
     rng = random.Random(seed)
@@ -438,13 +439,13 @@ def test_start_edges_taken_back_from_the_middle_leave_the_order_of_the_rest(seed
     logs, edges = zip(*(batch() for _ in range(6)), strict=True)
     since = [e for added in edges for e in added]
     gone = rng.sample(since, len(since) // 2)
-    merged = order.take_back(list(logs), gone)
+    merged = order.retract(list(logs), gone)
     left = list(since)
     for edge in gone:
         del left[len(left) - 1 - left[::-1].index(edge)]
     _assert_same_order(order, Precedence(horizons, links, before + left, durations))
     log, more = batch()
-    again = order.take_back([merged, log], more[:1])
+    again = order.retract([merged, log], more[:1])
     _assert_same_order(order, Precedence(horizons, links, before + left + more[1:], durations))
     order.undo(again)
     _assert_same_order(order, saved)
@@ -453,7 +454,7 @@ def test_start_edges_taken_back_from_the_middle_leave_the_order_of_the_rest(seed
 
 @pytest.mark.parametrize("seed", range(6))
 def test_a_cycle_no_edge_taken_back_may_pass_stays_when_they_go(seed):
-    # TakenBack says which cycles may run through edges about to go; one it clears must
+    # RetractedEdges says which cycles may run through edges about to go; one it clears must
     # survive their going (the test is one-sided: it may flag a cycle that survives too)
     rng = random.Random(seed)
     horizons = {f"R{i}": rng.randint(3, 7) for i in range(1, 5)}
@@ -466,9 +467,9 @@ def test_a_cycle_no_edge_taken_back_may_pass_stays_when_they_go(seed):
             order.add_start(edge)
             edges.append(edge)
     gone = rng.sample(edges, len(edges) // 3)
-    through = TakenBack(order)
+    through = RetractedEdges(order)
     for edge in gone:
-        through.take(*order.rows(edge))
+        through.add(*order.rows(edge))
     rest = list(edges)
     for edge in gone:
         rest.remove(edge)

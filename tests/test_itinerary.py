@@ -24,7 +24,7 @@ from cosmop.planning.realisation import message_links
 from cosmop.planning.timing import durations, itinerary
 from cosmop.scenario import load_scenario
 from cosmop.sim import simulate
-from cosmop.sim.timing import StepTimes, carry_instants, step_times
+from cosmop.sim.realised_times import StepTimes, carry_instants, step_times
 from cosmop.team.loop import plan_team
 
 CORRIDOR = Path(__file__).resolve().parents[1] / "examples" / "07_corridor" / "scenario.yaml"

@@ -20,8 +20,8 @@ LAYERS: tuple[frozenset[str], ...] = tuple(
         "io reading squares events",  # reading and writing files; squares; the mission's events
         "scene",  # the value types of a scenario
         "units missions control",  # SI units; top-down decomposition; reactive control
-        "physics traces maps planning",  # bodies overlapping; traces; grid maps; bottom-up synthesis
-        "scenario viz",  # the scenario loader; pictures
+        "traces maps planning",  # traces; grid maps; bottom-up synthesis
+        "scenario viz",  # the scenario loader (with its overlap checks); pictures
         "sim team export",  # the simulator (its results draw); the team's planning loop; ROS 2 bags
         "lifelong",  # a fleet serving a stream of orders
         "cli",  # the command line

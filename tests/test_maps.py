@@ -281,7 +281,7 @@ def test_importing_the_example_into_itself_gives_it_back(tmp_path):
 
 
 def test_a_template_ruamel_cannot_keep_is_written_plainly(tmp_path, monkeypatch):
-    import cosmop.maps.scene as scene_module
+    import cosmop.maps.to_scenario as scene_module
 
     def fail(*args, **kwargs):
         raise ValueError("ruamel could not")

@@ -9,7 +9,7 @@ from cosmop.logic import failing
 from cosmop.planning import obstacles
 from cosmop.planning.checker import check_robot_plan
 from cosmop.planning.regions import wall_regions
-from cosmop.planning.specification import MOTION_MARGIN, STEEPNESS, object_key, past_its_ends, wall_key
+from cosmop.planning.specification import MOTION_MARGIN, STEEPNESS, corner_clearance_key, object_key, wall_key
 from cosmop.planning.synthesis import synthesize
 from cosmop.scenario import parse_scenario
 from rooms import box_walls
@@ -178,14 +178,14 @@ def test_the_numeric_test_of_the_ends_never_passes_what_the_formula_breaks(monke
     synthesize(scene, "R1", MISSION, max_horizon=12)
     geometry, trace = seen[-1]
     walls = [wall_key(i) for i in range(len(scene.obstacles))] + [object_key("O2"), object_key("O1")]
-    keys = [past_its_ends(k) for k in walls]
+    keys = [corner_clearance_key(k) for k in walls]
     geometry._write([k for k in walls + keys if k not in geometry._written])
     rng = random.Random(7)
     sure, bites = 0, 0
     for _ in range(150):
         points = _about_an_end(rng, len(trace))
         moved = [{**s, "x": x, "y": y} for s, (x, y) in zip(trace, points, strict=True)]
-        unsure = set(geometry._sides.unsure(keys, moved))
+        unsure = set(geometry._half_planes.unsure(keys, moved))
         bad = {keys[i] for i in failing([geometry._written[k] for k in keys], moved)}
         own = {keys[i] for i in failing([geometry._written[k] for k in walls], moved)}
         assert not bad - own - unsure  # (the obstacle's own part is tested on its own)

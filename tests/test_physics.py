@@ -15,8 +15,8 @@ from typer.testing import CliRunner
 
 from cosmop.cli import app
 from cosmop.errors import ScenarioError
-from cosmop.physics import overlaps
 from cosmop.scenario import load_scenario, parse_scenario
+from cosmop.scenario.overlaps import overlaps
 
 ROOT = Path(__file__).resolve().parents[1]
 BASE = yaml.safe_load((ROOT / "examples" / "01_warehouse_2x2" / "scenario.yaml").read_text())

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 from cosmop.units import m_from_mm
 from cosmop.viz.palette import robot_colours
-from cosmop.viz.scene import DEFAULT_ROBOT_SIZE
+from cosmop.viz.scene_drawing import DEFAULT_ROBOT_SIZE
 
 if TYPE_CHECKING:
     from cosmop.scene import Scene

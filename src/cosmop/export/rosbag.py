@@ -39,7 +39,7 @@ from cosmop.export.markers import SceneMarkers
 from cosmop.io import atomic_path
 from cosmop.traces import Trace, as_trace
 from cosmop.units import m_from_mm
-from cosmop.viz.scene import ids_with_trace
+from cosmop.viz.scene_drawing import ids_with_trace
 
 if TYPE_CHECKING:
     from cosmop.planning.plan_types import PlanSet

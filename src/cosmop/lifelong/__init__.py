@@ -6,11 +6,11 @@ over time: a dispatcher gives each to an idle robot (:mod:`.dispatch`), whose ne
 planned from where it stands and ordered against the plans the others have committed to, with
 the same messages, exact checks and deadlock proof as a planned team, while the others keep
 moving (:mod:`.fleet`); robots may fail for good (:class:`Failure`).  :class:`FleetResult`
-reports throughput, waits, utilisation and safety (:mod:`.result`).
+reports throughput, waits, utilisation and safety (:mod:`.fleet_result`).
 """
 
 from cosmop.lifelong.dispatch import OrderState
 from cosmop.lifelong.fleet import Failure, FleetSettings, run_fleet
-from cosmop.lifelong.result import RUN_FORMAT, FleetResult, OrderRecord
+from cosmop.lifelong.fleet_result import RUN_FORMAT, FleetResult, OrderRecord
 
 __all__ = ["RUN_FORMAT", "Failure", "FleetResult", "FleetSettings", "OrderRecord", "OrderState", "run_fleet"]

@@ -34,7 +34,7 @@ import numpy as np
 
 from cosmop.events import parse_event
 from cosmop.lifelong.dispatch import OrderState, choose_robot, delivery_events
-from cosmop.lifelong.result import FleetResult
+from cosmop.lifelong.fleet_result import FleetResult
 from cosmop.planning.conflicts import ConflictSettings
 from cosmop.planning.plan_types import PlanSet, RobotPlan
 from cosmop.scene import Order, Scenario

@@ -9,7 +9,7 @@ from cosmop.maps.cover import boundary_walls, rectangle_cover, rectangle_walls
 from cosmop.maps.grid import MapError, OccupancyGrid
 from cosmop.maps.movingai import parse_movingai, read_movingai
 from cosmop.maps.rosmap import read_pgm, read_ros_map
-from cosmop.maps.scene import ImportedMap, import_map, scenario_text
+from cosmop.maps.to_scenario import ImportedMap, import_map, scenario_text
 
 __all__ = [
     "ImportedMap",

@@ -47,7 +47,7 @@ from typing import Any, TypeAlias, TypeVar
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["Link", "Node", "Precedence", "TakenBack"]
+__all__ = ["Link", "Node", "Precedence", "RetractedEdges"]
 
 Node = tuple[str, int]
 """A step of a plan: ``(robot, instant)``, instants 1..K (0 is the start)."""
@@ -77,6 +77,10 @@ class Link:
 
 class Precedence:
     """The partial order of a team's steps, with vector clocks and expected times.
+
+    The multi-robot literature calls it a *temporal plan graph* (Hönig et al., 2016): the steps
+    are its vertices, program order, messages and start edges its edges, and a step's vector
+    clock holds the steps that precede it.
 
     Parameters
     ----------
@@ -198,8 +202,10 @@ class Precedence:
     # -- construction -------------------------------------------------------------------------
 
     def _run(self) -> None:
-        self._D, self._B = [0] * self.size, [0] * self.size  # the clocks as sets of rows
-        self._F, self._S = [0.0] * self.size, [0.0] * self.size  # finish and start times
+        # row by row, the vector clocks as sets of rows: the steps complete by the step's
+        # completion, and before its start; then its earliest finish and start times
+        self._done_clocks, self._begin_clocks = [0] * self.size, [0] * self.size
+        self._finish_times, self._start_times = [0.0] * self.size, [0.0] * self.size
         progress = dict.fromkeys(self.robots, 0)  # instants completed
         self.order: list[Node] = []
         changed = True
@@ -214,7 +220,8 @@ class Precedence:
         for r in self.robots:  # "start of K+1" = after the whole plan
             k, o = progress[r], self.offsets[r]
             if k == self.horizons[r]:
-                self._B[o + k + 1], self._S[o + k + 1] = self._D[o + k], self._F[o + k]
+                self._begin_clocks[o + k + 1] = self._done_clocks[o + k]
+                self._start_times[o + k + 1] = self._finish_times[o + k]
         self.stuck = {r: progress[r] + 1 for r in self.robots if progress[r] < self.horizons[r]}
         self.complete = not self.stuck
         # a topological order of the steps (kept by _place): the starts, the steps in the order
@@ -230,7 +237,9 @@ class Precedence:
         return all(s != _NEVER and progress[node[s][0]] >= node[s][1] for s in sources)
 
     def _complete(self, row: int) -> None:
-        self._B[row], self._S[row], self._D[row], self._F[row] = self._anew(row)
+        begin, t_start, done, t_done = self._anew(row)
+        self._begin_clocks[row], self._start_times[row] = begin, t_start
+        self._done_clocks[row], self._finish_times[row] = done, t_done
         self.order.append(self._node[row])
 
     def _anew(self, row: int) -> tuple[int, float, int, float]:
@@ -248,8 +257,8 @@ class Precedence:
         the NumPy tables."""
         n = self.done_bits.shape[1]
         for rows, masks, times, bits, flat in (
-            (done, self._D, self._F, self.done_bits, self.finish_flat),
-            (begin, self._B, self._S, self.begin_bits, self.started_flat),
+            (done, self._done_clocks, self._finish_times, self.done_bits, self.finish_flat),
+            (begin, self._begin_clocks, self._start_times, self.begin_bits, self.started_flat),
         ):
             if rows:
                 packed = b"".join([masks[r].to_bytes(n, "little") for r in rows])
@@ -258,7 +267,7 @@ class Precedence:
 
     def _mirror_log(self, log: list[_Entry]) -> None:
         """:meth:`_mirror` the rows an undo log changed."""
-        D = self._D
+        D = self._done_clocks
         changed = [(entry[0], entry[1] is D) for entry in log if entry[0] is not None]
         self._mirror([r for r, done in changed if done], [r for r, done in changed if not done])
 
@@ -337,7 +346,7 @@ class Precedence:
         last step.  Written out in one loop: it is most of the ordering search's time.
         """
         place, succ, nxt, dur, last = self._ord, self._succ, self._next, self._dur, self._last
-        D, F, B, S = self._D, self._F, self._B, self._S
+        D, F, B, S = self._done_clocks, self._finish_times, self._begin_clocks, self._start_times
         queue = [(place[row], row) for row in pending]
         heapq.heapify(queue)
         pop, push, latest = heapq.heappop, heapq.heappush, self._latest
@@ -435,7 +444,7 @@ class Precedence:
 
     def _latest(self, rows: Sequence[int]) -> tuple[int, float]:
         """The clock and the time by which all of `rows` have completed."""
-        D, F = self._D, self._F
+        D, F = self._done_clocks, self._finish_times
         clock, t = D[rows[0]], F[rows[0]]
         for s in rows[1:]:
             clock |= D[s]
@@ -449,7 +458,7 @@ class Precedence:
         Parameters
         ----------
         log : list
-            An undo log of :meth:`add_start`, :meth:`add_starts` or :meth:`take_back`.
+            An undo log of :meth:`add_start`, :meth:`add_starts` or :meth:`retract`.
         """
         for entry in reversed(log):
             if entry[0] is None:
@@ -460,8 +469,11 @@ class Precedence:
                 masks[row], times[row] = old, t
         self._mirror_log(log)
 
-    def take_back(self, logs: Sequence[list[_Entry]], edges: Sequence[tuple[Node, Node]]) -> list[_Entry]:
-        """Remove some of the start edges that `logs` added, keeping the others where they are.
+    def retract(self, logs: Sequence[list[_Entry]], edges: Sequence[tuple[Node, Node]]) -> list[_Entry]:
+        """Retract some of the start edges that `logs` added, keeping the others where they are.
+
+        *Retraction* as in dependency-directed backtracking: only what the edges that go reach
+        changes, instead of undoing every log back to where the first of them was added.
 
         `logs` are the undo logs of every :meth:`add_start` and :meth:`add_starts` since some
         state *S*, oldest first; `edges` are to go.  The clocks and times they reach are computed
@@ -485,9 +497,9 @@ class Precedence:
         links: list[_Entry] = []
         values: dict[tuple[int, bool], _Entry] = {}
         seeds: set[int] = set()
-        D = self._D
+        D = self._done_clocks
         for log in logs:
-            if isinstance(log, _Compact):  # from an earlier take_back: its values by step
+            if isinstance(log, _Compact):  # from an earlier retract: its values by step
                 entries = log[: log.links]
                 if values:
                     for key, entry in log.values.items():
@@ -513,7 +525,8 @@ class Precedence:
     def _settle(self, seeds: set[int]) -> tuple[list[int], list[int]]:
         """Compute the steps `seeds`, and those after them that change, again from the steps
         they wait for; the rows whose completion (start) changed."""
-        place, D, F, B, S = self._ord, self._D, self._F, self._B, self._S
+        place, D, F = self._ord, self._done_clocks, self._finish_times
+        B, S = self._begin_clocks, self._start_times
         queue = [(place[row], row) for row in seeds]
         heapq.heapify(queue)
         seen, done, begin = set(seeds), [], []
@@ -561,7 +574,7 @@ class Precedence:
             return False
         if a == b:
             return i < j
-        return self._has(self._B, self._row(then), first)
+        return self._has(self._begin_clocks, self._row(then), first)
 
     def precedes(self, first: Node, then: Node) -> bool:
         """Whether ``first = (A, i)`` always completes before ``then = (B, j)`` completes.
@@ -574,7 +587,7 @@ class Precedence:
         (a, i), (b, j) = first, then
         if a == b:
             return i <= j
-        return j >= 1 and self._has(self._D, self._row(then), first)
+        return j >= 1 and self._has(self._done_clocks, self._row(then), first)
 
     def would_cycle(self, first: Node, then: Node) -> bool:
         """Whether the start edge ``first -> then`` closes a cycle: ``then`` must already
@@ -588,7 +601,7 @@ class Precedence:
         (a, i), (b, j) = first, then
         if a == b:
             return j <= i
-        return self._has(self._D, self._row(first), then)
+        return self._has(self._done_clocks, self._row(first), then)
 
     def done_before(self, row: int) -> int:
         """The steps that always complete before the step of `row` completes (its vector clock
@@ -599,7 +612,7 @@ class Precedence:
         row : int
             A step's row (``-1``: :data:`_NEVER`).
         """
-        return self._D[row] if row >= 0 else 0
+        return self._done_clocks[row] if row >= 0 else 0
 
     def completed(self, step: Node, robot: str) -> int:
         """How many of `robot`'s steps always complete by the completion of `step` (its entry
@@ -613,7 +626,7 @@ class Precedence:
             The robot whose steps are counted.
         """
         o, k = self.offsets[robot], self.horizons[robot]
-        return (self._D[self._row(step)] >> (o + 1) & ((1 << k) - 1)).bit_count()
+        return (self._done_clocks[self._row(step)] >> (o + 1) & ((1 << k) - 1)).bit_count()
 
     def places(self, steps: NDArray[np.int64], rows: NDArray[np.int64]) -> NDArray[np.int64]:
         """Where :meth:`completes_before` reads whether the step of row ``steps[n]`` completes
@@ -646,7 +659,7 @@ class Precedence:
     @property
     def makespan(self) -> float:
         """Earliest time the whole team is done (with the given durations)."""
-        return max((self._F[o + self.horizons[r]] for r, o in self.offsets.items()), default=0.0)
+        return max((self._finish_times[o + self.horizons[r]] for r, o in self.offsets.items()), default=0.0)
 
     def start_time(self, node: Node) -> float:
         """Earliest start of step ``(robot, k)`` (``k = K + 1``: the end of its plan).
@@ -656,39 +669,41 @@ class Precedence:
         node : Node
             The step ``(robot, k)``.
         """
-        return self._S[self._row(node)] if node[1] >= 1 else 0.0
+        return self._start_times[self._row(node)] if node[1] >= 1 else 0.0
 
 
-class TakenBack:
-    """Start edges about to be taken back from a :class:`Precedence`, and which cycles of its
-    order may run through them.  Edges are given as rows (:meth:`Precedence.rows`).
+class RetractedEdges:
+    """Start edges about to be retracted from a :class:`Precedence` (:meth:`Precedence.retract`),
+    and which cycles of its order may run through them.  Edges are given as rows
+    (:meth:`Precedence.rows`).  A search asks it which of its forced choices lose their
+    justification (the cycle the other choice would close) with the retraction.
 
     The edge ``(A, i) -> (B, j)`` closes a cycle when B's step j completes before A's step i
     does: a path runs from the one to the other.  That path may use a start edge
     ``(C, k) -> (D, l)`` only if the path reaches C's step k and leaves from D's step l (its
     start leads nowhere but to its completion), so only if :math:`(B, j) \\preceq (C, k)` and
-    :math:`(D, l) \\preceq (A, i)` in the order as it is.  If no edge taken back passes that
+    :math:`(D, l) \\preceq (A, i)` in the order as it is.  If no edge retracted passes that
     test, every such path avoids them all, and the cycle stays when they are gone.  The test is
     one-sided: an edge that passes it may still not be needed.
 
     Examples
     --------
     >>> order = Precedence({"A": 2, "B": 2}, starts=[(("A", 1), ("B", 1)), (("B", 2), ("A", 2))])
-    >>> gone = TakenBack(order)
+    >>> gone = RetractedEdges(order)
     >>> gone.may_pass(*order.rows((("B", 2), ("A", 1))))
     False
-    >>> gone.take(*order.rows((("A", 1), ("B", 1))))
+    >>> gone.add(*order.rows((("A", 1), ("B", 1))))
     >>> gone.may_pass(*order.rows((("B", 2), ("A", 1)))), gone.may_pass(*order.rows((("A", 2), ("B", 1))))
     (True, False)
     """
 
     def __init__(self, precedence: Precedence) -> None:
-        self.done = precedence._D
-        self.targets = 0  # the rows edges taken back lead to, as a set
+        self.done_before = precedence.done_before
+        self.targets = 0  # the rows edges retracted lead to, as a set
         self.before: dict[int, int] = {}  # such a row -> the rows that complete before a source
 
-    def take(self, source: int, target: int) -> None:
-        """Count the edge ``source -> target`` as taken back.
+    def add(self, source: int, target: int) -> None:
+        """Count the edge ``source -> target`` as retracted.
 
         Parameters
         ----------
@@ -697,11 +712,11 @@ class TakenBack:
         """
         if source != _NEVER:
             self.targets |= 1 << target
-            self.before[target] = self.before.get(target, 0) | self.done[source]
+            self.before[target] = self.before.get(target, 0) | self.done_before(source)
 
     def may_pass(self, source: int, target: int) -> bool:
         """Whether a cycle that the edge ``source -> target`` closes may run through an edge
-        taken back.
+        retracted.
 
         Parameters
         ----------
@@ -710,7 +725,7 @@ class TakenBack:
         """
         if source == _NEVER:
             return False
-        reach = self.done[source] & self.targets
+        reach = self.done_before(source) & self.targets
         while reach:
             low = reach & -reach
             if self.before[low.bit_length() - 1] >> target & 1:
@@ -720,7 +735,7 @@ class TakenBack:
 
 
 class _Compact(list[_Entry]):
-    """An undo log of :meth:`Precedence.take_back`: its links, then one value per step (the
+    """An undo log of :meth:`Precedence.retract`: its links, then one value per step (the
     oldest), also kept by step in :attr:`values`."""
 
     __slots__ = ("links", "values")

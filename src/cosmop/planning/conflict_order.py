@@ -7,11 +7,12 @@ is expected to begin first (:mod:`cosmop.planning.timing`) goes first, unless th
 cycle or it never ends (a robot parked for good).  Conflicts no order can resolve together are
 returned, irredundant, for re-planning.
 
-Two conflicts between the same robots often say the same thing more strongly or more weakly
-(:class:`_Implied`); only the strongest are searched and given to the solver.  The solver's
-work grows much faster than the conflicts (a single check of 10,000 conflicts can take a
-minute), so the search proves its own dead ends (:mod:`cosmop.planning.conflict_search`) and
-the solver is asked only when the search runs out of its budget.
+Two conflicts between the same robots often say the same thing more strongly or more weakly:
+one *dominates* the other (:class:`_Dominance`); only the undominated are searched and given to
+the solver.  The solver's work grows much faster than the conflicts (a single check of 10,000
+conflicts can take a minute), so the search proves its own dead ends
+(:mod:`cosmop.planning.conflict_search`) and the solver is asked only when the search runs out
+of its budget.
 """
 
 from __future__ import annotations
@@ -26,13 +27,13 @@ from shapely.geometry.base import BaseGeometry
 
 from cosmop.missions.precedence import Link, Node
 from cosmop.planning.conflict_search import (
-    Culprits,
+    CorrectionSetPicker,
     Edge,
+    OrientationTable,
     Search,
-    WayTable,
     backjump,
     depth_first,
-    ways_of,
+    possible_orientations,
 )
 from cosmop.planning.conflicts import Conflict
 
@@ -56,14 +57,14 @@ def order_conflicts(
     """Start edges that order every conflict in `found`, and the conflicts no order resolves.
 
     Both the search and the solver see only the conflicts no other one implies
-    (:class:`_Implied`): an order of those orders the rest.  Then:
+    (:class:`_Dominance`): an order of those orders the rest.  Then:
 
     1. a search over the two ways of ordering each conflict, with unit propagation and
        conflict-directed backjumping (:class:`~cosmop.planning.conflict_search.Search`).  Each
        dead end comes with the set of conflicts it follows from; one that follows from no
        choice is a *core* -- a set of conflicts no order resolves together -- and one conflict
        of each core is set aside (the most re-plannable, preferably of a robot already
-       re-planned: :class:`~cosmop.planning.conflict_search.Culprits`).  The cores are not
+       re-planned: :class:`~cosmop.planning.conflict_search.CorrectionSetPicker`).  The cores are not
        minimal, so each conflict set aside is then given back where the others allow it
        (:func:`_give_back`), and that is the answer;
     2. only if the search passes `max_backtracks` dead ends: the question settled exactly as a
@@ -100,11 +101,11 @@ def order_conflicts(
     rlimit : int
         Z3 resource limit of each scheduling call.
     """
-    table = WayTable.of(found, list(horizons))
-    implied, culprits = _Implied(found, table), Culprits(fixed)
+    table = OrientationTable.of(found, list(horizons))
+    implied, picker = _Dominance(found, table), CorrectionSetPicker(fixed)
     team = (horizons, links, starts, durations)
-    search = Search(found, implied, team, culprits, table)
-    if search.run(max_backtracks) and (settled := _give_back(search, culprits, max_backtracks)):
+    search = Search(found, implied, team, picker, table)
+    if search.run(max_backtracks) and (settled := _give_back(search, picker, max_backtracks)):
         return settled
     unresolved, cores = search.set_aside, search.cores
     gone = {id(c) for c in unresolved}
@@ -112,14 +113,14 @@ def order_conflicts(
     while (core := schedule.solve(implied.left(gone))) is not None:
         if not core:  # undecided within the solver's budget: what the search fails on stays
             return _give_up(found, horizons, links, starts, durations, max_backtracks, fixed, implied)
-        unresolved.append(culprits.pick(core))
+        unresolved.append(picker.pick(core))
         gone.add(id(unresolved[-1]))
         cores[id(unresolved[-1])] = core
     # Cores are not minimal, so a conflict set aside early may be orderable once later ones are
     # gone: give each back, the hardest to re-plan first, while a schedule remains.  No solver
     # call when the last schedule already orders it, nor when its own core is all back (the
     # core still proves that no schedule orders it with the others).
-    for conflict in sorted(unresolved, key=lambda c: -culprits.rank(c)):
+    for conflict in sorted(unresolved, key=lambda c: -picker.rank(c)):
         gone.discard(id(conflict))
         if all(id(c) not in gone for c in cores[id(conflict)]) or (
             schedule.way(conflict) is None and schedule.solve(implied.left(gone)) is not None
@@ -129,11 +130,11 @@ def order_conflicts(
             unresolved.remove(conflict)
     # the search's choices keep the makespan low; the schedule stands in where the search fails
     rest = [c for c in found if id(c) not in gone]
-    better, _, _ = backjump(rest, implied, team, culprits, max_backtracks)
+    better, _, _ = backjump(rest, implied, team, picker, max_backtracks)
     return (better if better is not None else schedule.edges(implied.left(gone))), unresolved
 
 
-def _give_back(search: Search, culprits: Culprits, budget: int) -> _Ordered | None:
+def _give_back(search: Search, picker: CorrectionSetPicker, budget: int) -> _Ordered | None:
     """Give back the conflicts `search` set aside that an order resolves with all the others.
 
     A conflict whose core's other members are all ordered stays set aside (its core proves it).
@@ -141,7 +142,7 @@ def _give_back(search: Search, culprits: Culprits, budget: int) -> _Ordered | No
     as it is: it stays set aside if the search finds a core (which must contain it, the rest
     being ordered).  ``(edges, unresolved)``, or ``None`` when the search runs out of `budget`.
     """
-    for conflict in sorted(search.set_aside, key=lambda c: -culprits.rank(c)):
+    for conflict in sorted(search.set_aside, key=lambda c: -picker.rank(c)):
         core = search.cores[id(conflict)]
         if not any(search.is_aside(c) for c in core if c is not conflict):
             continue
@@ -158,7 +159,7 @@ def _give_up(
     durations: Mapping[str, Sequence[float]],
     max_backtracks: int,
     fixed: Mapping[str, Sequence[BaseGeometry]] | None,
-    implied: _Implied,
+    implied: _Dominance,
 ) -> _Ordered:
     """Order what the search can, leaving each conflict it fails on unresolved (sound, not minimal)."""
     unresolved: list[Conflict] = []
@@ -186,7 +187,7 @@ class _Schedule:
     Z3's difference-logic solver decides it (about 4x faster than its simplex at 2,500
     conflicts).
 
-    A conflict that another asked one implies (:class:`_Implied`) is neither assumed nor, until
+    A conflict that another asked one implies (:class:`_Dominance`) is neither assumed nor, until
     it is needed, written: about two in three of a one-lane warehouse's conflicts, and the
     solver's work grows faster than their number.
     """
@@ -199,7 +200,7 @@ class _Schedule:
         starts: Sequence[Edge],
         durations: Mapping[str, Sequence[float]],
         rlimit: int,
-        implied: _Implied | None = None,
+        implied: _Dominance | None = None,
     ) -> None:
         import z3
 
@@ -226,8 +227,8 @@ class _Schedule:
             if target in s and source in e:
                 text.append(f"(assert {_after(s[target], e[source])})")
         self.solver.from_string("\n".join(text))
-        self.ways = {id(c): ways_of(c) for c in found}
-        self.implied = implied if implied is not None else _Implied(found)
+        self.ways = {id(c): possible_orientations(c) for c in found}
+        self.implied = implied if implied is not None else _Dominance(found)
         self.number = {id(c): n for n, c in enumerate(found)}
         self.label: dict[int, Any] = {}  # conflict -> its literal (a z3 Bool), once written
         self.by_id: dict[int, Conflict] = {}  # literal -> conflict
@@ -286,8 +287,12 @@ class _Schedule:
         return out
 
 
-class _Implied:
+class _Dominance:
     """Which conflicts imply which: of two between the same robots, one may say the other.
+
+    The stronger *dominates* the weaker: a *dominated* conflict is ordered by any order of a
+    conflict that dominates it, so only the undominated need ordering (as dominance rules prune
+    a scheduling search).
 
     "x before y" is the edge :math:`s_{B,j} \\ge e_{A,i} + \\epsilon`; the edge ``(A, i') ->
     (B, j')`` with :math:`i' \\ge i` and :math:`j' \\le j` implies it, by program order
@@ -296,14 +301,14 @@ class _Implied:
     of two conflicts that imply each other, the earlier in `found` stands for both.
     """
 
-    def __init__(self, found: Sequence[Conflict], table: WayTable | None = None) -> None:
+    def __init__(self, found: Sequence[Conflict], table: OrientationTable | None = None) -> None:
         self.index = {id(c): n for n, c in enumerate(found)}
         self.found = list(found)
-        # every conflict's ways as (A, i, B, j), robots numbered (WayTable); each pair of robots
+        # every conflict's ways as (A, i, B, j), robots numbered (OrientationTable); each pair of robots
         # numbered in the order it first appears
         pairs: dict[frozenset[str], int] = {}
         pair = np.array([pairs.setdefault(frozenset(c.robots), len(pairs)) for c in found], dtype=np.int64)
-        table = table if table is not None else WayTable.of(found, ())
+        table = table if table is not None else OrientationTable.of(found, ())
         present, ends = table.possible, table.ends
         order = np.argsort(pair, kind="stable")
         groups = np.split(order, np.flatnonzero(np.diff(pair[order])) + 1) if len(order) else []
@@ -353,7 +358,7 @@ class _Implied:
 
 def _implications(present: np.ndarray, ends: np.ndarray) -> np.ndarray:
     """``[..., d, c]``: whether each way of conflict *d* implies a way of *c*
-    (:class:`_Implied`), for conflicts between the same two robots: `present` ``(..., m, 2)``
+    (:class:`_Dominance`), for conflicts between the same two robots: `present` ``(..., m, 2)``
     says which ways they have, `ends` ``(..., m, 2, 4)`` each way as ``(A, i, B, j)`` with the
     robots numbered (leading axes: groups of conflicts, each on its own)."""
     # [..., d, c, d's way, c's way, field]

@@ -5,9 +5,14 @@ that the team's order stays acyclic: unit propagation of the orders that are for
 that follow time (the robot expected first goes first), and conflict-directed backjumping.
 Each dead end comes with the set of conflicts it follows from (:func:`_core`); one that follows
 from no choice is a *core*, a set of conflicts no order resolves together, found without a
-solver.  Of each core one conflict is set aside for re-planning (:class:`Culprits`).  What a
-dead end takes back is only what needs what goes (dependency-directed, as in Stallman and
-Sussman's reason maintenance): the rest of the order stays in place.
+solver.  Of each core one conflict is set aside for re-planning (:class:`CorrectionSetPicker`):
+the conflicts set aside hit every core, a *correction set*.  What a dead end takes back is only
+what needs what goes (dependency-directed *retraction*, as in Stallman and Sussman's reason
+maintenance): the rest of the order stays in place.
+
+A conflict is a *disjunctive edge* of the team's order (as in a disjunctive graph of job-shop
+scheduling): one of its two occupancies goes first, and each choice is one of its two
+*orientations* (:func:`orientations_of`), a start edge.
 """
 
 from __future__ import annotations
@@ -19,10 +24,19 @@ from typing import Any, Generic, Protocol, TypeVar
 import numpy as np
 from shapely.geometry.base import BaseGeometry
 
-from cosmop.missions.precedence import Link, Node, Precedence, TakenBack
+from cosmop.missions.precedence import Link, Node, Precedence, RetractedEdges
 from cosmop.planning.conflicts import Conflict, Occupancy, detours, replan_rank
 
-__all__ = ["Culprits", "Search", "WayTable", "backjump", "both_ways", "depth_first", "way_table", "ways_of"]
+__all__ = [
+    "CorrectionSetPicker",
+    "OrientationTable",
+    "Search",
+    "backjump",
+    "depth_first",
+    "orientation_arrays",
+    "orientations_of",
+    "possible_orientations",
+]
 
 Edge = tuple[Node, Node]
 """A start edge ``((A, i), (B, j))``: B starts step *j* once A has completed step *i*."""
@@ -39,7 +53,7 @@ _Taken = tuple[int, Edge, _Reason]
 
 
 class _Implications(Protocol):
-    """Which conflicts imply which (:class:`cosmop.planning.conflict_order._Implied`)."""
+    """Which conflicts dominate which (:class:`cosmop.planning.conflict_order._Dominance`)."""
 
     def among(self, conflicts: Sequence[Conflict]) -> tuple[np.ndarray, np.ndarray]: ...
 
@@ -59,7 +73,7 @@ class Search:
       with the choices among them kept, no order of them is acyclic.  The search jumps back to
       the latest of those choices and takes its other way, forced now by that set.  A dead end
       with no choice in it is a *core*: no order resolves it at all.  One of its conflicts is
-      set aside (:class:`Culprits`), and what depends on that conflict is taken back.
+      set aside (:class:`CorrectionSetPicker`), and what depends on that conflict is taken back.
     * taking back (:meth:`_retract`) keeps every later entry whose reason does not need what
       goes: choices, ways forced by cycles that cannot run through an edge that goes, ways
       forced by sets that lose nothing.  At 50 robots a core took back some 490 entries of
@@ -74,7 +88,7 @@ class Search:
 
     A conflict that another one in `found` implies is left to it while that one is not set
     aside (`implied.among(found)` gives the pairs, stronger and weaker, as indices into `found`:
-    :class:`cosmop.planning.conflict_order._Implied`).  The search keeps its state between
+    :class:`cosmop.planning.conflict_order._Dominance`).  The search keeps its state between
     questions: a conflict given back (:meth:`give_back`) is searched on from the order as it is.
     """
 
@@ -83,14 +97,14 @@ class Search:
         found: Sequence[Conflict],
         implied: _Implications,
         team: _Team,
-        culprits: Culprits,
-        table: WayTable | None = None,
+        picker: CorrectionSetPicker,
+        table: OrientationTable | None = None,
     ) -> None:
         horizons, links, starts, durations = team
-        self.found, self.culprits = found, culprits
+        self.found, self.picker = found, picker
         self.number = {id(c): i for i, c in enumerate(found)}
         self.precedence = Precedence(horizons, links, starts, durations)
-        self.sides = _Sides(found, self.precedence, table)
+        self.orientations = _OrientationTests(found, self.precedence, table)
         self.at: dict[int, int] = {}  # conflict -> its place in the trail
         self.graph: _Graph[int] = _Graph(self.precedence, links, starts, self.at)
         self.stronger, self.weaker = implied.among(found)
@@ -139,10 +153,10 @@ class Search:
         dead_ends, kept = 0, True
         while True:
             # a side that holds keeps holding until something is taken back (_pop)
-            held = self.sides.holds(self.precedence, self.live)
+            held = self.orientations.holds(self.precedence, self.live)
             live = self.live = self.live[~(held[:, 0] | held[:, 1])]
             open_ = ~self.aside[live] & ~self.hidden[live]
-            ways = self.sides.ways(self.precedence, live)
+            ways = self.orientations.ways(self.precedence, live)
             counts = np.where(open_, ways[:, 0].astype(np.int64) + ways[:, 1], -1)
             stuck = live[counts == 0]
             if len(stuck):
@@ -156,14 +170,14 @@ class Search:
             at = np.flatnonzero(counts == 1)
             side = dict(zip(live[at].tolist(), ways[at, 1].tolist(), strict=True))  # the way left
             # the hardest to re-plan first: the likely culprits come last, the least to take back
-            order = sorted(side, key=lambda i: -self.culprits.rank(self.found[i]))
-            self._take_forced([(i, self.sides.way(i, int(side[i]))) for i in order])
+            order = sorted(side, key=lambda i: -self.picker.rank(self.found[i]))
+            self._take_forced([(i, self.orientations.way(i, int(side[i]))) for i in order])
             if len(at):
                 continue
             pool = live[open_]
             if not len(pool):
                 return kept
-            i = int(pool[np.argmin(self.sides.expected_start(self.precedence, pool))])
+            i = int(pool[np.argmin(self.orientations.expected_start(self.precedence, pool))])
             self._take(i, _options(self.found[i], self.precedence)[0], None)
 
     def _dead_ends(self, stuck: list[int], back: int | None) -> str:
@@ -184,7 +198,7 @@ class Search:
                 break  # the set-asides first; if it is still a dead end, it comes back
             if choices:
                 i, edge = self.trail[max(choices)][:2]
-                other = self.sides.other_way(i, edge)
+                other = self.orientations.other_way(i, edge)
                 self._retract(max(choices), {i}, (i, other, frozenset(core)))
                 return "choice"
             if back is not None:
@@ -193,7 +207,7 @@ class Search:
                 break
             # on a tie, the one taken last (the least to take back): not taken yet, then the latest
             members = sorted(core, key=lambda i: -self.at.get(i, len(self.trail)))
-            picked = self.culprits.pick([self.found[i] for i in members])
+            picked = self.picker.pick([self.found[i] for i in members])
             culprit = next(i for i in members if self.found[i] is picked)
             gone.add(culprit)
             places.append(self._put_aside(culprit, core))
@@ -209,12 +223,12 @@ class Search:
         (:meth:`_retract`) may have lost its other way to a cycle since: it counts as forced
         from then on, and the set is traced again."""
         while True:
-            core = _core(stuck, self.sides, self.graph, self.trail, self.at)
+            core = _core(stuck, self.orientations, self.graph, self.trail, self.at)
             choices = [self.at[i] for i in core if i in self.at and self.trail[self.at[i]][3] is None]
             if not choices:
                 return core, choices
             i, edge, log, _ = self.trail[max(choices)]
-            other = self.sides.other_way(i, edge)
+            other = self.orientations.other_way(i, edge)
             if self.graph.path(*other, before=max(choices)) is None:
                 return core, choices
             self.trail[max(choices)] = (i, edge, log, True)
@@ -286,7 +300,7 @@ class Search:
         reason does not need what goes (:meth:`_needing`).
 
         The entries kept stay in the trail, in their order, as one batch, and the order drops
-        the edges that go (:meth:`~cosmop.missions.precedence.Precedence.take_back`).  `first`
+        the edges that go (:meth:`~cosmop.missions.precedence.Precedence.retract`).  `first`
         comes after them; if they close its cycle, it comes where its choice was, and they are
         taken again after it up to the first that closes a cycle then (what comes after that one
         may need it): the rest is left to the search.
@@ -314,12 +328,12 @@ class Search:
 
         An entry goes when its conflict is gone, when it was forced by a dead end's set that
         holds a conflict that goes, or when it was forced by a cycle that may run through an
-        edge that goes (:class:`~cosmop.missions.precedence.TakenBack`, one-sided).  Choices
+        edge that goes (:class:`~cosmop.missions.precedence.RetractedEdges`, one-sided).  Choices
         need nothing.  What stays keeps its reason: all it used stays before it.
         """
         log = self.trail[place][2] if place < len(self.trail) else None
         start = log.start if isinstance(log, _Batch) else place  # a batch goes back whole
-        through, dropped = TakenBack(self.precedence), set(gone)
+        through, dropped = RetractedEdges(self.precedence), set(gone)
         kept: list[_Taken] = []
         for n, (i, edge, _, reason) in enumerate(self.trail[start:], start):
             if n < place:
@@ -329,9 +343,11 @@ class Search:
             elif isinstance(reason, frozenset):
                 needs = not reason.isdisjoint(dropped)
             else:
-                needs = any(through.may_pass(*self.sides.rows[i][n]) for n in self.sides.others(i, edge))
+                needs = any(
+                    through.may_pass(*self.orientations.rows[i][n]) for n in self.orientations.others(i, edge)
+                )
             if needs:
-                through.take(*self.precedence.rows(edge))
+                through.add(*self.precedence.rows(edge))
                 dropped.add(i)
             else:
                 kept.append((i, edge, reason))
@@ -347,7 +363,7 @@ class Search:
             if not isinstance(log, _Batch) or log.start == n
         ]
         away = [edge for i, edge, _, _ in tail if i in dropped]
-        batch = _Batch(start, len(kept), self.precedence.take_back(logs, away))
+        batch = _Batch(start, len(kept), self.precedence.retract(logs, away))
         self.graph.remove(start, dropped)
         for i in dropped:
             self.at.pop(i, None)  # (a conflict set aside need not have been taken)
@@ -394,7 +410,7 @@ was added in), and why it was taken."""
 
 
 def backjump(
-    found: Sequence[Conflict], implied: _Implications, team: _Team, culprits: Culprits, budget: int
+    found: Sequence[Conflict], implied: _Implications, team: _Team, picker: CorrectionSetPicker, budget: int
 ) -> tuple[list[tuple[Edge, Conflict]] | None, list[Conflict], dict[int, list[Conflict]]]:
     """:class:`Search` run once: ``(edges, set aside, cores)``, ``edges`` ``None`` past `budget`.
 
@@ -402,16 +418,16 @@ def backjump(
     ----------
     found : sequence of Conflict
         The conflicts to order.
-    implied : _Implied
-        Which of them imply which (:class:`cosmop.planning.conflict_order._Implied`).
+    implied : _Dominance
+        Which of them imply which (:class:`cosmop.planning.conflict_order._Dominance`).
     team : tuple
         ``(horizons, links, starts, durations)``: the plans' order before any conflict's.
-    culprits : Culprits
+    picker : CorrectionSetPicker
         Which conflict of a core to set aside.
     budget : int
         Dead ends after which the search gives up.
     """
-    search = Search(found, implied, team, culprits)
+    search = Search(found, implied, team, picker)
     done = search.run(budget)
     return (search.edges if done else None), search.set_aside, search.cores
 
@@ -421,7 +437,11 @@ def _in(i: int, reason: _Reason) -> bool:
 
 
 def _core(
-    stuck: int, sides: _Sides, graph: _Graph[int], trail: list[_Entry], at: Mapping[int, int]
+    stuck: int,
+    orientations: _OrientationTests,
+    graph: _Graph[int],
+    trail: list[_Entry],
+    at: Mapping[int, int],
 ) -> set[int]:
     """`stuck` and every conflict its dead end follows from (:class:`Search`): the conflicts on
     the cycles that close its ways, and, for each of those forced, on the cycle its other way
@@ -435,7 +455,7 @@ def _core(
 
     core, traced = {stuck}, {stuck}
     todo: list[int] = []
-    for edge in sides.edges[stuck]:
+    for edge in orientations.edges[stuck]:
         if edge is not None:
             todo += cycle(edge, len(trail))
     while todo:
@@ -448,13 +468,17 @@ def _core(
         if isinstance(reason, frozenset):
             core |= reason
         elif reason is True:
-            for n in sides.others(i, chosen):
-                todo += cycle(sides.way(i, n), at[i])
+            for n in orientations.others(i, chosen):
+                todo += cycle(orientations.way(i, n), at[i])
     return core
 
 
-class Culprits:
+class CorrectionSetPicker:
     """Which conflict of a core to set aside (its robot is re-planned around the other side).
+
+    The conflicts set aside, one of each core, form a *correction set* (the term of unsat-core
+    and MaxSAT work: a set whose removal leaves the rest satisfiable, a hitting set of the
+    cores); this class picks its members, one core at a time.
 
     The most re-plannable (:func:`~cosmop.planning.conflicts.replan_rank`); of those, one whose
     robot is already re-planned this round: one more space to keep clear of costs a robot that
@@ -591,8 +615,9 @@ class _Graph(Generic[_Label]):
         return out
 
 
-class _Sides:
-    """Both ways of ordering every conflict, as arrays, to ask many questions at once.
+class _OrientationTests:
+    """Both orientations of every conflict (its two ways of ordering, its *sides*), as arrays,
+    tested against the order many at once.
 
     Side 0 puts occupancy ``a`` first, side 1 ``b``: "x before y" is the start edge from
     x's last step to y's first.  A side is *possible* when x ends and y does not start at the
@@ -601,9 +626,9 @@ class _Sides:
     """
 
     def __init__(
-        self, found: Sequence[Conflict], precedence: Precedence, table: WayTable | None = None
+        self, found: Sequence[Conflict], precedence: Precedence, table: OrientationTable | None = None
     ) -> None:
-        table = table if table is not None else WayTable.of(found, precedence.robots)
+        table = table if table is not None else OrientationTable.of(found, precedence.robots)
         self.edges = table.edges  # each side as a start edge, or None
         offset = np.array([precedence.offsets[r] for r in precedence.robots], dtype=np.int64)
         end = np.array([precedence.horizons[r] + 1 for r in precedence.robots], dtype=np.int64)
@@ -675,9 +700,10 @@ class _Sides:
 
 
 @dataclass(frozen=True)
-class WayTable:
-    """Every conflict's two ways (:func:`both_ways`), and the same as arrays (:func:`way_table`):
-    computed once for the search and :class:`~cosmop.planning.conflict_order._Implied`.
+class OrientationTable:
+    """Every conflict's two ways, the orientations of its disjunctive edge (:func:`orientations_of`),
+    and the same as arrays (:func:`orientation_arrays`): computed once for the search and
+    :class:`~cosmop.planning.conflict_order._Dominance`.
 
     Attributes
     ----------
@@ -694,7 +720,7 @@ class WayTable:
     ends: np.ndarray
 
     @classmethod
-    def of(cls, found: Sequence[Conflict], robots: Sequence[str]) -> WayTable:
+    def of(cls, found: Sequence[Conflict], robots: Sequence[str]) -> OrientationTable:
         """The table of `found`, the robots numbered in the order of `robots` (then as met).
 
         Parameters
@@ -704,12 +730,14 @@ class WayTable:
         robots : sequence of str
             Robot ids, numbered in this order.
         """
-        edges = [both_ways(c) for c in found]
-        return cls(edges, *way_table(edges, {r: n for n, r in enumerate(robots)}))
+        edges = [orientations_of(c) for c in found]
+        return cls(edges, *orientation_arrays(edges, {r: n for n, r in enumerate(robots)}))
 
 
-def way_table(ways: Sequence[Sequence[Edge | None]], number: dict[str, int]) -> tuple[np.ndarray, np.ndarray]:
-    """Every conflict's two ways (:func:`both_ways`) as arrays: whether each exists ``(n, 2)``,
+def orientation_arrays(
+    ways: Sequence[Sequence[Edge | None]], number: dict[str, int]
+) -> tuple[np.ndarray, np.ndarray]:
+    """Every conflict's two ways (:func:`orientations_of`) as arrays: whether each exists ``(n, 2)``,
     and each as ``(A, i, B, j)`` ``(n, 2, 4)``, the robots numbered by `number` (robots it
     lacks are added, numbered in the order they come).
 
@@ -733,9 +761,10 @@ def way_table(ways: Sequence[Sequence[Edge | None]], number: dict[str, int]) -> 
     return possible.reshape(len(ways), 2), ends
 
 
-def both_ways(conflict: Conflict) -> list[Edge | None]:
+def orientations_of(conflict: Conflict) -> list[Edge | None]:
     """The conflict's two ways as start edges, ``a`` first then ``b`` first: "x before y" for x
-    that ends and y that does not hold its place from the beginning (else ``None``).
+    that ends and y that does not hold its place from the beginning (else ``None``).  They are
+    the two *orientations* of the conflict's disjunctive edge (a disjunctive graph's term).
 
     Parameters
     ----------
@@ -748,15 +777,15 @@ def both_ways(conflict: Conflict) -> list[Edge | None]:
     ]
 
 
-def ways_of(conflict: Conflict) -> list[Edge]:
-    """The start edges that can order `conflict` (its possible :func:`both_ways`).
+def possible_orientations(conflict: Conflict) -> list[Edge]:
+    """The start edges that can order `conflict` (its possible :func:`orientations_of`).
 
     Parameters
     ----------
     conflict : Conflict
         A conflict between the plans.
     """
-    return [edge for edge in both_ways(conflict) if edge is not None]
+    return [edge for edge in orientations_of(conflict) if edge is not None]
 
 
 def depth_first(
@@ -796,16 +825,16 @@ def depth_first(
         (:func:`~cosmop.planning.conflicts.fixed_places`).
     """
     precedence = Precedence(horizons, links, starts, durations)
-    sides = _Sides(found, precedence)
+    orientations = _OrientationTests(found, precedence)
     chosen: list[tuple[Edge, Conflict, list[Any]]] = []
     stack: list[tuple[int, list[Edge], Conflict]] = []  # (depth, untried, conflict)
     backtracks, deepest = 0, -1
     culprit: Conflict | None = None
     while True:
-        open_ = ~sides.holds(precedence).any(axis=1)
+        open_ = ~orientations.holds(precedence).any(axis=1)
         if not open_.any():
             return [(edge, conflict) for edge, conflict, _ in chosen], None
-        counts = np.where(open_, sides.ways(precedence).sum(axis=1), -1)
+        counts = np.where(open_, orientations.ways(precedence).sum(axis=1), -1)
         stuck = [found[int(i)] for i in np.flatnonzero(counts == 0)]
         if stuck:
             if len(chosen) > deepest:
@@ -826,7 +855,7 @@ def depth_first(
         pool = np.flatnonzero(counts == 1)
         if not len(pool):
             pool = np.flatnonzero(open_)
-        conflict = found[pool[np.argmin(sides.expected_start(precedence, pool))]]
+        conflict = found[pool[np.argmin(orientations.expected_start(precedence, pool))]]
         options = _options(conflict, precedence)
         if len(options) > 1:
             stack.append((len(chosen), options[1:], conflict))
@@ -885,7 +914,7 @@ def _culprit(
     for edge, conflict in chosen:
         graph.push(edge, conflict)
     on_cycles: list[Conflict] = []
-    for edge in ways_of(stuck):
+    for edge in possible_orientations(stuck):
         on_cycles += graph.path(*edge) or []
     best = min(on_cycles, key=lambda c: replan_rank(c, fixed), default=stuck)
     return best if replan_rank(best, fixed) < 3 else stuck

@@ -33,7 +33,7 @@ Which obstacles start in :math:`S` changes only the number of rounds, never the 
 within reach of the box around the robot's start, home, its goods and its drop places.
 
 A wall or object to drives is also a second obstacle of :math:`O`,
-:func:`~cosmop.planning.specification.past_its_ends`: its GoTo part with departures from past
+:func:`~cosmop.planning.specification.corner_clearance_key`: its GoTo part with departures from past
 its ends made to pass them clear.  It implies the first; the claim holds with both in
 :math:`O`.  It is never in :math:`S` at the start: the solver pays for it only where a plan
 passes an end too close, which a numeric pre-test (:func:`_passes_ends`) rules out for most
@@ -60,8 +60,8 @@ from cosmop.planning.specification import (
     PASSING,
     PAST_AN_END,
     RobotProblem,
+    corner_clearance_key,
     object_key,
-    past_its_ends,
     specification,
     wall_key,
 )
@@ -141,13 +141,13 @@ class Geometry:
         walls = range(len(p.scene.obstacles))
         keys = [wall_key(i, handling) for handling in (False, True) for i in walls]
         keys += [object_key(o) for o in p.scene.objects]
-        keys += [past_its_ends(k) for k in [*map(wall_key, walls), *map(object_key, p.scene.objects)]]
+        keys += [corner_clearance_key(k) for k in [*map(wall_key, walls), *map(object_key, p.scene.objects)]]
         held = set(keys) if not lazy else _near_route(p) | {object_key(o) for o in p.own_objects}
         self._p, self._events = p, events
         self.held = conj(f for _, f in specification(replace(p, obstacles=frozenset(held)), events))
         self._waiting = [k for k in keys if k not in held]
         self._written: dict[str, Formula] = {}
-        self._sides = _Sides(p) if self._waiting else None
+        self._half_planes = _SeparatingHalfPlanes(p) if self._waiting else None
         self.admitted = 0
 
     def broken(self, trace: Sequence[Mapping[str, Any]]) -> list[str]:
@@ -158,9 +158,9 @@ class Geometry:
         trace : sequence of Mapping[str, Any]
             The plan: the value of each variable of the specification at instants 0..K.
         """
-        if self._sides is None:
+        if self._half_planes is None:
             return []
-        near = self._sides.unsure(self._waiting, trace)
+        near = self._half_planes.unsure(self._waiting, trace)
         self._write([k for k in near if k not in self._written])
         broken = [near[i] for i in failing([self._written[k] for k in near], trace)]
         # an obstacle driven through needs its own part first; its stronger one may follow
@@ -195,15 +195,16 @@ class Geometry:
 
 def _base(key: str) -> str:
     """The obstacle whose GoTo part the part named `key` strengthens, or `key` itself."""
-    return key.removesuffix(past_its_ends(""))
+    return key.removesuffix(corner_clearance_key(""))
 
 
 _GAP = 1e-3
 """mm by which the numeric one-side test must clear a half-plane (floating point is not exact)."""
 
 
-class _Sides:
-    """Each obstacle's half-planes that keep the robot, and its goods, clear of it (floats).
+class _SeparatingHalfPlanes:
+    """Each obstacle's half-planes that keep the robot, and its goods, clear of it (floats):
+    *separating* half-planes: a body whose centre lies inside one of them is apart from it.
 
     For a wall: its four regions (:func:`~cosmop.planning.regions.wall_regions`) for the
     robot's square grown by the margin, and for each good's square; for a resting object: its
@@ -238,7 +239,7 @@ class _Sides:
         for i in range(len(p.scene.obstacles)):  # a wall's handling parts: robot and goods
             self._row[wall_key(i, handling=True)] = self._row[wall_key(i)]
         for key in list(self._keys):  # the stronger GoTo part: kept clear by the same sides
-            self._row[past_its_ends(key)], self._roles[past_its_ends(key)] = self._row[key], 0
+            self._row[corner_clearance_key(key)], self._roles[corner_clearance_key(key)] = self._row[key], 0
         table = np.array([planes[k] for k in self._keys], dtype=float)  # (obstacles, bodies, 4 sides, abc)
         # no wall and no other robot's goods (only the robot's own, always held): keep the shape
         table = table.reshape(len(self._keys), 1 + len(goods), 4, 3)
@@ -310,9 +311,9 @@ _SIDE_AND_END = np.array([(0, 2), (0, 3), (1, 2), (1, 3), (2, 0), (2, 1), (3, 0)
 def _passes_ends(
     sides: NDArray[np.float64], robot: Sequence[tuple[float, float]], margin: float
 ) -> NDArray[np.bool_]:
-    """Per obstacle (`sides`: obstacles x 4 x abc, touching, scaled as in :class:`_Sides`),
+    """Per obstacle (`sides`: obstacles x 4 x abc, touching, scaled as in :class:`_SeparatingHalfPlanes`),
     whether every motion of `robot` surely meets what
-    :func:`~cosmop.planning.specification.past_its_ends` adds to the obstacle's own part.
+    :func:`~cosmop.planning.specification.corner_clearance_key` adds to the obstacle's own part.
 
     That is asked only of a motion that leaves a side for the margin from nearer (and may be
     a departure), from past one of the side's ends; it holds when the start is

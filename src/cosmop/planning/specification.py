@@ -244,9 +244,13 @@ def object_key(obj: str) -> str:
     return f"object {obj}"
 
 
-def past_its_ends(key: str) -> str:
+def corner_clearance_key(key: str) -> str:
     """The name of the stronger GoTo part for obstacle `key` (a wall to drives or an object):
     departures from past its ends pass them clear (:data:`PAST_AN_END`), ``"wall 3 past its ends"``.
+
+    Its *corner clearance*: the ends of a wall, the corners of an object, are the corners of
+    the obstacle grown by the robot's square (its configuration-space obstacle), and a motion
+    that leaves the line of one side from beyond such a corner keeps :data:`PASSING` from it.
 
     It implies the obstacle's own GoTo part, and costs the solver more: lazy geometry
     (:mod:`cosmop.planning.obstacles`) adds it only for the obstacles a plan passes too close.
@@ -299,7 +303,7 @@ class RobotProblem:
         :data:`MOTION_MARGIN`; 0 lets a motion slide along what it touches).
     obstacles : frozenset of str, optional
         Write the parts of only these obstacles (:func:`wall_key`, :func:`object_key`; a wall
-        is two, one to drives and one to picks and drops; :func:`past_its_ends` of either names
+        is two, one to drives and one to picks and drops; :func:`corner_clearance_key` of either names
         the stronger GoTo part); every wall and object by default.
         Lazy geometry (:mod:`cosmop.planning.obstacles`) writes the parts it needs only.
     spots : tuple of (Event, (float, float))
@@ -425,7 +429,7 @@ class RobotProblem:
         Parameters
         ----------
         key : str
-            An obstacle (:func:`wall_key`, :func:`object_key`, :func:`past_its_ends`).
+            An obstacle (:func:`wall_key`, :func:`object_key`, :func:`corner_clearance_key`).
         """
         return self.obstacles is None or key in self.obstacles
 
@@ -820,7 +824,7 @@ def _apart(x: Var, y: Var, faces: tuple[tuple[_Face, _Face], ...], ends: bool = 
     obstacle (not strictly inside either neighbouring side) the nearest part of the obstacle is
     the side itself, so a departure's gap only grows.  With `ends`, a departure from past an
     end must also pass that end clear (:func:`_past_an_end`); this formula implies the one
-    without, and is what :func:`past_its_ends` names.  The gap is never held near zero.
+    without, and is what :func:`corner_clearance_key` names.  The gap is never held near zero.
     """
     nx, ny = x.next(), y.next()
     dx, dy = nx - x, ny - y
@@ -862,7 +866,7 @@ class GoTo(Encoding):
     Touching is allowed at either end of the motion; otherwise it keeps
     :attr:`RobotProblem.margin`, departs from touching to it, or approaches from it steeply
     (:data:`MOTION_MARGIN`, :data:`STEEPNESS`, :func:`_apart`).  The part named
-    :func:`past_its_ends` also passes the obstacle's ends clear (:data:`PAST_AN_END`).
+    :func:`corner_clearance_key` also passes the obstacle's ends clear (:data:`PAST_AN_END`).
     """
 
     name = Primitive.GOTO
@@ -888,9 +892,11 @@ class GoTo(Encoding):
 
 def _goto_parts(p: RobotProblem, key: str) -> list[tuple[str, bool]]:
     """``(name, ends)`` of the GoTo parts written for obstacle `key`: its stronger one
-    (:func:`past_its_ends`), its own, or both, in that order (an unsat core shrunk by deleting
+    (:func:`corner_clearance_key`), its own, or both, in that order (an unsat core shrunk by deleting
     parts in order then keeps the obstacle's own part where that alone blocks)."""
-    return [(name, ends) for name, ends in ((past_its_ends(key), True), (key, False)) if p.written(name)]
+    return [
+        (name, ends) for name, ends in ((corner_clearance_key(key), True), (key, False)) if p.written(name)
+    ]
 
 
 class PickUp(Encoding):

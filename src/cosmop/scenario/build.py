@@ -309,7 +309,7 @@ class _Builder:
 
     def check_bodies(self, scene: Scene) -> None:
         """A physically possible scene: no body overlaps a wall or another body at the start."""
-        from cosmop.physics import overlaps
+        from cosmop.scenario.overlaps import overlaps
 
         found = overlaps(scene, units=self.units)
         if found:

@@ -5,15 +5,15 @@
 robot replans its remaining mission from where it is (:mod:`cosmop.sim.replan`); robots may be
 delayed at random (:mod:`cosmop.sim.delays`).  The result
 carries the ``cosmop.sim/1`` summary, with every step's planned and realised times
-(:mod:`cosmop.sim.timing`), and the ``cosmop.trace/1`` trace (:mod:`cosmop.sim.result`).
+(:mod:`cosmop.sim.realised_times`), and the ``cosmop.trace/1`` trace (:mod:`cosmop.sim.result`).
 """
 
 from cosmop.sim.delays import Delays
 from cosmop.sim.monitor import footprint_overlaps
+from cosmop.sim.realised_times import StepTimes
 from cosmop.sim.replan import replan, sensed_scene
 from cosmop.sim.result import SIM_FORMAT, Contact, Message, SimResult, SimSettings
 from cosmop.sim.simulation import simulate, time_limit
-from cosmop.sim.timing import StepTimes
 from cosmop.traces import TRACE_FORMAT
 
 __all__ = [

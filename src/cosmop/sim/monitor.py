@@ -29,7 +29,7 @@ def monitor(world: World, moving_speed: NDArray[np.float64]) -> None:
     world : World
         The running simulation; its contact log is updated.
     moving_speed : ndarray, shape (R,)
-        Each robot's speed this cycle, mm/s (:func:`~cosmop.sim.physics.integrate`).
+        Each robot's speed this cycle, mm/s (:func:`~cosmop.sim.unicycle.integrate`).
     """
     now = _touching(world)
     for pair in list(world.open_contacts):

@@ -30,7 +30,7 @@ from cosmop.planning.plan_types import PlanMessage, RobotPlan, State, Step
 from cosmop.planning.primitive_effects import initial_state
 from cosmop.planning.teamsafety import make_team_safe
 from cosmop.scene import Scene
-from cosmop.sim.timing import carry_instants
+from cosmop.sim.realised_times import carry_instants
 
 if TYPE_CHECKING:
     from cosmop.sim.world import Agent, World
@@ -221,7 +221,7 @@ def _install(agent: Agent, plan: RobotPlan, done: list[Event], *, new: bool) -> 
     """Replace the rest of `agent`'s plan with `plan` (`done`: the mission events done so far).
 
     The steps of a `new` plan were never planned (no instants); a re-ordered rest keeps the
-    instants of the steps it keeps (:func:`~cosmop.sim.timing.carry_instants`), and the robot
+    instants of the steps it keeps (:func:`~cosmop.sim.realised_times.carry_instants`), and the robot
     goes on with its current step unless that changed.
     """
     k = agent.step_index

@@ -22,7 +22,7 @@ from cosmop.io import write_atomic
 from cosmop.planning.plan_types import PRIMITIVES, PlanSet
 from cosmop.scene import Scenario, Scene
 from cosmop.sim.delays import Delays
-from cosmop.sim.timing import StepTimes
+from cosmop.sim.realised_times import StepTimes
 from cosmop.traces import Trace
 from cosmop.units import INTERNAL_UNITS
 
@@ -212,7 +212,7 @@ class SimResult:
         <cosmop.planning.plan_types.PlanSet.added>`): goods moved out of a robot's way.
     steps : Mapping[str, tuple of StepTimes]
         Every robot's steps with their planned (the plan set's itinerary) and realised start
-        and end (:mod:`cosmop.sim.timing`).
+        and end (:mod:`cosmop.sim.realised_times`).
     delays : Delays or None
         The delays the run drew (``SimSettings.delays``); ``None``: none.
     stops : Mapping[str, tuple of (float, float)]

@@ -53,7 +53,7 @@ The code is split along those jobs; :func:`simulate` runs one control cycle afte
    one executor per primitive, the motion in :mod:`cosmop.sim.motion`; a stalled robot
    replans, :func:`cosmop.sim.replan.replan_stalled`);
 2. the dynamic window gives the robots that drive their speeds, all at once;
-3. the robots move (:func:`cosmop.sim.physics.integrate`), the people walk
+3. the robots move (:func:`cosmop.sim.unicycle.integrate`), the people walk
    (:mod:`cosmop.sim.humans`), the clock ticks;
 4. the monitor logs contacts (:func:`cosmop.sim.monitor.monitor`), and a gripper lets go of
    the object it dropped once the robot has crept off it (:func:`cosmop.sim.execute.let_go`);
@@ -79,10 +79,10 @@ from cosmop.planning.timing import itinerary
 from cosmop.scene import Scenario
 from cosmop.sim.execute import decide, let_go
 from cosmop.sim.monitor import footprint_overlaps, monitor
-from cosmop.sim.physics import integrate
+from cosmop.sim.realised_times import step_times
 from cosmop.sim.recording import Recorder
 from cosmop.sim.result import DEFAULT_TIME_LIMIT, SIM_FORMAT, Contact, Message, SimResult, SimSettings
-from cosmop.sim.timing import step_times
+from cosmop.sim.unicycle import integrate
 from cosmop.sim.world import World
 from cosmop.traces import TRACE_FORMAT
 

@@ -3,7 +3,7 @@
 :class:`World` holds what the robots, people and objects are doing (poses, speeds, who carries
 what), the message bus and the safety monitor's log; :class:`Agent` is one robot's place in its
 plan.  Both are mutable and owned by :func:`cosmop.sim.simulation.simulate`; the executors
-(:mod:`cosmop.sim.execute`), the physics (:mod:`cosmop.sim.physics`) and the monitor
+(:mod:`cosmop.sim.execute`), the unicycles (:mod:`cosmop.sim.unicycle`) and the monitor
 (:mod:`cosmop.sim.monitor`) read and change them.  Units: mm, mm/s and radians inside (poses
 keep their heading in radians), seconds; degrees where a plan's pose is read.
 """
@@ -22,10 +22,10 @@ from cosmop.control.geometry import box_gaps, point_segment_linf, rect_gaps, seg
 from cosmop.control.paths import GlobalPath
 from cosmop.control.safety import Limits
 from cosmop.events import MESSAGE_KINDS, Event, Primitive, parse_event, realising_step
-from cosmop.physics import TOUCH  # the one tolerance under which two squares touch
 from cosmop.planning.conflicts import ConflictSettings
 from cosmop.planning.plan_types import PlanSet, Pose, RobotPlan, Step
 from cosmop.planning.realisation import event_instants
+from cosmop.scenario.overlaps import TOUCH  # the one tolerance under which two squares touch
 from cosmop.scene import Scenario
 from cosmop.sim.delays import DelayDraws
 from cosmop.sim.humans import Walker

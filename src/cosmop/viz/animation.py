@@ -30,7 +30,7 @@ from cosmop.scene import Scene
 from cosmop.traces import RobotState, Trace, as_trace, message_label
 from cosmop.viz.explain import Explainer, waiting_words
 from cosmop.viz.labels import text_marker
-from cosmop.viz.scene import (
+from cosmop.viz.scene_drawing import (
     ANIMATION_STYLE,
     DEFAULT_OBJECT_SIZE,
     DEFAULT_ROBOT_SIZE,
@@ -659,7 +659,7 @@ def save_animation(
 ) -> int:
     """Render `trace` to `path` (.gif with Pillow, .mp4 with ffmpeg); return the number of frames written.
 
-    Every frame is the scene as :func:`cosmop.viz.scene.draw_scene` draws it at that time
+    Every frame is the scene as :func:`cosmop.viz.scene_drawing.draw_scene` draws it at that time
     (a carried object on its carrier), each robot's trail so far, the planned paths (dashed),
     a ``?`` above a robot waiting for a message and a ``!`` for 1 s after it sent one; the title
     shows the simulated time. Axes in mm, equal aspect, fixed limits. The file is replaced

@@ -22,7 +22,7 @@ from cosmop.io import write_atomic
 from cosmop.planning.plan_types import MESSAGE_PRIMITIVES, PlanSet, RobotPlan
 from cosmop.scene import Scene
 from cosmop.viz.labels import Label, place_labels
-from cosmop.viz.scene import (
+from cosmop.viz.scene_drawing import (
     DEFAULT_ROBOT_SIZE,
     PLAN_STYLE,
     STEP_MARKS,

@@ -15,7 +15,7 @@ from collections.abc import Iterable
 from cosmop.events import ID_PATTERN, Primitive
 from cosmop.planning.plan_types import PlanSet
 from cosmop.scene import Scene
-from cosmop.viz.scene import DEFAULT_ROBOT_SIZE
+from cosmop.viz.scene_drawing import DEFAULT_ROBOT_SIZE
 
 __all__ = ["Box", "activity_box", "crop"]
 

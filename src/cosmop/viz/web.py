@@ -29,7 +29,13 @@ from cosmop.traces import Trace, as_trace, message_label
 from cosmop.units import UnitSystem
 from cosmop.viz.explain import Explainer, waiting_words
 from cosmop.viz.palette import robot_colours, to_hex
-from cosmop.viz.scene import DEFAULT_ROBOT_SIZE, STEP_MARKS, ids_with_trace, planned_path, replanned_path
+from cosmop.viz.scene_drawing import (
+    DEFAULT_ROBOT_SIZE,
+    STEP_MARKS,
+    ids_with_trace,
+    planned_path,
+    replanned_path,
+)
 
 __all__ = ["FIT_BELOW", "MESSAGE_SHOWN_S", "render_html", "save_html"]
 

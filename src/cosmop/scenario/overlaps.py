@@ -9,8 +9,8 @@ to the bound) is allowed everywhere, as in the planner.  A tolerance of :data:`T
 rounding of a file in metres from turning a touch into an overlap.
 
 :func:`overlaps` lists every overlap with the scenario field to blame (the later body in the
-file, or the body for a wall) and what it collides with; :mod:`cosmop.scenario` rejects the
-first as bad input.
+file, or the body for a wall) and what it collides with; the loader (:mod:`cosmop.scenario.build`)
+rejects the first as bad input.
 """
 
 from __future__ import annotations
