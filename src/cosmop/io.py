@@ -267,7 +267,7 @@ def abandon_staging() -> None:
 def _fsync_file(path: Path) -> None:
     """Flush a written file's data to disk (it may have been written by another process)."""
     # Windows flushes only through a handle open for writing; POSIX through any.
-    access = os.O_RDWR | os.O_BINARY if os.name == "nt" else os.O_RDONLY
+    access = os.O_RDWR | getattr(os, "O_BINARY", 0) if os.name == "nt" else os.O_RDONLY
     fd = os.open(path, access)
     try:
         os.fsync(fd)

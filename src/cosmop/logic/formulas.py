@@ -347,16 +347,16 @@ class Expr(Node):
 
     # -- arithmetic ---------------------------------------------------------------------------
     def __add__(self, other: object) -> LinExpr:
-        return _combine(self, other, 1)
+        return _combined(self, other, 1)
 
     def __radd__(self, other: object) -> LinExpr:
-        return _combine(other, self, 1)
+        return _combined(other, self, 1)
 
     def __sub__(self, other: object) -> LinExpr:
-        return _combine(self, other, -1)
+        return _combined(self, other, -1)
 
     def __rsub__(self, other: object) -> LinExpr:
-        return _combine(other, self, -1)
+        return _combined(other, self, -1)
 
     def __mul__(self, other: object) -> LinExpr:
         mine, theirs = _scalar(self), _scalar(other)
@@ -562,11 +562,11 @@ def as_expr(value: object) -> LinExpr:
     return LinExpr((), to_fraction(value))
 
 
-def _combine(left: object, right: object, sign: int) -> LinExpr:
-    """``left + sign * right`` as a :class:`LinExpr`, or ``NotImplemented`` for foreign operands."""
+def _combine(left: object, right: object, sign: int) -> LinExpr | None:
+    """``left + sign * right`` as a :class:`LinExpr`, or ``None`` for foreign operands."""
     for operand in (left, right):
         if not isinstance(operand, (Node, numbers.Number)) and not _is_bool(operand):
-            return NotImplemented
+            return None
     a, b = as_expr(left), as_expr(right)
     terms = a.terms + tuple((t, sign * c) for t, c in b.terms)
     return LinExpr(terms, a.const + sign * b.const)
@@ -969,9 +969,16 @@ class Compare(Formula):
         return f"{self.expr} {self.op} {'-' if self.const < 0 else ''}{const}"
 
 
+def _combined(left: object, right: object, sign: int) -> LinExpr:
+    """:func:`_combine` for the arithmetic operators: ``NotImplemented`` for foreign operands, so
+    that Python tries the other operand's method."""
+    result = _combine(left, right, sign)
+    return result if result is not None else NotImplemented
+
+
 def _compare(left: object, op: str, right: object) -> Compare:
     difference = _combine(left, right, -1)
-    if difference is NotImplemented:
+    if difference is None:
         raise TypeError(f"cannot compare {left!r} with {right!r}")
     return Compare(difference, op, 0)
 

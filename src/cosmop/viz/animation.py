@@ -24,6 +24,8 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any, cast
 
+import numpy as np
+
 from cosmop.io import atomic_path
 from cosmop.planning.plan_types import PlanSet
 from cosmop.scene import Scene
@@ -625,7 +627,10 @@ def _writer(animation: Any, suffix: str, fps: float, animator: _Animator) -> Any
                 if pixels is None or not isinstance(frames, list):
                     super().grab_frame(**savefig_kwargs)
                     return
-                image = Image.frombuffer("RGBA", self.frame_size, pixels, "raw", "RGBA", 0, 1)
+                # as an array (the buffer protocol, no copy): what PIL's types accept
+                image = Image.frombuffer(
+                    "RGBA", self.frame_size, np.frombuffer(pixels, np.uint8), "raw", "RGBA", 0, 1
+                )
                 frames.append(
                     image.convert("RGB").quantize(animator.palette_size, method=Image.Quantize.FASTOCTREE)
                 )
