@@ -20,7 +20,7 @@ from cosmop.errors import EventSyntaxError, InputWarning, ScenarioError
 from cosmop.events import ID_PATTERN, MESSAGE_KINDS, Event, parse_event
 from cosmop.io import read_text
 from cosmop.missions.handover import handovers
-from cosmop.reading import FieldPath, Marks, format_path, load_yaml
+from cosmop.reading import FieldPath, Marks, format_path, load_yaml, lookup, show
 from cosmop.scenario.plausible import implausible, out_of_range
 from cosmop.scenario.schema import (
     EXPECTED,
@@ -38,9 +38,7 @@ from cosmop.scenario.schema import (
     SceneModel,
     WorkspaceModel,
     expected_at,
-    lookup,
     model_at,
-    show,
     show_points,
 )
 from cosmop.scene import (

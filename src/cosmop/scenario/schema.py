@@ -3,7 +3,6 @@ expects, in words, for the error messages of :mod:`cosmop.scenario.build`."""
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from types import NoneType, UnionType
 from typing import Annotated, Any, Literal, Union, cast, get_args, get_origin
 
@@ -336,33 +335,6 @@ def _matches(pattern: str, part: str | int) -> bool:
     return pattern == "*" or pattern == part
 
 
-def lookup(data: Any, path: FieldPath) -> tuple[bool, Any]:
-    """The value at `path` in the parsed file `data`, if there is one.
-
-    Parameters
-    ----------
-    data : Any
-        The parsed file (mappings, lists and scalars).
-    path : tuple of str or int
-        Keys and list indices from the top level.
-
-    Returns
-    -------
-    found : bool
-        Whether `path` leads to a value.
-    value : Any
-        That value (None when not found).
-    """
-    for part in path:
-        if isinstance(data, Mapping):
-            if part not in data:
-                return False, None
-        elif not (isinstance(data, list) and isinstance(part, int) and 0 <= part < len(data)):
-            return False, None
-        data = data[part]
-    return True, data
-
-
 def show_points(*points: Point) -> str:
     """Points as a message shows them: ``[[0, 0], [1, 2.5]]``.
 
@@ -372,20 +344,3 @@ def show_points(*points: Point) -> str:
         The points ``(x, y)``, as the file wrote them.
     """
     return "[" + ", ".join(f"[{x:g}, {y:g}]" for x, y in points) + "]"
-
-
-def show(value: Any) -> str:
-    """A value of the parsed file as a message shows it: YAML's words for null and booleans,
-    else its ``repr``, cut to 80 characters.
-
-    Parameters
-    ----------
-    value : Any
-        The value.
-    """
-    if value is None:
-        return "nothing (null)"
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    text = repr(value)
-    return text if len(text) <= 80 else text[:77] + "..."
