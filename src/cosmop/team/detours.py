@@ -168,6 +168,8 @@ def _drop_elsewhere(
             drops = [e for e in current[robot] if e.kind == "drop" and e.obj == goods.what]
             if robot in out or len(drops) != 1 or drops[0].workspace is None:
                 continue
+            if any(goods.what in placed for r, placed in planner.placed.items() if r != robot):
+                continue  # handed over or packed: others' models have the goods at that spot
             keep = [other.region] + [g for r, places in safety.fixed.items() if r != robot for g in places]
             avoid = shapely.unary_union(keep).buffer(settings.clearance, join_style="mitre")
             own = goods_at(scene, planner.placed.get(robot, {}))
