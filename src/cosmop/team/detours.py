@@ -193,7 +193,7 @@ def _team_safe(planner: Planner, plans: Mapping[str, RobotPlan], settings: Confl
     used = {name for p in plans.values() for name in p.mission if name.startswith("msg(")}
     t0 = time.perf_counter()
     safety = make_team_safe(planner.scenario.scene, plans, settings=settings, used=used)
-    planner.phases["conflicts"] += time.perf_counter() - t0
+    planner.count_time("conflicts", time.perf_counter() - t0)
     return safety
 
 

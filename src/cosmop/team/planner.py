@@ -237,8 +237,8 @@ class Planner:
     rlimit : int
         The solver's resource limit per call.
     phases : dict of str to float
-        Seconds per phase of the loop; the planner adds the synthesis time to
-        ``phases["synthesize"]``.
+        Seconds per phase of the loop (:meth:`count_time`); the planner adds the synthesis time
+        to ``phases["synthesize"]``.
 
     Attributes
     ----------
@@ -268,6 +268,18 @@ class Planner:
     placed: dict[str, dict[str, tuple[float, float]]] = field(default_factory=dict, init=False)
     spots: dict[str, dict[Event, tuple[float, float]]] = field(default_factory=dict, init=False)
     cache: dict[tuple[Hashable, ...], Synthesis] = field(default_factory=dict, init=False)
+
+    def count_time(self, phase: str, seconds: float) -> None:
+        """Add `seconds` to the time of `phase` in :attr:`phases`.
+
+        Parameters
+        ----------
+        phase : str
+            A phase of the loop, e.g. ``"synthesize"``.
+        seconds : float
+            Wall time spent, s.
+        """
+        self.phases[phase] = self.phases.get(phase, 0.0) + seconds
 
     def restrictions(self) -> Restrictions:
         """The forbidden requests and added walls now, to :meth:`restore` after a trial."""
@@ -464,7 +476,7 @@ class Planner:
             self.cache[self.key(robot, events, explain or out[robot].feasible, window, forbidden)] = out[
                 robot
             ]
-        self.phases["synthesize"] = self.phases.get("synthesize", 0.0) + time.perf_counter() - t0
+        self.count_time("synthesize", time.perf_counter() - t0)
         return {robot: out[robot] for robot in jobs}
 
     def _cached(

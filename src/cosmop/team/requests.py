@@ -111,13 +111,13 @@ def coordinate_requests(
         t0 = time.perf_counter()
         requests = _requests(results, current, planner)
         if requests == asked:
-            planner.phases["coordinate"] += time.perf_counter() - t0
+            planner.count_time("coordinate", time.perf_counter() - t0)
             return answered(True)
         if iterations >= max_iterations:
             return answered(False, [f"coordination did not settle within {max_iterations} rounds"])
         iterations, asked = iterations + 1, requests
         coordinated = coordinate(base, requests)
-        planner.phases["coordinate"] += time.perf_counter() - t0
+        planner.count_time("coordinate", time.perf_counter() - t0)
         forbid = _bad_requests(coordinated)
         if forbid:
             # when goods nobody moves are asked for, a failed trial leads to a helper: no reasons
