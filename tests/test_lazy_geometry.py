@@ -65,16 +65,17 @@ def start(request, monkeypatch):
     return request.param
 
 
-def test_twelve_generated_shelf_rooms_agree(start):
-    """Six rooms each way (a sample: ``benchmarks/sweep_lazy.py`` runs thirty and more)."""
+def test_eight_generated_shelf_rooms_agree(start):
+    """Four rooms each way, two of each needing a request (a sample: ``benchmarks/sweep_lazy.py``
+    runs thirty and more)."""
     admitted, requested, feasible = 0, 0, 0
-    for seed in range(6) if start == "box" else range(15, 21):
+    for seed in range(4) if start == "box" else range(15, 19):
         scene = parse_scenario(shelves(seed)).scene
         lazy, _ = _agree(scene, "R1", FETCH, max_horizon=12)
         feasible += lazy.feasible
         admitted += lazy.admitted
         requested += bool(lazy.requests)
-    assert feasible >= 5 and requested >= 2  # some rooms need a request: the minimum is compared too
+    assert feasible == 4 and requested >= 2  # some rooms need a request: the minimum is compared too
     if start == "nothing near":
         assert admitted >= 6  # every wall the plans need was found by the loop
 
