@@ -174,8 +174,8 @@ def _drop_elsewhere(
             avoid = shapely.unary_union(keep).buffer(settings.clearance, join_style="mitre")
             own = goods_at(scene, planner.placed.get(robot, {}))
             spot = handover_spot(own, goods.what, drops[0].workspace, (robot,), avoid=avoid)
-            if spot is None:
-                continue
+            if spot is None or planner.spots.get(robot, {}).get(drops[0]) == spot:
+                continue  # no spot, or the one it has already: nothing new to try
             saved = dict(planner.spots.get(robot, {}))
             planner.spots.setdefault(robot, {})[drops[0]] = spot
             result = planner.run({robot: current[robot]})[robot]
