@@ -53,8 +53,8 @@ def _agree(scene, robot, mission, **options) -> tuple:
 @pytest.mark.parametrize("name", EXAMPLES)
 def test_the_examples_get_the_same_horizons_and_requests(name):
     scenario = load_scenario(ROOT / "examples" / name / "scenario.yaml")
-    # four robots of each example (the 10x10's ten take 20 s; sweep_lazy.py runs them all)
-    for robot, tasks in list(scenario.mission.tasks.items())[:4]:
+    # three robots of each example (the 10x10's ten take 20 s; sweep_lazy.py runs them all)
+    for robot, tasks in list(scenario.mission.tasks.items())[:3]:
         _agree(scenario.scene, robot, tasks, max_horizon=12)
 
 
