@@ -1,10 +1,10 @@
 """Plans that ``plan`` calls feasible execute: a sample of the generated-scenes sweep (issue 12, point 5).
 
 ``benchmarks/sweep_generated.py`` draws 200 seeded scenes (2 to 5 robots, random walls) and
-runs each as a user does; this is a sample of 7 of its seeds, in this process, chosen among
-those whose plans once failed in simulation (a pose flush against a wall, a pick pose reached
-along the object's face, a corridor 20 mm wider than the robot, a drop next to a waiting robot,
-a back-off into another robot's clearance, a wall corner touched while braking) or were once
+runs each as a user does; this is a sample of 4 of its seeds, in this process, chosen among
+those whose plans once failed in simulation (a pose flush against a wall, a drop next to a
+waiting robot, a wall corner touched while braking; the sweep runs the others, 41, 99 and 162
+among them) or were once
 called infeasible as a team (55: goods dropped where another robot stands at home for good,
 by a robot that must pass there to pick them: the drop is now moved within its dock).
 """
@@ -24,7 +24,7 @@ from cosmop.sim import SimSettings, simulate
 from cosmop.team.loop import plan_team
 from sweep_generated import scene
 
-SEEDS = (15, 41, 53, 55, 99, 162, 187)
+SEEDS = (15, 53, 55, 187)
 
 
 def _run(seed: int) -> tuple[int, bool, bool, int]:
