@@ -15,7 +15,7 @@ from shapely import LineString
 from cosmop.events import parse_event
 from cosmop.planning.aside import ROOM, place_aside
 from cosmop.planning.checker import check_plan
-from cosmop.planning.plan_file import PlanError, load_plan
+from cosmop.planning.plan_file import PlanError, load_plan, read_plan
 from cosmop.planning.plan_types import AddedTask, PlanSet
 from cosmop.planning.primitive_effects import plan_from_actions
 from cosmop.scenario import parse_scenario
@@ -94,7 +94,7 @@ def test_the_plan_file_keeps_the_added_task_and_the_checker_needs_it(helped, tmp
     )
     assert any("has a workspace W1 already" in v.message for v in report.violations)
     with pytest.raises(PlanError, match=r"added\[0\]\.point"):
-        PlanSet.from_dict({**result.plans.to_dict(), "added": [{**clash.to_dict(), "point": [1]}]})
+        read_plan({**result.plans.to_dict(), "added": [{**clash.to_dict(), "point": [1]}]})
 
 
 def test_when_no_robot_can_set_it_aside_the_reason_names_the_goods_and_each_robot_tried():

@@ -26,8 +26,8 @@ from typer.testing import CliRunner
 from cosmop.cli import app
 from cosmop.errors import CosmopInputError, ScenarioError
 from cosmop.planning.checker import check_plan
-from cosmop.planning.plan_file import PlanError, load_plan
-from cosmop.planning.plan_types import MAX_STEPS, PlanSet
+from cosmop.planning.plan_file import PlanError, load_plan, read_plan
+from cosmop.planning.plan_types import MAX_STEPS
 from cosmop.planning.synthesis import synthesize
 from cosmop.reading import (
     MAX_DEPTH,
@@ -177,7 +177,7 @@ def test_a_plan_longer_than_the_bound_is_refused():
     plan["steps"] = plan["steps"] + [plan["steps"][-1]] * MAX_STEPS
     plan["horizon"] = len(plan["steps"])
     with pytest.raises(PlanError, match="at most 1,000") as info:
-        PlanSet.from_dict(data)
+        read_plan(data)
     assert info.value.field == "robots.R1.steps"
 
 
@@ -269,7 +269,7 @@ def test_mutated_plan_reads_and_checks_or_says_why(data):
         path = data.draw(st.sampled_from(list(_paths(mutated))))
         mutated = _replace(mutated, path, data.draw(_LEAVES))
     try:
-        plan = PlanSet.from_dict(mutated, "fuzz.json")
+        plan = read_plan(mutated, "fuzz.json")
     except PlanError as err:
         assert err.file == "fuzz.json"
         return

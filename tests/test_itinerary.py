@@ -18,8 +18,8 @@ from typer.testing import CliRunner
 from cosmop.cli import app
 from cosmop.errors import CosmopInputError
 from cosmop.planning.checker import check_plan
-from cosmop.planning.plan_file import PlanError, load_plan
-from cosmop.planning.plan_types import Itinerary, PlanSet
+from cosmop.planning.plan_file import PlanError, load_plan, read_plan
+from cosmop.planning.plan_types import Itinerary
 from cosmop.planning.realisation import message_links
 from cosmop.planning.timing import durations, itinerary
 from cosmop.scenario import load_scenario
@@ -88,7 +88,7 @@ def test_the_plan_file_carries_the_itinerary_and_old_files_still_load(corridor, 
     for plan in data["robots"].values():  # a plan file of before: no times at all
         for s in plan["steps"]:
             del s["start"], s["end"]
-    old = PlanSet.from_dict(data)
+    old = read_plan(data)
     assert old.itinerary is None and check_plan(scenario, old).ok
     assert old.robots == result.plans.robots
 
@@ -135,7 +135,7 @@ def test_bad_times_name_the_field(corridor, edit, field, words):
     data = copy.deepcopy(result.plans.to_dict())
     edit(data)
     with pytest.raises(PlanError) as err:
-        PlanSet.from_dict(data, file="plan.json")
+        read_plan(data, file="plan.json")
     assert err.value.field == field and words in err.value.expected
     assert isinstance(err.value, CosmopInputError)
 

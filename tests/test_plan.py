@@ -25,6 +25,7 @@ from cosmop.planning import (
     plan_from_actions,
     successor,
 )
+from cosmop.planning.plan_file import read_plan
 from cosmop.scenario import load_scenario
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "01_warehouse_2x2" / "scenario.yaml"
@@ -75,8 +76,8 @@ def test_to_dict_has_the_documented_shape() -> None:
 
 def test_dict_round_trip() -> None:
     plans = plan_set()
-    assert PlanSet.from_dict(plans.to_dict()) == plans
-    assert PlanSet.from_dict(json.loads(json.dumps(plans.to_dict()))) == plans
+    assert read_plan(plans.to_dict()) == plans
+    assert read_plan(json.loads(json.dumps(plans.to_dict()))) == plans
 
 
 def test_save_and_load_round_trip(tmp_path: Path) -> None:
@@ -446,7 +447,7 @@ def test_from_dict_without_a_file() -> None:
     data = plan_set().to_dict()
     data["robots"]["R1"]["steps"][3]["primitive"] = "Fly"
     with pytest.raises(PlanError) as info:
-        PlanSet.from_dict(data)
+        read_plan(data)
     assert str(info.value) == (
         "robots.R1.steps[3].primitive: expected one of GoTo, PickUp, DropOff, Req, Res, got 'Fly'"
     )

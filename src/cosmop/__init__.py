@@ -31,7 +31,7 @@ if TYPE_CHECKING:
     from cosmop.sim import SimResult, SimSettings
     from cosmop.team.loop import TeamResult
 
-__version__ = "0.1.0"
+from cosmop._version import __version__
 
 __all__ = [
     "CheckReport",

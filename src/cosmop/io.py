@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import gc
+import json
 import os
 import shutil
 import stat
@@ -11,6 +12,7 @@ import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 from types import FrameType
+from typing import Any
 
 from cosmop.errors import CosmopInputError, OutputPathError
 
@@ -20,6 +22,7 @@ __all__ = [
     "atomic_path",
     "check_writable",
     "collector_paused",
+    "compact_json",
     "read_bytes",
     "read_text",
     "uninterrupted",
@@ -354,3 +357,37 @@ def read_text(path: str | os.PathLike[str], error: type[CosmopInputError], kind:
     except UnicodeDecodeError as err:
         message = f"expected UTF-8 text, found an invalid byte at offset {err.start}"
         raise error(message, file=os.fspath(path)) from None
+
+
+def compact_json(value: Any, width: int = 100, level: int = 0) -> str:
+    """JSON indented by two spaces, with every value that fits in `width` columns on one line.
+
+    A plan file read by people keeps a step with few objects on one line, and still shows
+    its structure where a line would be too long.
+
+    Parameters
+    ----------
+    value : Any
+        A JSON value (dicts, lists, strings, numbers, booleans, None).
+    width : int, optional
+        The widest line, in characters, that a value is kept on.
+    level : int, optional
+        The indentation level `value` starts at.
+
+    Returns
+    -------
+    str
+        The JSON text, with no final newline.
+    """
+    flat = json.dumps(value, ensure_ascii=False, separators=(", ", ": "))
+    if not isinstance(value, dict | list) or not value or len(flat) + 2 * level <= width:
+        return flat
+    pad, end = "  " * (level + 1), "  " * level
+    if isinstance(value, dict):
+        items = [
+            f"{pad}{json.dumps(key, ensure_ascii=False)}: {compact_json(item, width, level + 1)}"
+            for key, item in value.items()
+        ]
+        return "{\n" + ",\n".join(items) + "\n" + end + "}"
+    items = [pad + compact_json(item, width, level + 1) for item in value]
+    return "[\n" + ",\n".join(items) + "\n" + end + "]"

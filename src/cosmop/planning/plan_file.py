@@ -45,21 +45,19 @@ set's :class:`~cosmop.planning.plan_types.Itinerary`.  ``units`` (absent in olde
 :data:`cosmop.units.INTERNAL_UNITS`.  An infeasible scenario still has a plan file, with
 ``"feasible": false`` and a ``"reason"``.
 
-:func:`load_plan` and :func:`read_plan` (:meth:`PlanSet.from_dict
-<cosmop.planning.plan_types.PlanSet.from_dict>`) check the file's structure (the pydantic
+:func:`load_plan` and :func:`read_plan` check the file's structure (the pydantic
 models below, :data:`STRUCTURE`), then its consistency (events, horizons, objects, times), and
 raise :class:`PlanError` as one line naming the file, the field and what was expected and
 found (``plan.json: robots.R1.steps[3].primitive: expected one of GoTo, PickUp, DropOff, Req,
 Res, got 'Fly' (line 40, column 24)``).
 
 Whether a plan is *sound* for a scene (walls, poses, flags, mission) is the business of
-:mod:`cosmop.planning.checker`.  :func:`save_plan` (:meth:`PlanSet.save
-<cosmop.planning.plan_types.PlanSet.save>`) writes the file.
+:mod:`cosmop.planning.checker`.  :meth:`PlanSet.save
+<cosmop.planning.plan_types.PlanSet.save>` writes the file.
 """
 
 from __future__ import annotations
 
-import json
 import os
 from collections.abc import Mapping
 from typing import Annotated, Any, Literal, NoReturn
@@ -69,7 +67,7 @@ from typing_extensions import TypedDict
 
 from cosmop.errors import CosmopInputError, EventSyntaxError
 from cosmop.events import ID_PATTERN, Primitive, parse_event
-from cosmop.io import read_text, write_atomic
+from cosmop.io import read_text
 from cosmop.planning.plan_types import (
     MAX_STEPS,
     MESSAGE_PRIMITIVES,
@@ -98,7 +96,6 @@ __all__ = [
     "StepModel",
     "load_plan",
     "read_plan",
-    "save_plan",
 ]
 
 
@@ -497,35 +494,3 @@ def load_plan(path: str | os.PathLike[str]) -> PlanSet:
 # ----------------------------------------------------------------------------------------------
 # Writing
 # ----------------------------------------------------------------------------------------------
-
-
-def save_plan(plans: PlanSet, path: str | os.PathLike[str]) -> None:
-    """Write the plan file of `plans` (JSON, UTF-8), atomically.
-
-    The JSON is indented, with every list or object that fits on one line kept on one line (a
-    step with few objects is one line).
-
-    Parameters
-    ----------
-    plans : PlanSet
-        What to write (:meth:`PlanSet.to_dict <cosmop.planning.plan_types.PlanSet.to_dict>`).
-    path : str or os.PathLike
-        The destination; its directory must exist.
-    """
-    write_atomic(path, _pretty(plans.to_dict()) + "\n")
-
-
-def _pretty(value: Any, level: int = 0, width: int = 100) -> str:
-    """JSON indented by two spaces, with every value that fits in `width` columns on one line."""
-    compact = json.dumps(value, ensure_ascii=False, separators=(", ", ": "))
-    if not isinstance(value, dict | list) or not value or len(compact) + 2 * level <= width:
-        return compact
-    pad, end = "  " * (level + 1), "  " * level
-    if isinstance(value, dict):
-        items = [
-            f"{pad}{json.dumps(key, ensure_ascii=False)}: {_pretty(item, level + 1, width)}"
-            for key, item in value.items()
-        ]
-        return "{\n" + ",\n".join(items) + "\n" + end + "}"
-    items = [pad + _pretty(item, level + 1, width) for item in value]
-    return "[\n" + ",\n".join(items) + "\n" + end + "]"

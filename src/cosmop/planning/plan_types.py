@@ -29,6 +29,7 @@ from typing import Any
 from cosmop._frozen import reduce_frozen
 from cosmop.errors import EventSyntaxError
 from cosmop.events import Event, Primitive, parse_event
+from cosmop.io import compact_json, write_atomic
 from cosmop.scene import Scenario, Workspace
 from cosmop.units import INTERNAL_UNITS
 
@@ -675,31 +676,6 @@ class PlanSet:
             return scenario
         return replace(scenario, scene=replace(scene, workspaces={**scene.workspaces, **new}))
 
-    @classmethod
-    def from_dict(cls, data: Any, file: str | os.PathLike[str] | None = None) -> PlanSet:
-        """Validate a plan file's content (parsed JSON) and build the plan set.
-
-        Parameters
-        ----------
-        data : Any
-            The parsed JSON.
-        file : str or os.PathLike, optional
-            The file it came from, for error messages.
-
-        Returns
-        -------
-        PlanSet
-
-        Raises
-        ------
-        PlanError
-            If the content does not have the shape of a ``cosmop.plan/1`` file; the error
-            names the file, the field and what was expected.
-        """
-        from cosmop.planning.plan_file import read_plan  # the file's reader reads into these values
-
-        return read_plan(data, file)
-
     def save(self, path: str | os.PathLike[str]) -> None:
         """Write the plan file (JSON, UTF-8), atomically.
 
@@ -711,9 +687,7 @@ class PlanSet:
         path : str or os.PathLike
             The destination; its directory must exist.
         """
-        from cosmop.planning.plan_file import save_plan  # the file's writer writes these values
-
-        save_plan(self, path)
+        write_atomic(path, compact_json(self.to_dict()) + "\n")
 
     def to_text(self) -> str:
         """The plan set for people: per robot a header line and one line per step."""

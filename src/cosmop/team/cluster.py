@@ -55,7 +55,7 @@ def worker_version() -> str:
     is submitted, and the imports (about a second) are not paid by the first synthesis.
     """
     import cosmop.team.planner  # noqa: F401  (the module the syntheses are pickled from)
-    from cosmop import __version__
+    from cosmop._version import __version__
 
     return __version__
 
@@ -111,7 +111,7 @@ def _connect(address: str, timeout: float, field: str) -> Any:
 
 def _check_workers(client: Any, address: str, timeout: float, field: str) -> None:
     """At least one worker, each with this cosmop (a missing one would fail every synthesis)."""
-    from cosmop import __version__
+    from cosmop._version import __version__
 
     try:
         client.wait_for_workers(1, timeout=timeout)
