@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-import cosmop
+import cosmop._version
 from cosmop.cli import app
 from cosmop.scenario import load_scenario
 from cosmop.team.cluster import ClusterError, dask_executor
@@ -103,7 +103,7 @@ def test_a_scheduler_without_workers_is_named():
 
 def test_workers_running_another_cosmop_are_refused(cluster, monkeypatch):
     # the workers are other processes: they report the installed version, not this one
-    monkeypatch.setattr(cosmop, "__version__", "0.0.0-other")
+    monkeypatch.setattr(cosmop._version, "__version__", "0.0.0-other")
     with (
         pytest.raises(ClusterError, match=r"must run cosmop 0\.0\.0-other; tcp://"),
         dask_executor(cluster.scheduler_address),

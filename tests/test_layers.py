@@ -16,7 +16,7 @@ SOURCE = Path(__file__).resolve().parent.parent / "src" / "cosmop"
 LAYERS: tuple[frozenset[str], ...] = tuple(
     frozenset(floor.split())
     for floor in (
-        "errors _frozen docking automata logic",  # foundations: no scene, no file formats
+        "errors _frozen _version docking automata logic",  # foundations: no scene, no file formats
         "io reading squares events",  # reading and writing files; squares; the mission's events
         "scene",  # the value types of a scenario
         "units missions control",  # SI units; top-down decomposition; reactive control
