@@ -19,7 +19,8 @@ import numpy as np
 import pytest
 import shapely
 
-from cosmop.missions.precedence import Link, Precedence, RetractedEdges
+from cosmop.events import Link
+from cosmop.missions.precedence import Precedence, RetractedEdges
 from cosmop.planning import conflict_order
 from cosmop.planning.conflict_order import _Dominance, _Schedule, order_conflicts
 from cosmop.planning.conflict_search import CorrectionSetPicker, Search, backjump, possible_orientations

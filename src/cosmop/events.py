@@ -42,6 +42,8 @@ __all__ = [
     "ID_PATTERN",
     "MESSAGE_KINDS",
     "Event",
+    "Link",
+    "Node",
     "Primitive",
     "message",
     "parse_event",
@@ -395,3 +397,22 @@ def _forms() -> str:
 
 def _error(text: str, reason: str) -> EventSyntaxError:
     return EventSyntaxError(f"invalid event {text!r}: {reason}; {_forms()}")
+
+
+Node = tuple[str, int]
+"""A step of a plan (or of a robot's word of events): ``(robot, instant)``, instants 1..K (0 is
+the start)."""
+
+
+@dataclass(frozen=True)
+class Link:
+    """A message between two plans: sent by ``sender`` at instant ``send`` (its ``Res``),
+    awaited by ``receiver`` at instant ``wait`` (its ``Req``); ``send`` is ``None`` if no plan
+    sends it, ``wait`` ``None`` if no plan waits for it.  ``event`` is the message's name
+    (``msg(S,R,tag)`` or ``away(O,A,B)``)."""
+
+    event: str
+    sender: str
+    send: int | None
+    receiver: str
+    wait: int | None

@@ -27,8 +27,8 @@ import itertools
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
-from cosmop.events import Event
-from cosmop.missions.precedence import Link, Precedence
+from cosmop.events import Event, Link
+from cosmop.missions.precedence import Precedence
 
 __all__ = ["Handover", "Handovers", "handovers"]
 

@@ -41,16 +41,14 @@ from __future__ import annotations
 
 import heapq
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 from typing import Any, TypeAlias, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["Link", "Node", "Precedence", "RetractedEdges"]
+from cosmop.events import Link, Node
 
-Node = tuple[str, int]
-"""A step of a plan: ``(robot, instant)``, instants 1..K (0 is the start)."""
+__all__ = ["Precedence", "RetractedEdges"]
 
 _NEVER = -1  # the row of the source of a message nobody sends
 
@@ -59,20 +57,6 @@ _Entry: TypeAlias = tuple[Any, ...]
 masks, old mask, times, old time)`` for a step's clock and time raised (the lists changed)."""
 
 _T = TypeVar("_T")
-
-
-@dataclass(frozen=True)
-class Link:
-    """A message between two plans: sent by ``sender`` at instant ``send`` (its ``Res``),
-    awaited by ``receiver`` at instant ``wait`` (its ``Req``); ``send`` is ``None`` if no plan
-    sends it, ``wait`` ``None`` if no plan waits for it.  ``event`` is the message's name
-    (``msg(S,R,tag)`` or ``away(O,A,B)``)."""
-
-    event: str
-    sender: str
-    send: int | None
-    receiver: str
-    wait: int | None
 
 
 class Precedence:

@@ -30,9 +30,9 @@ from typing import TypeAlias
 import numpy as np
 
 from cosmop.automata import DFA
-from cosmop.events import parse_event
+from cosmop.events import Link, parse_event
 from cosmop.missions.mission import GlobalMission
-from cosmop.missions.precedence import Link, Precedence
+from cosmop.missions.precedence import Precedence
 from cosmop.missions.verification import Verification, verify
 
 __all__ = ["TeamVerdict", "blocking_word", "check_words", "team_modules", "verify_team", "word_links"]

@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 from shapely.geometry.base import BaseGeometry
 
-from cosmop.missions.precedence import Link, Node
+from cosmop.events import Link, Node
 from cosmop.planning.conflict_search import (
     CorrectionSetPicker,
     Edge,

@@ -24,7 +24,8 @@ from typing import Any, Generic, Protocol, TypeVar
 import numpy as np
 from shapely.geometry.base import BaseGeometry
 
-from cosmop.missions.precedence import Link, Node, Precedence, RetractedEdges
+from cosmop.events import Link, Node
+from cosmop.missions.precedence import Precedence, RetractedEdges
 from cosmop.planning.conflicts import Conflict, Occupancy, detours, replan_rank
 
 __all__ = [

@@ -39,8 +39,8 @@ import shapely
 from shapely import STRtree
 from shapely.geometry.base import BaseGeometry
 
-from cosmop.events import Primitive
-from cosmop.missions.precedence import Node, Precedence
+from cosmop.events import Node, Primitive
+from cosmop.missions.precedence import Precedence
 from cosmop.planning.plan_types import RobotPlan, State
 from cosmop.planning.primitive_effects import initial_state
 from cosmop.planning.realisation import TOLERANCE, at_pose

@@ -21,9 +21,9 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 
-from cosmop.events import parse_event
+from cosmop.events import Link, parse_event
 from cosmop.missions.mission import GlobalMission
-from cosmop.missions.precedence import Link, Precedence
+from cosmop.missions.precedence import Precedence
 from cosmop.missions.team import check_words
 from cosmop.planning.conflicts import ConflictSettings, conflicts, is_ordered, occupancies
 from cosmop.planning.plan_types import PlanSet, RobotPlan

@@ -21,8 +21,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import replace
 from typing import Any
 
-from cosmop.events import Event, Primitive, message, parse_event
-from cosmop.missions.precedence import Node
+from cosmop.events import Event, Node, Primitive, message, parse_event
 from cosmop.planning.checker import check_robot_plan
 from cosmop.planning.plan_types import RobotPlan, State, Step
 from cosmop.planning.primitive_effects import initial_state, plan_from_actions

@@ -21,8 +21,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 
 from cosmop.errors import EventSyntaxError
-from cosmop.events import Event, Primitive, parse_event, realising_step
-from cosmop.missions.precedence import Link
+from cosmop.events import Event, Link, Primitive, parse_event, realising_step
 from cosmop.planning.plan_types import RobotPlan, State, Step
 from cosmop.planning.primitive_effects import initial_state
 from cosmop.scene import Scene

@@ -24,9 +24,9 @@ from dataclasses import dataclass, field, replace
 import shapely
 from shapely.geometry.base import BaseGeometry
 
-from cosmop.events import Primitive, parse_event
+from cosmop.events import Link, Node, Primitive, parse_event
 from cosmop.io import collector_paused
-from cosmop.missions.precedence import Link, Node, Precedence
+from cosmop.missions.precedence import Precedence
 from cosmop.planning.conflict_order import order_conflicts
 from cosmop.planning.conflicts import (
     Conflict,
