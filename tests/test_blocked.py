@@ -13,15 +13,15 @@ import pytest
 from shapely import LineString
 
 from cosmop.events import parse_event
-from cosmop.planning.aside import ROOM, place_aside
-from cosmop.planning.checker import check_plan
 from cosmop.planning.plan_file import PlanError, load_plan, read_plan
 from cosmop.planning.plan_types import AddedTask, PlanSet
 from cosmop.planning.primitive_effects import plan_from_actions
 from cosmop.scenario import parse_scenario
 from cosmop.sim.simulation import simulate
 from cosmop.squares import square, swept_square
+from cosmop.team.aside import ROOM, place_aside
 from cosmop.team.loop import plan_team
+from cosmop.team.plan_set_checker import check_plan
 from cosmop.team.requests import _with_task
 from rooms import box_walls
 

@@ -25,7 +25,6 @@ from cosmop.planning import (
     RobotPlan,
     Step,
     Violation,
-    check_plan,
     check_robot_plan,
     overlaps,
     plan_from_actions,
@@ -33,8 +32,9 @@ from cosmop.planning import (
     swept_square,
 )
 from cosmop.planning.plan_types import PlanMessage
-from cosmop.planning.teamsafety import make_team_safe
 from cosmop.scenario import load_scenario, parse_scenario
+from cosmop.team.plan_set_checker import check_plan
+from cosmop.team.safe_plans import make_team_safe
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "01_warehouse_2x2" / "scenario.yaml"
 SCENARIO = load_scenario(EXAMPLE)

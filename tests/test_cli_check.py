@@ -10,8 +10,8 @@ from typer.testing import CliRunner
 from cosmop.cli import EXIT_INPUT_ERROR, app
 from cosmop.io import write_atomic
 from cosmop.planning import Coordination, PlanSet, plan_from_actions
-from cosmop.planning.teamsafety import make_team_safe
 from cosmop.scenario import load_scenario
+from cosmop.team.safe_plans import make_team_safe
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "01_warehouse_2x2" / "scenario.yaml"
 SCENE = load_scenario(EXAMPLE).scene

@@ -9,9 +9,9 @@ import yaml
 from typer.testing import CliRunner
 
 from cosmop.cli import app
-from cosmop.planning.checker import check_plan
 from cosmop.planning.plan_file import load_plan
 from cosmop.scenario import load_scenario
+from cosmop.team.plan_set_checker import check_plan
 
 ROOT = Path(__file__).resolve().parents[1]
 TASKS_FILE = ROOT / "examples" / "01_warehouse_2x2" / "scenario.yaml"

@@ -20,12 +20,12 @@ import pytest
 import shapely
 
 from cosmop.events import Link
-from cosmop.missions.precedence import Precedence, RetractedEdges
-from cosmop.planning import conflict_order
-from cosmop.planning.conflict_order import _Dominance, _Schedule, order_conflicts
-from cosmop.planning.conflict_search import CorrectionSetPicker, Search, backjump, possible_orientations
-from cosmop.planning.conflicts import Conflict, Occupancy, is_ordered
-from cosmop.planning.teamsafety import _reduce
+from cosmop.team import conflict_order
+from cosmop.team.conflict_order import _Dominance, _Schedule, order_conflicts
+from cosmop.team.conflict_search import CorrectionSetPicker, Search, backjump, possible_orientations
+from cosmop.team.conflicts import Conflict, Occupancy, is_ordered
+from cosmop.team.precedence import Precedence, RetractedEdges
+from cosmop.team.safe_plans import _reduce
 
 
 def _team(seed: int, robots: int = 4, steps: int = 6, conflicts: int = 24):

@@ -14,13 +14,13 @@ from pathlib import Path
 import pytest
 
 from cosmop.events import parse_event
-from cosmop.missions.coordination import Pair, blocking_word, coordinate
 from cosmop.missions.mission import GlobalMission, sequence_automaton
 from cosmop.missions.verification import verify
 from cosmop.planning.checker import check_robot_plan
 from cosmop.planning.realisation import request_phases
 from cosmop.planning.synthesis import synthesize
 from cosmop.scenario import load_scenario
+from cosmop.team.coordination_events import Pair, blocking_word, coordinate
 from paper_rules import west_only
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -125,7 +125,7 @@ def test_cli_export_and_its_bad_input(tmp_path):
 def test_simulate_writes_a_bag_and_refuses_an_existing_directory_before_any_work(tmp_path):
     from dataclasses import replace
 
-    from cosmop.planning.teamsafety import make_team_safe
+    from cosmop.team.safe_plans import make_team_safe
 
     scenario, plans, _ = run_2x2()
     safe = make_team_safe(scenario.scene, plans.robots)  # the CLI executes only team-safe plans
@@ -143,7 +143,7 @@ def test_simulate_writes_a_bag_and_refuses_an_existing_directory_before_any_work
 def test_a_timed_plan_stamps_each_pose_with_its_expected_time(tmp_path):
     from dataclasses import replace
 
-    from cosmop.planning.timing import itinerary
+    from cosmop.team.timing import itinerary
 
     scenario, plans, result = run_2x2()
     timed = replace(plans, itinerary=itinerary(scenario.scene, plans.robots))

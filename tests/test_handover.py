@@ -10,13 +10,13 @@ import yaml
 
 from cosmop.errors import ScenarioError
 from cosmop.events import Primitive, parse_event
-from cosmop.missions.handover import handovers
-from cosmop.planning.checker import check_plan
 from cosmop.planning.plan_types import PlanMessage, PlanSet, RobotPlan, Step
 from cosmop.planning.primitive_effects import plan_from_actions
 from cosmop.planning.synthesis import synthesize
 from cosmop.scenario import load_scenario, parse_scenario
+from cosmop.team.handover import handovers
 from cosmop.team.loop import plan_team
+from cosmop.team.plan_set_checker import check_plan
 
 RELAY = Path(__file__).resolve().parents[1] / "examples" / "12_relay" / "scenario.yaml"
 

@@ -18,7 +18,7 @@ from typer.testing import CliRunner
 
 from cosmop.cli import app
 from cosmop.errors import ScenarioError
-from cosmop.planning.checker import check_plan, check_robot_plan
+from cosmop.planning.checker import check_robot_plan
 from cosmop.planning.plan_file import load_plan
 from cosmop.planning.plan_types import State
 from cosmop.planning.primitive_effects import initial_state
@@ -27,6 +27,7 @@ from cosmop.planning.synthesis import synthesize
 from cosmop.scenario import load_scenario
 from cosmop.sim import SimSettings, simulate
 from cosmop.team.loop import plan_team
+from cosmop.team.plan_set_checker import check_plan
 
 ROOT = Path(__file__).resolve().parents[1]
 runner = CliRunner()

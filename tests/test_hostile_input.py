@@ -25,7 +25,6 @@ from typer.testing import CliRunner
 
 from cosmop.cli import app
 from cosmop.errors import CosmopInputError, ScenarioError
-from cosmop.planning.checker import check_plan
 from cosmop.planning.plan_file import PlanError, load_plan, read_plan
 from cosmop.planning.plan_types import MAX_STEPS
 from cosmop.planning.synthesis import synthesize
@@ -42,6 +41,7 @@ from cosmop.reading import (
 from cosmop.scenario import MAX_DFA_STATES, load_scenario, parse_scenario
 from cosmop.scene import MAX_TASK_EVENTS
 from cosmop.team.loop import plan_team
+from cosmop.team.plan_set_checker import check_plan
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "01_warehouse_2x2" / "scenario.yaml"

@@ -17,15 +17,15 @@ from typer.testing import CliRunner
 
 from cosmop.cli import app
 from cosmop.errors import CosmopInputError
-from cosmop.planning.checker import check_plan
 from cosmop.planning.plan_file import PlanError, load_plan, read_plan
 from cosmop.planning.plan_types import Itinerary
 from cosmop.planning.realisation import message_links
-from cosmop.planning.timing import durations, itinerary
 from cosmop.scenario import load_scenario
 from cosmop.sim import simulate
 from cosmop.sim.realised_times import StepTimes, carry_instants, step_times
 from cosmop.team.loop import plan_team
+from cosmop.team.plan_set_checker import check_plan
+from cosmop.team.timing import durations, itinerary
 
 CORRIDOR = Path(__file__).resolve().parents[1] / "examples" / "07_corridor" / "scenario.yaml"
 runner = CliRunner()

@@ -20,9 +20,10 @@ LAYERS: tuple[frozenset[str], ...] = tuple(
         "io reading squares events",  # reading and writing files; squares; the mission's events
         "scene",  # the value types of a scenario
         "units missions control",  # SI units; top-down decomposition; reactive control
-        "traces maps planning",  # traces; grid maps; bottom-up synthesis
+        "traces maps planning",  # traces; grid maps; one robot's planning and its checker
+        "team",  # what coordinates robots: conflicts, precedence, the team's checks and loop
         "scenario viz",  # the scenario loader (with its overlap checks); pictures
-        "sim team export",  # the simulator (its results draw); the team's planning loop; ROS 2 bags
+        "sim export",  # the simulator (its results draw); ROS 2 bags
         "lifelong",  # a fleet serving a stream of orders
         "cli",  # the command line
         "_entry",  # the program, with Ctrl-C answered while it starts
@@ -110,5 +111,5 @@ def test_an_upward_import_is_seen() -> None:
     found = _upward(source, "cosmop.planning.plan_types")
     assert [line.split(":")[0] for line in found] == ["line 3", "line 4", "line 5"]
     assert _upward(source, "cosmop.lifelong.fleet") == [
-        "line 5: cosmop.lifelong.fleet (layer 7) imports cosmop.cli (layer 8)"
+        "line 5: cosmop.lifelong.fleet (layer 8) imports cosmop.cli (layer 9)"
     ]

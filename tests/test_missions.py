@@ -26,9 +26,9 @@ from cosmop.automata import (
 )
 from cosmop.missions.decomposition import decompose, resynthesize, separability_counterexample
 from cosmop.missions.mission import GlobalMission, local_alphabets, sequence_automaton
-from cosmop.missions.team import check_words, verify_team
 from cosmop.missions.verification import verify
 from cosmop.scenario import load_scenario
+from cosmop.team.mission_proof import check_words, verify_team
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "01_warehouse_2x2"

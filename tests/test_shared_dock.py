@@ -7,11 +7,11 @@ from pathlib import Path
 import yaml
 
 from cosmop.missions.mission import GlobalMission
-from cosmop.planning.aside import dock_slots
 from cosmop.planning.synthesis import _as_written
 from cosmop.scenario import load_scenario, parse_scenario
 from cosmop.scene import Wall
 from cosmop.sim import footprint_overlaps, simulate
+from cosmop.team.aside import dock_slots
 from cosmop.team.loop import plan_team
 
 DOCK = Path(__file__).parent / "data" / "shared_dock.yaml"

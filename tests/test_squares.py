@@ -13,8 +13,8 @@ import random
 import numpy as np
 import shapely
 
-from cosmop.planning.conflicts import Occupancy, conflicts
 from cosmop.squares import overlap_depths, square, swept_square
+from cosmop.team.conflicts import Occupancy, conflicts
 
 
 def _region(rng: random.Random):

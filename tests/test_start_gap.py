@@ -12,13 +12,13 @@ import copy
 
 import pytest
 
-from cosmop.missions.precedence import Precedence
-from cosmop.planning.checker import check_plan
-from cosmop.planning.conflicts import ConflictSettings, conflicts, occupancies
 from cosmop.planning.realisation import message_links
 from cosmop.scenario import parse_scenario
 from cosmop.sim import footprint_overlaps, simulate
+from cosmop.team.conflicts import ConflictSettings, conflicts, occupancies
 from cosmop.team.loop import plan_team
+from cosmop.team.plan_set_checker import check_plan
+from cosmop.team.precedence import Precedence
 
 ROOM = [
     [[-4000, -3000], [4000, -3000]],

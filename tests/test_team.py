@@ -17,14 +17,14 @@ from typer.testing import CliRunner
 from cosmop.cli import app
 from cosmop.events import message, parse_event
 from cosmop.missions.mission import GlobalMission
-from cosmop.missions.precedence import Precedence
-from cosmop.planning.conflicts import conflicts, is_ordered, occupancies
 from cosmop.planning.plan_file import load_plan
 from cosmop.planning.realisation import message_links
 from cosmop.scenario import load_scenario, parse_scenario
 from cosmop.sim import simulate
 from cosmop.sim.recoordinate import Remaining, recoordinate
+from cosmop.team.conflicts import conflicts, is_ordered, occupancies
 from cosmop.team.loop import plan_team
+from cosmop.team.precedence import Precedence
 from team_checks import assert_complete_word, assert_no_overlap
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"

@@ -12,11 +12,11 @@ from typer.testing import CliRunner
 
 from cosmop.cli import app
 from cosmop.errors import ScenarioError
-from cosmop.planning.checker import check_plan
 from cosmop.planning.plan_file import PlanError, load_plan
 from cosmop.planning.plan_types import Coordination, PlanSet
 from cosmop.planning.primitive_effects import plan_from_actions
 from cosmop.scenario import load_scenario
+from cosmop.team.plan_set_checker import check_plan
 from cosmop.units import INTERNAL_UNITS, localize, mm_from_m, show_length, show_point, show_pose, show_speed
 from handmade_plans import R1_ACTIONS, R1_MISSION, R2_RES_ACTIONS, R2_RES_MISSION
 

@@ -12,7 +12,7 @@ The front door, for a script or a notebook::
 
 Each verb is a thin door onto the layer that does the work: :func:`cosmop.scenario.load_scenario`,
 :func:`cosmop.team.loop.plan_team` (the whole team: decomposition, synthesis, coordination,
-verification), :func:`cosmop.sim.simulate` and :func:`cosmop.planning.checker.check_plan`; the
+verification), :func:`cosmop.sim.simulate` and :func:`cosmop.team.plan_set_checker.check_plan`; the
 result types are :class:`Scenario`, :class:`PlanSet`, :class:`TeamResult`, :class:`SimResult`
 and :class:`CheckReport`.  ``import cosmop`` loads none of them until they are used, so the
 command line starts fast.  See ``ARCHITECTURE.md`` for the layers and the data flow.
@@ -134,7 +134,7 @@ def simulate(
 
 
 def check(scenario: Scenario, plans: PlanSet) -> CheckReport:
-    """The exact plan checker's verdict on a plan set (:func:`cosmop.planning.checker.check_plan`).
+    """The exact plan checker's verdict on a plan set (:func:`cosmop.team.plan_set_checker.check_plan`).
 
     Parameters
     ----------
@@ -146,6 +146,6 @@ def check(scenario: Scenario, plans: PlanSet) -> CheckReport:
     CheckReport
         ``ok``, and each violation with the robot, the step and why.
     """
-    from cosmop.planning.checker import check_plan
+    from cosmop.team.plan_set_checker import check_plan
 
     return check_plan(scenario, plans)

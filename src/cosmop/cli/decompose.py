@@ -19,10 +19,10 @@ from cosmop.io import check_writable, write_atomic
 from cosmop.missions.decomposition import Decomposition, Resynthesis
 from cosmop.missions.decomposition import decompose as run_decompose
 from cosmop.missions.mission import GlobalMission, sequence_of
-from cosmop.missions.team import TeamVerdict, verify_team
 from cosmop.missions.verification import Verification
 from cosmop.missions.verification import verify as run_verify
 from cosmop.scene import Scenario
+from cosmop.team.mission_proof import TeamVerdict, verify_team
 
 __all__ = ["Method", "decompose"]
 

@@ -16,10 +16,10 @@ from rich.text import Text
 from cosmop.cli._app import EXIT_INPUT_ERROR, ScenarioArgument, load, stderr, stdout
 from cosmop.cli.words import plan_verdict
 from cosmop.io import check_writable
-from cosmop.planning.checker import check_plan
 from cosmop.planning.plan_file import load_plan
 from cosmop.planning.plan_types import MAX_STEPS
 from cosmop.scene import Scenario
+from cosmop.team.plan_set_checker import check_plan
 
 if TYPE_CHECKING:
     from cosmop.team.loop import TeamResult

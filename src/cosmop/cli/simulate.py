@@ -15,11 +15,11 @@ from cosmop.cli._app import EXIT_INPUT_ERROR, ScenarioArgument, load, stderr, st
 from cosmop.cli.ecosystem import check_bag_target, write_bag_and_report
 from cosmop.cli.plan import SchedulerOption, WorkersOption, check_engine, plan_with_progress
 from cosmop.io import check_writable, uninterrupted
-from cosmop.planning.checker import check_plan
 from cosmop.planning.plan_file import load_plan
 from cosmop.planning.plan_types import PlanSet
 from cosmop.scene import Scenario
 from cosmop.sim import Delays, SimResult, SimSettings, StepTimes
+from cosmop.team.plan_set_checker import check_plan
 
 if TYPE_CHECKING:
     from cosmop.traces import Trace

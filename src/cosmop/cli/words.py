@@ -12,9 +12,9 @@ from cosmop.units import UnitSystem, show_point
 
 if TYPE_CHECKING:
     from cosmop.missions.decomposition import Decomposition
-    from cosmop.missions.team import TeamVerdict
     from cosmop.missions.verification import Verification
     from cosmop.planning.plan_types import PlanSet
+    from cosmop.team.mission_proof import TeamVerdict
 
 __all__ = ["decompose_verdict", "plan_verdict"]
 
@@ -77,7 +77,7 @@ def plan_verdict(plans: PlanSet, verification: TeamVerdict | None, units: UnitSy
     ----------
     plans : cosmop.planning.plan_types.PlanSet
         A feasible plan set: its hand-overs, messages and added tasks are told.
-    verification : cosmop.missions.team.TeamVerdict or None
+    verification : cosmop.team.mission_proof.TeamVerdict or None
         The team's verification (None: none was made, so nothing is proven).
     units : {"mm", "m"}, optional
         The scenario file's units, which places are shown in.

@@ -66,7 +66,7 @@ class DwaSettings:
         robot come arbitrarily close to a standing robot, and two robots that touch can never
         both move again; with a standoff they stop apart, and the per-arc check then lets them
         leave without closing in.  It is half the clearance the team's plans keep between
-        robots (:class:`~cosmop.planning.conflicts.ConflictSettings`, 100 mm): a robot that
+        robots (:class:`~cosmop.team.conflicts.ConflictSettings`, 100 mm): a robot that
         tracks its plan a few millimetres off still passes another where the plans let it
         (at the full clearance, a drift of 9 mm stopped robots for minutes in an aisle).
     turn_in_place : float

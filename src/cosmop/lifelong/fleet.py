@@ -35,7 +35,6 @@ import numpy as np
 from cosmop.events import parse_event
 from cosmop.lifelong.dispatch import OrderState, choose_robot, delivery_events
 from cosmop.lifelong.fleet_result import FleetResult
-from cosmop.planning.conflicts import ConflictSettings
 from cosmop.planning.plan_types import PlanSet, RobotPlan
 from cosmop.scene import Order, Scenario
 from cosmop.sim.recoordinate import recoordinate_world
@@ -44,6 +43,7 @@ from cosmop.sim.replan import replan, start_state
 from cosmop.sim.result import SimSettings
 from cosmop.sim.simulation import advance
 from cosmop.sim.world import Agent, World
+from cosmop.team.conflicts import ConflictSettings
 
 __all__ = ["Failure", "FleetSettings", "run_fleet"]
 

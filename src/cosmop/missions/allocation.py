@@ -8,7 +8,7 @@ events, which the bottom-up layer plans; the order between robots that :math:`K`
 then kept by messages (:func:`cosmop.missions.ordering.order_words`).  The alternative's own
 words interleave into the complete word :math:`s`, so that ordering always succeeds, and the
 sub-language the team then runs is contained in :math:`K`: the allocation is sound by
-construction, and :func:`cosmop.missions.team.check_words` re-proves it on the final plans.
+construction, and :func:`cosmop.team.mission_proof.check_words` re-proves it on the final plans.
 
 :func:`alternatives` enumerates the distinct alternatives, from the complete words of
 :math:`K` no longer than :math:`|Q| - 1` events (:math:`Q` the states of :math:`K`): every

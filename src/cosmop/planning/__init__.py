@@ -4,9 +4,10 @@ A robot's plan is a sequence of the paper's motion primitives -- ``GoTo``, ``Pic
 ``DropOff``, ``Req`` (request an object away, ``?ObjAway``) and ``Res`` (answer that it has been
 moved, ``!ObjAway``) -- with the state after each one (:mod:`cosmop.planning.plan_types`; what
 each primitive does to the state, :mod:`cosmop.planning.primitive_effects`; the plan file
-``cosmop.plan/1``, :mod:`cosmop.planning.plan_file`). :func:`check_plan` decides exactly, with
-shapely geometry and without any SMT encoding, whether a plan is sound for its scene and realises its mission
-(:mod:`cosmop.planning.checker`). :mod:`cosmop.planning.regions` holds the sound GoTo region
+``cosmop.plan/1``, :mod:`cosmop.planning.plan_file`). :func:`check_robot_plan` decides exactly, with
+shapely geometry and without any SMT encoding, whether one robot's plan is sound for its scene and
+realises its mission (:mod:`cosmop.planning.checker`; a whole plan set is checked by
+:mod:`cosmop.team.plan_set_checker`). :mod:`cosmop.planning.regions` holds the sound GoTo region
 constraints used by the bounded encoding. Units are millimetres and degrees throughout.
 """
 
@@ -15,7 +16,6 @@ from cosmop.planning.checker import (
     TOLERANCE,
     CheckReport,
     Violation,
-    check_plan,
     check_robot_plan,
     overlaps,
     square,
@@ -50,7 +50,6 @@ __all__ = [
     "State",
     "Step",
     "Violation",
-    "check_plan",
     "check_robot_plan",
     "initial_state",
     "load_plan",

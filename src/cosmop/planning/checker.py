@@ -47,9 +47,8 @@ lies wholly in W (a point W: O's centre is that point); ``return(R)``: the pose 
 is the initial pose; ``away(O,A,B)``: step *i* is ``Req(O)`` for the requester A, ``Res(O)``
 for the responder B.
 
-:func:`check_plan` adds the checks that involve the whole plan set: the plan names the
-scenario, every robot exists, a task-list mission is contained in each robot's plan (the
-coordinator only adds ``away`` events), and request/response pairs agree with the missions.
+:func:`cosmop.team.plan_set_checker.check_plan` checks a whole plan set: each robot's plan
+with :func:`check_robot_plan`, then the rules that involve several robots.
 """
 
 from __future__ import annotations
@@ -63,12 +62,11 @@ from shapely.geometry.base import BaseGeometry
 from cosmop.docking import DOCKING_HEADINGS, docking_pose, in_front
 from cosmop.errors import EventSyntaxError
 from cosmop.events import Event, Primitive, parse_event, realising_step
-from cosmop.planning.joint import check_team
-from cosmop.planning.plan_types import PlanSet, RobotPlan, State, Step
+from cosmop.planning.plan_types import RobotPlan, State, Step
 from cosmop.planning.primitive_effects import initial_state
 from cosmop.planning.realisation import TOLERANCE, angles_equal, at_pose, event_instants, holds_at
 from cosmop.planning.report import RULES, CheckReport, Violation
-from cosmop.scene import Scenario, Scene, Wall
+from cosmop.scene import Scene, Wall
 from cosmop.squares import square, swept_square
 from cosmop.units import UnitSystem, show_angle, show_length, show_number, show_point, show_pose
 
@@ -77,7 +75,6 @@ __all__ = [
     "TOLERANCE",
     "CheckReport",
     "Violation",
-    "check_plan",
     "check_robot_plan",
     "overlaps",
     "square",
@@ -674,199 +671,3 @@ def check_robot_plan(
             )
         ]
     return _RobotChecker(scene, robot_id, plan, start, moved).run()
-
-
-# ----------------------------------------------------------------------------------------------
-# The plan set
-# ----------------------------------------------------------------------------------------------
-
-
-def check_plan(scenario: Scenario, plan: PlanSet) -> CheckReport:
-    """Check a plan set against its scenario.
-
-    Every robot plan is checked with :func:`check_robot_plan`. The plan set as a whole must
-    also name the scenario; when the mission is given as task lists and the plan is feasible,
-    every robot with tasks has a plan whose mission contains its tasks in order, with only
-    ``away`` events added; every ``away`` event of a mission has its coordination pair, and
-    every pair appears in the missions of the requester and the responder.  The plan's added
-    tasks (goods moved out of a robot's way) extend the scene by their places and the task
-    lists by their two events; their places must not reuse a workspace id of the scenario.
-
-    Parameters
-    ----------
-    scenario : Scenario
-        The scenario the plan is for.
-    plan : PlanSet
-        The plans.
-
-    Returns
-    -------
-    CheckReport
-        ``ok`` when there is no violation; ``checked_steps`` counts the steps of the robots of
-        the scene.
-    """
-    violations: list[Violation] = [
-        Violation(
-            t.robot,
-            None,
-            "mission",
-            f"{t.robot}: the added task sets {t.object} down at {t.workspace}, but the scenario has a "
-            f"workspace {t.workspace} already; name the place anew",
-        )
-        for t in plan.added
-        if t.workspace in scenario.scene.workspaces
-    ]
-    scenario = plan.extend(scenario)
-    scene = scenario.scene
-    if plan.scenario != scenario.name:
-        violations.append(
-            Violation(
-                None,
-                None,
-                "scenario",
-                f"the plan is for scenario {plan.scenario!r}, but the scenario is {scenario.name!r}",
-            )
-        )
-    checked = 0
-    moved = {
-        s.object
-        for p in plan.robots.values()
-        for s in p.steps
-        if s.primitive == Primitive.PICKUP and s.object is not None  # (a PickUp always has one)
-    }
-    for robot_id, robot_plan in plan.robots.items():
-        violations.extend(check_robot_plan(scene, robot_id, robot_plan, moved=moved))
-        if robot_id in scene.robots:
-            checked += robot_plan.horizon
-    tasks = scenario.mission.tasks if scenario.mission is not None else None
-    if tasks is not None and plan.feasible:
-        added: dict[str, set[Event]] = {}
-        for task in plan.added:
-            added.setdefault(task.robot, set()).update(task.events)
-        for robot_id in sorted(set(tasks) | set(added), key=str):
-            sequence = tasks.get(robot_id, ())
-            violations.extend(
-                _check_tasks(robot_id, sequence, plan.robots.get(robot_id), added.get(robot_id, set()))
-            )
-    violations.extend(_check_coordination(plan))
-    if not plan.feasible:
-        violations.append(
-            Violation(None, None, "infeasible", f"the plan file marks the scenario infeasible: {plan.reason}")
-        )
-    elif not violations:  # the team-level rules presume sound single plans
-        violations.extend(check_team(scenario, plan))
-    return CheckReport(not violations, tuple(violations), checked)
-
-
-def _parsed(plan: RobotPlan) -> list[Event] | None:
-    try:
-        return list(plan.events)
-    except EventSyntaxError:
-        return None  # reported by check_robot_plan
-
-
-def _check_tasks(
-    robot_id: str, sequence: tuple[Event, ...], plan: RobotPlan | None, extra: set[Event]
-) -> list[Violation]:
-    """The plan's mission holds the tasks in order, adding only messages and the `extra` events."""
-    if not sequence and not extra:
-        return []
-    tasks = ", ".join(e.name for e in sequence) or "none"
-    if plan is None:
-        return [
-            Violation(
-                robot_id,
-                None,
-                "mission",
-                f"{robot_id}: the scenario gives {robot_id} the tasks {tasks}, "
-                f"but the plan has no plan for {robot_id}",
-            )
-        ]
-    events = _parsed(plan)
-    if events is None:
-        return []
-    matched: set[int] = set()
-    position = 0
-    for task in sequence:
-        while position < len(events) and events[position] != task:
-            position += 1
-        if position == len(events):
-            return [
-                Violation(
-                    robot_id,
-                    None,
-                    "mission",
-                    f"{robot_id}: the plan's mission ({', '.join(plan.mission) or 'empty'}) does not contain "
-                    f"the scenario's tasks ({tasks}) in order; {task.name} is missing",
-                )
-            ]
-        matched.add(position)
-        position += 1
-    missing = sorted(e.name for e in extra if e not in events)
-    if missing:
-        return [
-            Violation(
-                robot_id,
-                None,
-                "mission",
-                f"{robot_id}: the plan file adds a task for {robot_id}, but its mission lacks "
-                f"{', '.join(missing)}",
-            )
-        ]
-    added = [e.name for i, e in enumerate(events) if i not in matched and not e.is_message and e not in extra]
-    if added:
-        return [
-            Violation(
-                robot_id,
-                None,
-                "mission",
-                f"{robot_id}: the plan's mission adds {', '.join(added)}, which the scenario's tasks "
-                f"({tasks}) do not have; only messages (away, msg) may be added",
-            )
-        ]
-    return []
-
-
-def _check_coordination(plan: PlanSet) -> list[Violation]:
-    violations = []
-    pairs = {pair.event for pair in plan.coordination}
-    for robot_id, robot_plan in plan.robots.items():
-        for event in _parsed(robot_plan) or ():
-            if event.kind == "away" and robot_id in event.owners and event not in pairs:
-                violations.append(
-                    Violation(
-                        robot_id,
-                        None,
-                        "coordination",
-                        f"{robot_id}: the mission has {event.name}, but the plan's coordination list "
-                        f"has no pair {{object: {event.obj}, requester: {event.robot}, "
-                        f"responder: {event.responder}}}",
-                    )
-                )
-    for pair in plan.coordination:
-        event = pair.event
-        for role, robot_id in (("requester", pair.requester), ("responder", pair.responder)):
-            planned = plan.robots.get(robot_id)
-            if planned is None:
-                if plan.feasible:
-                    violations.append(
-                        Violation(
-                            robot_id,
-                            None,
-                            "coordination",
-                            f"{robot_id}: the coordination pair {event.name} names {robot_id} as {role}, "
-                            f"but the plan has no plan for {robot_id}",
-                        )
-                    )
-            elif event.name not in planned.mission:
-                primitive = Primitive.REQ if role == "requester" else Primitive.RES
-                violations.append(
-                    Violation(
-                        robot_id,
-                        None,
-                        "coordination",
-                        f"{robot_id}: the coordination pair {event.name} names {robot_id} as {role}, but its "
-                        f"mission does not include {event.name} (realised by {primitive}({pair.object}))",
-                    )
-                )
-    return violations

@@ -7,7 +7,7 @@ A message does not move anything, so it is placed after synthesis instead of by 
   plan: a send right after the step that realises the event before it, a wait right before the
   step that realises the event after it;
 * :func:`place_edges` turns start edges ("B may start step *j* once A has completed step *i*",
-  from :mod:`cosmop.planning.conflicts`) into messages: ``Res`` right after A's step *i*,
+  from :mod:`cosmop.team.conflicts`) into messages: ``Res`` right after A's step *i*,
   ``Req`` right before B's step *j*.
 
 Both go through :func:`insert_steps`, which keeps the plan's mission list in the order its

@@ -497,7 +497,7 @@ class Itinerary:
     Times are seconds from the moment the whole team starts (every robot at instant 0 at time
     0).  A step starts when its robot's previous step ends; a ``Req`` ends when its message has
     been sent, so the waiting shows as the ``Req``'s length.  The estimates come from
-    :func:`cosmop.planning.timing.itinerary`; a plan file shares them per step (``"start"``,
+    :func:`cosmop.team.timing.itinerary`; a plan file shares them per step (``"start"``,
     ``"end"``) so that other systems can reserve space and time, as fleet traffic schedules do.
 
     Parameters

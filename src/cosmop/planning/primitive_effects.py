@@ -32,7 +32,7 @@ def initial_state(
 
     Each robot is planned alone, against the objects as it knows them: goods another robot
     hands over to it lie where the other puts them down, goods others drop in a dock it shares
-    lie in their slots (:mod:`cosmop.missions.handover`, :func:`cosmop.planning.aside.dock_slots`).
+    lie in their slots (:mod:`cosmop.team.handover`, :func:`cosmop.team.aside.dock_slots`).
     Its plan lists that model at every step; instant 0 is the model before the first step.
 
     Parameters
@@ -46,7 +46,7 @@ def initial_state(
     moved : collection of str, optional
         The goods whose place at instant 0 is the plan's own (as its first step lists them,
         before that step's effect): goods the team moves, whose real places the team's checker
-        verifies (:mod:`cosmop.planning.joint`).  By default the goods the plan picks up.
+        verifies (:mod:`cosmop.team.plan_set_checker`).  By default the goods the plan picks up.
 
     Returns
     -------

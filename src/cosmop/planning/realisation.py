@@ -282,7 +282,7 @@ def request_phases(
     """Each ``Req(O)`` step of `plan` with the index in `events` of the first event realised at
     or after it (``len(events)`` if none is): the event the request prepares.
 
-    These are the requests :func:`cosmop.missions.coordination.coordinate` turns into
+    These are the requests :func:`cosmop.team.coordination_events.coordinate` turns into
     request/response pairs.
 
     Parameters

@@ -309,7 +309,7 @@ class RobotProblem:
     spots : tuple of (Event, (float, float))
         Drops pinned to one spot: the object's centre (mm) where the drop event must put it,
         inside the event's workspace.  A robot that hands goods over to another drops them
-        where the receiver was planned to pick them (:mod:`cosmop.missions.handover`).
+        where the receiver was planned to pick them (:mod:`cosmop.team.handover`).
 
     Attributes
     ----------

@@ -19,7 +19,6 @@ from pydantic import BaseModel, ValidationError
 from cosmop.errors import EventSyntaxError, InputWarning, ScenarioError
 from cosmop.events import ID_PATTERN, MESSAGE_KINDS, Event, parse_event
 from cosmop.io import read_text
-from cosmop.missions.handover import handovers
 from cosmop.reading import FieldPath, Marks, format_path, load_yaml, lookup, show
 from cosmop.scenario.plausible import implausible, out_of_range
 from cosmop.scenario.schema import (
@@ -58,6 +57,7 @@ from cosmop.scene import (
     Wall,
     Workspace,
 )
+from cosmop.team.handover import handovers
 from cosmop.units import (
     UnitSystem,
     default_dynamics,

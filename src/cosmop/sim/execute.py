@@ -360,7 +360,7 @@ def wait_for_message(world: World, agent: Agent, step: Step) -> Action | None:
 def send_message(world: World, agent: Agent, step: Step) -> Action | None:
     """``Res``: stop, then send the message (:meth:`~cosmop.sim.world.World.send`); a robot
     driving through the waypoint sends it on the way (a cut where a robot leaves a place it
-    shares lies a pass tolerance beyond the place: :class:`~cosmop.planning.conflicts.ConflictSettings`).
+    shares lies a pass tolerance beyond the place: :class:`~cosmop.team.conflicts.ConflictSettings`).
 
     Parameters
     ----------

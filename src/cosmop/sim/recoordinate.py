@@ -3,7 +3,7 @@
 When a stalled robot replans (:mod:`cosmop.sim.replan`), its new route may meet the other
 robots' routes where its old one did not.  Its new plan is therefore not executed on its own:
 the rest of every robot's plan, from where each robot is now, is ordered again by
-:func:`cosmop.planning.teamsafety.make_team_safe`, exactly as before the run --
+:func:`cosmop.team.safe_plans.make_team_safe`, exactly as before the run --
 
 * messages already sent stay sent: the steps that wait for them are done;
 * the messages that kept the robot's old plan apart from the others and have not been sent yet
@@ -25,12 +25,12 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from cosmop.events import Event, Primitive, parse_event
-from cosmop.planning.conflicts import ConflictSettings
 from cosmop.planning.plan_types import PlanMessage, RobotPlan, State, Step
 from cosmop.planning.primitive_effects import initial_state
-from cosmop.planning.teamsafety import make_team_safe
 from cosmop.scene import Scene
 from cosmop.sim.realised_times import carry_instants
+from cosmop.team.conflicts import ConflictSettings
+from cosmop.team.safe_plans import make_team_safe
 
 if TYPE_CHECKING:
     from cosmop.sim.world import Agent, World

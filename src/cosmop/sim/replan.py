@@ -22,11 +22,11 @@ from typing import TYPE_CHECKING, Any
 from cosmop.control.geometry import box_gaps
 from cosmop.events import Event, Primitive
 from cosmop.planning.checker import check_robot_plan
-from cosmop.planning.conflicts import ConflictSettings
 from cosmop.planning.plan_types import ObjectState, RobotPlan, State
 from cosmop.planning.primitive_effects import initial_state
 from cosmop.scene import Scene, Wall
 from cosmop.sim.recoordinate import recoordinate_world
+from cosmop.team.conflicts import ConflictSettings
 
 if TYPE_CHECKING:
     from cosmop.sim.world import Agent, World
@@ -216,7 +216,7 @@ def start_state(world: World, agent: Agent, picks: AbstractSet[str | None] = fro
     An object another robot carries, or one it has asked to be moved away (a ``Req`` step done),
     is away: not in its way.  Goods it still has to pick (`picks`) and does not carry are where
     its plan expects them: a robot that another hands them over to waits for them where the
-    other puts them down (:mod:`cosmop.missions.handover`), wherever they are now.
+    other puts them down (:mod:`cosmop.team.handover`), wherever they are now.
 
     Parameters
     ----------

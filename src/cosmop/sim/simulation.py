@@ -27,7 +27,7 @@ control cycle :math:`\\varepsilon` (the scenario's ``dynamics.cycle``):
     stops and waits for its message (the answer ``away(O, A, B)`` to a request, or a
     ``msg``); ``Res`` stops and sends it.  The message bus logs every message.  Plans are
     executed exactly as written: the messages that keep robots apart sit where the plan put
-    them (:mod:`cosmop.planning.teamsafety`).
+    them (:mod:`cosmop.team.safe_plans`).
 
 Robots are unicycles: each cycle the robot holds a turn rate in :math:`[-\\Omega, \\Omega]` and
 speeds up at most at :math:`A` or brakes at :math:`-b` until it has the speed it was given.
@@ -75,7 +75,6 @@ import numpy as np
 from cosmop.control.dwa import Drivers, Obstacles, dwa_commands
 from cosmop.control.neighbourhood import dwa_commands_near
 from cosmop.planning.plan_types import Itinerary, PlanSet, Pose
-from cosmop.planning.timing import itinerary
 from cosmop.scene import Scenario
 from cosmop.sim.execute import decide, let_go
 from cosmop.sim.monitor import footprint_overlaps, monitor
@@ -84,6 +83,7 @@ from cosmop.sim.recording import Recorder
 from cosmop.sim.result import DEFAULT_TIME_LIMIT, SIM_FORMAT, Contact, Message, SimResult, SimSettings
 from cosmop.sim.unicycle import integrate
 from cosmop.sim.world import World
+from cosmop.team.timing import itinerary
 from cosmop.traces import TRACE_FORMAT
 
 __all__ = [

@@ -22,7 +22,6 @@ from cosmop.control.geometry import box_gaps, point_segment_linf, rect_gaps, seg
 from cosmop.control.paths import GlobalPath
 from cosmop.control.safety import Limits
 from cosmop.events import MESSAGE_KINDS, Event, Primitive, parse_event, realising_step
-from cosmop.planning.conflicts import ConflictSettings
 from cosmop.planning.plan_types import PlanSet, Pose, RobotPlan, Step
 from cosmop.planning.realisation import event_instants
 from cosmop.scenario.overlaps import TOUCH  # the one tolerance under which two squares touch
@@ -30,6 +29,7 @@ from cosmop.scene import Scenario
 from cosmop.sim.delays import DelayDraws
 from cosmop.sim.humans import Walker
 from cosmop.sim.result import Contact, Message, SimSettings, drop_holds
+from cosmop.team.conflicts import ConflictSettings
 
 __all__ = ["TOUCH", "Action", "Agent", "World", "wrap_angle"]
 

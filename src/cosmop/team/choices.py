@@ -31,9 +31,9 @@ from cosmop.missions.allocation import (
 from cosmop.missions.mission import GlobalMission
 from cosmop.missions.ordering import order_words, with_messages
 from cosmop.planning.synthesis import Synthesis
-from cosmop.planning.timing import step_durations
 from cosmop.scene import Scenario
 from cosmop.team.planner import LocalMission, Planner
+from cosmop.team.timing import step_durations
 
 __all__ = ["Allocation", "allocate"]
 

@@ -1,6 +1,6 @@
 """Step 4 of the loop: the plans made team-safe, with detours where waiting cannot or should not do.
 
-Every place two plans share is ordered by a message (:func:`cosmop.planning.teamsafety.make_team_safe`).
+Every place two plans share is ordered by a message (:func:`cosmop.team.safe_plans.make_team_safe`).
 A conflict no order resolves (a robot parked for good where another must pass) is resolved by
 re-planning one robot with the other's space as walls (:func:`make_safe`).  Then, where waiting
 for a shared place costs the team more than a way around, the way around is taken
@@ -17,14 +17,14 @@ from dataclasses import dataclass
 import shapely
 
 from cosmop.events import Event
-from cosmop.planning.aside import handover_spot
-from cosmop.planning.conflicts import Conflict, ConflictSettings, Occupancy
-from cosmop.planning.lanes import lanes
 from cosmop.planning.plan_types import RobotPlan
 from cosmop.planning.synthesis import Synthesis
-from cosmop.planning.teamsafety import TeamSafety, Wait, make_team_safe
 from cosmop.scene import Scene, Wall
+from cosmop.team.aside import handover_spot
+from cosmop.team.conflicts import Conflict, ConflictSettings, Occupancy
+from cosmop.team.lanes import lanes
 from cosmop.team.planner import Planner, Window, goods_at
+from cosmop.team.safe_plans import TeamSafety, Wait, make_team_safe
 from cosmop.team.walls import walls_around
 from cosmop.units import show_point
 
@@ -154,7 +154,7 @@ def _drop_elsewhere(
     Walls cannot settle such a conflict when the robot that drops the goods must itself pass
     through the other's place (to pick them, say): instead the drop is pinned to another spot
     of its workspace, one the robot can dock to whose square keeps the clearance from the other
-    side and from every other robot's fixed places (:func:`cosmop.planning.aside.handover_spot`
+    side and from every other robot's fixed places (:func:`cosmop.team.aside.handover_spot`
     with `avoid`), and the robot is re-planned.  Returns, per robot re-planned, its synthesis and
     why; a robot whose re-plan fails keeps its plan and its drop.
     """
@@ -292,7 +292,7 @@ def shorten_waits(
 
     Each robot was planned alone, so its route ignores the others; the conflict step then makes
     robots wait for each other.  The waits on the itinerary's critical path
-    (:attr:`~cosmop.planning.teamsafety.Wait.critical`; no other wait, shortened, ends the team
+    (:attr:`~cosmop.team.safe_plans.Wait.critical`; no other wait, shortened, ends the team
     sooner), the longest first, get the ways around that apply (:func:`_ways_around`): the
     two robots re-planned to pass each other in lanes, or the waiting robot re-planned with the
     other's occupancy as walls.  A way is kept when the plans stay team-safe and the team's
@@ -355,7 +355,7 @@ def _ways_around(wait: Wait, safety: TeamSafety, scene: Scene, settings: Conflic
     """The ways around one wait, to try in order: ``(key, why, robot -> walls)``.
 
     Two robots that drive head-on through a place wide enough for both pass each other in
-    lanes (:func:`cosmop.planning.lanes.lanes`); the waiting robot can keep out of what it
+    lanes (:func:`cosmop.team.lanes.lanes`); the waiting robot can keep out of what it
     waits for, where that leaves its fixed places free (:meth:`TeamSafety.detours`).
     """
     out: list[_Way] = []

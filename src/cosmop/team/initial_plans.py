@@ -12,11 +12,11 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 from cosmop.events import Event, Primitive
-from cosmop.missions.handover import Handover, Handovers
-from cosmop.planning.aside import dock_slots, handover_spot
 from cosmop.planning.plan_types import RobotPlan
 from cosmop.planning.synthesis import Synthesis
 from cosmop.scene import Workspace
+from cosmop.team.aside import dock_slots, handover_spot
+from cosmop.team.handover import Handover, Handovers
 from cosmop.team.planner import Planner, goods_at
 
 __all__ = ["pack_docks", "plan_in_turn"]
@@ -26,7 +26,7 @@ def pack_docks(base: Mapping[str, tuple[Event, ...]], planner: Planner) -> tuple
     """Give goods that several robots drop into one workspace a slot each; why not (``()``: done).
 
     Each robot picks its own drop spot when planned alone, and robots sharing a dock would
-    pick the same one: the goods are packed first (:func:`cosmop.planning.aside.dock_slots`),
+    pick the same one: the goods are packed first (:func:`cosmop.team.aside.dock_slots`),
     each robot's drop is pinned to its goods' slot, and a robot knows the goods packed before
     its own in their slots from the start (it docks beside them).  The conflict step then
     orders the drops.
@@ -81,7 +81,7 @@ def plan_in_turn(
     its plan drops the goods becomes the receiver's (:meth:`Planner.hand_over`), and the
     receiver is planned in a later turn.  A receiver that cannot pick them there, and a cycle
     of givers and receivers, get a spot chosen for both
-    (:func:`cosmop.planning.aside.handover_spot`): the giver is planned again to drop there.
+    (:func:`cosmop.team.aside.handover_spot`): the giver is planned again to drop there.
 
     Parameters
     ----------

@@ -6,17 +6,17 @@
    of messages can work are tasks pruned, and then the plan is infeasible and names them.
 2. *Synthesize* every robot's shortest plan (its messages are put in afterwards).
 3. *Coordinate requests*: each Req(O) of robot A becomes the message ``away(O, A, B)`` from the
-   robot B whose mission picks O (:mod:`cosmop.missions.coordination`); the responders are
+   robot B whose mission picks O (:mod:`cosmop.team.coordination_events`); the responders are
    re-planned; repeat until no plan asks for anything new (capped).  A request that nobody can
    answer, or that would deadlock the team, is forbidden and the requester re-planned: its next
    best plan asks for less, or is a step longer.
-4. *Make the plans team-safe* (:mod:`cosmop.planning.teamsafety`): every place two plans share is
+4. *Make the plans team-safe* (:mod:`cosmop.team.safe_plans`): every place two plans share is
    ordered by a message.  A conflict that no order resolves (a robot parked for good where
    another must pass) is resolved by re-planning one robot with the other's space as an
    obstacle.
 5. *Verify*: the robots' words with all their messages cannot deadlock and do exactly what the
-   global mission asks (:func:`cosmop.missions.team.verify_team`); every plan set passes the
-   exact checker (:func:`cosmop.planning.checker.check_plan`).
+   global mission asks (:func:`cosmop.team.mission_proof.verify_team`); every plan set passes the
+   exact checker (:func:`cosmop.team.plan_set_checker.check_plan`).
 """
 
 from __future__ import annotations
@@ -31,23 +31,24 @@ from types import MappingProxyType
 from cosmop.errors import MissionTooLargeError
 from cosmop.events import Event, parse_event
 from cosmop.missions.allocation import Choice
-from cosmop.missions.coordination import Coordinated
 from cosmop.missions.decomposition import decompose
-from cosmop.missions.handover import handovers
 from cosmop.missions.mission import GlobalMission, sequence_of
-from cosmop.missions.team import TeamVerdict, check_words
-from cosmop.planning.checker import CheckReport, check_plan
-from cosmop.planning.conflicts import ConflictSettings
+from cosmop.planning.checker import CheckReport
 from cosmop.planning.plan_types import Coordination, PlanMessage, PlanSet, RobotPlan
 from cosmop.planning.synthesis import DEFAULT_RLIMIT, Synthesis
-from cosmop.planning.teamsafety import TeamSafety
-from cosmop.planning.timing import itinerary
 from cosmop.scene import Scenario
 from cosmop.team.choices import Allocation, allocate
+from cosmop.team.conflicts import ConflictSettings
+from cosmop.team.coordination_events import Coordinated
 from cosmop.team.detours import MadeSafe, make_safe, shorten_waits
+from cosmop.team.handover import handovers
 from cosmop.team.initial_plans import pack_docks, plan_in_turn
+from cosmop.team.mission_proof import TeamVerdict, check_words
+from cosmop.team.plan_set_checker import check_plan
 from cosmop.team.planner import Planner, Workers
 from cosmop.team.requests import RequestsAnswered, coordinate_requests
+from cosmop.team.safe_plans import TeamSafety
+from cosmop.team.timing import itinerary
 
 __all__ = ["PHASES", "WAYS_AROUND", "TeamResult", "plan_team"]
 

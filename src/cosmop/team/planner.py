@@ -21,10 +21,10 @@ from typing import Any, ParamSpec, TypeVar
 from cosmop.automata import DFA
 from cosmop.events import Event, parse_event
 from cosmop.io import uninterrupted
-from cosmop.missions.handover import Handover
 from cosmop.planning.plan_types import MAX_STEPS, AddedTask
 from cosmop.planning.synthesis import DEFAULT_RLIMIT, Synthesis, synthesize
 from cosmop.scene import Scenario, Scene, Wall
+from cosmop.team.handover import Handover
 
 __all__ = ["Planner", "Replanned", "Restrictions", "SynthesisJob", "Workers", "default_horizon", "goods_at"]
 

@@ -2,7 +2,7 @@
 
 A robot's plan may ask for goods in its way to be moved (``Req(O)``).  Each request becomes
 the message ``away(O, A, B)`` from the robot B whose mission picks O
-(:func:`cosmop.missions.coordination.coordinate`), and the robots that answer are re-planned,
+(:func:`cosmop.team.coordination_events.coordinate`), and the robots that answer are re-planned,
 until no plan asks for anything new.  A request that nobody can answer, or that would deadlock
 the team, is forbidden and the requester re-planned (its next best plan asks for less, or is a
 step longer); goods that block a robot and that no mission moves get a helper that sets them
@@ -17,14 +17,14 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, replace
 
 from cosmop.events import Event
-from cosmop.missions.coordination import Coordinated, coordinate
-from cosmop.missions.team import blocking_word
-from cosmop.planning.aside import ROOM, place_aside
-from cosmop.planning.conflicts import ConflictSettings
 from cosmop.planning.plan_types import MAX_STEPS, AddedTask, PlanSet, RobotPlan
 from cosmop.planning.realisation import request_phases
 from cosmop.planning.synthesis import Synthesis
 from cosmop.squares import square
+from cosmop.team.aside import ROOM, place_aside
+from cosmop.team.conflicts import ConflictSettings
+from cosmop.team.coordination_events import Coordinated, coordinate
+from cosmop.team.mission_proof import blocking_word
 from cosmop.team.planner import Planner, Replanned
 from cosmop.team.walls import walls_around
 from cosmop.units import show_point
@@ -216,7 +216,7 @@ def _move_aside(
 
     The paper's re-allocation: the requester itself is tried first (no message needed), then
     the other robots, those whose plans end soonest first.  The helper's mission gains
-    ``pick`` and ``drop`` of the goods at a free place (:func:`cosmop.planning.aside.place_aside`)
+    ``pick`` and ``drop`` of the goods at a free place (:func:`cosmop.team.aside.place_aside`)
     -- for the requester right before the event its request prepares (before the pick it is
     carrying from, if any), for another robot at its start, and the requester's request is then
     answered like any other (``away``).  The reasons, per goods and robot tried, say why some

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 from types import MappingProxyType
 
 from cosmop.events import Event
-from cosmop.missions.team import blocking_word as team_blocking_word
+from cosmop.team.mission_proof import blocking_word as team_blocking_word
 
 
 @dataclass(frozen=True)
@@ -75,7 +75,7 @@ def blocking_word(sequences: Mapping[str, Sequence[Event]]) -> tuple[str, ...] |
 
     Messages are asynchronous (a responder sends and goes on; a requester waits until the
     answer has been sent), as the robots execute them: see
-    :func:`cosmop.missions.team.blocking_word`.
+    :func:`cosmop.team.mission_proof.blocking_word`.
 
     Parameters
     ----------

@@ -1,6 +1,6 @@
 """The search that orders conflicts between plans and proves its own dead ends.
 
-:class:`Search` chooses one start edge per conflict (:mod:`cosmop.planning.conflict_order`) so
+:class:`Search` chooses one start edge per conflict (:mod:`cosmop.team.conflict_order`) so
 that the team's order stays acyclic: unit propagation of the orders that are forced, choices
 that follow time (the robot expected first goes first), and conflict-directed backjumping.
 Each dead end comes with the set of conflicts it follows from (:func:`_core`); one that follows
@@ -25,8 +25,8 @@ import numpy as np
 from shapely.geometry.base import BaseGeometry
 
 from cosmop.events import Link, Node
-from cosmop.missions.precedence import Precedence, RetractedEdges
-from cosmop.planning.conflicts import Conflict, Occupancy, detours, replan_rank
+from cosmop.team.conflicts import Conflict, Occupancy, detours, replan_rank
+from cosmop.team.precedence import Precedence, RetractedEdges
 
 __all__ = [
     "CorrectionSetPicker",
@@ -54,7 +54,7 @@ _Taken = tuple[int, Edge, _Reason]
 
 
 class _Implications(Protocol):
-    """Which conflicts dominate which (:class:`cosmop.planning.conflict_order._Dominance`)."""
+    """Which conflicts dominate which (:class:`cosmop.team.conflict_order._Dominance`)."""
 
     def among(self, conflicts: Sequence[Conflict]) -> tuple[np.ndarray, np.ndarray]: ...
 
@@ -89,7 +89,7 @@ class Search:
 
     A conflict that another one in `found` implies is left to it while that one is not set
     aside (`implied.among(found)` gives the pairs, stronger and weaker, as indices into `found`:
-    :class:`cosmop.planning.conflict_order._Dominance`).  The search keeps its state between
+    :class:`cosmop.team.conflict_order._Dominance`).  The search keeps its state between
     questions: a conflict given back (:meth:`give_back`) is searched on from the order as it is.
     """
 
@@ -275,7 +275,7 @@ class Search:
 
     def _take_batch(self, entries: list[_Taken], prefix: bool = False) -> None:
         """Take ``(conflict, edge, reason)`` entries in order, each unless the ones before it
-        close its cycle: in one pass (:meth:`~cosmop.missions.precedence.Precedence.add_starts`),
+        close its cycle: in one pass (:meth:`~cosmop.team.precedence.Precedence.add_starts`),
         taken back as one.  With `prefix`, only those before the first that closes a cycle
         (what comes after it may need it)."""
         if not entries:
@@ -301,7 +301,7 @@ class Search:
         reason does not need what goes (:meth:`_needing`).
 
         The entries kept stay in the trail, in their order, as one batch, and the order drops
-        the edges that go (:meth:`~cosmop.missions.precedence.Precedence.retract`).  `first`
+        the edges that go (:meth:`~cosmop.team.precedence.Precedence.retract`).  `first`
         comes after them; if they close its cycle, it comes where its choice was, and they are
         taken again after it up to the first that closes a cycle then (what comes after that one
         may need it): the rest is left to the search.
@@ -329,7 +329,7 @@ class Search:
 
         An entry goes when its conflict is gone, when it was forced by a dead end's set that
         holds a conflict that goes, or when it was forced by a cycle that may run through an
-        edge that goes (:class:`~cosmop.missions.precedence.RetractedEdges`, one-sided).  Choices
+        edge that goes (:class:`~cosmop.team.precedence.RetractedEdges`, one-sided).  Choices
         need nothing.  What stays keeps its reason: all it used stays before it.
         """
         log = self.trail[place][2] if place < len(self.trail) else None
@@ -420,7 +420,7 @@ def backjump(
     found : sequence of Conflict
         The conflicts to order.
     implied : _Dominance
-        Which of them imply which (:class:`cosmop.planning.conflict_order._Dominance`).
+        Which of them imply which (:class:`cosmop.team.conflict_order._Dominance`).
     team : tuple
         ``(horizons, links, starts, durations)``: the plans' order before any conflict's.
     picker : CorrectionSetPicker
@@ -481,7 +481,7 @@ class CorrectionSetPicker:
     and MaxSAT work: a set whose removal leaves the rest satisfiable, a hitting set of the
     cores); this class picks its members, one core at a time.
 
-    The most re-plannable (:func:`~cosmop.planning.conflicts.replan_rank`); of those, one whose
+    The most re-plannable (:func:`~cosmop.team.conflicts.replan_rank`); of those, one whose
     robot is already re-planned this round: one more space to keep clear of costs a robot that
     is re-planned anyway little, and a robot not re-planned yet a whole synthesis.  On a tie,
     the first in the core as given.
@@ -494,7 +494,7 @@ class CorrectionSetPicker:
         self._mover: dict[int, str | None] = {}
 
     def rank(self, conflict: Conflict) -> int:
-        """The conflict's :func:`~cosmop.planning.conflicts.replan_rank` (lower: re-planned first).
+        """The conflict's :func:`~cosmop.team.conflicts.replan_rank` (lower: re-planned first).
 
         Parameters
         ----------
@@ -704,7 +704,7 @@ class _OrientationTests:
 class OrientationTable:
     """Every conflict's two ways, the orientations of its disjunctive edge (:func:`orientations_of`),
     and the same as arrays (:func:`orientation_arrays`): computed once for the search and
-    :class:`~cosmop.planning.conflict_order._Dominance`.
+    :class:`~cosmop.team.conflict_order._Dominance`.
 
     Attributes
     ----------
@@ -805,7 +805,7 @@ def depth_first(
     last choice.  A conflict with a single way left is ordered first; otherwise the one expected
     to start first, the way that keeps the team's expected makespan lower.  The culprit is the
     conflict without a way at the deepest dead end.  The order is updated incrementally and
-    taken back on backtracking (:meth:`~cosmop.missions.precedence.Precedence.add_start`).
+    taken back on backtracking (:meth:`~cosmop.team.precedence.Precedence.add_start`).
 
     Parameters
     ----------
@@ -823,7 +823,7 @@ def depth_first(
         Dead ends after which the search gives up.
     fixed : Mapping[str, sequence of shapely geometry] or None
         Each robot's places re-planning cannot move
-        (:func:`~cosmop.planning.conflicts.fixed_places`).
+        (:func:`~cosmop.team.conflicts.fixed_places`).
     """
     precedence = Precedence(horizons, links, starts, durations)
     orientations = _OrientationTests(found, precedence)

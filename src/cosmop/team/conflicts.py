@@ -20,11 +20,11 @@ it: the scene put them there, and no plan could otherwise ever let them leave (r
 back are held to the clearance, as every other pair).
 Two occupancies of different robots (an object counts for the robots that move it)
 *conflict* when their regions' interiors overlap, and the conflict is *ordered* when one of
-them always ends before the other starts (:meth:`cosmop.missions.precedence.Precedence.before_start`).
+them always ends before the other starts (:meth:`cosmop.team.precedence.Precedence.before_start`).
 A plan set is team-safe when every conflict is ordered: then no execution the messages allow
 puts two robots, or a robot and another robot's goods, in one place at one time.
 
-The orders themselves are chosen by :mod:`cosmop.planning.conflict_order`.
+The orders themselves are chosen by :mod:`cosmop.team.conflict_order`.
 """
 
 from __future__ import annotations
@@ -40,12 +40,12 @@ from shapely import STRtree
 from shapely.geometry.base import BaseGeometry
 
 from cosmop.events import Node, Primitive
-from cosmop.missions.precedence import Precedence
 from cosmop.planning.plan_types import RobotPlan, State
 from cosmop.planning.primitive_effects import initial_state
 from cosmop.planning.realisation import TOLERANCE, at_pose
 from cosmop.scene import Scene
 from cosmop.squares import overlap_depths, square, swept_square
+from cosmop.team.precedence import Precedence
 from cosmop.units import UnitSystem, show_number, show_point
 
 __all__ = [

@@ -107,7 +107,7 @@ def handover_spot(
     avoid: shapely.Geometry | None = None,
 ) -> tuple[float, float] | None:
     """A spot for `obj` in `workspace` where each of `robots` can dock to it, chosen before either
-    is planned (a hand-over whose giver and receiver wait on each other, :mod:`cosmop.missions.handover`).
+    is planned (a hand-over whose giver and receiver wait on each other, :mod:`cosmop.team.handover`).
 
     Of a grid of the centres the workspace allows (its :meth:`~cosmop.scene.Workspace.centres`),
     the spots every robot can dock to are kept (as in :func:`place_aside`, and with no wall
@@ -207,7 +207,7 @@ def dock_slots(
     (the specification's gripper: both squares in one region of every wall); and, against
     the goods packed before, the good's square overlaps none of them (touching allowed) and
     the robot keeps `rest` (mm) from them, the room the conflict step gives a standing robot
-    (:class:`~cosmop.planning.conflicts.ConflictSettings`).  Goods are packed one at a time
+    (:class:`~cosmop.team.conflicts.ConflictSettings`).  Goods are packed one at a time
     into the dockable slot that leaves the most dockable slots to the goods still to come
     (ties: the slot farthest from the middle, packing from the edges in), trying every order
     of up to four goods and keeping the order that packs the most.  A heuristic: the solver,

@@ -30,10 +30,10 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 from cosmop.events import Primitive
-from cosmop.missions.precedence import Precedence
 from cosmop.planning.plan_types import Itinerary, RobotPlan, State
 from cosmop.planning.realisation import message_links
 from cosmop.scene import Dynamics, Scene
+from cosmop.team.precedence import Precedence
 
 __all__ = [
     "ExecutionModel",
@@ -235,7 +235,7 @@ def itinerary(
     :math:`d_{r,k}` (:func:`step_durations`) -- a ``Req`` not before its message has been sent:
     :math:`e_{r,k} = \\max(s_{r,k} + d_{r,k}, e_{q,j})` where step *j* of robot *q* is the
     ``Res`` that sends it.  That is the earliest schedule of the plans' partial order
-    (:class:`~cosmop.missions.precedence.Precedence`), the one robots that never wait longer
+    (:class:`~cosmop.team.precedence.Precedence`), the one robots that never wait longer
     than they must follow.  Times are rounded to the millisecond.
 
     Parameters

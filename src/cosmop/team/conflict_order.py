@@ -1,9 +1,9 @@
 """Ordering conflicts: start edges that keep two plans out of each other's places, without deadlock.
 
-A conflict (:mod:`cosmop.planning.conflicts`) is ordered by a *start edge*: one occupancy ends
+A conflict (:mod:`cosmop.team.conflicts`) is ordered by a *start edge*: one occupancy ends
 before the other starts.  :func:`order_conflicts` chooses one edge per conflict so that the
-team's order stays acyclic (no deadlock, :mod:`cosmop.missions.precedence`): the occupancy that
-is expected to begin first (:mod:`cosmop.planning.timing`) goes first, unless that closes a
+team's order stays acyclic (no deadlock, :mod:`cosmop.team.precedence`): the occupancy that
+is expected to begin first (:mod:`cosmop.team.timing`) goes first, unless that closes a
 cycle or it never ends (a robot parked for good).  Conflicts no order can resolve together are
 returned, irredundant, for re-planning.
 
@@ -11,7 +11,7 @@ Two conflicts between the same robots often say the same thing more strongly or 
 one *dominates* the other (:class:`_Dominance`); only the undominated are searched and given to
 the solver.  The solver's work grows much faster than the conflicts (a single check of 10,000
 conflicts can take a minute), so the search proves its own dead ends
-(:mod:`cosmop.planning.conflict_search`) and the solver is asked only when the search runs out
+(:mod:`cosmop.team.conflict_search`) and the solver is asked only when the search runs out
 of its budget.
 """
 
@@ -26,7 +26,7 @@ import numpy as np
 from shapely.geometry.base import BaseGeometry
 
 from cosmop.events import Link, Node
-from cosmop.planning.conflict_search import (
+from cosmop.team.conflict_search import (
     CorrectionSetPicker,
     Edge,
     OrientationTable,
@@ -35,7 +35,7 @@ from cosmop.planning.conflict_search import (
     depth_first,
     possible_orientations,
 )
-from cosmop.planning.conflicts import Conflict
+from cosmop.team.conflicts import Conflict
 
 __all__ = ["order_conflicts"]
 
@@ -60,11 +60,11 @@ def order_conflicts(
     (:class:`_Dominance`): an order of those orders the rest.  Then:
 
     1. a search over the two ways of ordering each conflict, with unit propagation and
-       conflict-directed backjumping (:class:`~cosmop.planning.conflict_search.Search`).  Each
+       conflict-directed backjumping (:class:`~cosmop.team.conflict_search.Search`).  Each
        dead end comes with the set of conflicts it follows from; one that follows from no
        choice is a *core* -- a set of conflicts no order resolves together -- and one conflict
        of each core is set aside (the most re-plannable, preferably of a robot already
-       re-planned: :class:`~cosmop.planning.conflict_search.CorrectionSetPicker`).  The cores are not
+       re-planned: :class:`~cosmop.team.conflict_search.CorrectionSetPicker`).  The cores are not
        minimal, so each conflict set aside is then given back where the others allow it
        (:func:`_give_back`), and that is the answer;
     2. only if the search passes `max_backtracks` dead ends: the question settled exactly as a
@@ -84,7 +84,7 @@ def order_conflicts(
     Parameters
     ----------
     found : sequence of Conflict
-        The conflicts between the plans (:func:`~cosmop.planning.conflicts.conflicts`).
+        The conflicts between the plans (:func:`~cosmop.team.conflicts.conflicts`).
     horizons : Mapping[str, int]
         Every robot's number of steps.
     links : sequence of Link
@@ -92,12 +92,12 @@ def order_conflicts(
     starts : sequence of (Node, Node)
         Start edges the order already has.
     durations : Mapping[str, sequence of float]
-        Expected seconds of each robot's steps (:func:`~cosmop.planning.timing.durations`).
+        Expected seconds of each robot's steps (:func:`~cosmop.team.timing.durations`).
     max_backtracks : int
         Dead ends after which the search hands over to the solver.
     fixed : Mapping[str, sequence of shapely geometry], optional
         Each robot's places re-planning cannot move
-        (:func:`~cosmop.planning.conflicts.fixed_places`), to choose which conflict to set aside.
+        (:func:`~cosmop.team.conflicts.fixed_places`), to choose which conflict to set aside.
     rlimit : int
         Z3 resource limit of each scheduling call.
     """

@@ -32,7 +32,7 @@ two clocks is the union of the sets: one integer operation, where a vector of on
 robot costs a NumPy call.  Packed copies in NumPy (:attr:`Precedence.done_bits`,
 :attr:`Precedence.begin_bits`) answer many questions at once.
 
-Times: with the expected duration of every step (:mod:`cosmop.planning.timing`) and every
+Times: with the expected duration of every step (:mod:`cosmop.team.timing`) and every
 robot starting at 0, :attr:`Precedence.finish` is the earliest completion of each step and
 :attr:`Precedence.makespan` the team's.
 """

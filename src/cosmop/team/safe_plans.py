@@ -1,8 +1,8 @@
 """Team-safe plans: every place two robots' plans share is ordered by a message.
 
 :func:`make_team_safe` takes plans that are each sound alone (and the messages they already
-have), finds their conflicts (:mod:`cosmop.planning.conflicts`), orders each one by a start
-edge (:mod:`cosmop.planning.conflict_order`) -- the occupancy expected first goes first, never
+have), finds their conflicts (:mod:`cosmop.team.conflicts`), orders each one by a start
+edge (:mod:`cosmop.team.conflict_order`) -- the occupancy expected first goes first, never
 closing a cycle -- drops the edges the others imply, and turns the rest into messages
 (:mod:`cosmop.planning.messages`): the robot that must wait gets a ``Req`` right before the
 step that enters the shared place, the other a ``Res`` right after the step that leaves it.
@@ -10,7 +10,7 @@ Conflicts no order can resolve (a robot parked for good where another must pass,
 orders that would wait on each other) are returned, for the caller to re-plan one robot around
 the other's space.
 
-Expected times come from :mod:`cosmop.planning.timing`, so the orders follow what is likely to
+Expected times come from :mod:`cosmop.team.timing`, so the orders follow what is likely to
 happen first and the team's makespan stays low.
 """
 
@@ -26,9 +26,13 @@ from shapely.geometry.base import BaseGeometry
 
 from cosmop.events import Link, Node, Primitive, parse_event
 from cosmop.io import collector_paused
-from cosmop.missions.precedence import Precedence
-from cosmop.planning.conflict_order import order_conflicts
-from cosmop.planning.conflicts import (
+from cosmop.planning.messages import CUT_GRAIN, cut_drives, merge_drives, place_edges, split_drives
+from cosmop.planning.plan_types import PlanMessage, RobotPlan, State
+from cosmop.planning.realisation import message_links
+from cosmop.scene import Scene
+from cosmop.squares import swept_square
+from cosmop.team.conflict_order import order_conflicts
+from cosmop.team.conflicts import (
     Conflict,
     ConflictSettings,
     Occupancy,
@@ -38,12 +42,8 @@ from cosmop.planning.conflicts import (
     occupancies,
     ranked_detours,
 )
-from cosmop.planning.messages import CUT_GRAIN, cut_drives, merge_drives, place_edges, split_drives
-from cosmop.planning.plan_types import PlanMessage, RobotPlan, State
-from cosmop.planning.realisation import message_links
-from cosmop.planning.timing import durations, start_pose
-from cosmop.scene import Scene
-from cosmop.squares import swept_square
+from cosmop.team.precedence import Precedence
+from cosmop.team.timing import durations, start_pose
 
 __all__ = ["TeamSafety", "Wait", "make_team_safe"]
 
@@ -131,7 +131,7 @@ class TeamSafety:
         dropped).
     flipped : int
         Of those, the orders that let go first the robot the itineraries expect there later:
-        where a cycle made the search depart from time (:mod:`cosmop.planning.conflict_search`).
+        where a cycle made the search depart from time (:mod:`cosmop.team.conflict_search`).
     waits : tuple of Wait
         Every conflict message's expected wait, the longest first.
     """
@@ -155,7 +155,7 @@ class TeamSafety:
 
     def detours(self, conflict: Conflict) -> list[tuple[int, str, Occupancy]]:
         """Who can be re-planned around `conflict`, best first, each with its rank
-        (:func:`~cosmop.planning.conflicts.ranked_detours`): ``(rank, robot, what to avoid)``.
+        (:func:`~cosmop.team.conflicts.ranked_detours`): ``(rank, robot, what to avoid)``.
 
         Parameters
         ----------
@@ -173,7 +173,7 @@ def _reduce(horizons: Mapping[str, int], links: Sequence[Link], chosen: Sequence
     Such a path leaves A's step *i* by one of its other edges: its next step, a message it
     sends, or another kept edge from it.  So the edge is implied iff one of those successors
     completes before B's step *j* starts, which the vector clocks of the order with every
-    chosen edge decide (:meth:`~cosmop.missions.precedence.Precedence.before_start`).  That
+    chosen edge decide (:meth:`~cosmop.team.precedence.Precedence.before_start`).  That
     order has the same paths as the kept edges at every point, because an edge is dropped only
     when the others imply it; and no path from a successor of A's step *i* runs through the
     edge itself, since the order has no cycle (the chosen orders are deadlock-free).  The edges
@@ -247,7 +247,7 @@ def make_team_safe(
     plans : Mapping[str, RobotPlan]
         Every robot's plan, sound alone, with the messages it already has (no deadlock).
     settings : ConflictSettings, optional
-        How conflicts are found (default :class:`~cosmop.planning.conflicts.ConflictSettings`).
+        How conflicts are found (default :class:`~cosmop.team.conflicts.ConflictSettings`).
     used : set of str, optional
         Message names already taken (new ones avoid them; the set is updated).
     starts : Mapping[str, State], optional
@@ -459,7 +459,7 @@ def _entry_exit(
 ) -> tuple[float, ...]:
     """Where a square of half side `half` moving from `p` to `q` starts and stops overlapping the
     convex `region`: fractions of the way in (0, 1), rounded outwards to the cut grain; the
-    exit lies `passing` mm beyond (:attr:`~cosmop.planning.conflicts.ConflictSettings.passing`)."""
+    exit lies `passing` mm beyond (:attr:`~cosmop.team.conflicts.ConflictSettings.passing`)."""
     corners = [
         (x + dx, y + dy) for x, y in region.exterior.coords for dx in (-half, half) for dy in (-half, half)
     ]

@@ -9,7 +9,7 @@ to that spot whenever G is planned again (:attr:`cosmop.planning.specification.R
 
 A *hand-over* is a pair of events of two robots' words: a ``drop`` of O by G and a ``pick`` of
 O by R such that, in the team's order (program order and messages,
-:class:`~cosmop.missions.precedence.Precedence` over the words' events), the drop comes before
+:class:`~cosmop.team.precedence.Precedence` over the words' events), the drop comes before
 the pick and is the last drop of O by another robot before it.  Only a robot's first pick of an
 object can be a hand-over: its model of the object starts at the hand-over spot.  A robot that
 meets the same goods again after another robot has moved them would need its model changed in
@@ -18,7 +18,7 @@ the middle of its plan; such missions are refused with a reason (:attr:`Handover
 The giver must be planned before the receiver (:meth:`Handovers.turns`).  When givers and
 receivers form a cycle (R1 hands O1 to R2, which hands O2 to R1), one hand-over of the cycle
 gets a spot chosen for both before either is planned
-(:func:`cosmop.planning.aside.handover_spot`).
+(:func:`cosmop.team.aside.handover_spot`).
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 from cosmop.events import Event, Link
-from cosmop.missions.precedence import Precedence
+from cosmop.team.precedence import Precedence
 
 __all__ = ["Handover", "Handovers", "handovers"]
 

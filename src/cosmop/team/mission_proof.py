@@ -8,7 +8,7 @@ it is the sender and *waits* for it where it is the receiver.  This module
   (:func:`team_modules`): the receiver accepts the message, shared with the sender, at any
   time before the point where it waits, and cannot pass that point before it has come;
 * proves the team correct for the global mission (:func:`verify_team`): no deadlock (the
-  partial order of :mod:`cosmop.missions.precedence` has no cycle and every awaited message is
+  partial order of :mod:`cosmop.team.precedence` has no cycle and every awaited message is
   sent), every run stays a prefix of the mission, and every complete run is a complete word of
   the mission -- the last two by the compositional assume-guarantee check of
   :mod:`cosmop.missions.verification`, once against the prefix-closure and once against the
@@ -32,8 +32,8 @@ import numpy as np
 from cosmop.automata import DFA
 from cosmop.events import Link, parse_event
 from cosmop.missions.mission import GlobalMission
-from cosmop.missions.precedence import Precedence
 from cosmop.missions.verification import Verification, verify
+from cosmop.team.precedence import Precedence
 
 __all__ = ["TeamVerdict", "blocking_word", "check_words", "team_modules", "verify_team", "word_links"]
 
