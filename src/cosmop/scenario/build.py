@@ -15,18 +15,18 @@ from pathlib import Path
 from typing import Any, NoReturn
 
 from pydantic import BaseModel, ValidationError
+from pydantic_core import ErrorDetails
 
 from cosmop.errors import EventSyntaxError, InputWarning, ScenarioError
 from cosmop.events import ID_PATTERN, MESSAGE_KINDS, Event, parse_event
 from cosmop.io import read_text
-from cosmop.reading import FieldPath, Marks, format_path, load_yaml, lookup, show
+from cosmop.reading import UNPRINTABLE, FieldPath, Marks, Structure, format_path, load_yaml, lookup, show
 from cosmop.scenario.plausible import implausible, out_of_range
 from cosmop.scenario.schema import (
     EXPECTED,
     MAX_DFA_STATES,
     RANGE,
     SCENARIO_VERSION,
-    UNPRINTABLE,
     DeliveryModel,
     DfaModel,
     HumanModel,
@@ -36,8 +36,6 @@ from cosmop.scenario.schema import (
     ScenarioModel,
     SceneModel,
     WorkspaceModel,
-    expected_at,
-    model_at,
     show_points,
 )
 from cosmop.scene import (
@@ -73,6 +71,7 @@ class _Builder:
     """Validates one scenario mapping and builds the :class:`Scenario`."""
 
     MODEL: type[BaseModel] = ScenarioModel  # the structure of the file's top level
+    STRUCTURE = Structure(ScenarioModel, EXPECTED, ScenarioError)  # its fields in words
     TOP_LEVEL = "a mapping with keys name, scene, mission at the top level"
 
     def __init__(self, data: Any, file: str | None, marks: Marks | None) -> None:
@@ -132,30 +131,13 @@ class _Builder:
                 return self.marks[loc[:length]][0]
         return math.inf
 
-    def _structure_error(self, error: Mapping[str, Any]) -> NoReturn:
+    def _structure_error(self, error: ErrorDetails) -> NoReturn:
         loc: FieldPath = tuple(error["loc"])
-        kind = error["type"]
-        if kind == UNPRINTABLE:  # a name, id, state or event: the message says what and where
-            self.fail(loc[: loc.index("[key]")] if "[key]" in loc else loc, error["msg"])
-        if "[key]" in loc:
+        if "[key]" in loc and error["type"] != UNPRINTABLE:  # a mapping's key that is not text
             cut = loc.index("[key]")
-            key = loc[cut - 1]
-            self.fail(loc[: cut - 1], f"keys here must be ids (text), got {show(key)}")
-        if kind == "extra_forbidden":
-            model = model_at(loc[:-1])
-            keys = model.model_fields.items() if model is not None else ()
-            allowed = ", ".join(f.alias or name for name, f in keys) or "none"
-            self.fail(loc, f"unknown key {loc[-1]!r}; expected one of: {allowed}")
-        if kind == "missing" and isinstance(loc[-1], str):
-            path, text = expected_at(loc)
-            detail = f": expected {text}" if text is not None and path == loc else ""
-            self.fail(loc, f"missing required key {loc[-1]!r}{detail}")
-        path, text = expected_at(loc)
-        if text is None:
-            self.fail(loc, str(error["msg"]))
-        found, value = lookup(self.data, path)
-        shown = show(value) if found else "nothing"
-        self.fail(path, f"expected {text}, got {shown}")
+            self.fail(loc[: cut - 1], f"keys here must be ids (text), got {show(loc[cut - 1])}")
+        path, problem = self.STRUCTURE.problem(error, self.data)
+        self.fail(path, problem)
 
     # -- semantics ----------------------------------------------------------------------------
 
@@ -718,6 +700,7 @@ class _OrdersBuilder(_Builder):
     """Reads an order stream of its own file: the scenario's ``orders`` key, nothing else."""
 
     MODEL = OrdersFileModel
+    STRUCTURE = Structure(OrdersFileModel, EXPECTED, ScenarioError)
     TOP_LEVEL = "a mapping with the key orders at the top level"
 
 

@@ -3,14 +3,13 @@ expects, in words, for the error messages of :mod:`cosmop.scenario.build`."""
 
 from __future__ import annotations
 
-from types import NoneType, UnionType
-from typing import Annotated, Any, Literal, Union, cast, get_args, get_origin
+from typing import Annotated, Any, Literal, cast
 
 from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field, field_validator
 from pydantic_core import PydanticCustomError
 
 from cosmop.docking import SIDES
-from cosmop.reading import FieldPath, unprintable
+from cosmop.reading import UNPRINTABLE, unprintable
 from cosmop.units import SCENARIO_UNITS
 
 MAX_DFA_STATES = 2000
@@ -39,9 +38,6 @@ def _printable(value: str) -> str:
         raise PydanticCustomError(UNPRINTABLE, problem)
     return value
 
-
-UNPRINTABLE = "unprintable"
-"""The pydantic error type of text that is not printable (its message says where and why)."""
 
 _Number = Annotated[float, Field(strict=True, allow_inf_nan=False)]
 _Positive = Annotated[float, Field(strict=True, allow_inf_nan=False, gt=0)]
@@ -251,88 +247,6 @@ EXPECTED: dict[tuple[str, ...], str] = {
         "#",
     ): 'a transition [state, event, state], e.g. [q0, "pick(R1,O1)", q1]',
 }
-
-
-def _unwrap(annotation: Any) -> Any:
-    while True:
-        origin = get_origin(annotation)
-        if origin is Annotated:
-            annotation = get_args(annotation)[0]
-        elif origin in (Union, UnionType):
-            members = [arg for arg in get_args(annotation) if arg is not NoneType]
-            if len(members) != 1:
-                return annotation
-            annotation = members[0]
-        else:
-            return annotation
-
-
-def model_at(path: FieldPath) -> type[BaseModel] | None:
-    """The pydantic model describing the mapping at `path`, if that position is a model.
-
-    Parameters
-    ----------
-    path : tuple of str or int
-        A field's path in the scenario file: keys and list indices from the top level.
-
-    Returns
-    -------
-    type of pydantic.BaseModel or None
-    """
-    annotation: Any = ScenarioModel
-    for part in path:
-        annotation = _unwrap(annotation)
-        if isinstance(annotation, type) and issubclass(annotation, BaseModel):
-            if not isinstance(part, str) or part not in annotation.model_fields:  # (the keys are names)
-                return None
-            annotation = annotation.model_fields[part].annotation
-        elif get_origin(annotation) is dict:
-            annotation = get_args(annotation)[1]
-        elif get_origin(annotation) is list:
-            annotation = get_args(annotation)[0]
-        else:
-            return None
-    annotation = _unwrap(annotation)
-    return annotation if isinstance(annotation, type) and issubclass(annotation, BaseModel) else None
-
-
-def _describe_keys(model: type[BaseModel]) -> str:
-    keys = [name if info.is_required() else f"{name} (optional)" for name, info in model.model_fields.items()]
-    return "a mapping with keys " + ", ".join(keys)
-
-
-def expected_at(loc: FieldPath) -> tuple[FieldPath, str | None]:
-    """The field to report for an error at `loc`, and what is expected there.
-
-    Parameters
-    ----------
-    loc : tuple of str or int
-        Where pydantic found the error: keys and list indices from the top level.
-
-    Returns
-    -------
-    path : tuple of str or int
-        `loc` or its nearest parent whose expectation is known (`loc` itself when none is).
-    expected : str or None
-        What that field expects, in words; None when nothing is known.
-    """
-    for length in range(len(loc), -1, -1):
-        prefix = loc[:length]
-        for pattern, text in EXPECTED.items():
-            if len(pattern) == length and all(
-                _matches(p, part) for p, part in zip(pattern, prefix, strict=True)
-            ):
-                return prefix, text
-        model = model_at(prefix)
-        if model is not None:
-            return prefix, _describe_keys(model)
-    return loc, None
-
-
-def _matches(pattern: str, part: str | int) -> bool:
-    if pattern == "#":
-        return isinstance(part, int)
-    return pattern == "*" or pattern == part
 
 
 def show_points(*points: Point) -> str:
