@@ -6,6 +6,7 @@ import json
 import types
 from pathlib import Path
 
+import pytest
 from typer.testing import CliRunner
 
 from cosmop.cli import app
@@ -69,3 +70,31 @@ def test_plan_verdict_in_words():
     assert text.startswith("Every robot has a safe plan; 1 hand-over")
     assert "no robot can wait forever" in text and "do exactly the team mission (proven)" in text
     assert "could not prove" in plan_verdict(plans, types.SimpleNamespace(holds=False))
+
+
+@pytest.mark.parametrize(
+    "command", ["validate", "decompose", "check", "plan", "simulate", "run", "import-map", "export", "view"]
+)
+def test_help_is_prose_for_the_user_not_the_docstrings_sections(command):
+    result = CliRunner().invoke(app, [command, "--help"], env={"COLUMNS": "100"})
+    assert result.exit_code == 0
+    assert "Usage: cosmop" in result.output
+    assert "----------" not in result.output  # no numpydoc section heading
+    assert "``" not in result.output  # no reStructuredText literal marks
+    assert "Options" in result.output
+
+
+def test_command_help_cuts_the_sections_and_joins_each_paragraph():
+    from cosmop.cli._app import command_help
+
+    doc = """Do it.
+
+        First line
+        of a paragraph with ``code``.
+
+        Parameters
+        ----------
+        x : int
+            The x.
+        """
+    assert command_help(doc) == "Do it.\n\nFirst line of a paragraph with code."

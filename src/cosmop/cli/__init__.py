@@ -16,7 +16,7 @@ to the library; input errors need no handling there.
 """
 
 from cosmop.cli import decompose, ecosystem, plan, run, simulate, validate
-from cosmop.cli._app import EXIT_INPUT_ERROR, app
+from cosmop.cli._app import EXIT_INPUT_ERROR, app, command_help
 
 __all__ = ["EXIT_INPUT_ERROR", "app", "main"]
 
@@ -32,7 +32,7 @@ for _name, _command in (
     ("export", ecosystem.export),
     ("view", ecosystem.view),
 ):
-    app.command(_name)(_command)
+    app.command(_name, help=command_help(_command.__doc__))(_command)
 
 
 def main() -> None:

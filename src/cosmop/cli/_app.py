@@ -8,6 +8,7 @@ status 2; Ctrl-C is the program's (:mod:`cosmop._entry`).  Commands load their s
 
 from __future__ import annotations
 
+import inspect
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any, NoReturn, cast
@@ -150,3 +151,32 @@ ScenarioArgument = Annotated[
 def stderr() -> Console:
     """A console on the current standard error, for progress bars and spinners."""
     return Console(file=sys.stderr, highlight=False)
+
+
+def command_help(doc: str | None) -> str:
+    """A command's help for ``--help``, from its docstring: the prose before the numpydoc
+    sections, each paragraph on one line (the terminal wraps it), literals without their marks.
+
+    The docstring's ``Parameters`` section documents the function for readers of the code; the
+    user reads the same thing, in plain words, beside each option.
+
+    Parameters
+    ----------
+    doc : str or None
+        The command function's docstring.
+
+    Returns
+    -------
+    str
+        Paragraphs separated by blank lines.
+    """
+    lines = inspect.cleandoc(doc or "").splitlines()
+    for at in range(len(lines) - 1):
+        if lines[at].strip() in _SECTIONS and set(lines[at + 1].strip()) == {"-"}:
+            lines = lines[:at]
+            break
+    paragraphs = "\n".join(lines).strip().split("\n\n")
+    return "\n\n".join(" ".join(p.split()).replace("``", "") for p in paragraphs)
+
+
+_SECTIONS = {"Parameters", "Returns", "Raises", "Notes", "Examples", "See Also"}
