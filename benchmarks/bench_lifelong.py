@@ -62,6 +62,9 @@ def cosmop_row(data: dict, until: float, timeout: float) -> dict:
         "wait_s": s["wait_s"],
         "contacts_while_moving": s["contacts_while_moving"],
         "messages": s["messages"],
+        "handover_wall_s": s.get("handover_wall_s"),
+        "handovers_refused": sum(1 for e in s["dispatch_log"] if not e["accepted"]),
+        "utilisation_mean": round(sum(s["utilisation"].values()) / max(len(s["utilisation"]), 1), 3),
     }
 
 

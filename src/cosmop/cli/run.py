@@ -201,9 +201,16 @@ def _verdict(result: FleetResult) -> str:
         else "no order delivered"
     )
     pending = result.released - result.delivered - result.lost
+    handing = result.handover_wall_s()
+    handovers = (
+        f"; a hand-over took {handing['p50']:.2f} s of wall time (median, p95 {handing['p95']:.2f} s)"
+        if handing["p50"] is not None
+        else ""
+    )
     return (
         f"{result.delivered} of {result.released} orders delivered "
         f"({result.deliveries_per_hour:.1f} per hour; "
         f"{pending} pending, {result.lost} lost); {waits}; contacts {len(result.contacts)}, while moving "
         f"{result.contacts_while_moving}; messages {len(result.messages)}; replans {result.replans}"
+        f"{handovers}"
     )

@@ -4,7 +4,9 @@
 cycle (:func:`cosmop.sim.simulation.advance`), and between cycles it
 
 1. releases the orders whose time has come into a pool (:mod:`.dispatch`);
-2. every ``dispatch_every`` seconds gives pooled orders to idle robots: the robot's next
+2. every ``dispatch_every`` seconds gives pooled orders to idle robots, and gives a robot that
+   has just dropped its goods the oldest pooled order it may serve at once, from the dock
+   (so that it goes home only when no work waits): the robot's next
    mission (pick, drop, home) is planned from where it stands, with the robots that stand
    (idle or failed) as obstacles (:func:`cosmop.sim.replan.replan`, every plan passing the
    exact checker), then ordered against the plans the others have committed to, by the same
@@ -26,6 +28,7 @@ from __future__ import annotations
 
 import math
 import re
+import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -205,19 +208,25 @@ def run_fleet(
     )
 
 
-def _dispatch(run: _Run) -> None:
-    """Hand pooled orders, oldest first, to idle robots (module docstring, step 2)."""
+def _dispatch(run: _Run, at_dock: Agent | None = None) -> None:
+    """Hand pooled orders, oldest first, to idle robots (module docstring, step 2).
+
+    `at_dock`, a robot that has just dropped its goods, competes with the idle robots for the
+    orders: if it is given one, the way home left in its plan is replaced by that order (whose
+    mission ends at home again, for when no more work waits); if not, it goes home.
+    """
     world = run.world
     idle = {a.id: a for a in world.agents if a.done and a.id not in run.busy and a.id not in run.failed}
+    if at_dock is not None:
+        idle[at_dock.id] = at_dock
     for state in list(run.pool):
         if not idle:
             return
         if state.retry_at > world.t:
             continue
-        j = world.object_ids.index(state.order.object)
-        if world.carried_by[j] >= 0 or world.shipped[j]:
-            continue  # another order's robot has these goods: wait for them to rest again
-        goods = tuple(float(v) for v in world.object_xy[j])
+        goods = _goods_at_rest(world, state)
+        if goods is None:
+            continue
         robot = choose_robot(
             world.scenario.scene,
             state.order,
@@ -230,10 +239,19 @@ def _dispatch(run: _Run) -> None:
             del idle[robot]
 
 
+def _goods_at_rest(world: World, state: OrderState) -> tuple[float, ...] | None:
+    """Where the order's goods lie, or None while a robot carries them or they are shipped."""
+    j = world.object_ids.index(state.order.object)
+    if world.carried_by[j] >= 0 or world.shipped[j]:
+        return None  # another order's robot has these goods: wait for them to rest again
+    return tuple(float(v) for v in world.object_xy[j])
+
+
 def _hand_over(run: _Run, agent: Agent, state: OrderState, goods: tuple[float, ...]) -> bool:
     """Plan `agent`'s mission for `state`'s order, order it with the others' and hand it over."""
     world, fleet = run.world, run.fleet
     scene = world.scenario.scene
+    began = time.perf_counter()  # the hand-over's wall time: dispatch, plan, coordinate, check
     events = delivery_events(scene, agent.id, state.order, goods)
     start = start_state(world, agent, {state.order.object})
     plan = replan(
@@ -255,6 +273,7 @@ def _hand_over(run: _Run, agent: Agent, state: OrderState, goods: tuple[float, .
             "robot": agent.id,
             "accepted": accepted,
             "why": why or None,
+            "wall_s": round(time.perf_counter() - began, 3),
         }
     )
     if not accepted:
@@ -267,7 +286,7 @@ def _hand_over(run: _Run, agent: Agent, state: OrderState, goods: tuple[float, .
     state.robot, state.served_by, state.assigned = agent.id, agent.id, world.t
     run.pool.remove(state)
     run.busy[agent.id] = state
-    run.busy_since[agent.id] = world.t
+    run.busy_since.setdefault(agent.id, world.t)  # a robot given work at a dock stays busy
     return True
 
 
@@ -302,6 +321,9 @@ def _deliveries(run: _Run) -> None:
             state.delivered = t
             run.delivered += 1
             world.ship(event.obj)
+            state.robot = None
+            if robot not in run.failed and run.pool:
+                _dispatch(run, at_dock=next(a for a in world.agents if a.id == robot))
     run.seen_events = len(world.events)
 
 

@@ -104,7 +104,8 @@ class FleetResult:
         Per failed robot: when (``t``), where it stands (``at``), what it carries, and whether
         the others could be ordered around it (``recoordinated``).
     dispatch_log : tuple of Mapping
-        Every hand-over tried: ``t``, ``order``, ``robot``, ``accepted``, ``why`` not.
+        Every hand-over tried: ``t``, ``order``, ``robot``, ``accepted``, ``why`` not, and
+        ``wall_s``, the wall time it took (plan, coordinate, check), s.
     contacts : tuple of Contact
     messages : tuple of Message
     replans : int
@@ -217,11 +218,12 @@ class FleetResult:
 
     def wait_s(self) -> dict[str, float | None]:
         """Release to delivery of the delivered orders, s: median, 95th percentile, maximum."""
-        waits = np.array([o.wait for o in self.orders if o.wait is not None])
-        if not len(waits):
-            return {"p50": None, "p95": None, "max": None}
-        p50, p95 = np.percentile(waits, [50, 95])
-        return {"p50": round(float(p50), 3), "p95": round(float(p95), 3), "max": round(float(waits.max()), 3)}
+        return _spread([o.wait for o in self.orders if o.wait is not None])
+
+    def handover_wall_s(self) -> dict[str, float | None]:
+        """Wall time of the hand-overs tried (plan, coordinate, check), s: median, 95th
+        percentile, maximum.  The only figures of the result that depend on the machine."""
+        return _spread([e["wall_s"] for e in self.dispatch_log if e.get("wall_s") is not None])
 
     def summary(self) -> dict[str, Any]:
         """The ``cosmop.run/1`` summary (what ``cosmop run --summary`` writes)."""
@@ -238,6 +240,7 @@ class FleetResult:
             },
             "deliveries_per_hour": round(self.deliveries_per_hour, 3),
             "wait_s": self.wait_s(),
+            "handover_wall_s": self.handover_wall_s(),
             "utilisation": dict(self.utilisation),
             "failures": {rid: dict(f) for rid, f in self.failures.items()},
             "contacts": len(self.contacts),
@@ -305,3 +308,11 @@ class FleetResult:
         buffer = io.BytesIO()
         self.plot().savefig(buffer, format="png")
         write_atomic(path, buffer.getvalue())
+
+
+def _spread(values: Sequence[float]) -> dict[str, float | None]:
+    """Median, 95th percentile and maximum of `values` (None for each when there are none)."""
+    if not values:
+        return {"p50": None, "p95": None, "max": None}
+    p50, p95 = np.percentile(values, [50, 95])
+    return {"p50": round(float(p50), 3), "p95": round(float(p95), 3), "max": round(float(max(values)), 3)}
