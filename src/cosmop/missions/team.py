@@ -30,7 +30,7 @@ from typing import TypeAlias
 import numpy as np
 
 from cosmop.automata import DFA
-from cosmop.events import Link, parse_event
+from cosmop.events import Event, Link, parse_event
 from cosmop.missions.mission import GlobalMission
 from cosmop.missions.precedence import Precedence
 from cosmop.missions.verification import Verification, verify
@@ -46,21 +46,20 @@ def word_links(words: Mapping[str, Sequence[str]]) -> list[Link]:
     words : mapping of str to sequence of str
         Every robot's word (event names), messages included.
     """
-    sends: dict[str, tuple[str, int]] = {}
-    waits: dict[str, tuple[str, int]] = {}
+    sends: dict[Event, tuple[str, int]] = {}
+    waits: dict[Event, tuple[str, int]] = {}
     for robot, word in words.items():
         for k, name in enumerate(word, 1):
-            event = parse_event(name)
+            event = parse_event(name)  # the words are the automata's letters: text
             if event.is_message:
-                (sends if robot == event.sender else waits).setdefault(name, (robot, k))
+                (sends if robot == event.sender else waits).setdefault(event, (robot, k))
     out = []
-    for name in sorted(set(sends) | set(waits)):
-        event = parse_event(name)
+    for event in sorted(set(sends) | set(waits), key=lambda e: e.name):
         assert event.sender is not None and event.receiver is not None  # a message names both
-        send = sends.get(name)
-        wait = waits.get(name)
+        send = sends.get(event)
+        wait = waits.get(event)
         out.append(
-            Link(name, event.sender, send[1] if send else None, event.receiver, wait[1] if wait else None)
+            Link(event, event.sender, send[1] if send else None, event.receiver, wait[1] if wait else None)
         )
     return out
 

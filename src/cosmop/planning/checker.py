@@ -62,7 +62,7 @@ from shapely.geometry.base import BaseGeometry
 
 from cosmop.docking import DOCKING_HEADINGS, docking_pose, in_front
 from cosmop.errors import EventSyntaxError
-from cosmop.events import Event, Primitive, parse_event, realising_step
+from cosmop.events import Event, Primitive, realising_step
 from cosmop.planning.joint import check_team
 from cosmop.planning.plan_types import PlanSet, RobotPlan, State, Step
 from cosmop.planning.primitive_effects import initial_state
@@ -518,7 +518,7 @@ class _RobotChecker:
         self.flags_static(k, prev, cur, "carried")
         self.flags_static(k, prev, cur, "away")
         assert step.message is not None  # (transition sends only steps with a message here)
-        event = parse_event(step.message)
+        event = step.message
         role, robot = (
             ("receiver", event.receiver) if step.primitive == Primitive.REQ else ("sender", event.sender)
         )
@@ -526,7 +526,7 @@ class _RobotChecker:
             self.add(
                 k,
                 "message",
-                f"{step.message} is {'awaited' if role == 'receiver' else 'sent'} by its {role} {robot}, "
+                f"{event.name} is {'awaited' if role == 'receiver' else 'sent'} by its {role} {robot}, "
                 f"not by {self.robot_id}",
             )
 
@@ -534,12 +534,7 @@ class _RobotChecker:
 
     def mission(self) -> None:
         events: list[Event] = []
-        for name in self.plan.mission:
-            try:
-                event = parse_event(name)
-            except EventSyntaxError as err:  # only for plans built around the constructor
-                self.add(None, "mission", str(err))
-                return
+        for event in self.plan.mission:
             if self.robot_id not in event.owners:
                 self.add(
                     None,
@@ -574,8 +569,8 @@ class _RobotChecker:
             return f"DropOff({event.obj}) that leaves {event.obj} in {event.workspace}"
         realised = realising_step(event, self.robot_id)
         assert realised is not None  # an away or msg here (a return is never asked): it has a step
-        primitive, obj, name = realised
-        return f"{primitive}({obj or name})"
+        primitive, obj, sent = realised
+        return f"{primitive}({obj or (sent.name if sent is not None else None)})"
 
     def unmatched(self, event: Event, n: int, total: int, last: int | None, events: list[Event]) -> str:
         after = "anywhere in the plan" if last is None else f"after instant {last} ({events[n - 2].name})"
@@ -796,8 +791,8 @@ def _check_tasks(
                     robot_id,
                     None,
                     "mission",
-                    f"{robot_id}: the plan's mission ({', '.join(plan.mission) or 'empty'}) does not contain "
-                    f"the scenario's tasks ({tasks}) in order; {task.name} is missing",
+                    f"{robot_id}: the plan's mission ({', '.join(e.name for e in plan.mission) or 'empty'}) "
+                    f"does not contain the scenario's tasks ({tasks}) in order; {task.name} is missing",
                 )
             ]
         matched.add(position)
@@ -858,7 +853,7 @@ def _check_coordination(plan: PlanSet) -> list[Violation]:
                             f"but the plan has no plan for {robot_id}",
                         )
                     )
-            elif event.name not in planned.mission:
+            elif event not in planned.mission:
                 primitive = Primitive.REQ if role == "requester" else Primitive.RES
                 violations.append(
                     Violation(

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 
-from cosmop.events import Link, parse_event
+from cosmop.events import Link
 from cosmop.missions.mission import GlobalMission
 from cosmop.missions.precedence import Precedence
 from cosmop.missions.team import check_words
@@ -48,7 +48,7 @@ def _messages(plan: PlanSet, plans: Mapping[str, RobotPlan]) -> list[Violation]:
                     link.receiver,
                     link.wait,
                     "message",
-                    f"{link.receiver} waits at instant {link.wait} for {link.event}, which "
+                    f"{link.receiver} waits at instant {link.wait} for {link.event.name}, which "
                     f"{link.sender}'s plan never sends: the robot would wait forever",
                 )
             )
@@ -58,7 +58,7 @@ def _messages(plan: PlanSet, plans: Mapping[str, RobotPlan]) -> list[Violation]:
                     link.sender,
                     link.send,
                     "message",
-                    f"{link.sender} sends {link.event} at instant {link.send}, but "
+                    f"{link.sender} sends {link.event.name} at instant {link.send}, but "
                     f"{link.receiver}'s plan never waits for it",
                 )
             )
@@ -83,19 +83,19 @@ def _messages(plan: PlanSet, plans: Mapping[str, RobotPlan]) -> list[Violation]:
                 "is one too many",
             )
         )
-    for robot, instant, name, first in repeated_messages(plans):
-        does = "sends" if parse_event(name).sender == robot else "awaits"
+    for robot, instant, event, first in repeated_messages(plans):
+        does = "sends" if event.sender == robot else "awaits"
         out.append(
             _violation(
                 robot,
                 instant,
                 "message",
-                f"{robot} {does} {name} again at instant {instant} (first at instant {first}); every message "
-                "is sent once and awaited once",
+                f"{robot} {does} {event.name} again at instant {instant} (first at instant {first}); "
+                "every message is sent once and awaited once",
             )
         )
-    used = {link.event for link in links if link.event.startswith("msg(")}
-    listed = {m.event for m in plan.messages}
+    used = {link.event.name for link in links if link.event.kind == "msg"}
+    listed = {m.event.name for m in plan.messages}
     for name in sorted(used - listed):
         out.append(_violation(None, None, "message", f"the plans use {name}, but the messages list lacks it"))
     for name in sorted(listed - used):
@@ -148,7 +148,8 @@ def check_team(
                     f"{conflict.describe()}, and no message orders them: the robots may meet there",
                 )
             )
-    words = {r: plans[r].mission if r in plans else () for r in scene.robots}
+    # the mission's automaton reads letters: the events' names
+    words = {r: tuple(e.name for e in plans[r].mission) if r in plans else () for r in scene.robots}
     verdict = check_words(GlobalMission.from_scenario(scenario), words)
     if not verdict.holds:
         violations.append(_violation(None, None, "mission", f"{verdict.reason()}"))
@@ -172,7 +173,7 @@ def _itinerary(plan: PlanSet, links: Sequence[Link]) -> list[Violation]:
                     link.receiver,
                     link.wait,
                     "itinerary",
-                    f"the itinerary has {link.receiver} stop waiting for {link.event} at {waited:g} s "
+                    f"the itinerary has {link.receiver} stop waiting for {link.event.name} at {waited:g} s "
                     f"(instant {link.wait}), but {link.sender} sends it at {sent:g} s (instant {link.send})",
                 )
             )

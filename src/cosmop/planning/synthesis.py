@@ -149,7 +149,7 @@ def _plan(
                 objects,
             )
         )
-    return RobotPlan.from_steps([e.name for e in word], steps), tuple(requested)
+    return RobotPlan.from_steps(word, steps), tuple(requested)
 
 
 def _count_requests(p: RobotProblem, unrolling: Unrolling | IncrementalUnrolling) -> z3.ArithRef:
