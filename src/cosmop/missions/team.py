@@ -35,7 +35,15 @@ from cosmop.missions.mission import GlobalMission
 from cosmop.missions.precedence import Precedence
 from cosmop.missions.verification import Verification, verify
 
-__all__ = ["TeamVerdict", "blocking_word", "check_words", "team_modules", "verify_team", "word_links"]
+__all__ = [
+    "TeamVerdict",
+    "blocking_word",
+    "check_words",
+    "stuck_waits",
+    "team_modules",
+    "verify_team",
+    "word_links",
+]
 
 
 def word_links(words: Mapping[str, Sequence[str]]) -> list[Link]:
@@ -169,6 +177,18 @@ def blocking_word(words: Mapping[str, Sequence[str]]) -> tuple[str, ...] | None:
     done = [words[r][k - 1] for r, k in precedence.order]
     waiting = [f"[{r} waits for {words[r][k - 1]}]" for r, k in precedence.stuck.items()]
     return tuple(done + waiting)
+
+
+def stuck_waits(words: Mapping[str, Sequence[str]]) -> dict[str, int]:
+    """Where the robots stuck in the team's deadlock wait: ``{robot: instant}`` (1-based, the
+    waits :func:`blocking_word` ends with, in its order); empty if the words cannot block.
+
+    Parameters
+    ----------
+    words : mapping of str to sequence of str
+        Every robot's word (event names), messages included.
+    """
+    return dict(Precedence({r: len(w) for r, w in words.items()}, word_links(words)).stuck)
 
 
 def verify_team(

@@ -222,8 +222,8 @@ class World:
             events = plan.events if plan is not None else ()
             self.agents.append(Agent(rid, i, steps, events))
         self.sent_messages: set[Event] = set()  # the message events sent so far
-        self.events: list[tuple[float, str, str]] = [  # (t, robot, event) as the robots do them
-            (0.0, a.id, f"return({a.id})")
+        self.events: list[tuple[float, str, Event]] = [  # (t, robot, event) as the robots do them
+            (0.0, a.id, Event("return", a.id))
             for a in self.agents
             if a.done and any(e.kind == "return" for e in a.mission)
         ]
@@ -566,7 +566,7 @@ class World:
         assert event.receiver is not None  # a message event
         self.messages.append(Message(round(self.t, 6), agent.id, event.receiver, event.obj, event.name))
         self.sent_messages.add(event)
-        self.events.append((round(self.t, 6), agent.id, event.name))
+        self.events.append((round(self.t, 6), agent.id, event))
 
     def awaited(self, agent: Agent, step: Step) -> Event | None:
         """The message a ``Req`` step waits for: its ``msg``, or the first ``away`` request about
@@ -618,7 +618,7 @@ class World:
         step : Step
             The step it finished.
         """
-        done = {name for _, robot, name in self.events if robot == agent.id}
+        done = {event for _, robot, event in self.events if robot == agent.id}
         realised = (step.primitive, step.object, step.message)
         wanted = [
             e
@@ -627,14 +627,14 @@ class World:
             and realising_step(e, agent.id) == realised
             and self._happened(e)
         ]
-        event = next((e for e in wanted if e.name not in done), None)
+        event = next((e for e in wanted if e not in done), None)
         if event is not None:
-            self.events.append((round(self.t, 6), agent.id, event.name))
-            done.add(event.name)
+            self.events.append((round(self.t, 6), agent.id, event))
+            done.add(event)
         # ``return`` holds as soon as the robot is home with the events before it done (as in
         # the plan: messages it sends from home come after it)
-        pending = next((e for e in agent.mission if e.name not in done), None)
+        pending = next((e for e in agent.mission if e not in done), None)
         if pending is not None and pending.kind == "return":
             home = self.scenario.scene.robots[agent.id].pose
             if math.dist(self.pose[agent.index, :2], home[:2]) <= self.settings.goal_tolerance + 1e-6:
-                self.events.append((round(self.t, 6), agent.id, pending.name))
+                self.events.append((round(self.t, 6), agent.id, pending))
