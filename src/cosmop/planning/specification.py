@@ -255,7 +255,7 @@ class ObstacleKey:
         if (self.wall is None) == (self.obj is None):
             raise ValueError("an obstacle is a wall or an object: give exactly one of them")
         if self.handling and (self.wall is None or self.past_ends):
-            raise ValueError("only a wall to drives or an object has a part for picks and drops")
+            raise ValueError("only a wall has parts for picks and drops, and they have no stronger one")
 
     @property
     def text(self) -> str:
