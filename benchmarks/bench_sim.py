@@ -25,6 +25,7 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
+from cosmop.events import Event  # noqa: E402
 from cosmop.planning import PlanSet, plan_from_actions  # noqa: E402
 from cosmop.scenario import load_scenario, parse_scenario  # noqa: E402
 from cosmop.sim import SimSettings, simulate  # noqa: E402
@@ -60,7 +61,7 @@ def bay_drives(n: int):
     for rid, robot in scenario.scene.robots.items():
         x, y, _ = robot.pose
         actions = [("GoTo", (x + 6000 - 1000 * (x % 2000 > 0), y, 0)), ("GoTo", (x, y, 0))]
-        robots[rid] = plan_from_actions(scenario.scene, rid, [f"return({rid})"], actions)
+        robots[rid] = plan_from_actions(scenario.scene, rid, [Event("return", rid)], actions)
     return scenario, PlanSet(scenario.name, True, robots)
 
 

@@ -13,6 +13,7 @@ from typer.testing import CliRunner
 
 from cosmop.automata import DFA
 from cosmop.cli import app
+from cosmop.events import parse_event
 from cosmop.missions.allocation import Alternative, Alternatives, alternatives, choose
 from cosmop.missions.mission import GlobalMission
 from cosmop.planning.synthesis import synthesize
@@ -159,7 +160,7 @@ def test_a_choice_of_dock_is_planned():
         w: synthesize(scenario.scene, "R1", [e.format(w) for e in word], unrequestable=nobody).horizon
         for w in ("W1", "W2")
     }
-    (chosen,) = [w for w in alone if f"drop(R1,O1,{w})" in team.plans.robots["R1"].mission]
+    (chosen,) = [w for w in alone if parse_event(f"drop(R1,O1,{w})") in team.plans.robots["R1"].mission]
     assert team.allocation.makespan == alone[chosen] == min(alone.values())
 
 

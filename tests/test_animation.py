@@ -20,6 +20,7 @@ import pytest
 pytest.importorskip("matplotlib")
 from PIL import Image  # matplotlib (hence Pillow) is installed
 
+from cosmop.events import parse_event
 from cosmop.planning import PlanSet, plan_from_actions
 from cosmop.scenario import parse_scenario
 from cosmop.viz import animation as animation_module
@@ -101,7 +102,7 @@ def make_plans() -> PlanSet:
     r1 = plan_from_actions(
         SCENE,
         "R1",
-        ["pick(R1,O1)", "drop(R1,O1,W1)", "return(R1)"],
+        [parse_event("pick(R1,O1)"), parse_event("drop(R1,O1,W1)"), parse_event("return(R1)")],
         [
             ("GoTo", (1750, -1000, 0)),
             ("PickUp", "O1"),

@@ -16,6 +16,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from shapely.geometry import LineString, box
 
+from cosmop.events import parse_event
 from cosmop.planning import (
     RULES,
     CheckReport,
@@ -50,12 +51,17 @@ from handmade_plans import (  # noqa: E402 - the shared hand-made plans
 )
 
 
+def _events(mission) -> list:
+    """The mission as events (the tests write some events as text)."""
+    return [parse_event(e) if isinstance(e, str) else e for e in mission]
+
+
 def r1_plan(actions=R1_ACTIONS, mission=R1_MISSION) -> RobotPlan:
-    return plan_from_actions(SCENE, "R1", mission, actions)
+    return plan_from_actions(SCENE, "R1", _events(mission), actions)
 
 
 def r2_plan(actions=R2_ACTIONS, mission=R2_MISSION) -> RobotPlan:
-    return plan_from_actions(SCENE, "R2", mission, actions)
+    return plan_from_actions(SCENE, "R2", _events(mission), actions)
 
 
 def coordinated() -> PlanSet:
@@ -166,7 +172,7 @@ def test_a_request_nobody_answers_is_a_violation() -> None:
     plans = coordinated()
     safe = make_team_safe(SCENE, plans.robots)
     robots = {
-        r: dataclasses.replace(p, mission=tuple(e for e in p.mission if not e.startswith("away(")))
+        r: dataclasses.replace(p, mission=tuple(e for e in p.mission if e.kind != "away"))
         for r, p in safe.plans.items()
     }
     r1 = robots["R1"]
@@ -182,7 +188,7 @@ def test_messages_that_wait_on_each_other_deadlock() -> None:
     # R1 waits for R2's message before sending its own, R2 waits for R1's first: nobody moves
     r1 = plans_with_messages("R1", [("Req", "msg(R2,R1,a)"), ("Res", "msg(R1,R2,b)")])
     r2 = plans_with_messages("R2", [("Req", "msg(R1,R2,b)"), ("Res", "msg(R2,R1,a)")])
-    messages = (PlanMessage("msg(R2,R1,a)", "order", "test"), PlanMessage("msg(R1,R2,b)", "order", "test"))
+    messages = tuple(PlanMessage(parse_event(m), "order", "test") for m in ("msg(R2,R1,a)", "msg(R1,R2,b)"))
     scenario = parse_scenario(
         {
             "name": "two",
@@ -203,13 +209,13 @@ def test_messages_that_wait_on_each_other_deadlock() -> None:
 
 def plans_with_messages(robot: str, steps) -> RobotPlan:
     pose = (0, 0, 0) if robot == "R1" else (2000, 0, 0)
-    made = [Step(p, None, pose, {}, m) for p, m in steps]
-    return RobotPlan.from_steps([m for _, m in steps], made)
+    made = [Step(p, None, pose, {}, parse_event(m)) for p, m in steps]
+    return RobotPlan.from_steps([parse_event(m) for _, m in steps], made)
 
 
 def test_instant_zero_is_the_scenario() -> None:
     # a return at instant 0 is realised by the initial pose itself
-    plan = plan_from_actions(SCENE, "R1", ["return(R1)"], [])
+    plan = plan_from_actions(SCENE, "R1", [parse_event("return(R1)")], [])
     assert check_robot_plan(SCENE, "R1", plan) == []
 
 
@@ -456,7 +462,7 @@ def test_dropping_at_a_point_workspace() -> None:
         "mission": {"tasks": {"R1": ["pick O1", "drop O1 at W1"]}},
     }
     scenario = parse_scenario(data)
-    mission = ["pick(R1,O1)", "drop(R1,O1,W1)"]
+    mission = [parse_event("pick(R1,O1)"), parse_event("drop(R1,O1,W1)")]
     good = plan_from_actions(
         scenario.scene,
         "R1",
@@ -487,7 +493,9 @@ def test_picking_through_a_wall() -> None:
         "mission": {"tasks": {"R1": ["pick O1"]}},
     }
     scene = parse_scenario(data).scene
-    plan = plan_from_actions(scene, "R1", ["pick(R1,O1)"], [("GoTo", (1000, 0, 0)), ("PickUp", "O1")])
+    plan = plan_from_actions(
+        scene, "R1", [parse_event("pick(R1,O1)")], [("GoTo", (1000, 0, 0)), ("PickUp", "O1")]
+    )
     v = only(check_robot_plan(scene, "R1", plan), "wall", 2)
     assert v.message == (
         "R1 at instant 2, PickUp(O1): the robot at (1000, 0) and O1 at (1250, 0) are on the two sides of "
@@ -683,7 +691,9 @@ def test_plan_mission_must_contain_the_tasks() -> None:
 
 
 def test_plan_mission_may_add_only_away_events() -> None:
-    extra = r2_plan([*R2_ACTIONS, ("GoTo", (1650, -1000, 0)), ("PickUp", "O1")], [*R2_MISSION, "pick(R2,O1)"])
+    extra = r2_plan(
+        [*R2_ACTIONS, ("GoTo", (1650, -1000, 0)), ("PickUp", "O1")], [*R2_MISSION, parse_event("pick(R2,O1)")]
+    )
     plans = PlanSet("warehouse-2x2", True, {"R1": r1_plan(), "R2": extra}, (Coordination("O2", "R1", "R2"),))
     violations = [v for v in check_plan(SCENARIO, plans).violations if v.rule == "mission"]
     assert len(violations) == 1

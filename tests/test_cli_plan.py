@@ -29,8 +29,8 @@ def test_plan_writes_a_checked_plan_and_a_png(tmp_path):
     # then the messages that keep the two robots apart
     assert plans.feasible and plans.messages
     assert [(c.object, c.requester, c.responder) for c in plans.coordination] == [("O2", "R1", "R2")]
-    assert plans.robots["R1"].mission[0] == "away(O2,R1,R2)"
-    assert plans.robots["R2"].mission[:2] == ("pick(R2,O2)", "away(O2,R1,R2)")
+    assert plans.robots["R1"].mission[0].name == "away(O2,R1,R2)"
+    assert [e.name for e in plans.robots["R2"].mission[:2]] == ["pick(R2,O2)", "away(O2,R1,R2)"]
     rows = {line.split("│")[1].strip(): line for line in result.stdout.splitlines() if line.count("│") > 5}
     assert "│ 7 " in rows["R1"] and "│ 7 " in rows["R2"]  # the shortest plans have 7 steps
     assert "Res(O2)" in [s.label for s in plans.robots["R2"].steps]

@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 import shapely
 
-from cosmop.events import Link
+from cosmop.events import Link, message
 from cosmop.team import conflict_order
 from cosmop.team.conflict_order import _Dominance, _Schedule, order_conflicts
 from cosmop.team.conflict_search import CorrectionSetPicker, Search, backjump, possible_orientations
@@ -223,7 +223,11 @@ def test_the_messages_kept_are_exactly_the_orders_the_others_do_not_imply(seed):
     rng = random.Random(seed)
     robots = [f"R{i}" for i in range(rng.randint(2, 5))]
     horizons = {r: rng.randint(2, 8) for r in robots}
-    links = [Link("m", robots[0], 1, robots[1], horizons[robots[1]])] if seed % 2 else []
+    links = (
+        [Link(message(robots[0], robots[1], "m"), robots[0], 1, robots[1], horizons[robots[1]])]
+        if seed % 2
+        else []
+    )
     chosen = []
     for _ in range(rng.randint(3, 25)):
         a, b = rng.sample(robots, 2)
@@ -246,7 +250,7 @@ def test_of_two_equal_orders_the_first_is_kept():
     chosen = [(edge, "first"), (other, "other"), (edge, "second")]
     assert _reduce(horizons, [], chosen) == [(edge, "first"), (other, "other")]
     # and one implied through the other robot's plan and a message goes
-    links = [Link("m", "A", 1, "C", 1)]
+    links = [Link(message("A", "C", "m"), "A", 1, "C", 1)]
     assert _reduce(horizons, links, [(other, "x"), ((("A", 1), ("B", 4)), "implied")]) == [(other, "x")]
 
 
@@ -306,7 +310,7 @@ def test_start_edges_added_in_batches_give_the_order_of_one_at_a_time(seed):
     links = []
     for n in range(4):
         a, b = rng.sample(sorted(horizons), 2)
-        link = Link(f"m{n}", a, rng.randint(1, horizons[a]), b, rng.randint(1, horizons[b]))
+        link = Link(message(a, b, f"m{n}"), a, rng.randint(1, horizons[a]), b, rng.randint(1, horizons[b]))
         if Precedence(horizons, [*links, link], (), durations).complete:
             links.append(link)
     built, one_by_one = (Precedence(horizons, links, (), durations) for _ in range(2))
@@ -424,7 +428,7 @@ def test_start_edges_taken_back_from_the_middle_leave_the_order_of_the_rest(seed
     rng = random.Random(seed)
     horizons = {f"R{i}": rng.randint(2, 7) for i in range(1, 6)}
     durations = {r: [rng.uniform(0.5, 4.0) for _ in range(k)] for r, k in horizons.items()}
-    links = [Link("m", "R1", 1, "R2", 2)]
+    links = [Link(message("R1", "R2", "m"), "R1", 1, "R2", 2)]
     order = Precedence(horizons, links, (), durations)
 
     def batch() -> tuple[list, list]:
@@ -488,7 +492,7 @@ def test_the_order_stays_topological_and_answers_in_bulk_as_one_step_at_a_time(s
     # take-back), and its packed tables say what `precedes`, `before_start` and `completed` say
     rng = random.Random(seed)
     horizons = {f"R{i}": rng.randint(2, 7) for i in range(1, 6)}
-    order = Precedence(horizons, [Link("m", "R1", 1, "R2", 2)])
+    order = Precedence(horizons, [Link(message("R1", "R2", "m"), "R1", 1, "R2", 2)])
     logs = []
     for _ in range(25):
         if logs and rng.random() < 0.3:

@@ -51,7 +51,7 @@ def test_a_delayed_team_completes_in_the_order_its_messages_set(corridor, delaye
     assert_no_overlap(scenario, result)
     # every robot realises its plan's events and messages in its plan's order...
     for rid, plan in plans.robots.items():
-        assert [e for _, robot, e in result.events if robot == rid] == list(plan.mission), rid
+        assert [e for _, robot, e in result.events if robot == rid] == [e.name for e in plan.mission], rid
     # ...and every Req ends after the Res that sends its message, however late that came
     assert result.messages
     for message in result.messages:

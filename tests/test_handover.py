@@ -108,7 +108,7 @@ def test_the_checker_refuses_a_pick_where_the_goods_no_longer_lie(relay):
 def _with_message(plan: RobotPlan, at: int, primitive: Primitive, name: str) -> RobotPlan:
     """`plan` with a message step after its step `at` (from 1)."""
     state = plan.steps[at - 1].state
-    step = Step(primitive, None, state.robot, state.objects, name)
+    step = Step(primitive, None, state.robot, state.objects, parse_event(name))
     return RobotPlan.from_steps(plan.mission, [*plan.steps[:at], step, *plan.steps[at:]])
 
 
@@ -119,7 +119,7 @@ def test_a_receiver_that_drives_over_the_goods_first_place_needs_an_order():
     r1 = plan_from_actions(
         scenario.scene,
         "R1",
-        ["pick(R1,O1)", "drop(R1,O1,H)", "msg(R1,R2,t)"],
+        [parse_event("pick(R1,O1)"), parse_event("drop(R1,O1,H)"), parse_event("msg(R1,R2,t)")],
         [
             ("GoTo", (-3720, 1905, 0)),
             ("GoTo", (-2500, 1600, 270)),
@@ -137,7 +137,7 @@ def test_a_receiver_that_drives_over_the_goods_first_place_needs_an_order():
     r2 = plan_from_actions(
         moved,
         "R2",
-        ["msg(R1,R2,t)", "pick(R2,O1)"],
+        [parse_event("msg(R1,R2,t)"), parse_event("pick(R2,O1)")],
         [
             ("GoTo", (1000, -250, 180)),
             ("GoTo", (-1000, -250, 180)),  # through the door
@@ -151,7 +151,7 @@ def test_a_receiver_that_drives_over_the_goods_first_place_needs_an_order():
         ],
     )
     r2 = _with_message(r2, 8, Primitive.REQ, "msg(R1,R2,t)")
-    messages = (PlanMessage("msg(R1,R2,t)", "order", "R2 picks O1 after R1 has dropped it"),)
+    messages = (PlanMessage(parse_event("msg(R1,R2,t)"), "order", "R2 picks O1 after R1 has dropped it"),)
     report = check_plan(scenario, PlanSet(scenario.name, True, {"R1": r1, "R2": r2}, messages=messages))
     texts = [v.message for v in report.violations]
     shelf = "O1 resting at (-2500, 1300) at its start"

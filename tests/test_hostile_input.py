@@ -25,6 +25,7 @@ from typer.testing import CliRunner
 
 from cosmop.cli import app
 from cosmop.errors import CosmopInputError, ScenarioError
+from cosmop.events import parse_event
 from cosmop.planning.plan_file import PlanError, load_plan, read_plan
 from cosmop.planning.plan_types import MAX_STEPS
 from cosmop.planning.synthesis import synthesize
@@ -362,8 +363,16 @@ def test_a_message_listed_by_both_robots_is_planned():
     )
     result = plan_team(scenario, workers=1)
     assert result.plans.feasible and result.report.ok
-    sent = [k for k, s in enumerate(result.plans.robots["R1"].steps, 1) if s.message == "msg(R1,R2,t)"]
-    awaited = [k for k, s in enumerate(result.plans.robots["R2"].steps, 1) if s.message == "msg(R1,R2,t)"]
+    sent = [
+        k
+        for k, s in enumerate(result.plans.robots["R1"].steps, 1)
+        if s.message == parse_event("msg(R1,R2,t)")
+    ]
+    awaited = [
+        k
+        for k, s in enumerate(result.plans.robots["R2"].steps, 1)
+        if s.message == parse_event("msg(R1,R2,t)")
+    ]
     assert len(sent) == len(awaited) == 1
 
 

@@ -11,6 +11,7 @@ the plan needs is found by the loop.
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
@@ -20,6 +21,14 @@ from cosmop.planning import obstacles
 from cosmop.planning.checker import check_robot_plan
 from cosmop.planning.obstacles import obstacle_of
 from cosmop.planning.plan_types import State
+from cosmop.planning.specification import (
+    ObstaclePart,
+    RobotProblem,
+    corner_clearance_key,
+    object_key,
+    specification,
+    wall_key,
+)
 from cosmop.planning.synthesis import synthesize
 from cosmop.scenario import load_scenario, parse_scenario
 from rooms import branching_words, room, shelves
@@ -101,10 +110,44 @@ def test_a_horizon_too_short_is_infeasible_both_ways(start):
 
 
 def test_parts_are_named_after_their_obstacle():
-    assert obstacle_of("wall 12 [[0, 0], [1, 0]]") == "wall 12"
-    assert obstacle_of("gripper clear of wall 4") == "wall 4 while handling"
-    assert obstacle_of("O1 dropped clear of wall 0") == "wall 0 while handling"
-    assert obstacle_of("object O7") == "object O7"
-    assert obstacle_of("room from O2 while handling O1") == "object O2"
-    assert obstacle_of("O1 dropped clear of O2") == "object O2"
+    assert [str(wall_key(12)), str(wall_key(4, handling=True)), str(object_key("O7"))] == [
+        "wall 12",
+        "wall 4 while handling",
+        "object O7",
+    ]
+    assert str(corner_clearance_key(wall_key(3))) == "wall 3 past its ends"
+    assert corner_clearance_key(object_key("O2")).base == object_key("O2")
+    part = ObstaclePart(wall_key(4, handling=True), wall_key(4).text, "gripper clear of ")
+    assert part.text == "gripper clear of wall 4" and obstacle_of(part) == wall_key(4, handling=True)
+    assert part.labelled("the bay's fence") == "gripper clear of the bay's fence"
     assert obstacle_of("Req O2") is None and obstacle_of("mission") is None
+
+
+# The grammar the parts' names once were parsed back with: every obstacle part still reads so.
+_GRAMMAR = (
+    re.compile(r"^((?:wall \d+|object \S+) past its ends)\b"),
+    re.compile(r"^(wall \d+)\b"),
+    re.compile(r"\bclear of (wall \d+)$"),
+    re.compile(r"^object (\S+)$"),
+    re.compile(r"^room from (\S+) while handling \S+$"),
+    re.compile(r"^\S+ dropped clear of (\S+)$"),
+)
+
+
+def _read_back(name: str) -> str | None:
+    for i, pattern in enumerate(_GRAMMAR):
+        if found := pattern.search(name):
+            key = found.group(1)
+            return (key, key, f"{key} while handling", f"object {key}")[min(i, 3)]
+    return None
+
+
+@pytest.mark.parametrize("example", ["01_warehouse_2x2", "09_blocked_bay"])
+def test_every_part_names_its_obstacle_in_words(example):
+    scenario = load_scenario(ROOT / "examples" / example / "scenario.yaml")
+    assert scenario.mission is not None and scenario.mission.tasks is not None
+    for robot, tasks in scenario.mission.tasks.items():
+        p = RobotProblem(scenario.scene, robot, tasks)
+        for name, _ in specification(p):
+            key = obstacle_of(name)
+            assert _read_back(str(name)) == (None if key is None else key.text), name

@@ -23,7 +23,7 @@ def test_example_1_coordinated():
     assert result.results["R2"].horizon == 7 and "Res(O2)" in [s.label for s in r2.steps]
 
     def tasks(plan):  # the mission without the messages that keep the robots apart
-        return tuple(e for e in plan.mission if not e.startswith("msg("))
+        return tuple(e.name for e in plan.mission if e.kind != "msg")
 
     assert tasks(r1) == ("away(O2,R1,R2)", "pick(R1,O1)", "drop(R1,O1,W1)", "return(R1)")
     assert tasks(r2) == ("pick(R2,O2)", "away(O2,R1,R2)", "drop(R2,O2,W2)", "return(R2)")
@@ -52,7 +52,7 @@ def test_a_blocking_object_nobody_picks_is_set_aside_by_the_requester():
     assert (task.robot, task.object) == ("R1", "O2") and "no mission moves it" in task.why
     # without the request R1 has no plan (the paper's R1 needs O2 gone), so it moves O2 itself
     assert not any("without requesting O2" in r for r in result.replans)
-    assert result.plans.robots["R1"].mission[:2] == ("pick(R1,O2)", "drop(R1,O2,aside_O2)")
+    assert [e.name for e in result.plans.robots["R1"].mission[:2]] == ["pick(R1,O2)", "drop(R1,O2,aside_O2)"]
 
 
 def test_worker_processes_do_not_change_the_result():
@@ -70,5 +70,5 @@ def test_a_mission_with_marked_states_plans_to_a_complete_state():
     data["mission"]["dfa"]["marked"] = ["q15"]
     team = plan_team(parse_scenario(data))
     assert team.plans.feasible, team.plans.reason
-    done = {e for plan in team.plans.robots.values() for e in plan.mission}
+    done = {e.name for plan in team.plans.robots.values() for e in plan.mission}
     assert {"return(R1)", "return(R2)"} <= done

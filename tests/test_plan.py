@@ -58,7 +58,7 @@ def test_to_dict_has_the_documented_shape() -> None:
     assert list(data) == ["format", "scenario", "feasible", "units", "robots", "coordination", "messages"]
     assert data["format"] == PLAN_FORMAT == "cosmop.plan/1"
     r1 = data["robots"]["R1"]
-    assert r1["mission"] == R1_MISSION
+    assert r1["mission"] == [e.name for e in R1_MISSION]
     assert r1["horizon"] == 7 == len(r1["steps"])
     assert r1["steps"][0] == {
         "primitive": "Req",
@@ -167,8 +167,8 @@ def test_constructor_validation() -> None:
         RobotPlan((), 2, (Step("GoTo", None, (0, 0, 0), objects),))
     with pytest.raises(ValueError, match="needs a reason"):
         PlanSet("s", False, {})
-    with pytest.raises(ValueError, match="invalid event"):
-        RobotPlan(("pick O1",), 0, ())  # the robot is implied only when reading a file
+    with pytest.raises(TypeError, match="holds Event values"):
+        RobotPlan(("pick(R1,O1)",), 0, ())  # text is parsed where it is read
 
 
 # ----------------------------------------------------------------------------------------------

@@ -6,6 +6,7 @@ from __future__ import annotations
 import pytest
 
 pytest.importorskip("matplotlib")
+from cosmop.events import Event, parse_event
 from cosmop.planning.plan_types import PlanMessage, PlanSet, RobotPlan, Step
 from cosmop.planning.primitive_effects import plan_from_actions
 from cosmop.scenario import parse_scenario
@@ -45,7 +46,7 @@ def _big_plans() -> PlanSet:
     r1 = plan_from_actions(
         BIG.scene,
         "R1",
-        ["pick(R1,O1)", "drop(R1,O1,W1)", "return(R1)"],
+        [parse_event("pick(R1,O1)"), parse_event("drop(R1,O1,W1)"), parse_event("return(R1)")],
         [
             ("GoTo", (2750, 2000, 0)),  # west of O1, touching it
             ("PickUp", "O1"),
@@ -157,7 +158,7 @@ def test_crowded_labels_are_thinned_but_robot_ids_always_show(close_figures):
     assert not any(a.overlaps(b) for i, a in enumerate(goods_boxes) for b in goods_boxes[i + 1 :])
 
 
-def _send_and_wait(plan: RobotPlan, after: int, primitive: str, events: list[str]) -> RobotPlan:
+def _send_and_wait(plan: RobotPlan, after: int, primitive: str, events: list[Event]) -> RobotPlan:
     """`plan` with a step that sends (Res) or waits for (Req) each of `events` after step `after`."""
     steps = list(plan.steps)
     here = steps[after - 1]
@@ -169,13 +170,13 @@ def _message_plans(count: int) -> PlanSet:
     """The 2x2 plans with `count` messages from R2 (sent after its pick) to R1 (waited for before
     its pick), and one more message that no plan sends or waits for."""
     plans = run_2x2()[1]
-    events = [f"msg(R2,R1,clear{k})" for k in range(count)]
+    events = [parse_event(f"msg(R2,R1,clear{k})") for k in range(count)]
     robots = {
         "R1": _send_and_wait(plans.robots["R1"], 1, "Req", events),
         "R2": _send_and_wait(plans.robots["R2"], 2, "Res", events),
     }
     messages = [PlanMessage(e, "conflict", "R1 waits until R2 has picked O2") for e in events]
-    messages.append(PlanMessage("msg(R1,R2,lost)", "order", "not in the plans"))
+    messages.append(PlanMessage(parse_event("msg(R1,R2,lost)"), "order", "not in the plans"))
     return PlanSet(plans.scenario, True, robots, plans.coordination, messages=messages)
 
 
@@ -185,8 +186,8 @@ def test_every_message_is_an_arrow_from_its_sender_to_the_receiver_who_waits(clo
     ax = draw_plan(scene, plans).axes[0]
     arrows = [p for p in ax.patches if p.get_gid() == "message"]
     assert len(arrows) == 1  # msg(R1,R2,lost) has no steps: no arrow
-    sent = next(s for s in plans.robots["R2"].steps if s.message == "msg(R2,R1,clear0)")
-    waited = next(s for s in plans.robots["R1"].steps if s.message == "msg(R2,R1,clear0)")
+    sent = next(s for s in plans.robots["R2"].steps if s.message == parse_event("msg(R2,R1,clear0)"))
+    waited = next(s for s in plans.robots["R1"].steps if s.message == parse_event("msg(R2,R1,clear0)"))
     start, end = arrows[0]._posA_posB
     assert tuple(start) == sent.robot[:2] and tuple(end) == waited.robot[:2]
     r2 = next(t for t in ax.texts if t.get_text() == "R2")

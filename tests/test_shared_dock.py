@@ -7,6 +7,7 @@ from pathlib import Path
 import yaml
 
 from cosmop.missions.mission import GlobalMission
+from cosmop.planning.specification import ObstaclePart, corner_clearance_key, wall_key
 from cosmop.planning.synthesis import _as_written
 from cosmop.scenario import load_scenario, parse_scenario
 from cosmop.scene import Wall
@@ -68,8 +69,20 @@ def test_reasons_name_walls_the_planner_adds_by_what_they_keep_out():
     n = len(walls)
     added = (Wall((0, 0), (1, 0), "the space of R2 standing at (0, 0)"),)
     scene = type(scenario.scene)(walls + added, scenario.scene.robots, scenario.scene.objects)
-    named = _as_written(
-        scene, (f"wall {n} [[0.0, 0.0], [1.0, 0.0]]", f"gripper clear of wall {n}", "gripper clear of wall 1")
+    parts = (
+        ObstaclePart(wall_key(n), wall_key(n).text, after=" [[0.0, 0.0], [1.0, 0.0]]"),
+        ObstaclePart(
+            corner_clearance_key(wall_key(n)), f"wall {n} past its ends", after=" [[0.0, 0.0], [1.0, 0.0]]"
+        ),
+        ObstaclePart(wall_key(n, handling=True), wall_key(n).text, "gripper clear of "),
+        ObstaclePart(wall_key(1, handling=True), wall_key(1).text, "gripper clear of "),
     )
+    assert [part.text for part in parts] == [
+        f"wall {n} [[0.0, 0.0], [1.0, 0.0]]",
+        f"wall {n} past its ends [[0.0, 0.0], [1.0, 0.0]]",
+        f"gripper clear of wall {n}",
+        "gripper clear of wall 1",
+    ]
     space = "the space of R2 standing at (0, 0)"
-    assert named == (space, f"gripper clear of {space}", "gripper clear of wall 1")
+    named = _as_written(scene, parts)
+    assert named == (space, f"{space} past its ends", f"gripper clear of {space}", "gripper clear of wall 1")

@@ -15,6 +15,7 @@ from typer.testing import CliRunner
 
 from cosmop.cli import app
 from cosmop.control.geometry import box_gaps, point_segment_linf
+from cosmop.events import parse_event
 from cosmop.planning import PlanSet
 from cosmop.scenario import load_scenario, parse_scenario
 from cosmop.sim import SIM_FORMAT, TRACE_FORMAT, SimSettings, simulate, time_limit
@@ -57,7 +58,7 @@ def _assert_done(result, scenario, plans) -> None:
 
 def _planned_messages(plans) -> set[str]:
     """Every message the plans send: away answers and msg events."""
-    return {pair.event.name for pair in plans.coordination} | {m.event for m in plans.messages}
+    return {pair.event.name for pair in plans.coordination} | {m.event.name for m in plans.messages}
 
 
 def test_2x2_completes_with_its_messages(warehouse_2x2):
@@ -328,7 +329,7 @@ def test_plans_are_executed_as_written(warehouse_2x2):
     result = simulate(scenario, plans)
     for rid, plan in plans.robots.items():
         done = [event for _, robot, event in result.events if robot == rid]
-        assert done == list(plan.mission), rid
+        assert done == [e.name for e in plan.mission], rid
 
 
 def test_cli_simulate(tmp_path, warehouse_2x2):
@@ -411,7 +412,7 @@ def test_robot_stopped_beside_its_waypoint_creeps_back_onto_the_segment():
         ("GoTo", (200, 200, 0)),
         ("GoTo", (201, 186, 0)),
     ]
-    plan = plan_from_actions(scenario.scene, "R1", ["return(R1)"], actions)
+    plan = plan_from_actions(scenario.scene, "R1", [parse_event("return(R1)")], actions)
     plans = PlanSet("corner", True, {"R1": plan})
     result = simulate(scenario, plans, settings=SimSettings(max_time=120, replan=False))
     assert result.completed

@@ -73,7 +73,7 @@ def test_requests_are_never_for_own_objects(small):
         ("DropOff", "O1"),
         ("Req", "O2"),
     }
-    names = [n for n, _ in specification(p)]
+    names = [str(n) for n, _ in specification(p)]
     assert "object O2" in names and any(n.startswith("wall 4") for n in names)
 
 

@@ -87,11 +87,11 @@ def test_an_order_between_robots_is_kept_by_a_message(ordered):
     plans = result.plans
     assert plans.feasible and result.report.ok
     kinds = {m.event: m.kind for m in plans.messages}
-    (order,) = [name for name, kind in kinds.items() if kind == "order"]
-    assert parse_event(order).sender == "R1" and parse_event(order).receiver == "R2"
+    (order,) = [event for event, kind in kinds.items() if kind == "order"]
+    assert order.sender == "R1" and order.receiver == "R2"
     r1, r2 = plans.robots["R1"].mission, plans.robots["R2"].mission
-    assert r1.index(order) == r1.index("drop(R1,O1,W1)") + 1  # sent right after the drop
-    assert r2.index(order) == r2.index("pick(R2,O2)") - 1  # awaited right before the pick
+    assert r1.index(order) == r1.index(parse_event("drop(R1,O1,W1)")) + 1  # sent right after the drop
+    assert r2.index(order) == r2.index(parse_event("pick(R2,O2)")) - 1  # awaited right before the pick
     run = simulate(scenario, plans)
     assert run.completed and run.contacts_while_moving == 0
     when = {event: t for t, _, event in run.events}
@@ -154,7 +154,7 @@ def test_a_replan_mid_run_is_ordered_again(corridor):
     scene = scenario.scene
     start = {r: Remaining(tuple(p.steps), tuple(p.mission), _initial(scenario, r)) for r, p in plans.items()}
     conflict_names = {m.event for m in result.plans.messages if m.kind == "conflict"}
-    used = {n for p in plans.values() for n in p.mission if n.startswith("msg(")}
+    used = {e for p in plans.values() for e in p.mission if e.kind == "msg"}
     outcome = recoordinate(
         scene,
         start,
@@ -165,7 +165,7 @@ def test_a_replan_mid_run_is_ordered_again(corridor):
         positions={o: tuple(spec.position) for o, spec in scene.objects.items()},
     )
     assert outcome.accepted and outcome.messages
-    assert set(outcome.dropped) == {n for n in conflict_names if "R1" in parse_event(n).owners}
+    assert set(outcome.dropped) == {e for e in conflict_names if "R1" in e.owners}
     assert {m.event for m in outcome.messages}.isdisjoint(conflict_names)  # fresh names
     links = message_links(outcome.plans)
     precedence = Precedence({r: p.horizon for r, p in outcome.plans.items()}, links)
@@ -190,7 +190,7 @@ def test_user_written_messages_order_a_tasks_mission():
     }
     result = plan_team(parse_scenario(data))
     assert result.plans.feasible and result.report.ok
-    kinds = {m.event: m.kind for m in result.plans.messages}
+    kinds = {m.event.name: m.kind for m in result.plans.messages}
     assert kinds["msg(R1,R2,stocked)"] == "mission"
     run = simulate(parse_scenario(data), result.plans)
     when = {event: t for t, _, event in run.events}

@@ -10,6 +10,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
+from cosmop.events import parse_event
 from cosmop.planning.plan_types import PlanMessage
 from cosmop.scenario import load_scenario
 from cosmop.traces import Trace, TraceError, load_trace
@@ -87,15 +88,19 @@ def _plans(near: tuple[float, float]):
         return SimpleNamespace(primitive=primitive, object=obj, message=message)
 
     r1 = SimpleNamespace(
-        steps=(step("GoTo"), step("DropOff", "O1"), step("Res", message="msg(R1,R2,after)")),
-        mission=("drop(R1,O1,W1)", "msg(R1,R2,after)"),
+        steps=(step("GoTo"), step("DropOff", "O1"), step("Res", message=parse_event("msg(R1,R2,after)"))),
+        mission=(parse_event("drop(R1,O1,W1)"), parse_event("msg(R1,R2,after)")),
     )
     x, y = near
     messages = (
-        PlanMessage("msg(R1,R2,after)", "order", "the mission orders ..."),
-        PlanMessage("msg(R2,R1,clear1)", "conflict", "...", (x - 100, y - 100, x + 100, y + 100)),
-        PlanMessage("msg(R2,R1,clear2)", "conflict", "...", (-9000.0, -9000.0, -8800.0, -8600.0)),
-        PlanMessage("msg(R1,R2,hello)", "mission", "the mission's message"),
+        PlanMessage(parse_event("msg(R1,R2,after)"), "order", "the mission orders ..."),
+        PlanMessage(
+            parse_event("msg(R2,R1,clear1)"), "conflict", "...", (x - 100, y - 100, x + 100, y + 100)
+        ),
+        PlanMessage(
+            parse_event("msg(R2,R1,clear2)"), "conflict", "...", (-9000.0, -9000.0, -8800.0, -8600.0)
+        ),
+        PlanMessage(parse_event("msg(R1,R2,hello)"), "mission", "the mission's message"),
     )
     return SimpleNamespace(robots={"R1": r1}, messages=messages)
 

@@ -12,6 +12,7 @@ from typer.testing import CliRunner
 
 from cosmop.cli import app
 from cosmop.errors import ScenarioError
+from cosmop.events import parse_event
 from cosmop.planning.plan_file import PlanError, load_plan
 from cosmop.planning.plan_types import Coordination, PlanSet
 from cosmop.planning.primitive_effects import plan_from_actions
@@ -166,7 +167,9 @@ def test_the_checker_speaks_metres_for_a_metres_file(tmp_path):
     si.write_text(SI_TEXT)
     scenario = load_scenario(si)
     assert scenario.units == "m" and load_scenario(MM_FILE).units == "mm"
-    through = plan_from_actions(scenario.scene, "R1", ["return(R1)"], [("GoTo", (1000, 1000, 0))])
+    through = plan_from_actions(
+        scenario.scene, "R1", [parse_event("return(R1)")], [("GoTo", (1000, 1000, 0))]
+    )
     report = check_plan(scenario, PlanSet("warehouse-2x2", True, {"R1": through}))
     messages = " ".join(v.message for v in report.violations)
     assert "GoTo from (-2, -1) to (1, 1) crosses wall [[-1,0],[1,0]]" in messages

@@ -200,6 +200,20 @@ class Event:
     def __str__(self) -> str:
         return self.name
 
+    # Events key sets and dicts in the planners' and the simulator's inner loops: hash and
+    # compare the cached canonical name (one text per event, as the fields are) rather than a
+    # fresh tuple of six fields each time.
+    def __hash__(self) -> int:
+        return hash(self.name)
+
+    def __eq__(self, other: object) -> bool:
+        if self is other:
+            return True
+        if other.__class__ is not Event:
+            return NotImplemented
+        assert isinstance(other, Event)  # (for the type checker)
+        return self.name == other.name
+
 
 def parse_event(text: str, robot: str | None = None) -> Event:
     """Parse the textual form of a mission event.
@@ -328,8 +342,8 @@ class Primitive(StrEnum):
     """Send a message (``!``) and go on at once."""
 
 
-def realising_step(event: Event, robot: str) -> tuple[Primitive, str | None, str | None] | None:
-    """The step that realises `event` in `robot`'s plan: ``(primitive, object, message tag)``.
+def realising_step(event: Event, robot: str) -> tuple[Primitive, str | None, Event | None] | None:
+    """The step that realises `event` in `robot`'s plan: ``(primitive, object, message)``.
 
     ``pick(R,O)`` is ``PickUp`` of O and ``drop(R,O,W)`` is ``DropOff`` of O (inside W); a message
     is a ``Req`` in its receiver's plan and a ``Res`` in its sender's, of the object for
@@ -345,8 +359,10 @@ def realising_step(event: Event, robot: str) -> tuple[Primitive, str | None, str
 
     Returns
     -------
-    tuple of (Primitive, str or None, str or None) or None
-        The step's primitive, the object it handles and the message's name (``msg`` only).
+    tuple of (Primitive, str or None, Event or None) or None
+        The step's primitive, the object it handles and the message (``msg`` only): what a
+        :class:`~cosmop.planning.plan_types.Step` holds as ``primitive``, ``object`` and
+        ``message``.
 
     Examples
     --------
@@ -359,7 +375,7 @@ def realising_step(event: Event, robot: str) -> tuple[Primitive, str | None, str
         return Primitive.DROPOFF, event.obj, None
     if event.kind in MESSAGE_KINDS:
         primitive = Primitive.REQ if robot == event.receiver else Primitive.RES
-        return (primitive, event.obj, None) if event.kind == "away" else (primitive, None, event.name)
+        return (primitive, event.obj, None) if event.kind == "away" else (primitive, None, event)
     return None
 
 
@@ -408,10 +424,10 @@ the start)."""
 class Link:
     """A message between two plans: sent by ``sender`` at instant ``send`` (its ``Res``),
     awaited by ``receiver`` at instant ``wait`` (its ``Req``); ``send`` is ``None`` if no plan
-    sends it, ``wait`` ``None`` if no plan waits for it.  ``event`` is the message's name
+    sends it, ``wait`` ``None`` if no plan waits for it.  ``event`` is the message
     (``msg(S,R,tag)`` or ``away(O,A,B)``)."""
 
-    event: str
+    event: Event
     sender: str
     send: int | None
     receiver: str

@@ -35,7 +35,8 @@ import numpy as np
 from pydantic import Field
 from typing_extensions import TypedDict
 
-from cosmop.errors import CosmopInputError
+from cosmop.errors import CosmopInputError, EventSyntaxError
+from cosmop.events import Event, parse_event
 from cosmop.io import atomic_path, collector_paused, read_text
 from cosmop.reading import Structure, load_json, show
 from cosmop.units import INTERNAL_UNITS, check_units_field
@@ -787,7 +788,15 @@ def message_label(message: Mapping[str, Any]) -> str:
     for key in ("object", "event", "kind", "type"):
         value = message.get(key)
         if isinstance(value, str):
-            if key == "event" and value.startswith("msg(") and value.count(",") == 2:
-                return value[:-1].rsplit(",", 1)[-1]  # a msg event's tag says what it is about
+            if key == "event" and (event := _event_or_none(value)) is not None and event.tag is not None:
+                return event.tag  # a msg event's tag says what it is about
             return value
     return "message"
+
+
+def _event_or_none(text: str) -> Event | None:
+    """The event a trace's text names, or None for text of another kind (kept as it is)."""
+    try:
+        return parse_event(text)
+    except EventSyntaxError:
+        return None

@@ -35,7 +35,6 @@ from typing import Any
 
 import numpy as np
 
-from cosmop.events import parse_event
 from cosmop.lifelong.dispatch import OrderState, choose_robot, delivery_events
 from cosmop.lifelong.fleet_result import FleetResult
 from cosmop.planning.plan_types import PlanSet, RobotPlan
@@ -309,8 +308,7 @@ def _standing(run: _Run, agent: Agent) -> list[tuple[float, float, float]]:
 def _deliveries(run: _Run) -> None:
     """Record the drops of the cycle: the order is delivered and its goods are shipped."""
     world = run.world
-    for t, robot, name in world.events[run.seen_events :]:
-        event = parse_event(name)
+    for t, robot, event in world.events[run.seen_events :]:
         state = run.busy.get(robot)
         if (
             event.kind == "drop"

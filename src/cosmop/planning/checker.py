@@ -60,8 +60,7 @@ from shapely.geometry import LineString
 from shapely.geometry.base import BaseGeometry
 
 from cosmop.docking import DOCKING_HEADINGS, docking_pose, in_front
-from cosmop.errors import EventSyntaxError
-from cosmop.events import Event, Primitive, parse_event, realising_step
+from cosmop.events import Event, Primitive, realising_step
 from cosmop.planning.plan_types import RobotPlan, State, Step
 from cosmop.planning.primitive_effects import initial_state
 from cosmop.planning.realisation import TOLERANCE, angles_equal, at_pose, event_instants, holds_at
@@ -515,7 +514,7 @@ class _RobotChecker:
         self.flags_static(k, prev, cur, "carried")
         self.flags_static(k, prev, cur, "away")
         assert step.message is not None  # (transition sends only steps with a message here)
-        event = parse_event(step.message)
+        event = step.message
         role, robot = (
             ("receiver", event.receiver) if step.primitive == Primitive.REQ else ("sender", event.sender)
         )
@@ -523,7 +522,7 @@ class _RobotChecker:
             self.add(
                 k,
                 "message",
-                f"{step.message} is {'awaited' if role == 'receiver' else 'sent'} by its {role} {robot}, "
+                f"{event.name} is {'awaited' if role == 'receiver' else 'sent'} by its {role} {robot}, "
                 f"not by {self.robot_id}",
             )
 
@@ -531,12 +530,7 @@ class _RobotChecker:
 
     def mission(self) -> None:
         events: list[Event] = []
-        for name in self.plan.mission:
-            try:
-                event = parse_event(name)
-            except EventSyntaxError as err:  # only for plans built around the constructor
-                self.add(None, "mission", str(err))
-                return
+        for event in self.plan.mission:
             if self.robot_id not in event.owners:
                 self.add(
                     None,
@@ -571,8 +565,8 @@ class _RobotChecker:
             return f"DropOff({event.obj}) that leaves {event.obj} in {event.workspace}"
         realised = realising_step(event, self.robot_id)
         assert realised is not None  # an away or msg here (a return is never asked): it has a step
-        primitive, obj, name = realised
-        return f"{primitive}({obj or name})"
+        primitive, obj, sent = realised
+        return f"{primitive}({obj or (sent.name if sent is not None else None)})"
 
     def unmatched(self, event: Event, n: int, total: int, last: int | None, events: list[Event]) -> str:
         after = "anywhere in the plan" if last is None else f"after instant {last} ({events[n - 2].name})"

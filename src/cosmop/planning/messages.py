@@ -21,7 +21,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import replace
 from typing import Any
 
-from cosmop.events import Event, Node, Primitive, message, parse_event
+from cosmop.events import Event, Node, Primitive, message
 from cosmop.planning.checker import check_robot_plan
 from cosmop.planning.plan_types import RobotPlan, State, Step
 from cosmop.planning.primitive_effects import initial_state, plan_from_actions
@@ -39,8 +39,8 @@ __all__ = [
     "wait_early",
 ]
 
-Insert = tuple[int, int, str]
-"""``(after instant p, 0 for a send / 1 for a wait, message event name)``."""
+Insert = tuple[int, int, Event]
+"""``(after instant p, 0 for a send / 1 for a wait, message event)``."""
 
 
 def strip_messages(mission: Sequence[Event]) -> tuple[Event, ...]:
@@ -263,7 +263,7 @@ def insert_steps(
     plan: RobotPlan,
     inserts: Sequence[Insert],
     start: State | None = None,
-    mission: Sequence[str] | None = None,
+    mission: Sequence[Event] | None = None,
 ) -> tuple[RobotPlan, dict[int, int]]:
     """`plan` with a ``Res`` (send) or ``Req`` (wait) step of each message inserted.
 
@@ -279,7 +279,7 @@ def insert_steps(
         Where each message goes: after instant *p* (0 = before the first step).
     start : State, optional
         Instant 0 when it is not the scenario.
-    mission : sequence of str, optional
+    mission : sequence of Event, optional
         The new plan's mission list, when the caller knows it; by default the old mission with
         each message placed where its step is.
 
@@ -290,18 +290,20 @@ def insert_steps(
     """
     if mission is None:
         instants = event_instants(plan, robot, scene, start=start)
+        # ties are broken by the events' names (their order as text)
         keyed = [
-            ((float(t) if t is not None else float(plan.horizon), 0, 0), name)
-            for t, name in zip(instants, plan.mission, strict=True)
+            ((float(t) if t is not None else float(plan.horizon), 0, 0), event.name, event)
+            for t, event in zip(instants, plan.mission, strict=True)
         ]
-        keyed += [((p + 0.5, rank, n), name) for n, (p, rank, name) in enumerate(sorted(inserts))]
-        mission = [name for _, name in sorted(keyed)]
+        ordered = sorted(inserts, key=lambda item: (item[0], item[1], item[2].name))
+        keyed += [((p + 0.5, rank, n), event.name, event) for n, (p, rank, event) in enumerate(ordered)]
+        mission = [event for *_, event in sorted(keyed, key=lambda item: item[:2])]
     # messages after one instant go in the mission's order (a wait the mission puts before a
     # send stays before it, even when the event between them needs no step)
-    order = {name: i for i, name in enumerate(mission)}
-    at: dict[int, list[tuple[int, int, str]]] = {}
-    for p, rank, name in inserts:
-        at.setdefault(p, []).append((order.get(name, len(order)), rank, name))
+    order = {event: i for i, event in enumerate(mission)}
+    at: dict[int, list[tuple[int, int, str, Event]]] = {}
+    for p, rank, event in inserts:
+        at.setdefault(p, []).append((order.get(event, len(order)), rank, event.name, event))
     state = start or initial_state(scene, robot, plan, scene.objects)
     steps: list[Step] = []
     moved: dict[int, int] = {0: 0}
@@ -311,9 +313,9 @@ def insert_steps(
             steps.append(step)
             state = step.state
             moved[k] = len(steps)
-        for _, rank, name in sorted(at.get(k, ())):
+        for _, rank, _, event in sorted(at.get(k, ()), key=lambda item: item[:3]):
             primitive = Primitive.RES if rank == 0 else Primitive.REQ
-            steps.append(Step(primitive, None, state.robot, state.objects, name))
+            steps.append(Step(primitive, None, state.robot, state.objects, event))
     return RobotPlan.from_steps(mission, steps), moved
 
 
@@ -351,15 +353,15 @@ def place_mission_messages(
             continue
         if event.sender == robot:
             p = 0 if seen == 0 else (instants[seen - 1] or 0)
-            inserts.append((p, 0, event.name))
+            inserts.append((p, 0, event))
         else:
             nxt = instants[seen] if seen < len(instants) else None
             p = plan.horizon if nxt is None else max(nxt - 1, 0)
             before = instants[seen - 1] if seen > 0 else None
             if before is not None:
                 p = max(p, before)
-            inserts.append((p, 1, event.name))
-    new, _ = insert_steps(scene, robot, plan, inserts, start, [e.name for e in mission])
+            inserts.append((p, 1, event))
+    new, _ = insert_steps(scene, robot, plan, inserts, start, mission)
     return new
 
 
@@ -368,12 +370,12 @@ def place_edges(
     plans: Mapping[str, RobotPlan],
     edges: Sequence[tuple[Node, Node]],
     tag: str = "clear",
-    used: set[str] | None = None,
+    used: set[Event] | None = None,
     starts: Mapping[str, State] | None = None,
-) -> tuple[dict[str, RobotPlan], list[tuple[str, tuple[Node, Node], tuple[Node, Node]]]]:
+) -> tuple[dict[str, RobotPlan], list[tuple[Event, tuple[Node, Node], tuple[Node, Node]]]]:
     """One message per start edge ``((A, i), (B, j))``: A sends after step *i*, B waits before *j*.
 
-    Returns the new plans and, per message, ``(event name, old edge, edge in new instants)``;
+    Returns the new plans and, per message, ``(event, old edge, edge in new instants)``;
     the new edge ``((A, i'), (B, j'))`` names A's ``Res`` and B's ``Req`` steps.
 
     Parameters
@@ -386,35 +388,34 @@ def place_edges(
         The start edges ``((A, i), (B, j))``: B may start step *j* once A has completed step *i*.
     tag : str
         The messages' tags are this followed by a number.
-    used : set of str, optional
-        Message names already taken; the new ones are added to it.
+    used : set of Event, optional
+        Messages already taken; the new ones are added to it.
     starts : Mapping[str, State], optional
         The robots' states at instant 0, by id, when it is not the scenario.
     """
     used = set() if used is None else used
     inserts: dict[str, list[Insert]] = {r: [] for r in plans}
-    names = []
+    events = []
     for n, ((a, i), (b, j)) in enumerate(edges, 1):
         number = n
-        name = message(a, b, f"{tag}{number}").name
-        while name in used:
+        event = message(a, b, f"{tag}{number}")
+        while event in used:
             number += len(edges)
-            name = message(a, b, f"{tag}{number}").name
-        used.add(name)
-        inserts[a].append((i, 0, name))
-        inserts[b].append((j - 1, 1, name))
-        names.append(name)
+            event = message(a, b, f"{tag}{number}")
+        used.add(event)
+        inserts[a].append((i, 0, event))
+        inserts[b].append((j - 1, 1, event))
+        events.append(event)
     out: dict[str, RobotPlan] = {}
     moved: dict[str, dict[int, int]] = {}
     for robot, plan in plans.items():
         start = (starts or {}).get(robot)
         out[robot], moved[robot] = insert_steps(scene, robot, plan, inserts[robot], start)
-    placed: list[tuple[str, tuple[Node, Node], tuple[Node, Node]]] = []
-    for name, edge in zip(names, edges, strict=True):
-        event = parse_event(name)
+    placed: list[tuple[Event, tuple[Node, Node], tuple[Node, Node]]] = []
+    for event, edge in zip(events, edges, strict=True):
         sender, receiver = event.sender, event.receiver
         assert sender is not None and receiver is not None  # a message has both
-        send = next(k for k, s in enumerate(out[sender].steps, 1) if s.message == name)
-        wait = next(k for k, s in enumerate(out[receiver].steps, 1) if s.message == name)
-        placed.append((name, edge, ((sender, send), (receiver, wait))))
+        send = next(k for k, s in enumerate(out[sender].steps, 1) if s.message == event)
+        wait = next(k for k, s in enumerate(out[receiver].steps, 1) if s.message == event)
+        placed.append((event, edge, ((sender, send), (receiver, wait))))
     return out, placed

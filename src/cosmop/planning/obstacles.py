@@ -42,7 +42,6 @@ obstacles and models before the exact one.
 
 from __future__ import annotations
 
-import re
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from fractions import Fraction
@@ -59,6 +58,9 @@ from cosmop.planning.specification import (
     HANDLING_CLEARANCE,
     PASSING,
     PAST_AN_END,
+    ObstacleKey,
+    ObstaclePart,
+    PartName,
     RobotProblem,
     corner_clearance_key,
     object_key,
@@ -66,44 +68,19 @@ from cosmop.planning.specification import (
     wall_key,
 )
 
-_OBSTACLE = (
-    re.compile(r"^((?:wall \d+|object \S+) past its ends)\b"),  # GoTo passing the ends clear
-    re.compile(r"^(wall \d+)\b"),  # GoTo clear of wall i
-    re.compile(r"\bclear of (wall \d+)$"),  # the gripper and a drop, clear of wall i
-    re.compile(r"^object (\S+)$"),  # GoTo clear of object o
-    re.compile(r"^room from (\S+) while handling \S+$"),
-    re.compile(r"^\S+ dropped clear of (\S+)$"),
-)
 
+def obstacle_of(name: PartName) -> ObstacleKey | None:
+    """The obstacle a part of the specification keeps clear of, or ``None``.
 
-def obstacle_of(name: str) -> str | None:
-    """The obstacle a specification part keeps clear of, or ``None``.
-
-    A wall is two obstacles: ``"wall 3"`` to drives and ``"wall 3 while handling"`` to picks
-    and drops (they concern different instants and places); an object is one, ``"object O2"``.
+    A wall is two obstacles: ``wall 3`` to drives and ``wall 3 while handling`` to picks and
+    drops (they concern different instants and places); an object is one, ``object O2``.
 
     Parameters
     ----------
-    name : str
-        The name of a part of a robot's specification.
-
-    Examples
-    --------
-    >>> obstacle_of("wall 3 [[0, 0], [1, 0]]"), obstacle_of("gripper clear of wall 3")
-    ('wall 3', 'wall 3 while handling')
-    >>> obstacle_of("O1 dropped clear of O2")
-    'object O2'
-    >>> obstacle_of("wall 3 past its ends [[0, 0], [1, 0]]"), obstacle_of("object O2 past its ends")
-    ('wall 3 past its ends', 'object O2 past its ends')
-    >>> obstacle_of("PickUp O1") is None
-    True
+    name : str or ObstaclePart
+        The name of a part of a robot's specification (only an obstacle part's names one).
     """
-    for i, pattern in enumerate(_OBSTACLE):
-        found = pattern.search(name)
-        if found:
-            key = found.group(1)
-            return (key, key, f"{key} while handling", f"object {key}")[min(i, 3)]
-    return None
+    return name.obstacle if isinstance(name, ObstaclePart) else None
 
 
 class Geometry:
@@ -146,11 +123,11 @@ class Geometry:
         self._p, self._events = p, events
         self.held = conj(f for _, f in specification(replace(p, obstacles=frozenset(held)), events))
         self._waiting = [k for k in keys if k not in held]
-        self._written: dict[str, Formula] = {}
+        self._written: dict[ObstacleKey, Formula] = {}
         self._half_planes = _SeparatingHalfPlanes(p) if self._waiting else None
         self.admitted = 0
 
-    def broken(self, trace: Sequence[Mapping[str, Any]]) -> list[str]:
+    def broken(self, trace: Sequence[Mapping[str, Any]]) -> list[ObstacleKey]:
         """The obstacles not yet held whose parts the plan `trace` breaks (exact evaluation).
 
         Parameters
@@ -164,15 +141,15 @@ class Geometry:
         self._write([k for k in near if k not in self._written])
         broken = [near[i] for i in failing([self._written[k] for k in near], trace)]
         # an obstacle driven through needs its own part first; its stronger one may follow
-        return [k for k in broken if _base(k) == k or _base(k) not in broken]
+        return [k for k in broken if k.base == k or k.base not in broken]
 
-    def admit(self, keys: Sequence[str]) -> Formula:
+    def admit(self, keys: Sequence[ObstacleKey]) -> Formula:
         """Move the obstacles `keys` into the solver's share: their parts, to assert.
 
         Parameters
         ----------
-        keys : sequence of str
-            Obstacles not yet held (:func:`obstacle_of` names).
+        keys : sequence of ObstacleKey
+            Obstacles not yet held.
         """
         self._write([k for k in keys if k not in self._written])
         added = conj(self._written.pop(k) for k in keys)
@@ -182,20 +159,15 @@ class Geometry:
         self.held = conj([self.held, added])
         return added
 
-    def _write(self, keys: Sequence[str]) -> None:
+    def _write(self, keys: Sequence[ObstacleKey]) -> None:
         if not keys:
             return
-        groups: dict[str, list[Formula]] = {k: [] for k in keys}
+        groups: dict[ObstacleKey, list[Formula]] = {k: [] for k in keys}
         for name, formula in specification(replace(self._p, obstacles=frozenset(keys)), self._events):
             key = obstacle_of(name)
-            if key in groups:
+            if key is not None and key in groups:
                 groups[key].append(formula)
         self._written.update({k: conj(fs) for k, fs in groups.items()})
-
-
-def _base(key: str) -> str:
-    """The obstacle whose GoTo part the part named `key` strengthens, or `key` itself."""
-    return key.removesuffix(corner_clearance_key(""))
 
 
 _GAP = 1e-3
@@ -217,8 +189,8 @@ class _SeparatingHalfPlanes:
         self._p = p
         side, margin = p.side, p.margin
         goods = {o: to_fraction(p.scene.objects[o].size) for o in p.own_objects}
-        planes: dict[str, list[list[tuple[Fraction, Fraction, Any]]]] = {}
-        self._roles: dict[str, int] = {}  # 0: a wall to drives, 1: to picks and drops, 2: an object
+        planes: dict[ObstacleKey, list[list[tuple[Fraction, Fraction, Any]]]] = {}
+        self._roles: dict[ObstacleKey, int] = {}  # 0: a wall to drives, 1: to picks and drops, 2: an object
         self._handling = {a.code for a in p.actions if a.primitive in (Primitive.PICKUP, Primitive.DROPOFF)}
         for i, w in enumerate(p.scene.obstacles):
             regions = [wall_regions(w.start, w.end, g) for g in (side + 2 * margin, *goods.values())]
@@ -251,7 +223,7 @@ class _SeparatingHalfPlanes:
         self._margin = float(margin)
         self._goods = list(goods)
 
-    def unsure(self, keys: Sequence[str], trace: Sequence[Mapping[str, Any]]) -> list[str]:
+    def unsure(self, keys: Sequence[ObstacleKey], trace: Sequence[Mapping[str, Any]]) -> list[ObstacleKey]:
         """The obstacles among `keys` that the plan does not keep to one side of, in order.
 
         A wall's drive parts look at the robot at every instant; its parts for picks and drops
@@ -262,7 +234,7 @@ class _SeparatingHalfPlanes:
             return []
         fixed = [k for k in keys if k in self._row]  # not the robot's own goods: they move
         own = [k for k in keys if k not in self._row]  # their stronger parts
-        ok = {k: self._own_ends(_base(k).removeprefix(object_key("")), trace) for k in own}
+        ok = {k: self._own_ends(k.obj, trace) for k in own if k.obj is not None}
         ok.update(zip(fixed, self._one_side(fixed, trace), strict=True))
         return [k for k in keys if not ok[k]]
 
@@ -281,7 +253,7 @@ class _SeparatingHalfPlanes:
                 return False
         return True
 
-    def _one_side(self, keys: Sequence[str], trace: Sequence[Mapping[str, Any]]) -> np.ndarray:
+    def _one_side(self, keys: Sequence[ObstacleKey], trace: Sequence[Mapping[str, Any]]) -> np.ndarray:
         """Per obstacle of `keys` (all with sides), whether the plan `trace` surely keeps its parts."""
         if not keys:
             return np.zeros(0, dtype=bool)
@@ -297,7 +269,7 @@ class _SeparatingHalfPlanes:
             goods &= _clear(rows[:, b], [tuple(float(v) for v in p.obj(o).read(trace[j])[:2]) for j in at])
         clear = np.where(role == 0, robot_all, np.where(role == 1, robot_handling & goods, robot_all & goods))
         ok = np.asarray(clear.any(axis=1))
-        ends = np.array([_base(k) != k for k in keys])
+        ends = np.array([k.past_ends for k in keys])
         if ends.any():  # the stronger part differs only for starts past an end, near a side
             stronger_rows = [self._row[k] for k, stronger in zip(keys, ends, strict=True) if stronger]
             ok[ends] |= _passes_ends(self._touching[stronger_rows], robot, self._margin)
@@ -348,7 +320,7 @@ def _clear(planes: NDArray[np.float64], points: Sequence[tuple[float, ...]]) -> 
     return on_it
 
 
-def _near_route(p: RobotProblem) -> set[str]:
+def _near_route(p: RobotProblem) -> set[ObstacleKey]:
     """The obstacles within reach of where the robot must be.
 
     To drives: the walls and objects in the box around the robot's start and home, its goods

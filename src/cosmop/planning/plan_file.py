@@ -66,7 +66,7 @@ from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Fie
 from typing_extensions import TypedDict
 
 from cosmop.errors import CosmopInputError, EventSyntaxError
-from cosmop.events import ID_PATTERN, Primitive, parse_event
+from cosmop.events import ID_PATTERN, Event, Primitive, parse_event
 from cosmop.io import read_text
 from cosmop.planning.plan_types import (
     MAX_STEPS,
@@ -327,7 +327,7 @@ class _PlanReader:
         mission = []
         for i, text in enumerate(plan.mission):
             try:
-                mission.append(parse_event(text, robot=robot).name)
+                mission.append(parse_event(text, robot=robot))
             except EventSyntaxError as err:
                 self.fail((*path, "mission", i), str(err))
         if plan.horizon != len(plan.steps):
@@ -360,7 +360,7 @@ class _PlanReader:
             self.fail((*path, "object"), f"expected one of the step's objects ({listed}), got {obj!r}")
         return Step(primitive, obj, step.robot, objects, message)
 
-    def step_message(self, step: StepModel, path: FieldPath, primitive: Primitive) -> str | None:
+    def step_message(self, step: StepModel, path: FieldPath, primitive: Primitive) -> Event | None:
         """The step's ``message`` (a msg event of a Req or Res), or None."""
         if step.message is None:
             return None
@@ -371,15 +371,15 @@ class _PlanReader:
             )
         return self.msg_event(step.message, (*path, "message"))
 
-    def msg_event(self, text: str, path: FieldPath) -> str:
-        """The canonical name of the message event `text` (``msg(S,R,tag)``)."""
+    def msg_event(self, text: str, path: FieldPath) -> Event:
+        """The message event `text` (``msg(S,R,tag)``)."""
         try:
             event = parse_event(text)
         except EventSyntaxError as err:
             self.fail(path, str(err))
         if event.kind != "msg":
             self.fail(path, f"expected a msg(SENDER,RECEIVER,TAG) event, got {event.name}")
-        return event.name
+        return event
 
     def slots(self, steps: list[StepModel], path: FieldPath) -> tuple[tuple[float, float], ...] | None:
         """The steps' ``start`` and ``end`` (s), checked in order; None when no step has them."""
@@ -431,15 +431,14 @@ class _PlanReader:
         return Coordination(pair.object, pair.requester, pair.responder)
 
     def message(self, item: MessageModel, path: FieldPath) -> PlanMessage:
-        name = self.msg_event(item.event, (*path, "event"))
-        event = parse_event(name)
+        event = self.msg_event(item.event, (*path, "event"))
         for key, robot, given in (
             ("sender", event.sender, item.sender),
             ("receiver", event.receiver, item.receiver),
         ):
             if given is not None and given != robot:
-                self.fail((*path, key), f"expected {robot!r} (from {name}), got {show(given)}")
-        return PlanMessage(name, item.kind, item.protects, item.place)
+                self.fail((*path, key), f"expected {robot!r} (from {event.name}), got {show(given)}")
+        return PlanMessage(event, item.kind, item.protects, item.place)
 
 
 def read_plan(data: Any, file: str | os.PathLike[str] | None = None) -> PlanSet:

@@ -27,8 +27,7 @@ from types import MappingProxyType
 from typing import Any
 
 from cosmop._frozen import reduce_frozen
-from cosmop.errors import EventSyntaxError
-from cosmop.events import Event, Primitive, parse_event
+from cosmop.events import Event, Primitive
 from cosmop.io import compact_json, write_atomic
 from cosmop.scene import Scenario, Workspace
 from cosmop.units import INTERNAL_UNITS
@@ -169,14 +168,18 @@ class Step:
         The robot's pose after the step, ``(x, y, heading)`` in mm and degrees.
     objects : Mapping[str, ObjectState]
         Every object's state after the step, by id (read-only).
-    message : str, optional
+    message : Event, optional
         For ``Req`` (wait) and ``Res`` (send) of a message: its event ``msg(S,R,tag)``.
 
     Raises
     ------
     ValueError
         If the primitive is unknown, or `object` is missing (or given, for ``GoTo``), or a
-        message is given to a primitive other than ``Req``/``Res`` or together with an object.
+        message is given to a primitive other than ``Req``/``Res`` or together with an object,
+        or is not a ``msg`` event.
+    TypeError
+        If the message is not an :class:`~cosmop.events.Event` (text is parsed where it is
+        read, with :func:`~cosmop.events.parse_event`).
     """
 
     __reduce__ = reduce_frozen  # picklable for worker processes
@@ -185,7 +188,7 @@ class Step:
     object: str | None
     robot: Pose
     objects: Mapping[str, ObjectState]
-    message: str | None = None
+    message: Event | None = None
 
     def __post_init__(self) -> None:
         if self.primitive not in PRIMITIVES:
@@ -194,10 +197,10 @@ class Step:
         if self.message is not None:
             if self.primitive not in MESSAGE_PRIMITIVES or self.object is not None:
                 raise ValueError(f"only Req and Res without an object carry a message, not {self.primitive}")
-            event = parse_event(self.message)
-            if event.kind != "msg":
-                raise ValueError(f"a step's message is a msg(S,R,tag) event, got {self.message!r}")
-            object.__setattr__(self, "message", event.name)
+            if not isinstance(self.message, Event):
+                raise TypeError(f"a step's message is an Event, got {self.message!r}")
+            if self.message.kind != "msg":
+                raise ValueError(f"a step's message is a msg(S,R,tag) event, got {self.message.name}")
         elif self.primitive in OBJECT_PRIMITIVES and not self.object:
             raise ValueError(f"{self.primitive} needs the object it acts on")
         if self.primitive == Primitive.GOTO and self.object is not None:
@@ -208,7 +211,7 @@ class Step:
     @property
     def label(self) -> str:
         """The primitive with its object or message: ``PickUp(O1)``, ``Req(msg(R2,R1,t))``, ``GoTo``."""
-        what = self.object if self.object is not None else self.message
+        what = self.object if self.message is None else self.message.name
         return self.primitive if what is None else f"{self.primitive}({what})"
 
     @property
@@ -220,7 +223,7 @@ class Step:
         """The JSON form of the step (``object`` is ``null`` for ``GoTo``; ``message`` only when set)."""
         data: dict[str, Any] = {"primitive": self.primitive, "object": self.object}
         if self.message is not None:
-            data["message"] = self.message
+            data["message"] = self.message.name
         data["robot"] = [_num(v) for v in self.robot]
         data["objects"] = {oid: state.to_dict() for oid, state in self.objects.items()}
         return data
@@ -247,10 +250,9 @@ class RobotPlan:
 
     Parameters
     ----------
-    mission : tuple of str
-        The events the plan realises, in order, as canonical names (``pick(R1,O1)``,
-        ``drop(R1,O1,W1)``, ``return(R1)``, ``away(O2,R1,R2)``). :class:`~cosmop.events.Event`
-        values and the paper's compact names are accepted and stored canonically.
+    mission : tuple of Event
+        The events the plan realises, in order (in a plan file: their canonical names,
+        ``pick(R1,O1)``, ``drop(R1,O1,W1)``, ``return(R1)``, ``away(O2,R1,R2)``).
     horizon : int
         K, the number of steps.
     steps : tuple of Step
@@ -259,24 +261,21 @@ class RobotPlan:
     Raises
     ------
     ValueError
-        If `horizon` differs from the number of steps or a mission event cannot be parsed.
+        If `horizon` differs from the number of steps.
+    TypeError
+        If a mission item is not an :class:`~cosmop.events.Event` (text is parsed where it is
+        read, with :func:`~cosmop.events.parse_event`).
     """
 
-    mission: tuple[str, ...]
+    mission: tuple[Event, ...]
     horizon: int
     steps: tuple[Step, ...]
 
     def __post_init__(self) -> None:
-        names = []
+        object.__setattr__(self, "mission", tuple(self.mission))
         for item in self.mission:
-            if isinstance(item, Event):
-                names.append(item.name)
-            else:
-                try:
-                    names.append(parse_event(item).name)
-                except EventSyntaxError as err:
-                    raise ValueError(str(err)) from None
-        object.__setattr__(self, "mission", tuple(names))
+            if not isinstance(item, Event):
+                raise TypeError(f"a plan's mission holds Event values, got {item!r}")
         object.__setattr__(self, "steps", tuple(self.steps))
         if isinstance(self.horizon, bool) or not isinstance(self.horizon, int):
             raise ValueError(f"the horizon must be an integer, got {self.horizon!r}")
@@ -284,24 +283,23 @@ class RobotPlan:
             raise ValueError(f"the horizon {self.horizon} differs from the number of steps {len(self.steps)}")
 
     @classmethod
-    def from_steps(cls, mission: Iterable[str | Event], steps: Iterable[Step]) -> RobotPlan:
+    def from_steps(cls, mission: Iterable[Event], steps: Iterable[Step]) -> RobotPlan:
         """A plan whose horizon is the number of `steps`.
 
         Parameters
         ----------
-        mission : iterable of str or Event
+        mission : iterable of Event
             The events the plan realises.
         steps : iterable of Step
             Instants 1 to K.
         """
         steps = tuple(steps)
-        names = tuple(item.name if isinstance(item, Event) else item for item in mission)
-        return cls(names, len(steps), steps)
+        return cls(tuple(mission), len(steps), steps)
 
     @property
     def events(self) -> tuple[Event, ...]:
-        """The mission as :class:`~cosmop.events.Event` values."""
-        return tuple(parse_event(name) for name in self.mission)
+        """The mission (the same as :attr:`mission`; kept for the callers that name it so)."""
+        return self.mission
 
     def state(self, k: int, initial: State | None = None) -> State:
         """The state at instant `k`.
@@ -337,7 +335,7 @@ class RobotPlan:
     def to_dict(self) -> dict[str, Any]:
         """The JSON form: ``{"mission": [...], "horizon": K, "steps": [...]}``."""
         return {
-            "mission": list(self.mission),
+            "mission": [event.name for event in self.mission],
             "horizon": self.horizon,
             "steps": [step.to_dict() for step in self.steps],
         }
@@ -387,8 +385,8 @@ class PlanMessage:
 
     Parameters
     ----------
-    event : str
-        The message event ``msg(S,R,tag)`` (canonical text).
+    event : Event
+        The message event ``msg(S,R,tag)``.
     kind : {"order", "conflict", "mission"}
         Why it exists (:data:`MESSAGE_REASONS`).
     protects : str
@@ -398,39 +396,39 @@ class PlanMessage:
         the two robots share.
     """
 
-    event: str
+    event: Event
     kind: str
     protects: str
     place: tuple[float, float, float, float] | None = None
 
     def __post_init__(self) -> None:
-        event = parse_event(self.event)
-        if event.kind != "msg":
-            raise ValueError(f"a planned message is a msg(S,R,tag) event, got {self.event!r}")
+        if not isinstance(self.event, Event):
+            raise TypeError(f"a planned message's event is an Event, got {self.event!r}")
+        if self.event.kind != "msg":
+            raise ValueError(f"a planned message is a msg(S,R,tag) event, got {self.event.name}")
         if self.kind not in MESSAGE_REASONS:
             raise ValueError(f"a message's kind is one of {', '.join(MESSAGE_REASONS)}, got {self.kind!r}")
-        object.__setattr__(self, "event", event.name)
         if self.place is not None:
             object.__setattr__(self, "place", _floats(self.place, 4, "a place"))
 
     @property
     def sender(self) -> str:
         """The robot that sends the message."""
-        sender = parse_event(self.event).sender
+        sender = self.event.sender
         assert sender is not None  # a msg event names its sender
         return sender
 
     @property
     def receiver(self) -> str:
         """The robot that waits for it."""
-        receiver = parse_event(self.event).receiver
+        receiver = self.event.receiver
         assert receiver is not None  # a msg event names its receiver
         return receiver
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON form: ``{"event", "sender", "receiver", "kind", "protects"[, "place"]}``."""
         data: dict[str, Any] = {
-            "event": self.event,
+            "event": self.event.name,
             "sender": self.sender,
             "receiver": self.receiver,
             "kind": self.kind,
@@ -695,13 +693,15 @@ class PlanSet:
         if self.reason:
             lines.append(f"reason: {self.reason}")
         for robot, plan in self.robots.items():
-            lines.append(f"{robot} ({plan.horizon} steps): {', '.join(plan.mission) or 'no mission'}")
+            lines.append(
+                f"{robot} ({plan.horizon} steps): {', '.join(e.name for e in plan.mission) or 'no mission'}"
+            )
             times = self.itinerary.times[robot] if self.itinerary is not None else None
             lines.extend("  " + line for line in plan.to_text(times).splitlines())
         for pair in self.coordination:
             lines.append(f"coordination: {pair.responder} moves {pair.object} away for {pair.requester}")
         for message in self.messages:
-            lines.append(f"message {message.event} ({message.kind}): {message.protects}")
+            lines.append(f"message {message.event.name} ({message.kind}): {message.protects}")
         for task in self.added:
             x, y = task.point
             lines.append(f"added: {task.robot} sets {task.object} down at ({x:g}, {y:g}): {task.why}")

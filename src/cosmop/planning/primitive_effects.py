@@ -145,7 +145,7 @@ def _ahead(pose: Pose, gap: float) -> tuple[float, float]:
 
 
 def plan_from_actions(
-    scene: Scene, robot_id: str, mission: Iterable[str | Event], actions: Iterable[Action]
+    scene: Scene, robot_id: str, mission: Iterable[Event], actions: Iterable[Action]
 ) -> RobotPlan:
     """A robot plan from a list of primitives, each applied with :func:`successor`.
 
@@ -155,7 +155,7 @@ def plan_from_actions(
         The scene; instant 0 is :func:`initial_state`.
     robot_id : str
         The robot.
-    mission : iterable of str or Event
+    mission : iterable of Event
         The mission the plan is meant to realise.
     actions : iterable of tuple
         ``("GoTo", (x, y, heading))`` or ``(primitive, object)`` for the others.
@@ -166,7 +166,7 @@ def plan_from_actions(
 
     Examples
     --------
-    >>> plan = plan_from_actions(scene, "R2", ["pick(R2,O2)"],
+    >>> plan = plan_from_actions(scene, "R2", [parse_event("pick(R2,O2)")],
     ...                          [("GoTo", (1650, -1000, 0)), ("PickUp", "O2")])  # doctest: +SKIP
     """
     state = initial_state(scene, robot_id)

@@ -20,8 +20,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 
-from cosmop.errors import EventSyntaxError
-from cosmop.events import Event, Link, Primitive, parse_event, realising_step
+from cosmop.events import Event, Link, Primitive, realising_step
 from cosmop.planning.plan_types import RobotPlan, State, Step
 from cosmop.planning.primitive_effects import initial_state
 from cosmop.scene import Scene
@@ -148,26 +147,19 @@ def event_instants(
     return out
 
 
-def _events(plan: RobotPlan) -> list[Event]:
-    try:
-        return list(plan.events)
-    except EventSyntaxError:
-        return []
-
-
 def _message_steps(robot: str, plan: RobotPlan) -> list[tuple[int, Step, Event | None]]:
     """The plan's Req and Res steps (instant after each) with the message each sends or awaits.
 
     A step that names its ``message`` is that message; a ``Req(O)`` or ``Res(O)`` is the next
     ``away`` event of O in the mission with the robot in that role (``None`` when none is left).
     """
-    pending = [e for e in _events(plan) if e.kind == "away"]
+    pending = [e for e in plan.mission if e.kind == "away"]
     out: list[tuple[int, Step, Event | None]] = []
     for k, step in enumerate(plan.steps, 1):
         if step.primitive not in (Primitive.REQ, Primitive.RES):
             continue
         if step.message is not None:
-            out.append((k, step, parse_event(step.message)))
+            out.append((k, step, step.message))
             continue
         role = "receiver" if step.primitive == Primitive.REQ else "sender"
         event = next((e for e in pending if e.obj == step.object and getattr(e, role) == robot), None)
@@ -215,7 +207,7 @@ def unsent_answers(plans: Mapping[str, RobotPlan]) -> list[tuple[str, int, str]]
     ]
 
 
-def repeated_messages(plans: Mapping[str, RobotPlan]) -> list[tuple[str, int, str, int]]:
+def repeated_messages(plans: Mapping[str, RobotPlan]) -> list[tuple[str, int, Event, int]]:
     """``(robot, instant, message, first instant)`` of every ``Req`` or ``Res`` step that awaits
     or sends a ``msg`` an earlier step of the same plan already awaits or sends.
 
@@ -228,13 +220,13 @@ def repeated_messages(plans: Mapping[str, RobotPlan]) -> list[tuple[str, int, st
     """
     out = []
     for robot, plan in plans.items():
-        first: dict[tuple[str, Primitive], int] = {}
+        first: dict[tuple[Event, Primitive], int] = {}
         for k, step, event in _message_steps(robot, plan):
             if event is None or step.message is None:
                 continue  # an away: a second Req(O) or Res(O) finds no away left (above)
-            key = (event.name, step.primitive)
+            key = (event, step.primitive)
             if key in first:
-                out.append((robot, k, event.name, first[key]))
+                out.append((robot, k, event, first[key]))
             first.setdefault(key, k)
     return out
 
@@ -251,22 +243,21 @@ def message_links(plans: Mapping[str, RobotPlan]) -> list[Link]:
     plans : Mapping[str, RobotPlan]
         Every robot's plan, by robot id.
     """
-    sends: dict[str, tuple[str, int]] = {}
-    waits: dict[str, tuple[str, int]] = {}
+    sends: dict[Event, tuple[str, int]] = {}
+    waits: dict[Event, tuple[str, int]] = {}
     for robot, plan in plans.items():
         for k, step, event in _message_steps(robot, plan):
             if event is not None:
                 table = waits if step.primitive == Primitive.REQ else sends
-                table.setdefault(event.name, (robot, k))
+                table.setdefault(event, (robot, k))
     out = []
-    for name in sorted(set(sends) | set(waits)):
-        event = parse_event(name)
+    for event in sorted(set(sends) | set(waits), key=lambda e: e.name):
         sender, receiver = event.sender, event.receiver
         assert sender is not None and receiver is not None  # a message has both
-        send, wait = sends.get(name), waits.get(name)
+        send, wait = sends.get(event), waits.get(event)
         out.append(
             Link(
-                name,
+                event,
                 sender,
                 send[1] if send is not None and send[0] == sender else None,
                 receiver,

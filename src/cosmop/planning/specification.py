@@ -216,12 +216,116 @@ def _released(carried: Var | Formula) -> Formula:
     return _negated(_later(carried))
 
 
-def wall_key(i: int, handling: bool = False) -> str:
-    """The name of wall `i` (its index in the scene) as an obstacle: ``"wall 3"`` to drives,
-    ``"wall 3 while handling"`` to picks and drops (the gripper, the good set down).
+@dataclass(frozen=True)
+class ObstacleKey:
+    """One obstacle as the specification's parts keep clear of it: a wall (by its index in the
+    scene) or a resting object, with what the parts concern.
 
-    The names of the specification's parts are built from these keys, and
-    :func:`cosmop.planning.obstacles.obstacle_of` reads them back.
+    A wall is two obstacles, one to drives and one to picks and drops (`handling`: the gripper,
+    the good set down); an object is one.  A wall to drives or an object also has a stronger
+    GoTo part (`past_ends`, :func:`corner_clearance_key`).  :attr:`text` is the obstacle's name
+    in words, ``"wall 3"``, ``"wall 3 while handling"``, ``"object O2"``, ``"wall 3 past its
+    ends"``.
+
+    Parameters
+    ----------
+    wall : int, optional
+        The wall's index in the scene's obstacles (a wall).
+    obj : str, optional
+        The object's id (an object); exactly one of `wall` and `obj` is given.
+    handling : bool
+        The wall to picks and drops, not to drives (walls only).
+    past_ends : bool
+        The stronger GoTo part: departures from past the obstacle's ends pass them clear (not
+        with `handling`).
+
+    Raises
+    ------
+    ValueError
+        If not exactly one of `wall` and `obj` is given, or `handling` is given for an object
+        or together with `past_ends`.
+    """
+
+    wall: int | None = None
+    obj: str | None = None
+    handling: bool = False
+    past_ends: bool = False
+
+    def __post_init__(self) -> None:
+        if (self.wall is None) == (self.obj is None):
+            raise ValueError("an obstacle is a wall or an object: give exactly one of them")
+        if self.handling and (self.wall is None or self.past_ends):
+            raise ValueError("only a wall has parts for picks and drops, and they have no stronger one")
+
+    @property
+    def text(self) -> str:
+        """The obstacle in words: ``"wall 3"``, ``"wall 3 while handling"``, ``"object O2"``,
+        ``"wall 3 past its ends"``."""
+        name = f"wall {self.wall}" if self.wall is not None else f"object {self.obj}"
+        if self.handling:
+            name += " while handling"
+        return f"{name} past its ends" if self.past_ends else name
+
+    @property
+    def base(self) -> ObstacleKey:
+        """The obstacle whose GoTo part this one strengthens, or the key itself."""
+        return ObstacleKey(self.wall, self.obj, self.handling) if self.past_ends else self
+
+    def __str__(self) -> str:
+        return self.text
+
+
+@dataclass(frozen=True)
+class ObstaclePart:
+    """The name of a part of the specification that keeps the robot, or its goods, clear of one
+    obstacle: the obstacle and the words that name the part.
+
+    The part's name in words, :attr:`text`, is `before` + `ref` + `after`, e.g. ``"gripper
+    clear of "`` + ``"wall 3"``, ``"room from "`` + ``"O2"`` + ``" while handling O1"``, or
+    ``"wall 3"`` + ``" [[0, 0], [1, 0]]"`` (the wall's ends).
+
+    Parameters
+    ----------
+    obstacle : ObstacleKey
+        The obstacle the part keeps clear of.
+    ref : str
+        The words that name the obstacle in the part's name.
+    before, after : str
+        The words before and after them.
+    """
+
+    obstacle: ObstacleKey
+    ref: str
+    before: str = ""
+    after: str = ""
+
+    @property
+    def text(self) -> str:
+        """The part's name in words (as the explanations of an infeasible mission write it)."""
+        return f"{self.before}{self.ref}{self.after}"
+
+    def labelled(self, label: str) -> str:
+        """The name with the wall called `label` (what it keeps the robot out of) instead of
+        its number, and without its ends.
+
+        Parameters
+        ----------
+        label : str
+            The wall's label.
+        """
+        return f"{self.before}{label}{' past its ends' if self.obstacle.past_ends else ''}"
+
+    def __str__(self) -> str:
+        return self.text
+
+
+PartName = str | ObstaclePart
+"""The name of a part of the specification: words, or an obstacle part's name."""
+
+
+def wall_key(i: int, handling: bool = False) -> ObstacleKey:
+    """Wall `i` (its index in the scene) as an obstacle: to drives (``"wall 3"``), or to picks
+    and drops (``"wall 3 while handling"``: the gripper, the good set down).
 
     Parameters
     ----------
@@ -230,23 +334,23 @@ def wall_key(i: int, handling: bool = False) -> str:
     handling : bool
         The wall to picks and drops, not to drives.
     """
-    return f"wall {i} while handling" if handling else f"wall {i}"
+    return ObstacleKey(wall=i, handling=handling)
 
 
-def object_key(obj: str) -> str:
-    """The name of object `obj` as an obstacle: ``"object O2"``.
+def object_key(obj: str) -> ObstacleKey:
+    """Object `obj` as an obstacle: ``"object O2"``.
 
     Parameters
     ----------
     obj : str
         The object's id.
     """
-    return f"object {obj}"
+    return ObstacleKey(obj=obj)
 
 
-def corner_clearance_key(key: str) -> str:
-    """The name of the stronger GoTo part for obstacle `key` (a wall to drives or an object):
-    departures from past its ends pass them clear (:data:`PAST_AN_END`), ``"wall 3 past its ends"``.
+def corner_clearance_key(key: ObstacleKey) -> ObstacleKey:
+    """The stronger GoTo part for obstacle `key` (a wall to drives or an object): departures
+    from past its ends pass them clear (:data:`PAST_AN_END`), ``"wall 3 past its ends"``.
 
     Its *corner clearance*: the ends of a wall, the corners of an object, are the corners of
     the obstacle grown by the robot's square (its configuration-space obstacle), and a motion
@@ -257,10 +361,10 @@ def corner_clearance_key(key: str) -> str:
 
     Parameters
     ----------
-    key : str
+    key : ObstacleKey
         The obstacle (:func:`wall_key` to drives, or :func:`object_key`).
     """
-    return f"{key} past its ends"
+    return ObstacleKey(key.wall, key.obj, past_ends=True)
 
 
 @dataclass(frozen=True)
@@ -301,7 +405,7 @@ class RobotProblem:
     margin : Fraction
         mm a GoTo keeps from walls and resting objects between its ends (default
         :data:`MOTION_MARGIN`; 0 lets a motion slide along what it touches).
-    obstacles : frozenset of str, optional
+    obstacles : frozenset of ObstacleKey, optional
         Write the parts of only these obstacles (:func:`wall_key`, :func:`object_key`; a wall
         is two, one to drives and one to picks and drops; :func:`corner_clearance_key` of either names
         the stronger GoTo part); every wall and object by default.
@@ -339,7 +443,7 @@ class RobotProblem:
     unrequestable: frozenset[str] = frozenset()
     automaton: DFA | None = None
     margin: Fraction = MOTION_MARGIN
-    obstacles: frozenset[str] | None = None
+    obstacles: frozenset[ObstacleKey] | None = None
     spots: tuple[tuple[Event, tuple[float, float]], ...] = ()
     actions: tuple[Action, ...] = field(init=False)
     sort: str = field(init=False)
@@ -423,12 +527,12 @@ class RobotProblem:
         """:math:`\\epsilon`, the mission event the step performs: 1 + its index in `mission`, 0 none."""
         return Var("event", "int")
 
-    def written(self, key: str) -> bool:
+    def written(self, key: ObstacleKey) -> bool:
         """Whether the parts of obstacle `key` are written (:attr:`obstacles`).
 
         Parameters
         ----------
-        key : str
+        key : ObstacleKey
             An obstacle (:func:`wall_key`, :func:`object_key`, :func:`corner_clearance_key`).
         """
         return self.obstacles is None or key in self.obstacles
@@ -601,7 +705,7 @@ class Encoding:
         """
         raise NotImplementedError
 
-    def parts(self, p: RobotProblem, obj: str | None) -> list[tuple[str, Formula]]:
+    def parts(self, p: RobotProblem, obj: str | None) -> list[tuple[PartName, Formula]]:
         """Named formulas that hold whenever :math:`\\bigcirc \\pi` is this primitive on `obj`.
 
         Parameters
@@ -614,21 +718,21 @@ class Encoding:
         raise NotImplementedError
 
 
-def _gripper_clear(p: RobotProblem, obj: str, ox: Expr, oy: Expr) -> list[tuple[str, Formula]]:
+def _gripper_clear(p: RobotProblem, obj: str, ox: Expr, oy: Expr) -> list[tuple[PartName, Formula]]:
     """Robot and object squares in one region of every wall: no wall between them (the gripper).
 
     The regions of one wall computed for the two sizes are the same half-planes shifted by each
     square's support, so both squares in the i-th of them put their union on one side.
     """
     side = _num(p.scene.objects[obj].size)
-    out: list[tuple[str, Formula]] = []
+    out: list[tuple[PartName, Formula]] = []
     for i, wall in p.walls(handling=True):
         pairs = zip(
             wall_regions(wall.start, wall.end, p.side), wall_regions(wall.start, wall.end, side), strict=True
         )
         out.append(
             (
-                f"gripper clear of {wall_key(i)}",
+                ObstaclePart(wall_key(i, handling=True), wall_key(i).text, "gripper clear of "),
                 disj(_half_plane(a, p.x, p.y) & _half_plane(b, ox, oy) for a, b in pairs),
             )
         )
@@ -643,14 +747,16 @@ and puts another down on its other side (or picks one up there) is wedged: every
 slides along a face it touches.  A millimetre of room lets it leave without touching."""
 
 
-def _handling_room(p: RobotProblem, obj: str, places: list[BaseGeometry] | None) -> list[tuple[str, Formula]]:
+def _handling_room(
+    p: RobotProblem, obj: str, places: list[BaseGeometry] | None
+) -> list[tuple[PartName, Formula]]:
     """The robot keeps :data:`HANDLING_CLEARANCE` from every resting object but `obj`.
 
     `places` are where the robot's centre can be while handling `obj` (shapely geometries;
     ``None``: anywhere).  An object this robot never moves rests where it started: when it is
     far from every such place its constraint always holds, and is left out (a smaller formula).
     """
-    out: list[tuple[str, Formula]] = []
+    out: list[tuple[PartName, Formula]] = []
     for o in p.obstacle_objects():
         if o == obj:
             continue
@@ -666,7 +772,8 @@ def _handling_room(p: RobotProblem, obj: str, places: list[BaseGeometry] | None)
                     continue
         w = p.obj(o)
         apart = disj([p.x <= w.x - gap, p.x >= w.x + gap, p.y <= w.y - gap, p.y >= w.y + gap])
-        out.append((f"room from {o} while handling {obj}", Implies(w.resting, apart)))
+        name = ObstaclePart(object_key(o), o, "room from ", f" while handling {obj}")
+        out.append((name, Implies(w.resting, apart)))
     return out
 
 
@@ -715,7 +822,7 @@ def _objects_static(p: RobotProblem, *, carried: bool = True, skip: str | None =
     return _static(*out)
 
 
-def away_frames(p: RobotProblem) -> list[tuple[str, Formula]]:
+def away_frames(p: RobotProblem) -> list[tuple[PartName, Formula]]:
     """:math:`\\Box(\\bigcirc\\top \\rightarrow (\\bigcirc a_o \\leftrightarrow a_o) \\vee
     \\bigcirc(\\pi = \\mathrm{Req}_o))` for each good the robot may request: only its request
     moves it away.
@@ -729,7 +836,7 @@ def away_frames(p: RobotProblem) -> list[tuple[str, Formula]]:
     p : RobotProblem
         The robot's planning problem.
     """
-    out: list[tuple[str, Formula]] = []
+    out: list[tuple[PartName, Formula]] = []
     for a in p.actions:
         if a.primitive != Primitive.REQ or a.obj is None:
             continue
@@ -874,29 +981,34 @@ class GoTo(Encoding):
     def targets(self, p: RobotProblem) -> tuple[str | None, ...]:
         return (None,)
 
-    def parts(self, p: RobotProblem, obj: str | None) -> list[tuple[str, Formula]]:
+    def parts(self, p: RobotProblem, obj: str | None) -> list[tuple[PartName, Formula]]:
         x, y = p.x, p.y
-        out = [("GoTo keeps the objects", _objects_static(p))]
+        out: list[tuple[PartName, Formula]] = [("GoTo keeps the objects", _objects_static(p))]
         for i, wall in enumerate(p.scene.obstacles):
             if written := _goto_parts(p, wall_key(i)):
-                sides = _wall_sides(p, wall, wall_key(i))
-                coordinates = [list(wall.start), list(wall.end)]
-                out += [(f"{name} {coordinates}", _apart(x, y, sides, ends=ends)) for name, ends in written]
+                sides = _wall_sides(p, wall, wall_key(i).text)
+                coordinates = f" {[list(wall.start), list(wall.end)]}"
+                out += [
+                    (ObstaclePart(key, key.text, after=coordinates), _apart(x, y, sides, ends=key.past_ends))
+                    for key in written
+                ]
         for o in p.scene.objects:
             if written := _goto_parts(p, object_key(o)):
                 v = p.obj(o)
                 sides = _object_sides(v, p.clearance(o), p.margin)
-                out += [(name, Implies(v.resting, _apart(x, y, sides, ends=ends))) for name, ends in written]
+                out += [
+                    (ObstaclePart(key, key.text), Implies(v.resting, _apart(x, y, sides, ends=key.past_ends)))
+                    for key in written
+                ]
         return out
 
 
-def _goto_parts(p: RobotProblem, key: str) -> list[tuple[str, bool]]:
-    """``(name, ends)`` of the GoTo parts written for obstacle `key`: its stronger one
-    (:func:`corner_clearance_key`), its own, or both, in that order (an unsat core shrunk by deleting
-    parts in order then keeps the obstacle's own part where that alone blocks)."""
-    return [
-        (name, ends) for name, ends in ((corner_clearance_key(key), True), (key, False)) if p.written(name)
-    ]
+def _goto_parts(p: RobotProblem, key: ObstacleKey) -> list[ObstacleKey]:
+    """The obstacles of the GoTo parts written for obstacle `key`: its stronger one
+    (:func:`corner_clearance_key`, which passes the ends clear), its own, or both, in that order
+    (an unsat core shrunk by deleting parts in order then keeps the obstacle's own part where
+    that alone blocks)."""
+    return [k for k in (corner_clearance_key(key), key) if p.written(k)]
 
 
 class PickUp(Encoding):
@@ -907,7 +1019,7 @@ class PickUp(Encoding):
     def targets(self, p: RobotProblem) -> tuple[str | None, ...]:
         return p.own_objects
 
-    def parts(self, p: RobotProblem, obj: str | None) -> list[tuple[str, Formula]]:
+    def parts(self, p: RobotProblem, obj: str | None) -> list[tuple[PartName, Formula]]:
         assert obj is not None  # PickUp acts on an object
         v, d = p.obj(obj), p.clearance(obj)
         assert isinstance(v.x, Var) and isinstance(v.y, Var)  # its own goods: their position varies
@@ -928,7 +1040,7 @@ class DropOff(Encoding):
     def targets(self, p: RobotProblem) -> tuple[str | None, ...]:
         return p.own_objects
 
-    def parts(self, p: RobotProblem, obj: str | None) -> list[tuple[str, Formula]]:
+    def parts(self, p: RobotProblem, obj: str | None) -> list[tuple[PartName, Formula]]:
         assert obj is not None  # DropOff acts on an object
         v, d = p.obj(obj), p.clearance(obj)
         assert isinstance(v.x, Var) and isinstance(v.y, Var)  # its own goods: their position varies
@@ -936,14 +1048,16 @@ class DropOff(Encoding):
         released = conj(_released(p.obj(o).carried) for o in p.scene.objects)
         place = _docked(p, obj, v.x.next(), v.y.next(), d)
         rest = _objects_static(p, carried=False, skip=obj)
-        out = [(f"DropOff {obj}", _robot_static(p) & held & released & place & rest)]
+        out: list[tuple[PartName, Formula]] = [
+            (f"DropOff {obj}", _robot_static(p) & held & released & place & rest)
+        ]
         out += _gripper_clear(p, obj, v.x.next(), v.y.next()) + _handling_room(p, obj, _drop_places(p, obj))
         side = _num(p.scene.objects[obj].size)
         for i, wall in p.walls(handling=True):
-            regions = wall_regions(wall.start, wall.end, side, wall_key(i))
+            regions = wall_regions(wall.start, wall.end, side, wall_key(i).text)
             out.append(
                 (
-                    f"{obj} dropped clear of {wall_key(i)}",
+                    ObstaclePart(wall_key(i, handling=True), wall_key(i).text, f"{obj} dropped clear of "),
                     disj(_half_plane(h, v.x.next(), v.y.next()) for h in regions),
                 )
             )
@@ -960,7 +1074,9 @@ class DropOff(Encoding):
                     v.y.next() >= w.y + gap,
                 ]
             )
-            out.append((f"{obj} dropped clear of {o}", Implies(w.resting, apart)))
+            out.append(
+                (ObstaclePart(object_key(o), o, f"{obj} dropped clear of "), Implies(w.resting, apart))
+            )
         return out
 
 
@@ -974,7 +1090,7 @@ class Req(Encoding):
             return ()
         return tuple(o for o in p.scene.objects if o not in p.own_objects and o not in p.unrequestable)
 
-    def parts(self, p: RobotProblem, obj: str | None) -> list[tuple[str, Formula]]:
+    def parts(self, p: RobotProblem, obj: str | None) -> list[tuple[PartName, Formula]]:
         assert obj is not None  # Req acts on an object
         v, d, side = p.obj(obj), p.clearance(obj), p.side
         assert isinstance(v.away, Var)  # a good it may request: its away flag varies
@@ -994,7 +1110,7 @@ class Res(Encoding):
     def targets(self, p: RobotProblem) -> tuple[str | None, ...]:
         return p.answered_objects
 
-    def parts(self, p: RobotProblem, obj: str | None) -> list[tuple[str, Formula]]:
+    def parts(self, p: RobotProblem, obj: str | None) -> list[tuple[PartName, Formula]]:
         assert obj is not None  # Res acts on an object
         return [(f"Res {obj}", _robot_static(p) & _objects_static(p) & p.obj(obj).carried)]
 
@@ -1055,7 +1171,7 @@ def mission_formula(p: RobotProblem, events: Sequence[Event] | None = None) -> F
     return phase
 
 
-def automaton_parts(p: RobotProblem) -> list[tuple[str, Formula]]:
+def automaton_parts(p: RobotProblem) -> list[tuple[PartName, Formula]]:
     """The branching local mission ``p.automaton`` over the instants (see the module docstring).
 
     With :math:`g_e` the goal of event :math:`e` (:func:`_goal`), the parts are, for every
@@ -1128,7 +1244,7 @@ def initial_state(p: RobotProblem) -> Formula:
     return conj(parts)
 
 
-def specification(p: RobotProblem, events: Sequence[Event] | None = None) -> list[tuple[str, Formula]]:
+def specification(p: RobotProblem, events: Sequence[Event] | None = None) -> list[tuple[PartName, Formula]]:
     """The named parts of :math:`\\phi_{\\mathcal{P}}(\\mathcal{M}) \\wedge \\phi_{K}` for one robot.
 
     Every part holds at instant 0 of a plan; their conjunction is the whole specification.
@@ -1143,7 +1259,7 @@ def specification(p: RobotProblem, events: Sequence[Event] | None = None) -> lis
     codes = [a.code for a in p.actions]
     primitives = p.primitives
     assert primitives is not None  # set by RobotProblem
-    parts: list[tuple[str, Formula]] = [
+    parts: list[tuple[PartName, Formula]] = [
         ("initial state", initial_state(p)),
         ("one primitive per step", Always(Implies(Next(TRUE), Next(disj(p.pi.eq(c) for c in codes))))),
     ]

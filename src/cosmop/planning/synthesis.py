@@ -30,7 +30,6 @@ quarter slower than in a local worker process.
 
 from __future__ import annotations
 
-import re
 import time
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
@@ -46,12 +45,14 @@ from cosmop.events import MESSAGE_KINDS, Event, Primitive, parse_event
 from cosmop.io import collector_paused
 from cosmop.logic import Formula, IncrementalUnrolling, Signature, Unrolling, assert_all, conj, to_fraction
 from cosmop.planning.messages import answer_early, place_mission_messages, strip_messages, wait_early
-from cosmop.planning.obstacles import Geometry, obstacle_of
+from cosmop.planning.obstacles import Geometry
 from cosmop.planning.plan_types import ObjectState, RobotPlan, State, Step
 from cosmop.planning.reach import unreachable
 from cosmop.planning.specification import (
     MOTION_MARGIN,
     NONE,
+    ObstaclePart,
+    PartName,
     RobotProblem,
     decode,
     events_of,
@@ -149,7 +150,7 @@ def _plan(
                 objects,
             )
         )
-    return RobotPlan.from_steps([e.name for e in word], steps), tuple(requested)
+    return RobotPlan.from_steps(word, steps), tuple(requested)
 
 
 def _count_requests(p: RobotProblem, unrolling: Unrolling | IncrementalUnrolling) -> z3.ArithRef:
@@ -641,7 +642,7 @@ def _explain_automaton(p: RobotProblem, K: int, rlimit: int) -> tuple[str, tuple
     """Why no word of a branching mission can be planned within ``K`` steps (a minimal core)."""
     blocking = _core(p, specification(p), K, rlimit)
     head = f"{p.robot} cannot complete any word of its mission within {K} steps"
-    return _because(head, _as_written(p.scene, blocking), K), blocking or ()
+    return _because(head, _as_written(p.scene, blocking), K), tuple(part.text for part in blocking or ())
 
 
 def _explain(p: RobotProblem, events: tuple[Event, ...], K: int, rlimit: int) -> tuple[str, tuple[str, ...]]:
@@ -659,25 +660,21 @@ def _explain(p: RobotProblem, events: tuple[Event, ...], K: int, rlimit: int) ->
         assert event.obj is not None  # picks and drops name their object
         sides = p.scene.objects[event.obj].sides
         reason += f" (sides of {event.obj} tried: {', '.join(sides)})"
-    return reason, blocking or ()
+    return reason, tuple(part.text for part in blocking or ())
 
 
-_WALL_PART = re.compile(r"\bwall (\d+)(?P<rest>( past its ends)?)(?: \[\[[^\]]*\], \[[^\]]*\]\])?")
-
-
-def _as_written(scene: Scene, blocking: tuple[str, ...] | None) -> tuple[str, ...] | None:
+def _as_written(scene: Scene, blocking: tuple[ObstaclePart, ...] | None) -> tuple[str, ...] | None:
     """`blocking` in the user's words: a wall the planner added is named by its label (what it
     keeps the robot out of), and parts that name the same thing are said once."""
-    if not blocking:
-        return blocking
+    if blocking is None:
+        return None
 
-    def name(match: re.Match[str]) -> str:
-        label = scene.obstacles[int(match.group(1))].label
-        whole: str = match.group(0)
-        rest: str = match.group("rest")
-        return whole if label is None else label + rest
+    def name(part: ObstaclePart) -> str:
+        wall = part.obstacle.wall
+        label = scene.obstacles[wall].label if wall is not None else None
+        return part.text if label is None else part.labelled(label)
 
-    return tuple(dict.fromkeys(_WALL_PART.sub(name, part) for part in blocking))
+    return tuple(dict.fromkeys(name(part) for part in blocking))
 
 
 def _because(head: str, blocking: tuple[str, ...] | None, K: int) -> str:
@@ -691,8 +688,8 @@ def _because(head: str, blocking: tuple[str, ...] | None, K: int) -> str:
 
 
 def _core(
-    p: RobotProblem, parts: Sequence[tuple[str, Formula]], K: int, rlimit: int
-) -> tuple[str, ...] | None:
+    p: RobotProblem, parts: Sequence[tuple[PartName, Formula]], K: int, rlimit: int
+) -> tuple[ObstaclePart, ...] | None:
     """A minimal set of obstacle parts of `parts` that leaves no plan of ``K`` steps.
 
     Every other part (the initial state, the primitives' effects, the mission) is asserted;
@@ -705,10 +702,10 @@ def _core(
     ctx = z3.Context()
     u = Unrolling(Signature.of(conj(f for _, f in parts)), K, ctx=ctx)
     s = _solver(rlimit, ctx)
-    names: dict[str, str] = {}
+    names: dict[str, ObstaclePart] = {}
     guards = []
     for j, (name, f) in enumerate(parts):
-        if obstacle_of(name) is not None:
+        if isinstance(name, ObstaclePart):
             label = z3.Bool(f"part{j}", ctx)
             names[str(label)] = name
             guards.append(label)

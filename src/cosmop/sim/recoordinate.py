@@ -24,7 +24,7 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from cosmop.events import Event, Primitive, parse_event
+from cosmop.events import Event, Primitive
 from cosmop.planning.plan_types import PlanMessage, RobotPlan, State, Step
 from cosmop.planning.primitive_effects import initial_state
 from cosmop.scene import Scene
@@ -45,14 +45,14 @@ class Remaining:
     Attributes
     ----------
     steps : tuple of Step
-    mission : tuple of str
+    mission : tuple of Event
         The events those steps still realise, messages included, in order.
     start : State
         Where the robot is and how it sees the objects now.
     """
 
     steps: tuple[Step, ...]
-    mission: tuple[str, ...]
+    mission: tuple[Event, ...]
     start: State
 
 
@@ -68,7 +68,7 @@ class Recoordination:
         Every robot's rest of plan, with the new messages in place (when accepted).
     messages : tuple of PlanMessage
         The messages added.
-    dropped : tuple of str
+    dropped : tuple of Event
         The conflict messages of the old plans that the new order replaces.
     reason : str, optional
         Why not, when not accepted.
@@ -77,27 +77,27 @@ class Recoordination:
     accepted: bool
     plans: Mapping[str, RobotPlan]
     messages: tuple[PlanMessage, ...]
-    dropped: tuple[str, ...]
+    dropped: tuple[Event, ...]
     reason: str | None = None
 
 
-def _without(rest: Remaining, names: set[str]) -> RobotPlan:
-    """The rest of a plan without the message steps and events in `names`."""
+def _without(rest: Remaining, events: set[Event]) -> RobotPlan:
+    """The rest of a plan without the message steps and events in `events`."""
     steps = [
-        s for s in rest.steps if not (s.message in names and s.primitive in (Primitive.REQ, Primitive.RES))
+        s for s in rest.steps if not (s.message in events and s.primitive in (Primitive.REQ, Primitive.RES))
     ]
     steps = [
         s
         for s in steps
-        if not (s.primitive == Primitive.REQ and s.message is None and _away_of(rest, s) in names)
+        if not (s.primitive == Primitive.REQ and s.message is None and _away_of(rest, s) in events)
     ]
-    mission = [e for e in rest.mission if e not in names]
+    mission = [e for e in rest.mission if e not in events]
     return RobotPlan.from_steps(mission, steps)
 
 
-def _away_of(rest: Remaining, step: Step) -> str | None:
+def _away_of(rest: Remaining, step: Step) -> Event | None:
     """The away event a ``Req(O)`` step waits for, from the mission."""
-    return next((e for e in rest.mission if e.startswith(f"away({step.object},")), None)
+    return next((e for e in rest.mission if e.kind == "away" and e.obj == step.object), None)
 
 
 def recoordinate(
@@ -105,9 +105,9 @@ def recoordinate(
     rests: Mapping[str, Remaining],
     robot: str,
     *,
-    sent: Iterable[str],
-    conflict_messages: Iterable[str],
-    used: set[str],
+    sent: Iterable[Event],
+    conflict_messages: Iterable[Event],
+    used: set[Event],
     positions: Mapping[str, tuple[float, float] | None],
     settings: ConflictSettings | None = None,
 ) -> Recoordination:
@@ -120,12 +120,12 @@ def recoordinate(
         Every robot's remaining plan (the stalled robot's new plan among them).
     robot : str
         The robot with the new plan.
-    sent : iterable of str
+    sent : iterable of Event
         Messages already sent (their waits are done).
-    conflict_messages : iterable of str
+    conflict_messages : iterable of Event
         The messages that keep plans apart (the others are the mission's own).
-    used : set of str
-        Message names already used (new ones avoid them; updated).
+    used : set of Event
+        Messages already used (new ones avoid them; updated).
     positions : Mapping[str, tuple or None]
         Where every object is now (``None``: carried).
     settings : ConflictSettings, optional
@@ -135,7 +135,7 @@ def recoordinate(
     Recoordination
     """
     sent = set(sent)
-    pending = {name for name in set(conflict_messages) - sent if robot in parse_event(name).owners}
+    pending = {event for event in set(conflict_messages) - sent if robot in event.owners}
     drop = sent | pending
     plans = {r: _without(rest, drop) for r, rest in rests.items()}
     starts = {r: rest.start for r, rest in rests.items()}
@@ -147,10 +147,10 @@ def recoordinate(
             False,
             {},
             (),
-            tuple(sorted(pending)),
+            tuple(sorted(pending, key=lambda e: e.name)),
             f"the new plans share a place no order resolves: {safety.unresolved[0].describe()}",
         )
-    return Recoordination(True, safety.plans, safety.messages, tuple(sorted(pending)))
+    return Recoordination(True, safety.plans, safety.messages, tuple(sorted(pending, key=lambda e: e.name)))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -160,7 +160,7 @@ def recoordinate(
 
 def recoordinate_world(
     world: World, agent: Agent, new: RobotPlan, start: State, settings: ConflictSettings | None = None
-) -> tuple[bool, str, list[str]]:
+) -> tuple[bool, str, list[Event]]:
     """Order the rest of every robot's plan again around `agent`'s `new` plan from `start`.
 
     When accepted, every robot's executor takes its new rest (``world.conflict_messages``
@@ -188,7 +188,7 @@ def recoordinate_world(
         else:
             todo = splits[other.id][1]
             rests[other.id] = Remaining(
-                tuple(other.steps[other.step_index :]), tuple(e.name for e in todo), _state_now(world, other)
+                tuple(other.steps[other.step_index :]), tuple(todo), _state_now(world, other)
             )
     positions = {
         oid: None
@@ -202,7 +202,7 @@ def recoordinate_world(
         agent.id,
         sent=world.sent_messages,
         conflict_messages=world.conflict_messages,
-        used=world.message_names,
+        used=world.used_messages,
         positions=positions,
         settings=settings or world.conflict_settings,
     )
@@ -229,7 +229,7 @@ def _install(agent: Agent, plan: RobotPlan, done: list[Event], *, new: bool) -> 
     kept = [] if new else agent.steps[k:]
     agent.plan_instants = agent.plan_instants[:k] + carry_instants(kept, agent.plan_instants[k:], plan.steps)
     agent.steps = agent.steps[:k] + list(plan.steps)
-    agent.mission = list(done) + [parse_event(e) for e in plan.mission]
+    agent.mission = list(done) + list(plan.mission)
     if new or (k < len(agent.steps) and agent.steps[k] != current):
         agent.restart_step()
 

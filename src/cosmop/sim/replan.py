@@ -131,9 +131,7 @@ def replan_stalled(world: World, agent: Agent) -> None:
     world.replan_attempts += 1
     _, todo = agent.split_mission(world.scenario)
     # the mission's own events and messages; messages that kept plans apart are ordered afresh
-    remaining = [
-        e for e in todo if e.name not in world.conflict_messages and e.name not in world.sent_messages
-    ]
+    remaining = [e for e in todo if e not in world.conflict_messages and e not in world.sent_messages]
     start = start_state(world, agent, {e.obj for e in remaining if e.kind == "pick"})
     # A replan should not be much longer than what is left of the plan: bound the search there
     # (an infeasible replan -- a blocked doorway -- would otherwise search every horizon).
@@ -159,7 +157,7 @@ def replan_stalled(world: World, agent: Agent) -> None:
             "robot": agent.id,
             "accepted": accepted,
             "why": why or None,
-            "messages": added,
+            "messages": [event.name for event in added],
         }
     )
     if accepted:
@@ -185,7 +183,7 @@ def route(agent: Agent, start: Sequence[float]) -> dict[str, Any]:
             {
                 "pose": [round(float(v), 3) for v in s.robot],
                 "primitive": str(s.primitive),
-                "about": s.object or s.message,
+                "about": s.object or (s.message.name if s.message is not None else None),
             }
             for s in steps
         ],

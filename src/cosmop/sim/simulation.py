@@ -328,7 +328,7 @@ def _result(
         robot_ids=world.robot_ids,
         human_ids=world.human_ids,
         object_ids=world.object_ids,
-        events=tuple(world.events),
+        events=tuple((t, robot, event.name) for t, robot, event in world.events),
         added=tuple(e.name for task in plans.added for e in task.events),
         replan_log=tuple(world.replan_log),
         delays=world.settings.delays,

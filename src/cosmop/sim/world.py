@@ -21,7 +21,7 @@ from cosmop.control.dwa import Obstacles
 from cosmop.control.geometry import box_gaps, point_segment_linf, rect_gaps, segment_array, segment_bounds
 from cosmop.control.paths import GlobalPath
 from cosmop.control.safety import Limits
-from cosmop.events import MESSAGE_KINDS, Event, Primitive, parse_event, realising_step
+from cosmop.events import MESSAGE_KINDS, Event, Primitive, realising_step
 from cosmop.planning.plan_types import PlanSet, Pose, RobotPlan, Step
 from cosmop.planning.realisation import event_instants
 from cosmop.scenario.overlaps import TOUCH  # the one tolerance under which two squares touch
@@ -171,7 +171,7 @@ class Agent:
         scenario : Scenario
             The running scenario.
         """
-        plan = RobotPlan.from_steps([e.name for e in self.mission], self.steps)
+        plan = RobotPlan.from_steps(self.mission, self.steps)
         instants = event_instants(plan, self.id, scenario.scene)
         done = [
             e for e, t in zip(self.mission, instants, strict=True) if t is not None and t <= self.step_index
@@ -221,9 +221,9 @@ class World:
             steps = plan.steps if plan is not None else ()
             events = plan.events if plan is not None else ()
             self.agents.append(Agent(rid, i, steps, events))
-        self.sent_messages: set[str] = set()  # the message events sent so far
-        self.events: list[tuple[float, str, str]] = [  # (t, robot, event) as the robots do them
-            (0.0, a.id, f"return({a.id})")
+        self.sent_messages: set[Event] = set()  # the message events sent so far
+        self.events: list[tuple[float, str, Event]] = [  # (t, robot, event) as the robots do them
+            (0.0, a.id, Event("return", a.id))
             for a in self.agents
             if a.done and any(e.kind == "return" for e in a.mission)
         ]
@@ -234,11 +234,9 @@ class World:
         self.replans = 0  # accepted replans
         self.replan_attempts = 0
         self.replan_log: list[dict[str, Any]] = []  # every replan: time, robot, accepted, messages
-        # the messages that keep plans apart (re-ordered on a replan) and every message name used
+        # the messages that keep plans apart (re-ordered on a replan) and every message used
         self.conflict_messages = {m.event for m in plans.messages if m.kind == "conflict"}
-        self.message_names = {
-            name for p in plans.robots.values() for name in p.mission if name.startswith("msg(")
-        }
+        self.used_messages = {e for p in plans.robots.values() for e in p.mission if e.kind == "msg"}
         self.t = 0.0  # simulated time, s
         self._layout_key: tuple[bytes, bytes] | None = None  # what the sensed layout was made for
         self._static_memo: dict[
@@ -558,7 +556,7 @@ class World:
             Its ``Res`` step.
         """
         if step.message is not None:
-            event = parse_event(step.message)
+            event = step.message
         else:
             assert step.object is not None  # a Res without a message answers about its object
             answers = agent.realising(Primitive.RES, step.object)
@@ -567,8 +565,8 @@ class World:
             event = answers[min(sent, len(answers) - 1)]
         assert event.receiver is not None  # a message event
         self.messages.append(Message(round(self.t, 6), agent.id, event.receiver, event.obj, event.name))
-        self.sent_messages.add(event.name)
-        self.events.append((round(self.t, 6), agent.id, event.name))
+        self.sent_messages.add(event)
+        self.events.append((round(self.t, 6), agent.id, event))
 
     def awaited(self, agent: Agent, step: Step) -> Event | None:
         """The message a ``Req`` step waits for: its ``msg``, or the first ``away`` request about
@@ -582,8 +580,8 @@ class World:
             Its ``Req`` step.
         """
         if step.message is not None:
-            return parse_event(step.message)
-        pending = [e for e in agent.realising(Primitive.REQ, step.object) if e.name not in self.sent_messages]
+            return step.message
+        pending = [e for e in agent.realising(Primitive.REQ, step.object) if e not in self.sent_messages]
         return pending[0] if pending else None
 
     def received(self, agent: Agent, step: Step) -> bool:
@@ -598,7 +596,7 @@ class World:
         """
         if step.message is not None:
             return step.message in self.sent_messages
-        return any(e.name in self.sent_messages for e in agent.realising(Primitive.REQ, step.object))
+        return any(e in self.sent_messages for e in agent.realising(Primitive.REQ, step.object))
 
     def _happened(self, event: Event) -> bool:
         """Whether the step that realises `event` made it happen: a drop left its object in the
@@ -607,7 +605,7 @@ class World:
             xy = self.object_xy[self.object_ids.index(event.obj)]
             return drop_holds(self.scenario.scene, event, xy)
         if event.kind in MESSAGE_KINDS:
-            return event.name in self.sent_messages
+            return event in self.sent_messages
         return True
 
     def log_events(self, agent: Agent, step: Step) -> None:
@@ -620,7 +618,7 @@ class World:
         step : Step
             The step it finished.
         """
-        done = {name for _, robot, name in self.events if robot == agent.id}
+        done = {event for _, robot, event in self.events if robot == agent.id}
         realised = (step.primitive, step.object, step.message)
         wanted = [
             e
@@ -629,14 +627,14 @@ class World:
             and realising_step(e, agent.id) == realised
             and self._happened(e)
         ]
-        event = next((e for e in wanted if e.name not in done), None)
+        event = next((e for e in wanted if e not in done), None)
         if event is not None:
-            self.events.append((round(self.t, 6), agent.id, event.name))
-            done.add(event.name)
+            self.events.append((round(self.t, 6), agent.id, event))
+            done.add(event)
         # ``return`` holds as soon as the robot is home with the events before it done (as in
         # the plan: messages it sends from home come after it)
-        pending = next((e for e in agent.mission if e.name not in done), None)
+        pending = next((e for e in agent.mission if e not in done), None)
         if pending is not None and pending.kind == "return":
             home = self.scenario.scene.robots[agent.id].pose
             if math.dist(self.pose[agent.index, :2], home[:2]) <= self.settings.goal_tolerance + 1e-6:
-                self.events.append((round(self.t, 6), agent.id, pending.name))
+                self.events.append((round(self.t, 6), agent.id, pending))

@@ -216,7 +216,8 @@ def _settle_own_choices(
         )
         for (r, (words, forbidden)), res in results.items():
             if res.plan is not None:
-                costs[(r, res.plan.mission, forbidden)] = res
+                # the alternatives' words are the automaton's letters: the events' names
+                costs[(r, tuple(e.name for e in res.plan.mission), forbidden)] = res
                 planner.remember(r, res.plan.events, forbidden, res)
             else:  # no word of the group can be planned: each keeps the reason
                 costs.update({(r, w, forbidden): res for w in words})
@@ -231,7 +232,7 @@ def _settle_own_choices(
             if job is None:
                 return True
             plan = results[(robot, job)].plan
-            return plan is None or plan.mission == alt.words[robot]
+            return plan is None or tuple(e.name for e in plan.mission) == alt.words[robot]
 
         found = Alternatives(tuple(a for a in found.items if cheapest(a)), found.exhaustive, found.explored)
     return found, costs, settled

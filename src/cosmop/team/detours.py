@@ -190,7 +190,7 @@ def _drop_elsewhere(
 def _team_safe(planner: Planner, plans: Mapping[str, RobotPlan], settings: ConflictSettings) -> TeamSafety:
     """:func:`make_team_safe` of `plans`, its new messages named apart from those the plans
     already send, timed as the conflict phase."""
-    used = {name for p in plans.values() for name in p.mission if name.startswith("msg(")}
+    used = {e for p in plans.values() for e in p.mission if e.kind == "msg"}
     t0 = time.perf_counter()
     safety = make_team_safe(planner.scenario.scene, plans, settings=settings, used=used)
     planner.count_time("conflicts", time.perf_counter() - t0)

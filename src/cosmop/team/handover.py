@@ -169,14 +169,14 @@ def handovers(words: Mapping[str, Sequence[Event]]) -> Handovers:
 def _order(words: Mapping[str, Sequence[Event]]) -> Precedence:
     """The team's order on the words' events: program order and messages (event *i* of a
     word is step *i*; a message's receiver performs it after its sender)."""
-    sends: dict[str, tuple[str, int]] = {}
-    waits: dict[str, tuple[str, int]] = {}
+    sends: dict[Event, tuple[str, int]] = {}
+    waits: dict[Event, tuple[str, int]] = {}
     for robot, word in words.items():
         for i, event in enumerate(word, 1):
             if event.is_message:
-                (sends if event.sender == robot else waits).setdefault(event.name, (robot, i))
+                (sends if event.sender == robot else waits).setdefault(event, (robot, i))
     links = [
-        Link(name, sends[name][0], sends[name][1], waits[name][0], waits[name][1])
-        for name in sorted(set(sends) & set(waits))
+        Link(event, sends[event][0], sends[event][1], waits[event][0], waits[event][1])
+        for event in sorted(set(sends) & set(waits), key=lambda e: e.name)
     ]
     return Precedence({r: len(w) for r, w in words.items()}, links)

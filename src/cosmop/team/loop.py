@@ -258,7 +258,8 @@ def _loop(
     verdict = None
     if not reasons:
         t0 = time.perf_counter()
-        verdict = check_words(mission, {r: p.mission for r, p in plans.items()})
+        # the mission's automaton reads letters: the events' names
+        verdict = check_words(mission, {r: tuple(e.name for e in p.mission) for r, p in plans.items()})
         planner.phases["verify"] = time.perf_counter() - t0
         if not verdict.holds:
             reasons = (verdict.reason() or "the coordinated missions violate the global mission",)
@@ -323,8 +324,8 @@ def _plan_messages(plans: Mapping[str, RobotPlan], notes: Mapping[str, tuple[str
     """The plan file's entries for the messages of the mission (orders, user's messages)."""
     out = []
     for robot, plan in plans.items():
-        for name in plan.mission:
-            if name in notes and (event := parse_event(name)).kind == "msg" and event.sender == robot:
-                kind, text = notes[name]
-                out.append(PlanMessage(name, kind, text))
+        for event in plan.mission:
+            if event.kind == "msg" and event.sender == robot and event.name in notes:
+                kind, text = notes[event.name]
+                out.append(PlanMessage(event, kind, text))
     return out

@@ -30,12 +30,20 @@ from typing import TypeAlias
 import numpy as np
 
 from cosmop.automata import DFA
-from cosmop.events import Link, parse_event
+from cosmop.events import Event, Link, parse_event
 from cosmop.missions.mission import GlobalMission
 from cosmop.missions.verification import Verification, verify
 from cosmop.team.precedence import Precedence
 
-__all__ = ["TeamVerdict", "blocking_word", "check_words", "team_modules", "verify_team", "word_links"]
+__all__ = [
+    "TeamVerdict",
+    "blocking_word",
+    "check_words",
+    "stuck_waits",
+    "team_modules",
+    "verify_team",
+    "word_links",
+]
 
 
 def word_links(words: Mapping[str, Sequence[str]]) -> list[Link]:
@@ -46,21 +54,20 @@ def word_links(words: Mapping[str, Sequence[str]]) -> list[Link]:
     words : mapping of str to sequence of str
         Every robot's word (event names), messages included.
     """
-    sends: dict[str, tuple[str, int]] = {}
-    waits: dict[str, tuple[str, int]] = {}
+    sends: dict[Event, tuple[str, int]] = {}
+    waits: dict[Event, tuple[str, int]] = {}
     for robot, word in words.items():
         for k, name in enumerate(word, 1):
-            event = parse_event(name)
+            event = parse_event(name)  # the words are the automata's letters: text
             if event.is_message:
-                (sends if robot == event.sender else waits).setdefault(name, (robot, k))
+                (sends if robot == event.sender else waits).setdefault(event, (robot, k))
     out = []
-    for name in sorted(set(sends) | set(waits)):
-        event = parse_event(name)
+    for event in sorted(set(sends) | set(waits), key=lambda e: e.name):
         assert event.sender is not None and event.receiver is not None  # a message names both
-        send = sends.get(name)
-        wait = waits.get(name)
+        send = sends.get(event)
+        wait = waits.get(event)
         out.append(
-            Link(name, event.sender, send[1] if send else None, event.receiver, wait[1] if wait else None)
+            Link(event, event.sender, send[1] if send else None, event.receiver, wait[1] if wait else None)
         )
     return out
 
@@ -170,6 +177,18 @@ def blocking_word(words: Mapping[str, Sequence[str]]) -> tuple[str, ...] | None:
     done = [words[r][k - 1] for r, k in precedence.order]
     waiting = [f"[{r} waits for {words[r][k - 1]}]" for r, k in precedence.stuck.items()]
     return tuple(done + waiting)
+
+
+def stuck_waits(words: Mapping[str, Sequence[str]]) -> dict[str, int]:
+    """Where the robots stuck in the team's deadlock wait: ``{robot: instant}`` (1-based, the
+    waits :func:`blocking_word` ends with, in its order); empty if the words cannot block.
+
+    Parameters
+    ----------
+    words : mapping of str to sequence of str
+        Every robot's word (event names), messages included.
+    """
+    return dict(Precedence({r: len(w) for r, w in words.items()}, word_links(words)).stuck)
 
 
 def verify_team(

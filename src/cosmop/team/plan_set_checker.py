@@ -28,7 +28,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 
 from cosmop.errors import EventSyntaxError
-from cosmop.events import Event, Link, Primitive, parse_event
+from cosmop.events import Event, Link, Primitive
 from cosmop.missions.mission import GlobalMission
 from cosmop.planning.checker import check_robot_plan
 from cosmop.planning.plan_types import PlanSet, RobotPlan
@@ -56,7 +56,7 @@ def _messages(plan: PlanSet, plans: Mapping[str, RobotPlan]) -> list[Violation]:
                     link.receiver,
                     link.wait,
                     "message",
-                    f"{link.receiver} waits at instant {link.wait} for {link.event}, which "
+                    f"{link.receiver} waits at instant {link.wait} for {link.event.name}, which "
                     f"{link.sender}'s plan never sends: the robot would wait forever",
                 )
             )
@@ -66,7 +66,7 @@ def _messages(plan: PlanSet, plans: Mapping[str, RobotPlan]) -> list[Violation]:
                     link.sender,
                     link.send,
                     "message",
-                    f"{link.sender} sends {link.event} at instant {link.send}, but "
+                    f"{link.sender} sends {link.event.name} at instant {link.send}, but "
                     f"{link.receiver}'s plan never waits for it",
                 )
             )
@@ -91,19 +91,19 @@ def _messages(plan: PlanSet, plans: Mapping[str, RobotPlan]) -> list[Violation]:
                 "is one too many",
             )
         )
-    for robot, instant, name, first in repeated_messages(plans):
-        does = "sends" if parse_event(name).sender == robot else "awaits"
+    for robot, instant, event, first in repeated_messages(plans):
+        does = "sends" if event.sender == robot else "awaits"
         out.append(
             _violation(
                 robot,
                 instant,
                 "message",
-                f"{robot} {does} {name} again at instant {instant} (first at instant {first}); every message "
-                "is sent once and awaited once",
+                f"{robot} {does} {event.name} again at instant {instant} (first at instant {first}); "
+                "every message is sent once and awaited once",
             )
         )
-    used = {link.event for link in links if link.event.startswith("msg(")}
-    listed = {m.event for m in plan.messages}
+    used = {link.event.name for link in links if link.event.kind == "msg"}
+    listed = {m.event.name for m in plan.messages}
     for name in sorted(used - listed):
         out.append(_violation(None, None, "message", f"the plans use {name}, but the messages list lacks it"))
     for name in sorted(listed - used):
@@ -156,7 +156,8 @@ def check_team(
                     f"{conflict.describe()}, and no message orders them: the robots may meet there",
                 )
             )
-    words = {r: plans[r].mission if r in plans else () for r in scene.robots}
+    # the mission's automaton reads letters: the events' names
+    words = {r: tuple(e.name for e in plans[r].mission) if r in plans else () for r in scene.robots}
     verdict = check_words(GlobalMission.from_scenario(scenario), words)
     if not verdict.holds:
         violations.append(_violation(None, None, "mission", f"{verdict.reason()}"))
@@ -180,7 +181,7 @@ def _itinerary(plan: PlanSet, links: Sequence[Link]) -> list[Violation]:
                     link.receiver,
                     link.wait,
                     "itinerary",
-                    f"the itinerary has {link.receiver} stop waiting for {link.event} at {waited:g} s "
+                    f"the itinerary has {link.receiver} stop waiting for {link.event.name} at {waited:g} s "
                     f"(instant {link.wait}), but {link.sender} sends it at {sent:g} s (instant {link.send})",
                 )
             )
@@ -302,8 +303,8 @@ def _check_tasks(
                     robot_id,
                     None,
                     "mission",
-                    f"{robot_id}: the plan's mission ({', '.join(plan.mission) or 'empty'}) does not contain "
-                    f"the scenario's tasks ({tasks}) in order; {task.name} is missing",
+                    f"{robot_id}: the plan's mission ({', '.join(e.name for e in plan.mission) or 'empty'}) "
+                    f"does not contain the scenario's tasks ({tasks}) in order; {task.name} is missing",
                 )
             ]
         matched.add(position)
@@ -364,7 +365,7 @@ def _check_coordination(plan: PlanSet) -> list[Violation]:
                             f"but the plan has no plan for {robot_id}",
                         )
                     )
-            elif event.name not in planned.mission:
+            elif event not in planned.mission:
                 primitive = Primitive.REQ if role == "requester" else Primitive.RES
                 violations.append(
                     Violation(

@@ -24,7 +24,7 @@ from cosmop.squares import square
 from cosmop.team.aside import ROOM, place_aside
 from cosmop.team.conflicts import ConflictSettings
 from cosmop.team.coordination_events import Coordinated, coordinate
-from cosmop.team.mission_proof import blocking_word
+from cosmop.team.mission_proof import stuck_waits
 from cosmop.team.planner import Planner, Replanned
 from cosmop.team.walls import walls_around
 from cosmop.units import show_point
@@ -167,11 +167,11 @@ def _bad_requests(coordinated: Coordinated) -> list[dict[str, dict[str, str]]]:
         return [unanswered] if unanswered else []
     words = {r: [e.name for e in seq] for r, seq in coordinated.sequences.items()}
     options = []
-    for line in blocking_word(words) or ():
-        if line.startswith("[") and " waits for away(" in line:
-            robot, _, event = line[1:-1].partition(" waits for ")
-            obj = event[5:].split(",")[0]
-            options.append({robot: {obj: f"waiting for {obj} deadlocks the team ({event})"}})
+    for robot, k in stuck_waits(words).items():
+        event = coordinated.sequences[robot][k - 1]
+        if event.kind == "away" and event.obj is not None:
+            obj = event.obj
+            options.append({robot: {obj: f"waiting for {obj} deadlocks the team ({event.name})"}})
     return options
 
 

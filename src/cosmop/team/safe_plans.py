@@ -24,7 +24,7 @@ from dataclasses import dataclass, field, replace
 import shapely
 from shapely.geometry.base import BaseGeometry
 
-from cosmop.events import Link, Node, Primitive, parse_event
+from cosmop.events import Event, Link, Node, Primitive
 from cosmop.io import collector_paused
 from cosmop.planning.messages import CUT_GRAIN, cut_drives, merge_drives, place_edges, split_drives
 from cosmop.planning.plan_types import PlanMessage, RobotPlan, State
@@ -53,8 +53,8 @@ _Drive = tuple[tuple[float, float], tuple[float, float]]
 _Order = tuple[tuple[Node, Node], Conflict]
 """A start edge chosen for a conflict, with the conflict."""
 
-_Placed = tuple[str, tuple[Node, Node], tuple[Node, Node]]
-"""A message placed for a start edge: its name, the edge, and the edge in the new instants."""
+_Placed = tuple[Event, tuple[Node, Node], tuple[Node, Node]]
+"""A message placed for a start edge: its event, the edge, and the edge in the new instants."""
 
 _Context = tuple[
     Scene,
@@ -62,7 +62,7 @@ _Context = tuple[
     Mapping[str, State] | None,
     Mapping[str, tuple[float, float] | None] | None,
     str | None,
-    set[str] | None,
+    set[Event] | None,
 ]
 """What every ordering attempt shares: ``(scene, settings, starts, positions, about, used)``."""
 
@@ -78,8 +78,8 @@ class Wait:
         the shared place before it gets there).
     robot, other : str
         The robot that waits and the robot it waits for.
-    message : str
-        The message's event name.
+    message : Event
+        The message's event.
     conflict : Conflict
         The conflict the message orders.
     first, then : Occupancy
@@ -95,7 +95,7 @@ class Wait:
     seconds: float
     robot: str
     other: str
-    message: str
+    message: Event
     conflict: Conflict = field(repr=False)
     first: Occupancy = field(repr=False)
     then: Occupancy = field(repr=False)
@@ -233,7 +233,7 @@ def make_team_safe(
     plans: Mapping[str, RobotPlan],
     *,
     settings: ConflictSettings | None = None,
-    used: set[str] | None = None,
+    used: set[Event] | None = None,
     starts: Mapping[str, State] | None = None,
     positions: Mapping[str, tuple[float, float] | None] | None = None,
     about: str | None = None,
@@ -248,8 +248,8 @@ def make_team_safe(
         Every robot's plan, sound alone, with the messages it already has (no deadlock).
     settings : ConflictSettings, optional
         How conflicts are found (default :class:`~cosmop.team.conflicts.ConflictSettings`).
-    used : set of str, optional
-        Message names already taken (new ones avoid them; the set is updated).
+    used : set of Event, optional
+        Messages already taken (new ones avoid them; the set is updated).
     starts : Mapping[str, State], optional
         The robots' states at instant 0 when it is not the scenario (re-coordination mid-run).
     positions : Mapping[str, tuple or None], optional
@@ -315,8 +315,8 @@ def _order(
     new_plans, placed = place_edges(scene, plans, [edge for edge, _ in kept], "clear", taken, starts)
     new_plans = {r: merge_drives(p, waypoints[r]) for r, p in new_plans.items()}
     messages = tuple(
-        PlanMessage(name, "conflict", _protects(new_plans, name, conflict), conflict.place)
-        for (name, _, _), (_, conflict) in zip(placed, kept, strict=True)
+        PlanMessage(event, "conflict", _protects(new_plans, event, conflict), conflict.place)
+        for (event, _, _), (_, conflict) in zip(placed, kept, strict=True)
     )
     final = Precedence(
         {r: p.horizon for r, p in new_plans.items()},
@@ -369,10 +369,10 @@ def _waits(
     """
     critical = _critical_waits(plans, order)
     out = []
-    for (name, _, _), ((first_step, _), conflict) in zip(placed, kept, strict=True):
-        robot, other = parse_event(name).receiver, parse_event(name).sender
+    for (event, _, _), ((first_step, _), conflict) in zip(placed, kept, strict=True):
+        robot, other = event.receiver, event.sender
         assert robot is not None and other is not None  # a message has both
-        k = next(k for k, s in enumerate(plans[robot].steps, 1) if s.message == name)
+        k = next(k for k, s in enumerate(plans[robot].steps, 1) if s.message == event)
         first, then = (conflict.a, conflict.b) if conflict.a.last == first_step else (conflict.b, conflict.a)
         seconds = float(order.finish[robot][k] - order.finish[robot][k - 1])
         drives: tuple[_Drive, ...] | None = None
@@ -383,8 +383,8 @@ def _waits(
             and then.first == then.last
         ):
             drives = (ends[first.first], ends[then.first])
-        out.append(Wait(seconds, robot, other, name, conflict, first, then, drives, (robot, k) in critical))
-    return tuple(sorted(out, key=lambda w: (-w.seconds, w.message)))
+        out.append(Wait(seconds, robot, other, event, conflict, first, then, drives, (robot, k) in critical))
+    return tuple(sorted(out, key=lambda w: (-w.seconds, w.message.name)))
 
 
 def _critical_waits(plans: Mapping[str, RobotPlan], order: Precedence) -> set[Node]:
@@ -501,12 +501,11 @@ def _roomy(
     return roomy
 
 
-def _protects(plans: Mapping[str, RobotPlan], name: str, conflict: Conflict) -> str:
-    event = parse_event(name)
+def _protects(plans: Mapping[str, RobotPlan], event: Event, conflict: Conflict) -> str:
     a, b = event.sender, event.receiver
     assert a is not None and b is not None  # a message has both
-    send = next(k for k, s in enumerate(plans[a].steps, 1) if s.message == name)
-    wait = next(k for k, s in enumerate(plans[b].steps, 1) if s.message == name)
+    send = next(k for k, s in enumerate(plans[a].steps, 1) if s.message == event)
+    wait = next(k for k, s in enumerate(plans[b].steps, 1) if s.message == event)
     cleared = plans[a].steps[send - 2].label if send >= 2 else "its start"
     entered = plans[b].steps[wait].label if wait < plans[b].horizon else "the end of its plan"
     return (

@@ -44,9 +44,9 @@ def waiting_words(scene: Scene, plans: PlanSet | None = None) -> dict[str, str]:
         know gets :meth:`Explainer.awaits`'s fallback.
     """
     explainer = Explainer(scene, plans)
-    names = [m.event for m in (plans.messages if plans is not None else ())]
-    names += [e for plan in (plans.robots.values() if plans is not None else ()) for e in plan.mission]
-    return {name: explainer.awaits(name) for name in dict.fromkeys(names) if _is_message(name)}
+    events = [m.event for m in (plans.messages if plans is not None else ())]
+    events += [e for plan in (plans.robots.values() if plans is not None else ()) for e in plan.mission]
+    return {e.name: explainer.awaits_event(e) for e in dict.fromkeys(events) if e.is_message}
 
 
 @dataclass(frozen=True)
@@ -68,7 +68,7 @@ class Explainer:
         Parameters
         ----------
         name : str
-            The message event's canonical name.
+            The message event's canonical name (as a trace writes it).
 
         Returns
         -------
@@ -79,9 +79,25 @@ class Explainer:
             event = parse_event(name)
         except EventSyntaxError:
             return f"waits for the message {name}"
+        return self.awaits_event(event)
+
+    def awaits_event(self, event: Event) -> str:
+        """Why a robot waits for the message `event` (:meth:`awaits`, for an event already read).
+
+        Parameters
+        ----------
+        event : Event
+            The message event (``msg`` or ``away``).
+
+        Returns
+        -------
+        str
+            A sentence such as "waits for R2 to clear the way near W3".
+        """
+        name = event.name
         if event.kind == "away":
             return f"waits for {event.responder} to move {event.obj} out of its way"
-        known = self._message(name)
+        known = self._message(event)
         sender = event.sender
         if known is None:
             return f"waits for a message from {sender} ({event.tag or name})"
@@ -104,10 +120,10 @@ class Explainer:
             return f"waits for {who} (a person) to pass"
         return f"gives way to {who}"
 
-    def _message(self, name: str) -> PlanMessage | None:
+    def _message(self, event: Event) -> PlanMessage | None:
         if self.plans is None:
             return None
-        return next((m for m in self.plans.messages if m.event == name), None)
+        return next((m for m in self.plans.messages if m.event == event), None)
 
     def _where(self, message: PlanMessage) -> str:
         """ "near W3" when the shared place lies near a workspace, else "at (x, y)" in the file's units."""
@@ -135,7 +151,7 @@ class Explainer:
         )
         if plan is None:
             return None
-        send = next((k for k, s in enumerate(plan.steps) if s.message == event.name), None)
+        send = next((k for k, s in enumerate(plan.steps) if s.message == event), None)
         for step in reversed(plan.steps[:send] if send is not None else ()):
             if step.primitive == Primitive.DROPOFF:
                 where = _drop_workspace(plan, step.object)
@@ -147,12 +163,7 @@ class Explainer:
 
 def _drop_workspace(plan: RobotPlan, obj: str | None) -> str | None:
     """The workspace the plan's mission drops `obj` in (its first drop of it)."""
-    for name in plan.mission:
-        event = parse_event(name)
+    for event in plan.mission:
         if event.kind == "drop" and event.obj == obj:
             return event.workspace
     return None
-
-
-def _is_message(name: str) -> bool:
-    return name.startswith(("msg(", "away("))

@@ -17,7 +17,7 @@ import textwrap
 from pathlib import Path
 from typing import Any
 
-from cosmop.events import parse_event
+from cosmop.events import Event
 from cosmop.io import write_atomic
 from cosmop.planning.plan_types import MESSAGE_PRIMITIVES, PlanSet, RobotPlan
 from cosmop.scene import Scene
@@ -136,11 +136,11 @@ def _boxes(ax: Any, squares: list[tuple[float, float, float]]) -> list[tuple[flo
     return out
 
 
-def _message_ends(plans: PlanSet, event: str) -> tuple[tuple[float, float], tuple[float, float]] | None:
+def _message_ends(plans: PlanSet, event: Event) -> tuple[tuple[float, float], tuple[float, float]] | None:
     """Where a message is sent and where it is waited for: the poses (mm) of the sender's step
     that sends `event` and of the receiver's step that waits for it; None if either is missing."""
     ends = []
-    for rid in (parse_event(event).sender, parse_event(event).receiver):
+    for rid in (event.sender, event.receiver):
         plan = plans.robots.get(rid) if rid is not None else None
         step = next((s for s in plan.steps if s.message == event), None) if plan is not None else None
         if step is None:
@@ -309,7 +309,7 @@ def _primitive_labels(plan: RobotPlan, colour: Any, messages: bool = True) -> li
     for step in plan.steps:
         if step.primitive in STEP_MARKS and (messages or step.message is None):
             x, y, _ = step.robot
-            what = step.object or (step.message.split(",")[-1].rstrip(")") if step.message else "")
+            what = step.object or (step.message.tag or "" if step.message is not None else "")
             text = STEP_MARKS[step.primitive] + (what if step.primitive in MESSAGE_PRIMITIVES else "")
             labels.append(Label(x, y, text, {"fontsize": 8, "color": colour, "weight": "bold"}))
     return labels
