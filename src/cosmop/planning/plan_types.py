@@ -296,11 +296,6 @@ class RobotPlan:
         steps = tuple(steps)
         return cls(tuple(mission), len(steps), steps)
 
-    @property
-    def events(self) -> tuple[Event, ...]:
-        """The mission (the same as :attr:`mission`; kept for the callers that name it so)."""
-        return self.mission
-
     def state(self, k: int, initial: State | None = None) -> State:
         """The state at instant `k`.
 

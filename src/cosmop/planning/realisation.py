@@ -130,7 +130,7 @@ def event_instants(
         One entry per event: its instant, or ``None`` for the first event that cannot be
         realised after the previous one and every event after it.
     """
-    events = plan.events if events is None else tuple(events)
+    events = plan.mission if events is None else tuple(events)
     states = [start or initial_state(scene, robot, plan, scene.objects), *(s.state for s in plan.steps)]
     out: list[int | None] = []
     last: int | None = None

@@ -576,7 +576,7 @@ def _place_messages(p: RobotProblem, plan: RobotPlan, full: tuple[Event, ...]) -
     plan = answer_early(plan)
     if p.start is None:  # where a robot waits for answers: before it drives (no start state mid-run)
         plan = wait_early(p.scene, p.robot, plan)
-    return place_mission_messages(p.scene, p.robot, plan, plan.events if p.automaton else full, p.start)
+    return place_mission_messages(p.scene, p.robot, plan, plan.mission if p.automaton else full, p.start)
 
 
 def _why_no_plan(

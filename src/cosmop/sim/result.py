@@ -407,7 +407,7 @@ class SimResult:
         scene = plans.extend(scenario).scene
         out: dict[str, bool] = {}
         for plan in plans.robots.values():
-            for event in plan.events:
+            for event in plan.mission:
                 if event.kind == "drop":
                     assert event.obj is not None  # a drop names its object
                     position, by = self.objects[event.obj]

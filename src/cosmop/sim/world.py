@@ -219,7 +219,7 @@ class World:
         for i, rid in enumerate(self.robot_ids):
             plan = plans.robots.get(rid)
             steps = plan.steps if plan is not None else ()
-            events = plan.events if plan is not None else ()
+            events = plan.mission if plan is not None else ()
             self.agents.append(Agent(rid, i, steps, events))
         self.sent_messages: set[Event] = set()  # the message events sent so far
         self.events: list[tuple[float, str, Event]] = [  # (t, robot, event) as the robots do them

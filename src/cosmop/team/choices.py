@@ -218,7 +218,7 @@ def _settle_own_choices(
             if res.plan is not None:
                 # the alternatives' words are the automaton's letters: the events' names
                 costs[(r, tuple(e.name for e in res.plan.mission), forbidden)] = res
-                planner.remember(r, res.plan.events, forbidden, res)
+                planner.remember(r, res.plan.mission, forbidden, res)
             else:  # no word of the group can be planned: each keeps the reason
                 costs.update({(r, w, forbidden): res for w in words})
 

@@ -27,7 +27,6 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 
-from cosmop.errors import EventSyntaxError
 from cosmop.events import Event, Link, Primitive
 from cosmop.missions.mission import GlobalMission
 from cosmop.planning.checker import check_robot_plan
@@ -265,13 +264,6 @@ def check_plan(scenario: Scenario, plan: PlanSet) -> CheckReport:
     return CheckReport(not violations, tuple(violations), checked)
 
 
-def _parsed(plan: RobotPlan) -> list[Event] | None:
-    try:
-        return list(plan.events)
-    except EventSyntaxError:
-        return None  # reported by check_robot_plan
-
-
 def _check_tasks(
     robot_id: str, sequence: tuple[Event, ...], plan: RobotPlan | None, extra: set[Event]
 ) -> list[Violation]:
@@ -289,9 +281,7 @@ def _check_tasks(
                 f"but the plan has no plan for {robot_id}",
             )
         ]
-    events = _parsed(plan)
-    if events is None:
-        return []
+    events = plan.mission
     matched: set[int] = set()
     position = 0
     for task in sequence:
@@ -338,7 +328,7 @@ def _check_coordination(plan: PlanSet) -> list[Violation]:
     violations = []
     pairs = {pair.event for pair in plan.coordination}
     for robot_id, robot_plan in plan.robots.items():
-        for event in _parsed(robot_plan) or ():
+        for event in robot_plan.mission:
             if event.kind == "away" and robot_id in event.owners and event not in pairs:
                 violations.append(
                     Violation(

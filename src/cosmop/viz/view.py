@@ -63,7 +63,7 @@ def _used(scene: Scene, plans: PlanSet) -> tuple[list[Box], set[str], set[str]]:
             if step.primitive == Primitive.DROPOFF and step.object in step.objects:
                 size = scene.objects[step.object].size if step.object in scene.objects else 0.0
                 boxes.append(_square(*step.objects[step.object].position, size))
-        workspaces |= {e.workspace for e in plan.events if e.kind == "drop" and e.workspace}
+        workspaces |= {e.workspace for e in plan.mission if e.kind == "drop" and e.workspace}
     if not plans.feasible and plans.reason:  # show what the reason talks about, too
         named = set(_ID.findall(plans.reason))
         objects |= named & set(scene.objects)
