@@ -87,6 +87,10 @@ def test_an_orders_file_is_read_against_the_scene(tmp_path):
     with pytest.raises(ScenarioError) as info:
         load_orders(path, scenario)
     assert str(info.value).startswith(f"{path}: orders[0].to[0]: unknown workspace 'W9'")
+    path.write_text("orders: [{at: 0, object: O1, to: W1}]\nfoo: 1\n")  # an orders file's keys
+    with pytest.raises(ScenarioError) as info:
+        load_orders(path, scenario)
+    assert str(info.value) == f"{path}: foo: unknown key 'foo'; expected one of: orders (line 2, column 1)"
 
 
 def test_the_fleet_delivers_the_stream_safely_and_ships_the_goods():
