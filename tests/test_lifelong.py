@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import json
 from functools import lru_cache
 
@@ -149,3 +150,45 @@ def test_cosmop_run_writes_the_summary_and_refuses_bad_options(tmp_path):
     assert unknown.exit_code == 2 and "R9 is not a robot" in unknown.stderr
     plan = runner.invoke(app, ["plan", str(scenario), "-o", str(tmp_path / "p.json")])
     assert plan.exit_code == 2 and "cosmop run" in plan.stderr
+
+
+def test_a_robot_with_work_waiting_takes_it_at_the_dock_not_after_going_home():
+    orders = [
+        {"at": 0, "object": "O1", "to": "W1", "by": "R1"},
+        {"at": 0, "object": "O2", "to": "W2", "by": "R1"},
+    ]
+    scenario = parse_scenario(_data(orders))
+    result = run_fleet(scenario, fleet=FleetSettings(until=150.0))
+    first, second = result.orders
+    assert first.delivered is not None and second.delivered is not None
+    given = [e for e in result.dispatch_log if e["order"] == 1 and e["accepted"]]
+    # handed over in the cycle that recorded the drop, from the dock
+    assert given and given[0]["t"] == pytest.approx(first.delivered, abs=0.11)
+    assert all(e["wall_s"] >= 0 for e in result.dispatch_log)
+    assert result.summary()["handover_wall_s"]["p50"] is not None
+    assert result.contacts_while_moving == 0
+
+
+def test_refused_hand_overs_keep_the_order_and_wait_longer_each_time(monkeypatch):
+    import cosmop.lifelong.fleet as fleet_module
+
+    real, refusals = fleet_module.recoordinate_world, []
+
+    def refuse_three_times(world, agent, plan, start):
+        if len(refusals) < 3:  # the world says "not now" three times
+            refusals.append(world.t)
+            return False, "a test refusal", []
+        return real(world, agent, plan, start)
+
+    monkeypatch.setattr(fleet_module, "recoordinate_world", refuse_three_times)
+    orders = [{"at": 0, "object": "O1", "to": "W1", "by": "R1"}]
+    result = run_fleet(parse_scenario(_data(orders)), fleet=FleetSettings(until=150.0))
+    (order,) = result.orders
+    assert order.lost is None and order.delivered is not None  # refusals alone lose nothing
+    gaps = [b - a for a, b in itertools.pairwise(refusals)]
+    # 5 s, then twice that, each to the next dispatch (one a second)
+    assert 5 <= gaps[0] <= 6.01 and 10 <= gaps[1] <= 11.01
+    assert (
+        order.refused is not None and order.refused.startswith("R1 at ") and "a test refusal" in order.refused
+    )
+    assert [e["accepted"] for e in result.dispatch_log] == [False, False, False, True]

@@ -37,9 +37,11 @@ class OrderState:
     delivered : float or None
         When its goods lay in the dock, s.
     lost : str or None
-        Why it will never be delivered (a robot failed carrying the goods, no robot can plan it).
+        Why it will never be delivered (a robot failed carrying the goods).
     tries : int
         Plans tried for it that were not handed over.
+    refused : str or None
+        The last refusal: which robot, when, and why (an order still pending says so).
     retry_at : float
         Not tried again before this time, s.
     """
@@ -52,6 +54,7 @@ class OrderState:
     delivered: float | None = None
     lost: str | None = None
     tries: int = 0
+    refused: str | None = None
     retry_at: float = 0.0
 
 

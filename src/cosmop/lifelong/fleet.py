@@ -13,8 +13,9 @@ cycle (:func:`cosmop.sim.simulation.advance`), and between cycles it
    messages and exact checks as a planned team (:func:`cosmop.sim.recoordinate.recoordinate_world`:
    the conflicts of every robot's rest are ordered again and the team proved deadlock-free);
    only then is it handed over.  The robots not involved keep their plans and keep moving.
-   An order whose plan is refused waits ``retry_after`` seconds; after ``max_tries`` it is
-   lost, with the reason;
+   An order whose plan is refused stays in the pool and waits ``retry_after`` seconds, twice
+   as long after each refusal up to ``max_retry_after``: in a world that moves, a refusal
+   says "not now", never "never", so refusals alone do not lose an order;
 3. ships delivered goods: once the drop is recorded the goods leave the world, so docks do not
    fill up (:meth:`cosmop.sim.world.World.ship`);
 4. fails robots (:class:`Failure`): a failed robot stands for good, its order returns to the
@@ -101,9 +102,10 @@ class FleetSettings:
     dispatch_every : float
         Seconds between two dispatches (each may hand over several orders).
     retry_after : float
-        Seconds an order waits after its plan was refused before it is tried again.
-    max_tries : int
-        Refused plans after which an order is lost.
+        Seconds an order waits after its first refused plan before it is tried again; the
+        wait doubles after each further refusal.
+    max_retry_after : float
+        The longest wait between two tries, s.
     max_horizon : int
         Longest plan of one order (steps).
     rlimit : int
@@ -113,7 +115,7 @@ class FleetSettings:
     until: float
     dispatch_every: float = 1.0
     retry_after: float = 5.0
-    max_tries: int = 3
+    max_retry_after: float = 60.0
     max_horizon: int = 16
     rlimit: int = 50_000_000
 
@@ -277,10 +279,8 @@ def _hand_over(run: _Run, agent: Agent, state: OrderState, goods: tuple[float, .
     )
     if not accepted:
         state.tries += 1
-        state.retry_at = world.t + fleet.retry_after
-        if state.tries >= fleet.max_tries:
-            state.lost = f"no robot could be given it ({state.tries} tries; last: {agent.id}, {why})"
-            run.pool.remove(state)
+        state.refused = f"{agent.id} at {world.t:.1f} s: {why}"
+        state.retry_at = world.t + min(fleet.retry_after * 2 ** (state.tries - 1), fleet.max_retry_after)
         return False
     state.robot, state.served_by, state.assigned = agent.id, agent.id, world.t
     run.pool.remove(state)

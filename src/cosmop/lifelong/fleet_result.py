@@ -54,6 +54,8 @@ class OrderRecord:
         When a robot took it and when its goods lay in the dock, s.
     lost : str or None
         Why it will never be delivered.
+    refused : str or None
+        Its last refused hand-over: which robot, when and why (why a pending order waits).
     """
 
     index: int
@@ -64,6 +66,7 @@ class OrderRecord:
     assigned: float | None
     delivered: float | None
     lost: str | None
+    refused: str | None = None
 
     @property
     def wait(self) -> float | None:
@@ -84,6 +87,7 @@ class OrderRecord:
             "robot": self.robot,
             **rounded,
             "lost": self.lost,
+            "refused": self.refused,
         }
 
 
@@ -169,7 +173,15 @@ class FleetResult:
         """
         orders = tuple(
             OrderRecord(
-                s.index, s.order.object, s.order.at, s.order.to, s.served_by, s.assigned, s.delivered, s.lost
+                s.index,
+                s.order.object,
+                s.order.at,
+                s.order.to,
+                s.served_by,
+                s.assigned,
+                s.delivered,
+                s.lost,
+                s.refused,
             )
             for s in states
         )
