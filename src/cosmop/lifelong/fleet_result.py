@@ -108,8 +108,9 @@ class FleetResult:
         Per failed robot: when (``t``), where it stands (``at``), what it carries, and whether
         the others could be ordered around it (``recoordinated``).
     dispatch_log : tuple of Mapping
-        Every hand-over tried: ``t``, ``order``, ``robot``, ``accepted``, ``why`` not, and
-        ``wall_s``, the wall time it took (plan, coordinate, check), s.
+        Every hand-over tried: ``t``, ``order``, ``robot``, ``accepted``, ``why`` not,
+        ``wall_s``, the wall time it took (plan, coordinate, check), s, and ``plan_wall_s``, the
+        part of it that planned the robot's mission (the rest ordered it with the others).
     contacts : tuple of Contact
     messages : tuple of Message
     replans : int
