@@ -63,7 +63,9 @@ def cosmop_row(data: dict, until: float, timeout: float) -> dict:
         "contacts_while_moving": s["contacts_while_moving"],
         "messages": s["messages"],
         "handover_wall_s": s.get("handover_wall_s"),
-        "handover_plan_wall_s_p50": _median([e["plan_wall_s"] for e in s["dispatch_log"] if "plan_wall_s" in e]),
+        "handover_plan_wall_s_p50": _median(
+            [e["plan_wall_s"] for e in s["dispatch_log"] if "plan_wall_s" in e]
+        ),
         "handovers_refused": sum(1 for e in s["dispatch_log"] if not e["accepted"]),
         "utilisation_mean": round(sum(s["utilisation"].values()) / max(len(s["utilisation"]), 1), 3),
     }
