@@ -192,3 +192,28 @@ def test_the_numeric_test_of_the_ends_never_passes_what_the_formula_breaks(monke
         sure += len(keys) - len(unsure)
         bites += len(bad - own)
     assert sure > 0 and bites > 0  # the pre-test passes some; the stronger part breaks some
+
+
+def test_obstacle_keys_are_one_object_each_and_survive_another_process():
+    import pickle
+    import subprocess
+    import sys
+
+    assert wall_key(3) is wall_key(3) and corner_clearance_key(object_key("O2")).base is object_key("O2")
+    assert str(corner_clearance_key(wall_key(3))) == "wall 3 past its ends"
+    # a worker process hashes text differently: the key is rebuilt there, not its hash copied
+    data = pickle.dumps({object_key("O2"): 1, wall_key(1, handling=True): 2})
+    code = (
+        "import pickle, sys; from cosmop.planning.specification import object_key, wall_key; "
+        "d = pickle.loads(sys.stdin.buffer.read()); "
+        "print(d[object_key('O2')], d[wall_key(1, handling=True)], next(iter(d)) is object_key('O2'))"
+    )
+    for seed in ("1", "2"):
+        out = subprocess.run(
+            [sys.executable, "-c", code],
+            input=data,
+            capture_output=True,
+            check=True,
+            env={"PYTHONHASHSEED": seed},
+        )
+        assert out.stdout.split() == [b"1", b"2", b"True"]

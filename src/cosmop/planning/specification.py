@@ -250,12 +250,22 @@ class ObstacleKey:
     obj: str | None = None
     handling: bool = False
     past_ends: bool = False
+    _hash: int = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if (self.wall is None) == (self.obj is None):
             raise ValueError("an obstacle is a wall or an object: give exactly one of them")
         if self.handling and (self.wall is None or self.past_ends):
             raise ValueError("only a wall has parts for picks and drops, and they have no stronger one")
+        # keys index the constraints of every synthesis: hash them once
+        object.__setattr__(self, "_hash", hash((self.wall, self.obj, self.handling, self.past_ends)))
+
+    def __hash__(self) -> int:
+        return self._hash
+
+    def __reduce__(self) -> tuple[Any, tuple[int | None, str | None, bool, bool]]:
+        # rebuilt where it is unpickled: a text's hash differs between processes
+        return (_key, (self.wall, self.obj, self.handling, self.past_ends))
 
     @property
     def text(self) -> str:
@@ -269,7 +279,7 @@ class ObstacleKey:
     @property
     def base(self) -> ObstacleKey:
         """The obstacle whose GoTo part this one strengthens, or the key itself."""
-        return ObstacleKey(self.wall, self.obj, self.handling) if self.past_ends else self
+        return _key(self.wall, self.obj, self.handling, False) if self.past_ends else self
 
     def __str__(self) -> str:
         return self.text
@@ -323,6 +333,13 @@ PartName = str | ObstaclePart
 """The name of a part of the specification: words, or an obstacle part's name."""
 
 
+@lru_cache(maxsize=1 << 16)
+def _key(wall: int | None, obj: str | None, handling: bool, past_ends: bool) -> ObstacleKey:
+    """One key per obstacle: equal keys are the same object, so dicts find them by identity
+    (hundreds of thousands of lookups in one team's syntheses)."""
+    return ObstacleKey(wall, obj, handling, past_ends)
+
+
 def wall_key(i: int, handling: bool = False) -> ObstacleKey:
     """Wall `i` (its index in the scene) as an obstacle: to drives (``"wall 3"``), or to picks
     and drops (``"wall 3 while handling"``: the gripper, the good set down).
@@ -334,7 +351,7 @@ def wall_key(i: int, handling: bool = False) -> ObstacleKey:
     handling : bool
         The wall to picks and drops, not to drives.
     """
-    return ObstacleKey(wall=i, handling=handling)
+    return _key(i, None, handling, False)
 
 
 def object_key(obj: str) -> ObstacleKey:
@@ -345,7 +362,7 @@ def object_key(obj: str) -> ObstacleKey:
     obj : str
         The object's id.
     """
-    return ObstacleKey(obj=obj)
+    return _key(None, obj, False, False)
 
 
 def corner_clearance_key(key: ObstacleKey) -> ObstacleKey:
@@ -364,7 +381,7 @@ def corner_clearance_key(key: ObstacleKey) -> ObstacleKey:
     key : ObstacleKey
         The obstacle (:func:`wall_key` to drives, or :func:`object_key`).
     """
-    return ObstacleKey(key.wall, key.obj, past_ends=True)
+    return _key(key.wall, key.obj, False, True)
 
 
 @dataclass(frozen=True)
