@@ -34,6 +34,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from fractions import Fraction
+from functools import lru_cache
 from typing import Any
 
 
@@ -70,6 +71,7 @@ def _support(vx: Fraction, vy: Fraction, half: Fraction) -> Fraction:
     return half * (abs(vx) + abs(vy))
 
 
+@lru_cache(maxsize=1 << 16)  # exact arithmetic, asked again for every wall at every synthesis
 def wall_regions(
     start: tuple[float, float], end: tuple[float, float], side: float | Fraction, name: str = "wall"
 ) -> tuple[HalfPlane, HalfPlane, HalfPlane, HalfPlane]:
