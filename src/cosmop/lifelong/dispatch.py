@@ -3,9 +3,10 @@
 Released orders wait in a pool, oldest first.  An order goes to an idle robot that may serve
 it (``Order.by``): the one with the least estimated work, the L1 distance from where it stands
 to the goods and from the goods to the nearest of the order's docks (mm).  A robot that is busy
-takes the next order as soon as it is idle again, so among busy robots the one whose committed
-plan ends soonest is served first.  The mission handed over is the order's delivery and the way
-home: ``pick``, ``drop`` at that dock, ``return``.
+competes again as soon as it has dropped its goods (from the dock, its way home still ahead)
+or is idle, so among busy robots the one whose order is done soonest is served first.  The
+mission handed over is the order's delivery and the way home: ``pick``, ``drop`` at that dock,
+``return``; the way home is replaced by the next order when one is given at the dock.
 """
 
 from __future__ import annotations
