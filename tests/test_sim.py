@@ -464,3 +464,33 @@ def test_a_robot_waiting_for_a_message_holds_no_robot_that_must_send_it():
     assert not world.crowded(r1.index)
     world.sent_messages.add(r2.step.message)
     assert world.crowded(r1.index)  # R2 may leave now: R1 keeps its promise
+
+
+def test_goods_are_put_down_only_where_no_robot_has_come_during_the_handling():
+    # The drop's spot is checked before the gripper works and again when it lets go: a robot
+    # that drove up during the handling time must not find goods appearing against it.
+    from cosmop.sim.execute import decide
+
+    scenario = load_scenario(EXAMPLES / "01_warehouse_2x2" / "scenario.yaml")
+    world = World(scenario, plan_team(scenario).plans, 0, SimSettings())
+    giver = next(a for a in world.agents if any(s.primitive == "DropOff" for s in a.steps))
+    other = next(a for a in world.agents if a is not giver)
+    giver.step_index = next(k for k, s in enumerate(giver.steps) if s.primitive == "DropOff")
+    step = giver.step
+    j = world.object_ids.index(step.object)
+    world.carried_by[j] = giver.index
+    world.pose[giver.index] = [*step.robot[:2], np.radians(step.robot[2])]
+    giver.dock_stage, giver.handling_left = "handle", world.dt  # the gripper's last cycle
+    spot = np.array(step.objects[step.object].position, dtype=float)
+    away = spot - world.pose[giver.index, :2]  # beyond the spot, seen from the giver
+    away /= np.abs(away).max()
+    reach = world.robot_half[other.index] + world.object_half[j] + 20.0  # 20 mm from the goods
+    world.pose[other.index] = [*(spot + away * reach), 0.0]
+    world.v[:] = 0.0
+    world.v[other.index] = 300.0  # driving: its stopping distance is far more than 20 mm
+    assert not world.crowded(giver.index)  # the giver itself is not crowded: only its spot is
+    decide(world, giver)
+    assert world.carried_by[j] == giver.index  # held: the goods would appear against a mover
+    world.pose[other.index] = [*(spot + away * (reach + 2000.0)), 0.0]  # it has driven on
+    decide(world, giver)
+    assert world.carried_by[j] == -1 and np.allclose(world.object_xy[j], spot)

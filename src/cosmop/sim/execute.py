@@ -238,7 +238,8 @@ def _dock_and_handle(
     than ``dock_tolerance`` from it; *dock* -- brake, then creep onto it (the gripper touches
     object `grip` from now on, if given); blocked within `reach` (mm) of the pose, the gripper
     works from there; it also waits until `clear` allows; *handle* -- stand ``handling_time``
-    (and while another robot crowds it: a parked robot keeps its promise), then `handle`.
+    (and while another robot crowds it: a parked robot keeps its promise), then `handle` once
+    `clear` allows again (another robot may have come close during the handling).
     """
     s = world.settings
     i = agent.index
@@ -269,6 +270,8 @@ def _dock_and_handle(
     if agent.dock_stage == "handle":
         agent.handling_left -= world.dt
         if agent.handling_left > 1e-9 or world.crowded(i):
+            return HOLD
+        if clear is not None and not clear():  # asked again: others moved during the handling
             return HOLD
         handle()
         return None
