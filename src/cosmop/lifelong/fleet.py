@@ -4,9 +4,9 @@
 cycle (:func:`cosmop.sim.simulation.advance`), and between cycles it
 
 1. releases the orders whose time has come into a pool (:mod:`.dispatch`);
-2. every ``dispatch_every`` seconds gives pooled orders to idle robots, and gives a robot that
-   has just dropped its goods the oldest pooled order it may serve at once, from the dock
-   (so that it goes home only when no work waits): the robot's next
+2. every ``dispatch_every`` seconds gives pooled orders to idle robots, and a robot that has
+   just dropped its goods competes for them at once, from the dock (so that it goes home only
+   when no work waits); each robot is tried once per dispatch.  The robot's next
    mission (pick, drop, home) is planned from where it stands, with the robots that stand
    (idle or failed) as obstacles (:func:`cosmop.sim.replan.replan`, every plan passing the
    exact checker), then ordered against the plans the others have committed to, by the same
@@ -236,8 +236,8 @@ def _dispatch(run: _Run, at_dock: Agent | None = None) -> None:
         )
         if robot is None:
             continue
-        if _hand_over(run, idle[robot], state, goods):
-            del idle[robot]
+        _hand_over(run, idle[robot], state, goods)
+        del idle[robot]  # given the order, or refused: one plan tried per robot and dispatch
 
 
 def _goods_at_rest(world: World, state: OrderState) -> tuple[float, ...] | None:
