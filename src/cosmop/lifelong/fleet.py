@@ -248,8 +248,9 @@ def _goods_at_rest(world: World, state: OrderState) -> tuple[float, ...] | None:
     return tuple(float(v) for v in world.object_xy[j])
 
 
-def _hand_over(run: _Run, agent: Agent, state: OrderState, goods: tuple[float, ...]) -> bool:
-    """Plan `agent`'s mission for `state`'s order, order it with the others' and hand it over."""
+def _hand_over(run: _Run, agent: Agent, state: OrderState, goods: tuple[float, ...]) -> None:
+    """Plan `agent`'s mission for `state`'s order, order it with the others' and hand it over;
+    a refusal leaves the order in the pool, to be tried again later (module docstring, step 2)."""
     world, fleet = run.world, run.fleet
     scene = world.scenario.scene
     began = time.perf_counter()  # the hand-over's wall time: dispatch, plan, coordinate, check
@@ -283,12 +284,11 @@ def _hand_over(run: _Run, agent: Agent, state: OrderState, goods: tuple[float, .
         state.tries += 1
         state.refused = f"{agent.id} at {world.t:.1f} s: {why}"
         state.retry_at = world.t + min(fleet.retry_after * 2 ** (state.tries - 1), fleet.max_retry_after)
-        return False
+        return
     state.robot, state.served_by, state.assigned = agent.id, agent.id, world.t
     run.pool.remove(state)
     run.busy[agent.id] = state
     run.busy_since.setdefault(agent.id, world.t)  # a robot given work at a dock stays busy
-    return True
 
 
 def _standing(run: _Run, agent: Agent) -> list[tuple[float, float, float]]:
