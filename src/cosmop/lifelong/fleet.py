@@ -4,9 +4,9 @@
 cycle (:func:`cosmop.sim.simulation.advance`), and between cycles it
 
 1. releases the orders whose time has come into a pool (:mod:`.dispatch`);
-2. every ``dispatch_every`` seconds gives pooled orders to idle robots, and a robot that has
-   just dropped its goods competes for them at once, from the dock (so that it goes home only
-   when no work waits); each robot is tried once per dispatch.  The robot's next
+2. every ``dispatch_every`` seconds, and at once when a robot has just dropped its goods (it
+   competes from the dock, so that it goes home only when no work waits), gives pooled orders
+   to idle robots; each robot is tried once per dispatch.  The robot's next
    mission (pick, drop, home) is planned from where it stands, with the robots that stand
    (idle or failed) as obstacles (:func:`cosmop.sim.replan.replan`, every plan passing the
    exact checker), then ordered against the plans the others have committed to, by the same

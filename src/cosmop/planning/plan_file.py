@@ -488,8 +488,3 @@ def load_plan(path: str | os.PathLike[str]) -> PlanSet:
         raise PlanError("the file is empty; expected a cosmop.plan/1 JSON object", file=file)
     data = load_json(text, file, PlanError, unique_keys=True)
     return _PlanReader(file, text).plan_set(data)  # the text: errors say the field's line
-
-
-# ----------------------------------------------------------------------------------------------
-# Writing
-# ----------------------------------------------------------------------------------------------

@@ -296,6 +296,12 @@ class RobotPlan:
         steps = tuple(steps)
         return cls(tuple(mission), len(steps), steps)
 
+    @property
+    def word(self) -> tuple[str, ...]:
+        """The mission as the top-down layer's automata read it: the events' names (their
+        letters)."""
+        return tuple(event.name for event in self.mission)
+
     def state(self, k: int, initial: State | None = None) -> State:
         """The state at instant `k`.
 

@@ -136,6 +136,7 @@ def recoordinate(
     """
     sent = set(sent)
     pending = {event for event in set(conflict_messages) - sent if robot in event.owners}
+    dropped = tuple(sorted(pending, key=lambda e: e.name))  # by name: the order the log shows
     drop = sent | pending
     plans = {r: _without(rest, drop) for r, rest in rests.items()}
     starts = {r: rest.start for r, rest in rests.items()}
@@ -147,10 +148,10 @@ def recoordinate(
             False,
             {},
             (),
-            tuple(sorted(pending, key=lambda e: e.name)),
+            dropped,
             f"the new plans share a place no order resolves: {safety.unresolved[0].describe()}",
         )
-    return Recoordination(True, safety.plans, safety.messages, tuple(sorted(pending, key=lambda e: e.name)))
+    return Recoordination(True, safety.plans, safety.messages, dropped)
 
 
 # ----------------------------------------------------------------------------------------------

@@ -216,8 +216,7 @@ def _settle_own_choices(
         )
         for (r, (words, forbidden)), res in results.items():
             if res.plan is not None:
-                # the alternatives' words are the automaton's letters: the events' names
-                costs[(r, tuple(e.name for e in res.plan.mission), forbidden)] = res
+                costs[(r, res.plan.word, forbidden)] = res
                 planner.remember(r, res.plan.mission, forbidden, res)
             else:  # no word of the group can be planned: each keeps the reason
                 costs.update({(r, w, forbidden): res for w in words})
@@ -232,7 +231,7 @@ def _settle_own_choices(
             if job is None:
                 return True
             plan = results[(robot, job)].plan
-            return plan is None or tuple(e.name for e in plan.mission) == alt.words[robot]
+            return plan is None or plan.word == alt.words[robot]
 
         found = Alternatives(tuple(a for a in found.items if cheapest(a)), found.exhaustive, found.explored)
     return found, costs, settled

@@ -258,8 +258,7 @@ def _loop(
     verdict = None
     if not reasons:
         t0 = time.perf_counter()
-        # the mission's automaton reads letters: the events' names
-        verdict = check_words(mission, {r: tuple(e.name for e in p.mission) for r, p in plans.items()})
+        verdict = check_words(mission, {r: p.word for r, p in plans.items()})
         planner.phases["verify"] = time.perf_counter() - t0
         if not verdict.holds:
             reasons = (verdict.reason() or "the coordinated missions violate the global mission",)

@@ -163,6 +163,11 @@ class TeamVerdict:
         return None
 
 
+def _word_order(words: Mapping[str, Sequence[str]]) -> Precedence:
+    """The partial order the words' messages put on their events (one step per event)."""
+    return Precedence({r: len(w) for r, w in words.items()}, word_links(words))
+
+
 def blocking_word(words: Mapping[str, Sequence[str]]) -> tuple[str, ...] | None:
     """A shortest word into the team's deadlock (then the waits), or ``None`` if it cannot block.
 
@@ -171,7 +176,11 @@ def blocking_word(words: Mapping[str, Sequence[str]]) -> tuple[str, ...] | None:
     words : mapping of str to sequence of str
         Every robot's word (event names), messages included.
     """
-    precedence = Precedence({r: len(w) for r, w in words.items()}, word_links(words))
+    return _blocking(_word_order(words), words)
+
+
+def _blocking(precedence: Precedence, words: Mapping[str, Sequence[str]]) -> tuple[str, ...] | None:
+    """:func:`blocking_word` read off the words' order `precedence`."""
     if precedence.complete:
         return None
     done = [words[r][k - 1] for r, k in precedence.order]
@@ -188,7 +197,7 @@ def stuck_waits(words: Mapping[str, Sequence[str]]) -> dict[str, int]:
     words : mapping of str to sequence of str
         Every robot's word (event names), messages included.
     """
-    return dict(Precedence({r: len(w) for r, w in words.items()}, word_links(words)).stuck)
+    return dict(_word_order(words).stuck)
 
 
 def verify_team(
@@ -304,9 +313,9 @@ def check_words(mission: GlobalMission, words: Mapping[str, Sequence[str]]) -> T
         Every robot's word (event names), messages included.
     """
     words = {r: tuple(words.get(r, ())) for r in mission.robots} | {r: tuple(w) for r, w in words.items()}
-    precedence = Precedence({r: len(w) for r, w in words.items()}, word_links(words))
+    precedence = _word_order(words)
     if not precedence.complete:
-        return TeamVerdict(False, blocking_word(words), None, None, None)
+        return TeamVerdict(False, _blocking(precedence, words), None, None, None)
     assert mission.complete is not None  # set on construction
     for factor in mission.complete.components:
         word = _factor_counterexample(factor, words, precedence)

@@ -155,8 +155,7 @@ def check_team(
                     f"{conflict.describe()}, and no message orders them: the robots may meet there",
                 )
             )
-    # the mission's automaton reads letters: the events' names
-    words = {r: tuple(e.name for e in plans[r].mission) if r in plans else () for r in scene.robots}
+    words = {r: plans[r].word if r in plans else () for r in scene.robots}
     verdict = check_words(GlobalMission.from_scenario(scenario), words)
     if not verdict.holds:
         violations.append(_violation(None, None, "mission", f"{verdict.reason()}"))

@@ -99,7 +99,8 @@ class Precedence:
 
     Examples
     --------
-    >>> order = Precedence({"A": 2, "B": 2}, [Link("m", "A", 1, "B", 2)])
+    >>> from cosmop.events import message
+    >>> order = Precedence({"A": 2, "B": 2}, [Link(message("A", "B", "m"), "A", 1, "B", 2)])
     >>> order.precedes(("A", 1), ("B", 2)), order.precedes(("A", 2), ("B", 2))
     (True, False)
     >>> order.makespan
