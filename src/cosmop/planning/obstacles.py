@@ -43,7 +43,6 @@ obstacles and models before the exact one.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import replace
 from fractions import Fraction
 from typing import Any
 
@@ -121,7 +120,7 @@ class Geometry:
         keys += [corner_clearance_key(k) for k in [*map(wall_key, walls), *map(object_key, p.scene.objects)]]
         held = set(keys) if not lazy else _near_route(p) | {object_key(o) for o in p.own_objects}
         self._p, self._events = p, events
-        self.held = conj(f for _, f in specification(replace(p, obstacles=frozenset(held)), events))
+        self.held = conj(f for _, f in specification(p.with_obstacles(frozenset(held)), events))
         self._waiting = [k for k in keys if k not in held]
         self._written: dict[ObstacleKey, Formula] = {}
         self._half_planes = _SeparatingHalfPlanes(p) if self._waiting else None
@@ -163,7 +162,7 @@ class Geometry:
         if not keys:
             return
         groups: dict[ObstacleKey, list[Formula]] = {k: [] for k in keys}
-        for name, formula in specification(replace(self._p, obstacles=frozenset(keys)), self._events):
+        for name, formula in specification(self._p.with_obstacles(frozenset(keys)), self._events):
             key = obstacle_of(name)
             if key is not None and key in groups:
                 groups[key].append(formula)
@@ -197,24 +196,20 @@ class _SeparatingHalfPlanes:
             planes[wall_key(i)] = [[(h.a, h.b, h.c) for h in body] for body in regions]
             self._roles[wall_key(i)], self._roles[wall_key(i, handling=True)] = 0, 1
         robot_gap = max(margin, HANDLING_CLEARANCE)
-        for o, ob in p.scene.objects.items():
-            if o in goods:
-                continue  # own goods move: always held
-            at, size = p.at_start(o)[0], to_fraction(ob.size)
-            ox, oy = to_fraction(at[0]), to_fraction(at[1])
-            robot = list(square_sides(ox, oy, (size + side) / 2 + robot_gap))
-            carried = [list(square_sides(ox, oy, (size + g) / 2)) for g in goods.values()]
-            planes[object_key(o)] = [robot, *carried]
+        others = [o for o in p.scene.objects if o not in goods]  # own goods move: always held
+        for o in others:
             self._roles[object_key(o)] = 2
-        self._keys = list(planes)
+        self._keys = list(planes) + [object_key(o) for o in others]
         self._row = {k: n for n, k in enumerate(self._keys)}
         for i in range(len(p.scene.obstacles)):  # a wall's handling parts: robot and goods
             self._row[wall_key(i, handling=True)] = self._row[wall_key(i)]
         for key in list(self._keys):  # the stronger GoTo part: kept clear by the same sides
             self._row[corner_clearance_key(key)], self._roles[corner_clearance_key(key)] = self._row[key], 0
-        table = np.array([planes[k] for k in self._keys], dtype=float)  # (obstacles, bodies, 4 sides, abc)
-        # no wall and no other robot's goods (only the robot's own, always held): keep the shape
-        table = table.reshape(len(self._keys), 1 + len(goods), 4, 3)
+        walls = np.array([planes[k] for k in planes], dtype=float)  # (obstacles, bodies, 4 sides, abc)
+        # no wall or no other object: keep the shape
+        walls = walls.reshape(len(planes), 1 + len(goods), 4, 3)
+        reach = [float(side / 2 + robot_gap), *(float(g / 2) for g in goods.values())]
+        table = np.concatenate([walls, _object_sides(p, others, reach)])
         table /= np.abs(table[..., :2]).sum(axis=-1, keepdims=True)
         self._table = table
         grown = np.array([float(margin if self._roles[k] == 0 else robot_gap) for k in self._keys])
@@ -274,6 +269,25 @@ class _SeparatingHalfPlanes:
             stronger_rows = [self._row[k] for k, stronger in zip(keys, ends, strict=True) if stronger]
             ok[ends] |= _passes_ends(self._touching[stronger_rows], robot, self._margin)
         return ok
+
+
+def _object_sides(p: RobotProblem, objects: Sequence[str], reach: Sequence[float]) -> NDArray[np.float64]:
+    """The sides of resting `objects` (:func:`~cosmop.planning.regions.square_sides`, in floats)
+    for bodies whose centres stay ``reach[b]`` (mm) plus an object's half side away from it:
+    ``(objects, bodies, 4 sides, abc)``, the rows of :class:`_SeparatingHalfPlanes`."""
+    table = np.zeros((len(objects), len(reach), 4, 3))
+    if not objects:
+        return table
+    at = np.array([p.at_start(o)[0] for o in objects], dtype=float)
+    half = np.array([p.scene.objects[o].size / 2.0 for o in objects], dtype=float)
+    d = half[:, None] + np.asarray(reach, dtype=float)[None, :]  # (objects, bodies)
+    ox, oy = at[:, 0, None], at[:, 1, None]
+    one, zero = np.ones_like(d), np.zeros_like(d)
+    table[:, :, 0] = np.stack([-one, zero, d - ox], axis=-1)  # left
+    table[:, :, 1] = np.stack([one, zero, ox + d], axis=-1)  # right
+    table[:, :, 2] = np.stack([zero, -one, d - oy], axis=-1)  # below
+    table[:, :, 3] = np.stack([zero, one, oy + d], axis=-1)  # above
+    return table
 
 
 _SIDE_AND_END = np.array([(0, 2), (0, 3), (1, 2), (1, 3), (2, 0), (2, 1), (3, 0), (3, 1)])
@@ -350,9 +364,13 @@ def _near_route(p: RobotProblem) -> set[ObstacleKey]:
     )
     if len(walls) and not handling.is_empty:
         near |= {wall_key(int(i), handling=True) for i in np.flatnonzero(shapely.intersects(handling, walls))}
-    for o, ob in scene.objects.items():
-        if route.intersects(shapely.Point(*p.at_start(o)[0]).buffer(ob.size, cap_style="square")):
-            near.add(object_key(o))
+    if scene.objects:  # each object's square grown by its side meets the route's box (or touches it)
+        ids = list(scene.objects)
+        at = np.array([p.at_start(o)[0] for o in ids], dtype=float)
+        size = np.array([scene.objects[o].size for o in ids], dtype=float)[:, None]
+        x0, y0, x1, y1 = route.bounds
+        meets = ((at - size <= (x1, y1)) & (at + size >= (x0, y0))).all(axis=1)
+        near |= {object_key(o) for o, yes in zip(ids, meets, strict=True) if yes}
     return near
 
 

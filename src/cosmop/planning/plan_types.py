@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass, field, replace
 from types import MappingProxyType
 from typing import Any
@@ -43,6 +43,7 @@ __all__ = [
     "Coordination",
     "Itinerary",
     "ObjectState",
+    "ObjectStates",
     "PlanMessage",
     "PlanSet",
     "Point",
@@ -93,13 +94,8 @@ def _floats(values: Iterable[Any], n: int, what: str) -> tuple[float, ...]:
     return result
 
 
-def _object_map(objects: Mapping[str, ObjectState]) -> Mapping[str, ObjectState]:
-    for name, state in objects.items():
-        if not isinstance(state, ObjectState):
-            raise TypeError(f"object {name!r}: expected an ObjectState, got {type(state).__name__}")
-    if isinstance(objects, MappingProxyType):
-        return objects
-    return MappingProxyType(dict(objects))
+def _object_map(objects: Mapping[str, ObjectState]) -> ObjectStates:
+    return objects if isinstance(objects, ObjectStates) else ObjectStates(objects)
 
 
 @dataclass(frozen=True)
@@ -129,6 +125,73 @@ class ObjectState:
     def to_dict(self) -> dict[str, Any]:
         """The JSON form: ``{"position": [x, y], "carried": bool, "away": bool}``."""
         return {"position": [_num(v) for v in self.position], "carried": self.carried, "away": self.away}
+
+
+class ObjectStates(Mapping[str, "ObjectState"]):
+    """Every object's :class:`ObjectState` at one instant, by id: read-only, checked once.
+
+    Each step of a plan lists every object of the scene (a warehouse holds thousands of goods),
+    and most steps change none: a step or state given an ``ObjectStates`` keeps it as it is
+    instead of copying and checking it again.
+
+    Parameters
+    ----------
+    states : Mapping[str, ObjectState] or iterable of (str, ObjectState)
+        The objects' states.
+
+    Raises
+    ------
+    TypeError
+        If a value is not an :class:`ObjectState`.
+    """
+
+    __slots__ = ("_states",)
+
+    def __init__(self, states: Mapping[str, ObjectState] | Iterable[tuple[str, ObjectState]] = ()) -> None:
+        table = dict(states)
+        for name, state in table.items():
+            if not isinstance(state, ObjectState):
+                raise TypeError(f"object {name!r}: expected an ObjectState, got {type(state).__name__}")
+        self._states = table
+
+    def updated(self, changes: Mapping[str, ObjectState]) -> ObjectStates:
+        """These states with `changes` (only they are checked again).
+
+        Parameters
+        ----------
+        changes : Mapping[str, ObjectState]
+            New states of some objects.
+        """
+        if not changes:
+            return self
+        out = ObjectStates(changes)
+        out._states = {**self._states, **out._states}
+        return out
+
+    def __getitem__(self, name: str) -> ObjectState:
+        return self._states[name]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._states)
+
+    def __len__(self) -> int:
+        return len(self._states)
+
+    def __contains__(self, name: object) -> bool:
+        return name in self._states
+
+    def __eq__(self, other: object) -> bool:
+        if isinstance(other, ObjectStates):
+            return self is other or self._states == other._states
+        return isinstance(other, Mapping) and self._states == dict(other)
+
+    __hash__ = None  # type: ignore[assignment]  # like a dict: equal by content, not hashable
+
+    def __repr__(self) -> str:
+        return f"ObjectStates({self._states!r})"
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (ObjectStates, (self._states,))
 
 
 @dataclass(frozen=True)

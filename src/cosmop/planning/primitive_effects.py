@@ -11,15 +11,16 @@ nothing.  No rule is checked here: that is :mod:`cosmop.planning.checker`'s busi
 from __future__ import annotations
 
 import math
+import weakref
 from collections.abc import Collection, Iterable, Sequence
 from typing import Any
 
 from cosmop.docking import in_front
 from cosmop.events import Event, Primitive
-from cosmop.planning.plan_types import PRIMITIVES, ObjectState, Pose, RobotPlan, State, Step
+from cosmop.planning.plan_types import PRIMITIVES, ObjectState, ObjectStates, Pose, RobotPlan, State, Step
 from cosmop.scene import Scene
 
-__all__ = ["Action", "initial_state", "plan_from_actions", "successor"]
+__all__ = ["Action", "initial_state", "plan_from_actions", "scenario_objects", "successor"]
 
 
 def initial_state(
@@ -60,16 +61,46 @@ def initial_state(
         If the scene has no robot `robot_id`.
     """
     robot = scene.robots[robot_id]
-    objects = {o: ObjectState(obj.position, carried=False, away=False) for o, obj in scene.objects.items()}
+    objects = scenario_objects(scene)
     steps = plan.steps if isinstance(plan, RobotPlan) else tuple(plan or ())
     if steps:
         if moved is None:
             moved = {s.object for s in steps if s.primitive == Primitive.PICKUP and s.object is not None}
         first = steps[0].objects
-        for oid in moved:
-            if oid in objects and oid in first:
-                objects[oid] = ObjectState(first[oid].position, carried=False, away=False)
+        rest = objects  # only goods the plan lists elsewhere change (often none of thousands)
+        objects = objects.updated(
+            {
+                oid: ObjectState(first[oid].position)
+                for oid in moved
+                if oid in rest and oid in first and first[oid].position != rest[oid].position
+            }
+        )
     return State(robot=robot.pose, objects=objects)
+
+
+_AT_REST: dict[int, tuple[weakref.ReferenceType[Scene], ObjectStates]] = {}
+"""The scenario's objects of the scenes asked about lately, by identity (scenes are not hashable)."""
+
+
+def scenario_objects(scene: Scene) -> ObjectStates:
+    """Every object of `scene` where the scenario puts it, resting and not away.
+
+    Made once per scene: every plan's instant 0 starts from it, and a warehouse holds thousands
+    of goods.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene.
+    """
+    hit = _AT_REST.get(id(scene))
+    if hit is not None and hit[0]() is scene:
+        return hit[1]
+    states = ObjectStates({o: ObjectState(obj.position) for o, obj in scene.objects.items()})
+    if len(_AT_REST) >= 32:  # scenes come and go (a replan's sensed scene): keep a few
+        _AT_REST.clear()
+    _AT_REST[id(scene)] = (weakref.ref(scene), states)
+    return states
 
 
 Action = tuple[str, Any] | tuple[str]
@@ -115,7 +146,7 @@ def successor(
         raise ValueError(f"unknown primitive {primitive!r}; expected one of {', '.join(PRIMITIVES)}")
     kind = Primitive(primitive)
     robot = state.robot
-    objects = dict(state.objects)
+    objects: dict[str, ObjectState] = {}  # the objects the step changes
     if kind == Primitive.GOTO:
         if to is None:
             raise ValueError("GoTo needs a target pose `to`")
@@ -125,13 +156,14 @@ def successor(
     elif obj is None:  # as Step says it
         raise ValueError(f"{primitive} needs the object it acts on")
     elif kind == Primitive.PICKUP:
-        objects[obj] = ObjectState(objects[obj].position, carried=True, away=objects[obj].away)
+        was = state.objects[obj]
+        objects[obj] = ObjectState(was.position, carried=True, away=was.away)
     elif kind == Primitive.DROPOFF:
         gap = (scene.robots[robot_id].size + scene.objects[obj].size) / 2.0
-        objects[obj] = ObjectState(_ahead(robot, gap), carried=False, away=objects[obj].away)
+        objects[obj] = ObjectState(_ahead(robot, gap), carried=False, away=state.objects[obj].away)
     elif kind == Primitive.REQ:
-        objects[obj] = ObjectState(objects[obj].position, carried=objects[obj].carried, away=True)
-    return Step(kind, obj, robot, objects)
+        objects[obj] = ObjectState(state.objects[obj].position, carried=state.objects[obj].carried, away=True)
+    return Step(kind, obj, robot, ObjectStates(state.objects).updated(objects))
 
 
 def _ahead(pose: Pose, gap: float) -> tuple[float, float]:

@@ -42,10 +42,11 @@ mission.
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from fractions import Fraction
-from functools import lru_cache
+from functools import cached_property, lru_cache
 from types import MappingProxyType
 from typing import Any
 
@@ -179,6 +180,11 @@ class ObjectVars:
         return cls(
             Var(f"{obj}.x", sort), Var(f"{obj}.y", sort), Var(f"{obj}.p", "bool"), Var(f"{obj}.a", "bool")
         )
+
+    @property
+    def varies(self) -> bool:
+        """Whether some field is a variable (some primitive of the robot can change it)."""
+        return any(isinstance(t, Var) for t in (self.x, self.y, self.carried, self.away))
 
     @property
     def resting(self) -> Formula:
@@ -499,23 +505,34 @@ class RobotProblem:
             )
         return out
 
-    @property
+    # asked for every object of every part: worked out once (a warehouse holds thousands of goods)
+    @cached_property
     def own_objects(self) -> tuple[str, ...]:
-        """Objects the mission picks or drops (never requested: the robot handles them)."""
-        return tuple(
-            o
-            for o in self.scene.objects
-            if any(e.obj == o and e.kind in ("pick", "drop") for e in self.mission)
-        )
+        """Objects the mission picks or drops (never requested: the robot handles them), in the
+        scene's order."""
+        handled = {e.obj for e in self.mission if e.kind in ("pick", "drop")}
+        return tuple(o for o in self.scene.objects if o in handled)
 
-    @property
+    @cached_property
     def answered_objects(self) -> tuple[str, ...]:
-        """Objects of the ``away`` events this robot answers."""
-        return tuple(
-            o
-            for o in self.scene.objects
-            if any(e.kind == "away" and e.obj == o and e.responder == self.robot for e in self.mission)
-        )
+        """Objects of the ``away`` events this robot answers, in the scene's order."""
+        answered = {e.obj for e in self.mission if e.kind == "away" and e.responder == self.robot}
+        return tuple(o for o in self.scene.objects if o in answered)
+
+    def with_obstacles(self, keys: frozenset[ObstacleKey]) -> RobotProblem:
+        """The same problem writing the parts of only the obstacles `keys` (:attr:`obstacles`).
+
+        ``dataclasses.replace`` would work out the actions, sorts and terms again; they do not
+        depend on which obstacles are written.
+
+        Parameters
+        ----------
+        keys : frozenset of ObstacleKey
+            The obstacles whose parts are written.
+        """
+        out = copy.copy(self)
+        object.__setattr__(out, "obstacles", frozenset(keys))
+        return out
 
     # -- variables -----------------------------------------------------------------------------
     @property

@@ -31,7 +31,7 @@ quarter slower than in a local worker process.
 from __future__ import annotations
 
 import time
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import Any
@@ -46,7 +46,7 @@ from cosmop.io import collector_paused
 from cosmop.logic import Formula, IncrementalUnrolling, Signature, Unrolling, assert_all, conj, to_fraction
 from cosmop.planning.messages import answer_early, place_mission_messages, strip_messages, wait_early
 from cosmop.planning.obstacles import Geometry
-from cosmop.planning.plan_types import ObjectState, RobotPlan, State, Step
+from cosmop.planning.plan_types import ObjectState, ObjectStates, RobotPlan, State, Step
 from cosmop.planning.reach import unreachable
 from cosmop.planning.specification import (
     MOTION_MARGIN,
@@ -133,15 +133,15 @@ def _plan(
         word = tuple(p.mission[int(s["event"]) - 1] for s in trace if int(s["event"]) > 0)
     steps: list[Step] = []
     requested: list[str] = []
+    # most objects have no variable (the plan never moves them): read once, kept in every step
+    varying = [o for o in p.scene.objects if p.obj(o).varies]
+    every = ObjectStates({o: _object_state(p, o, trace[0]) for o in p.scene.objects})
     for state in trace[1:]:
         action = decode(p, int(state["pi"]))
         if action.primitive == Primitive.REQ:
             assert action.obj is not None  # a request names its object
             requested.append(action.obj)
-        objects: dict[str, ObjectState] = {}
-        for o in p.scene.objects:
-            x, y, carried, away = p.obj(o).read(state)
-            objects[o] = ObjectState((_value(x), _value(y)), bool(carried), bool(away))
+        objects = every.updated({o: _object_state(p, o, state) for o in varying})
         steps.append(
             Step(
                 action.primitive,
@@ -151,6 +151,12 @@ def _plan(
             )
         )
     return RobotPlan.from_steps(word, steps), tuple(requested)
+
+
+def _object_state(p: RobotProblem, obj: str, state: Mapping[str, Any]) -> ObjectState:
+    """Object `obj` at one instant of a trace."""
+    x, y, carried, away = p.obj(obj).read(state)
+    return ObjectState((_value(x), _value(y)), bool(carried), bool(away))
 
 
 def _count_requests(p: RobotProblem, unrolling: Unrolling | IncrementalUnrolling) -> z3.ArithRef:

@@ -409,17 +409,21 @@ class World:
     def _measure_static_gaps(self, points: np.ndarray, half: float) -> np.ndarray:
         """:meth:`static_gaps`, measured (`points` ``(n, 2)``)."""
         gap = np.full(len(points), np.inf)
-        if len(self.walls):
-            # the walls within NEAR of the points' box first: a farther wall is more than NEAR
-            # from every point, so it cannot be the nearest of a point nearer than that to one
-            # of them; the other points are measured against every wall
-            lo, hi = points.min(axis=0, initial=np.inf), points.max(axis=0, initial=-np.inf)
-            near = rect_gaps(lo, hi, self._wall_lo, self._wall_hi) <= _NEAR
+        unsure = np.ones(len(points), dtype=bool)
+        reach = _NEAR
+        while len(self.walls) and unsure.any():
+            # the walls within `reach` of the unsure points' box: a farther wall is more than
+            # `reach` from each of them, so it cannot be the nearest of a point nearer than that
+            # to one of them; the rest look again four times as far (rings, not every wall)
+            todo = points[unsure]
+            lo, hi = todo.min(axis=0), todo.max(axis=0)
+            near = rect_gaps(lo, hi, self._wall_lo, self._wall_hi) <= reach
             if near.any():
-                gap = (point_segment_linf(points, self.walls[near]) - half).min(axis=1)
-            unsure = gap > _NEAR - half
-            if unsure.any() and not near.all():
-                gap[unsure] = (point_segment_linf(points[unsure], self.walls) - half).min(axis=1)
+                gap[unsure] = (point_segment_linf(todo, self.walls[near]) - half).min(axis=1)
+            if near.all():
+                break
+            unsure &= gap > reach - half
+            reach *= 4.0
         if self.resting().any():
             gap = np.minimum(gap, box_gaps(points, half, self.resting_boxes()).min(axis=1))
         return gap

@@ -305,13 +305,13 @@ def _object_occupancies(
     team's order leaves it: where the last drop before it put it (or where it starts).
     """
     out, problems = [], []
+    handlings: dict[str, list[tuple[str, int, Primitive]]] = {}  # by object: few of the scene's
+    for robot, plan in plans.items():
+        for k, step in enumerate(plan.steps, 1):
+            if step.object is not None and step.primitive in (Primitive.PICKUP, Primitive.DROPOFF):
+                handlings.setdefault(step.object, []).append((robot, k, step.primitive))
     for oid, spec in scene.objects.items():
-        handling = [
-            (robot, k, step.primitive)
-            for robot, plan in plans.items()
-            for k, step in enumerate(plan.steps, 1)
-            if step.object == oid and step.primitive in (Primitive.PICKUP, Primitive.DROPOFF)
-        ]
+        handling = handlings.get(oid)
         if not handling:
             continue
         handling.sort(key=lambda h: (precedence.start_time((h[0], h[1])), h[0], h[1]))

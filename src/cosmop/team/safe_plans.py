@@ -275,7 +275,9 @@ def make_team_safe(
     context: _Context = (scene, settings, starts, positions, about, used)
     uncut = frozenset() if settings.cut else frozenset(plans)
     # each robot's cuts depend on the others' whole drives only: made once, undone robot by robot
-    cut = _cut_where_shared(scene, plans, settings, starts, positions, walls) if settings.cut else plans
+    cut = (
+        _cut_where_shared(scene, plans, settings, starts, positions, walls, about) if settings.cut else plans
+    )
     best = None
     while True:
         attempt = _order(context, {r: p if r in uncut else cut[r] for r, p in plans.items()}, waypoints)
@@ -424,6 +426,7 @@ def _cut_where_shared(
     starts: Mapping[str, State] | None,
     positions: Mapping[str, tuple[float, float] | None] | None,
     walls: BaseGeometry | None,
+    about: str | None = None,
 ) -> dict[str, RobotPlan]:
     """Every drive cut where it enters and where it leaves a place another robot uses.
 
@@ -431,6 +434,8 @@ def _cut_where_shared(
     waits just before it enters, not before its whole drive, and the other is told as soon as
     it leaves (the temporal plan graph's grain: an order between the pieces of two drives that
     share a region).  The plans stay sound: a piece sweeps part of what the drive swept.
+    With `about`, only the conflicts of that robot are ordered, so only the places it shares
+    with the others cut drives: its own against everyone's, the others' against its.
     """
     precedence = Precedence({r: p.horizon for r, p in plans.items()}, message_links(plans))
     items, _ = occupancies(scene, plans, precedence, settings, starts, positions)
@@ -445,7 +450,7 @@ def _cut_where_shared(
             if step.primitive != Primitive.GOTO or math.dist(p[:2], q[:2]) < 2 * settings.piece:
                 continue
             for j in tree.query(swept_square(p, q, grown), predicate="intersects"):
-                if robot not in items[j].parties:
+                if robot not in items[j].parties and (about in (None, robot) or about in items[j].parties):
                     region = items[j].region
                     cuts.setdefault(k, []).extend(_entry_exit(p, q, grown / 2.0, region, settings.passing))
             cuts[k] = _spaced(cuts.get(k, []), settings.piece / math.dist(p[:2], q[:2]))
