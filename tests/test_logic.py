@@ -487,6 +487,21 @@ def test_shared_subformulas_are_encoded_once():
     assert first.sort() == second.sort() == z3.BoolSort(CTX)
 
 
+def test_an_equal_copy_of_a_formula_is_looked_up_by_its_first_representative():
+    # the specification builds the same sub-formula again and again: the memo keeps the first
+    # one met and finds copies by identity after one comparison, not one per instant
+    u = Unrolling(SIG, 3, ctx=CTX)
+    first = Always(Until(p, q) | (i >= 2))
+    copy = Always(Until(p, q) | (i >= 2))
+    assert copy == first and copy is not first
+    a = u.encode(first)
+    memo_size = len(u._memo)
+    b = u.encode(copy)
+    assert len(u._memo) == memo_size and a.eq(b)
+    assert all(key[0] is first for key in u._memo if key[0] == first)
+    assert all(key[0] is first.arg for key in u._memo if key[0] == copy.arg)
+
+
 # --------------------------------------------------------------------------------------------
 # the incremental encoding
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import copy
 import json
+import pickle
 from pathlib import Path
 from typing import Any
 
@@ -15,6 +16,7 @@ from cosmop.planning import (
     PLAN_FORMAT,
     Coordination,
     ObjectState,
+    ObjectStates,
     PlanError,
     PlanSet,
     RobotPlan,
@@ -26,6 +28,7 @@ from cosmop.planning import (
     successor,
 )
 from cosmop.planning.plan_file import read_plan
+from cosmop.planning.primitive_effects import scenario_objects
 from cosmop.scenario import load_scenario
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "01_warehouse_2x2" / "scenario.yaml"
@@ -484,3 +487,43 @@ def test_missing_plan_file(tmp_path: Path) -> None:
     with pytest.raises(PlanError) as info:
         load_plan(tmp_path / "absent.json")
     assert str(info.value) == f"{tmp_path / 'absent.json'}: file not found"
+
+
+# ----------------------------------------------------------------------------------------------
+# the objects' states of a step: one checked, shared map
+
+
+def test_object_states_are_checked_once_and_shared_by_the_steps_that_keep_them() -> None:
+    states = ObjectStates({"O1": ObjectState((1.0, 2.0)), "O2": ObjectState((3.0, 4.0))})
+    with pytest.raises(TypeError, match="O3"):
+        ObjectStates({"O3": (1.0, 2.0)})  # type: ignore[dict-item]
+    step = Step("GoTo", None, (0.0, 0.0, 0.0), states)
+    assert step.objects is states and State((0.0, 0.0, 0.0), states).objects is states
+    moved = states.updated({"O1": ObjectState((1.0, 2.0), carried=True)})
+    assert list(moved) == ["O1", "O2"] and moved["O1"].carried and not states["O1"].carried
+    assert states.updated({}) is states
+    with pytest.raises(TypeError):
+        states.updated({"O2": "here"})  # type: ignore[dict-item]
+    assert states == {"O1": ObjectState((1.0, 2.0)), "O2": ObjectState((3.0, 4.0))}
+    assert states != moved and states != {"O1": ObjectState((1.0, 2.0))}
+    assert pickle.loads(pickle.dumps(states)) == states
+    with pytest.raises(TypeError):
+        hash(states)
+    # a plain mapping given to a step is checked and made one
+    plain = Step("GoTo", None, (0.0, 0.0, 0.0), {"O1": ObjectState((1.0, 2.0))})
+    assert isinstance(plain.objects, ObjectStates)
+
+
+def test_scenario_objects_are_made_once_and_moved_goods_start_where_the_plan_lists_them() -> None:
+    assert scenario_objects(SCENE) is scenario_objects(SCENE)
+    assert {o: s.position for o, s in scenario_objects(SCENE).items()} == {
+        o: tuple(ob.position) for o, ob in SCENE.objects.items()
+    }
+    robot, obj = next(iter(SCENE.robots)), next(iter(SCENE.objects))
+    elsewhere = scenario_objects(SCENE).updated({obj: ObjectState((123.0, 456.0))})
+    first = Step(
+        "PickUp", obj, SCENE.robots[robot].pose, elsewhere.updated({obj: ObjectState((123.0, 456.0), True)})
+    )
+    start = initial_state(SCENE, robot, [first])
+    assert start.objects[obj] == ObjectState((123.0, 456.0))
+    assert all(start.objects[o] is scenario_objects(SCENE)[o] for o in SCENE.objects if o != obj)

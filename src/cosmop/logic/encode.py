@@ -132,6 +132,11 @@ class _Encoding:
         self._K = -1
         self._grow(K)
         self._memo: dict[tuple[Formula, int], z3.BoolRef] = {}
+        # one representative of each formula met, by identity: the specification builds the
+        # same sub-formula many times, and a memo lookup of an equal copy compares whole trees
+        self._canonical: dict[Formula, Formula] = {}
+        # id -> (the formula, kept alive so that its id stays its own; its representative)
+        self._seen: dict[int, tuple[Formula, Formula]] = {}
         self._integral: dict[LinExpr, bool] = {}
         self._scales: dict[Compare, int] = {}
 
@@ -377,6 +382,10 @@ class _Encoding:
     # -- formulas -----------------------------------------------------------------------------
     def _lit(self, f: Formula, k: int) -> Any:
         """:math:`[\\![f]\\!]_k`, memoised."""
+        seen = self._seen.get(id(f))
+        if seen is None:
+            seen = self._seen[id(f)] = (f, self._canonical.setdefault(f, f))
+        f = seen[1]
         key = (f, k)
         known = self._memo.get(key)
         if known is not None:
