@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Iterable, Iterator, Mapping
+from collections.abc import ItemsView, Iterable, Iterator, KeysView, Mapping, ValuesView
 from dataclasses import dataclass, field, replace
 from types import MappingProxyType
 from typing import Any
@@ -170,6 +170,19 @@ class ObjectStates(Mapping[str, "ObjectState"]):
 
     def __getitem__(self, name: str) -> ObjectState:
         return self._states[name]
+
+    # the dictionary's own views and lookups: thousands of objects are read at a time
+    def get(self, name: str, default: Any = None) -> Any:
+        return self._states.get(name, default)
+
+    def keys(self) -> KeysView[str]:
+        return self._states.keys()
+
+    def values(self) -> ValuesView[ObjectState]:
+        return self._states.values()
+
+    def items(self) -> ItemsView[str, ObjectState]:
+        return self._states.items()
 
     def __iter__(self) -> Iterator[str]:
         return iter(self._states)

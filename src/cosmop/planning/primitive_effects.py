@@ -12,7 +12,8 @@ from __future__ import annotations
 
 import math
 import weakref
-from collections.abc import Collection, Iterable, Sequence
+from collections.abc import Collection, Iterable, Mapping, Sequence
+from collections.abc import Set as AbstractSet
 from typing import Any
 
 from cosmop.docking import in_front
@@ -67,12 +68,14 @@ def initial_state(
         if moved is None:
             moved = {s.object for s in steps if s.primitive == Primitive.PICKUP and s.object is not None}
         first = steps[0].objects
+        if not isinstance(moved, AbstractSet | Mapping):
+            moved = set(moved)  # looked up once per object listed
         rest = objects  # only goods the plan lists elsewhere change (often none of thousands)
         objects = objects.updated(
             {
-                oid: ObjectState(first[oid].position)
-                for oid in moved
-                if oid in rest and oid in first and first[oid].position != rest[oid].position
+                oid: ObjectState(state.position)
+                for oid, state in first.items()
+                if oid in moved and oid in rest and state.position != rest[oid].position
             }
         )
     return State(robot=robot.pose, objects=objects)

@@ -233,6 +233,7 @@ def start_state(world: World, agent: Agent, picks: AbstractSet[str | None] = fro
         if k > 0
         else initial_state(world.scenario.scene, agent.id, agent.steps, world.object_ids).objects
     )
+    requested = {st.object for st in done_steps if st.primitive == Primitive.REQ}
     objects = {}
     for j, oid in enumerate(world.object_ids):
         carried = world.carried_by[j] == i
@@ -240,7 +241,7 @@ def start_state(world: World, agent: Agent, picks: AbstractSet[str | None] = fro
             objects[oid] = ObjectState(expected[oid].position, carried=False, away=False)
             continue
         away = (world.carried_by[j] >= 0 and not carried) or bool(world.shipped[j])  # not in its way
-        away = away or any(st.primitive == Primitive.REQ and st.object == oid for st in done_steps)
+        away = away or oid in requested
         pos = world.object_xy[j]
         objects[oid] = ObjectState(
             (round(float(pos[0])), round(float(pos[1]))), carried=bool(carried), away=away
