@@ -173,6 +173,15 @@ class ObjectStates(Mapping[str, "ObjectState"]):
 
     # the dictionary's own views and lookups: thousands of objects are read at a time
     def get(self, name: str, default: Any = None) -> Any:
+        """The state of object `name`, or `default` when the map has none.
+
+        Parameters
+        ----------
+        name : str
+            The object's id.
+        default : object, optional
+            What to answer for an unknown id.
+        """
         return self._states.get(name, default)
 
     def keys(self) -> KeysView[str]:
