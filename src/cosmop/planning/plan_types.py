@@ -205,7 +205,9 @@ class ObjectStates(Mapping[str, "ObjectState"]):
     def __eq__(self, other: object) -> bool:
         if isinstance(other, ObjectStates):
             return self is other or self._states == other._states
-        return isinstance(other, Mapping) and self._states == dict(other)
+        if not isinstance(other, Mapping):
+            return NotImplemented
+        return self._states == dict(other)
 
     __hash__ = None  # type: ignore[assignment]  # like a dict: equal by content, not hashable
 
