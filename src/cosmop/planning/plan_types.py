@@ -94,10 +94,6 @@ def _floats(values: Iterable[Any], n: int, what: str) -> tuple[float, ...]:
     return result
 
 
-def _object_map(objects: Mapping[str, ObjectState]) -> ObjectStates:
-    return objects if isinstance(objects, ObjectStates) else ObjectStates(objects)
-
-
 @dataclass(frozen=True)
 class ObjectState:
     """The state of one movable object at one instant, as a robot's plan sees it.
@@ -153,6 +149,17 @@ class ObjectStates(Mapping[str, "ObjectState"]):
             if not isinstance(state, ObjectState):
                 raise TypeError(f"object {name!r}: expected an ObjectState, got {type(state).__name__}")
         self._states = table
+
+    @classmethod
+    def of(cls, states: Mapping[str, ObjectState]) -> ObjectStates:
+        """`states` as an ``ObjectStates``: itself when it is one (already checked), else checked.
+
+        Parameters
+        ----------
+        states : Mapping[str, ObjectState]
+            The objects' states.
+        """
+        return states if isinstance(states, ObjectStates) else cls(states)
 
     def updated(self, changes: Mapping[str, ObjectState]) -> ObjectStates:
         """These states with `changes` (only they are checked again).
@@ -237,7 +244,7 @@ class State:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "robot", _floats(self.robot, 3, "a robot pose"))
-        object.__setattr__(self, "objects", _object_map(self.objects))
+        object.__setattr__(self, "objects", ObjectStates.of(self.objects))
 
 
 @dataclass(frozen=True)
@@ -293,7 +300,7 @@ class Step:
         if self.primitive == Primitive.GOTO and self.object is not None:
             raise ValueError(f"GoTo acts on no object, got {self.object!r}")
         object.__setattr__(self, "robot", _floats(self.robot, 3, "a robot pose"))
-        object.__setattr__(self, "objects", _object_map(self.objects))
+        object.__setattr__(self, "objects", ObjectStates.of(self.objects))
 
     @property
     def label(self) -> str:

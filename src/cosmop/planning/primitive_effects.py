@@ -62,7 +62,7 @@ def initial_state(
         If the scene has no robot `robot_id`.
     """
     robot = scene.robots[robot_id]
-    objects = scenario_objects(scene)
+    objects = base = scenario_objects(scene)
     steps = plan.steps if isinstance(plan, RobotPlan) else tuple(plan or ())
     if steps:
         if moved is None:
@@ -70,12 +70,12 @@ def initial_state(
         first = steps[0].objects
         if not isinstance(moved, AbstractSet | Mapping):
             moved = set(moved)  # looked up once per object listed
-        rest = objects  # only goods the plan lists elsewhere change (often none of thousands)
-        objects = objects.updated(
+        # only goods the plan lists elsewhere change (often none of thousands)
+        objects = base.updated(
             {
                 oid: ObjectState(state.position)
                 for oid, state in first.items()
-                if oid in moved and oid in rest and state.position != rest[oid].position
+                if oid in moved and oid in base and state.position != base[oid].position
             }
         )
     return State(robot=robot.pose, objects=objects)
@@ -166,7 +166,7 @@ def successor(
         objects[obj] = ObjectState(_ahead(robot, gap), carried=False, away=state.objects[obj].away)
     elif kind == Primitive.REQ:
         objects[obj] = ObjectState(state.objects[obj].position, carried=state.objects[obj].carried, away=True)
-    return Step(kind, obj, robot, ObjectStates(state.objects).updated(objects))
+    return Step(kind, obj, robot, ObjectStates.of(state.objects).updated(objects))
 
 
 def _ahead(pose: Pose, gap: float) -> tuple[float, float]:
