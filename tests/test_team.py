@@ -17,14 +17,17 @@ from typer.testing import CliRunner
 from cosmop.cli import app
 from cosmop.events import message, parse_event
 from cosmop.missions.mission import GlobalMission
+from cosmop.planning import PlanSet, plan_from_actions
 from cosmop.planning.plan_file import load_plan
 from cosmop.planning.realisation import message_links
 from cosmop.scenario import load_scenario, parse_scenario
 from cosmop.sim import simulate
 from cosmop.sim.recoordinate import Remaining, recoordinate
-from cosmop.team.conflicts import conflicts, is_ordered, occupancies
+from cosmop.team.conflicts import ConflictSettings, conflicts, is_ordered, occupancies
 from cosmop.team.loop import plan_team
 from cosmop.team.precedence import Precedence
+from cosmop.team.safe_plans import make_team_safe
+from handmade_plans import R2_ACTIONS, R2_MISSION
 from team_checks import assert_complete_word, assert_no_overlap
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -240,3 +243,29 @@ def test_two_robots_never_give_way_around_each_other_in_one_round():
     }
     # alone, a conflict goes ahead with its best way
     assert _give_way(safety, [spot]) == {"R1": [(spot, "O2's spot")]}
+
+
+def test_goods_shipped_on_drop_still_need_their_drop_spot_free_while_dropped():
+    """A lifelong run ships delivered goods, but they appear on the drop spot while the gripper
+    lets go: a robot planned to stand there then must be ordered (else the drop waits for it
+    while it waits for the dropper's message, for ever)."""
+    scenario = load_scenario(EXAMPLES / "01_warehouse_2x2" / "scenario.yaml")
+    scene = scenario.scene
+    # R1 ends diagonally beside where R2 drops O2 (1250, 2050), its grown square 40 mm into it
+    r1 = plan_from_actions(scene, "R1", [], [("GoTo", (1250 + 260, 2050 + 260, 90))])
+    r2 = plan_from_actions(scene, "R2", list(R2_MISSION), R2_ACTIONS)
+    plans = PlanSet(scenario.name, True, {"R1": r1, "R2": r2}).robots
+    precedence = Precedence({r: p.horizon for r, p in plans.items()}, message_links(plans))
+    for shipped in (False, True):
+        items, _ = occupancies(scene, plans, precedence, ConflictSettings(shipped_on_drop=shipped))
+        (held,) = [o for o in items if o.what == "O2" and o.first == ("R2", 4)]
+        assert held.last == (("R2", 4) if shipped else None)  # the drop's interval, or for good
+        found = [c for c in conflicts(items) if {c.a.what, c.b.what} == {"O2", "R1"}]
+        assert found and not any(is_ordered(c, precedence) for c in found)
+    # ordered by messages; the goods' conflict with R1 is among those ordered
+    shipped = ConflictSettings(shipped_on_drop=True)
+    safe = make_team_safe(scene, plans, settings=shipped).plans
+    precedence = Precedence({r: p.horizon for r, p in safe.items()}, message_links(safe))
+    found = conflicts(occupancies(scene, safe, precedence, shipped)[0])
+    assert any({c.a.what, c.b.what} == {"O2", "R1"} for c in found)
+    assert precedence.complete and all(is_ordered(c, precedence) for c in found)

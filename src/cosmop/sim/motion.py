@@ -33,6 +33,7 @@ __all__ = [
     "REPLANNED",
     "back_onto_segment",
     "brake",
+    "crawl",
     "creep_is_safe",
     "creep_onto_goal",
     "creep_out",
@@ -189,12 +190,16 @@ def drive(
     if left < agent.best_path_left - s.stall_progress:
         agent.best_path_left = left
         agent.last_progress_t = world.t
-    elif world.t - agent.last_progress_t > s.detour_time and world.t >= agent.detour_until:
-        detour(world, agent, goal)
-    elif world.t - agent.last_progress_t > s.stall_time:
-        action = _on_stall(world, agent)
+    elif world.t - agent.last_progress_t > s.detour_time:
+        action = crawl(world, agent)
         if action is not None:
             return action
+        if world.t >= agent.detour_until:
+            detour(world, agent, goal)
+        elif world.t - agent.last_progress_t > s.stall_time:
+            action = _on_stall(world, agent)
+            if action is not None:
+                return action
     stop = left if final else math.inf
     return ("drive", (target, stop, agent.goal_clearance))
 
@@ -232,6 +237,45 @@ def _on_stall(world: World, agent: Agent) -> Action | None:
     agent.last_progress_t = world.t
     agent.best_path_left = math.inf
     return REPLANNED if agent.drive_phase == "start" else None
+
+
+def crawl(world: World, agent: Agent) -> Action | None:
+    """A robot held still by the dynamic window in a tight passage: creep a little way along
+    its path; ``None`` when that does not apply (something else holds it).
+
+    In a passage barely wider than the robot (goods on both faces of an aisle), a few
+    millimetres off its path the robot must move sideways before it can go on, and every arc
+    of the window grazes something: it would stand for ever, detours and replans finding the
+    same path.  The docking creep (straight, slow, exact) takes it up to ``dock_tolerance``
+    along the path, never past a vertex (never round a corner), turned along the way, when that
+    move is passively safe and no robot or person is within twice the window's standoff of it:
+    a robot held by another waits for it as before (creeping up to it would crowd it).
+
+    Parameters
+    ----------
+    world : World
+        The running simulation.
+    agent : Agent
+        The driving robot, its path set.
+    """
+    s = world.settings
+    i = agent.index
+    if world.v[i] > 0 or agent.path is None:
+        return None
+    xy = (float(world.pose[i, 0]), float(world.pose[i, 1]))
+    target, _ = agent.path.lookahead(xy, s.dock_tolerance, corner=0.0)
+    if math.dist(target, xy) <= 1e-6:
+        return None
+    others = np.delete(world.robot_boxes(), i, axis=0)
+    if world.walkers:
+        others = np.vstack([others, world.people_boxes()])
+    way = np.array([[*xy, *target]])
+    if (
+        point_segment_linf(others[:, :2], way)[:, 0] - world.robot_half[i] - others[:, 2] < 2 * s.dwa.standoff
+    ).any():
+        return None
+    pose = (target[0], target[1], math.degrees(math.atan2(target[1] - xy[1], target[0] - xy[0])))
+    return ("dock", pose) if creep_is_safe(world, agent, pose) else None
 
 
 def detour(world: World, agent: Agent, goal: tuple[float, float, float]) -> None:
@@ -360,7 +404,10 @@ def creep_is_safe(world: World, agent: Agent, target: Pose | None = None) -> boo
             return bool(np.all(is_safe(point_segment_linf(xy, world.walls) - half, speed, 0.0, dyn)))
         return True
     path = xy[None, :] + np.linspace(0.0, 1.0, 12)[:, None] * (np.asarray(target[:2]) - xy)[None, :]
-    if still and (box_gaps(path, half, boxes[still]) < -1e-6).any():
+    # the square swept along the segment, exactly: its gap to a box is the box centre's
+    # L-infinity distance to the segment less both half sides
+    way = np.array([[*xy, *target[:2]]], dtype=float)
+    if still and (point_segment_linf(boxes[still, :2], way)[:, 0] - half - boxes[still, 2] < -1e-6).any():
         return False
     if len(world.walls):
         return bool((point_segment_linf(path, world.walls) - half >= -1e-6).all())

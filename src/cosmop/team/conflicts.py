@@ -10,7 +10,8 @@ from the start of one step to the completion of another (:class:`Occupancy`):
 * a robot's ``GoTo`` step *k* holds the area it sweeps (the convex hull of its squares at the
   two ends) during that step;
 * an object rests at its scenario position until its first ``PickUp`` completes, and where a
-  ``DropOff`` puts it from that step's start until it is picked again (or forever).
+  ``DropOff`` puts it from that step's start until it is picked again (or forever; goods
+  shipped on drop, until that ``DropOff`` completes).
 
 Robot regions are grown by half the clearance the simulator keeps between moving robots
 (:attr:`ConflictSettings.clearance`), so that two of them closer than that overlap; objects are
@@ -89,8 +90,8 @@ class ConflictSettings:
         lies this much beyond it, so that the message sent there is never early.
     shipped_on_drop : bool
         Goods leave the world once a plan drops them (a lifelong run ships delivered goods,
-        :mod:`cosmop.lifelong`): they hold their dock only until the drop (default false: goods
-        rest where they are dropped for good).
+        :mod:`cosmop.lifelong`): they hold their drop spot only during the drop (default false:
+        goods rest where they are dropped for good).
     """
 
     clearance: float = 100.0
@@ -155,8 +156,9 @@ class Occupancy:
 
     @property
     def is_drive(self) -> bool:
-        """Whether it is what one GoTo step sweeps (a standing spans more than one step)."""
-        return self.first is not None and self.first == self.last
+        """Whether it is what one GoTo step sweeps (a robot's standing spans more than one
+        step; goods shipped on drop hold their spot during one ``DropOff``)."""
+        return self.what in self.parties and self.first is not None and self.first == self.last
 
     def accounts_for(self, other: Occupancy) -> bool:
         """Whether this occupancy and `other` never need an order: they are the same robot's,
@@ -333,8 +335,11 @@ def _object_occupancies(
                 position = None
             else:
                 position, first = plans[robot].steps[k - 1].objects[oid].position, (robot, k)
-        if position is not None and not (shipped_on_drop and first is not None):
-            out.append(_resting(oid, spec.size, parties, position, first, None, models, scene.units))
+        if position is not None:
+            # shipped goods still appear on the drop spot while the gripper lets go: that spot
+            # must be free then, or the drop waits for whoever stands there
+            last = first if shipped_on_drop and first is not None else None
+            out.append(_resting(oid, spec.size, parties, position, first, last, models, scene.units))
     return out, problems
 
 
@@ -615,7 +620,7 @@ def ranked_detours(
         places = _geometries(list(fixed.get(robot, ())))
         if (shapely.area(shapely.intersection(keep.region, places)) > 1e-9).any():
             continue
-        drive = mover.first == mover.last
+        drive = mover.is_drive
         out.append((0 if drive and keep.last is None else 1 if drive else 2, robot, keep))
     return sorted(out, key=lambda o: o[0])
 

@@ -378,12 +378,8 @@ def _waits(
         first, then = (conflict.a, conflict.b) if conflict.a.last == first_step else (conflict.b, conflict.a)
         seconds = float(order.finish[robot][k] - order.finish[robot][k - 1])
         drives: tuple[_Drive, ...] | None = None
-        if (
-            first.first is not None
-            and first.first == first.last
-            and then.first is not None
-            and then.first == then.last
-        ):
+        if first.is_drive and then.is_drive:
+            assert first.first is not None and then.first is not None  # (a drive has its step)
             drives = (ends[first.first], ends[then.first])
         out.append(Wait(seconds, robot, other, event, conflict, first, then, drives, (robot, k) in critical))
     return tuple(sorted(out, key=lambda w: (-w.seconds, w.message.name)))
