@@ -15,10 +15,12 @@ from typer.testing import CliRunner
 
 from cosmop.cli import app
 from cosmop.control.geometry import box_gaps, point_segment_linf
+from cosmop.control.paths import GlobalPath
 from cosmop.events import parse_event
 from cosmop.planning import PlanSet
 from cosmop.scenario import load_scenario, parse_scenario
 from cosmop.sim import SIM_FORMAT, TRACE_FORMAT, SimSettings, simulate, time_limit
+from cosmop.sim.motion import crawl, creep_is_safe
 from cosmop.sim.world import World
 from cosmop.team.loop import plan_team
 from cosmop.traces import Trace, TraceError, _rounded, as_trace, load_trace
@@ -494,3 +496,40 @@ def test_goods_are_put_down_only_where_no_robot_has_come_during_the_handling():
     world.pose[other.index] = [*(spot + away * (reach + 2000.0)), 0.0]  # it has driven on
     decide(world, giver)
     assert world.carried_by[j] == -1 and np.allclose(world.object_xy[j], spot)
+
+
+def _aisle_world(other: tuple[float, float]) -> World:
+    """A 500 mm robot 4 mm right of a good's corner and 19 mm too high to pass below it (the
+    stall of a 50-robot run), and a second robot at `other`."""
+    data = {
+        "name": "tight aisle",
+        "scene": {
+            "obstacles": [[[0, 0], [6000, 0]]],
+            "robots": {
+                "R1": {"size": 500, "pose": [1854, 1568.6, 180]},
+                "R2": {"size": 500, "pose": [*other, 0]},
+            },
+            "objects": {"O1": {"size": 200, "position": [1500, 1900]}},
+            "workspaces": {"W1": {"x": [5000, 5900], "y": [3000, 3900]}},
+        },
+        "mission": {"tasks": {"R1": ["pick O1", "drop O1 at W1", "return"]}},
+    }
+    world = World(parse_scenario(data), PlanSet("tight aisle", True, {}), 0, SimSettings())
+    world.agents[0].path = GlobalPath(((1854.0, 1568.6), (1851.0, 1549.0), (400.0, 1449.0)), 0.8)
+    return world
+
+
+def test_a_robot_stuck_in_a_tight_aisle_creeps_along_its_path_and_not_into_a_robot():
+    world = _aisle_world((5000, 3000))
+    agent = world.agents[0]
+    kind, pose = crawl(world, agent)
+    # to the path's next vertex (20 mm away, not past it), turned towards it
+    assert kind == "dock" and pose[:2] == pytest.approx((1851.0, 1549.0))
+    assert pose[2] == pytest.approx(np.degrees(np.arctan2(-19.6, -3.0)))
+    # straight on to a pose clear of the good, but cutting its corner on the way: refused
+    assert world.static_gaps(np.array([[1000.0, 1500.0]]), 250.0)[0] > 0
+    assert not creep_is_safe(world, agent, (1000.0, 1500.0, 180.0))
+    assert creep_is_safe(world, agent, pose)
+    # a robot 60 mm from the way: it waits for it as before, it does not creep up to it
+    near = _aisle_world((1854, 1008.6))
+    assert crawl(near, near.agents[0]) is None
