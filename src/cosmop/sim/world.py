@@ -157,7 +157,9 @@ class Agent:
         self.stopped_until = None
 
     def restart_step(self) -> None:
-        """Forget how the current step was being executed: it starts afresh next cycle."""
+        """Forget how the current step was being executed: it starts afresh next cycle (a robot
+        that waited for a message the new order no longer has is no longer parked)."""
+        self.waiting = False
         self.drive_phase = "start"
         self.dock_stage = None
         self.path = None
