@@ -15,7 +15,15 @@ from collections.abc import Iterable, Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["box_gaps", "per_row", "point_segment_linf", "rect_gaps", "segment_array", "segment_bounds"]
+__all__ = [
+    "box_gaps",
+    "per_row",
+    "point_segment_linf",
+    "rect_gaps",
+    "segment_array",
+    "segment_bounds",
+    "swept_box_gaps",
+]
 
 
 def segment_array(segments: Iterable[Sequence[Sequence[float]]]) -> NDArray[np.float64]:
@@ -181,3 +189,34 @@ def box_gaps(
     d = d - half  # (`half` may broadcast to more axes than the gaps have)
     d -= b[..., 2]
     return d
+
+
+def swept_box_gaps(
+    start: Sequence[float] | NDArray[np.float64],
+    end: Sequence[float] | NDArray[np.float64],
+    half: float,
+    boxes: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """L-infinity gaps between the square swept straight from `start` to `end` and boxes.
+
+    The square of half side :math:`h` swept along :math:`[a, b]` is the Minkowski sum of the
+    segment and the square, so its gap to the box of centre :math:`c` and half side :math:`k`
+    is :math:`d_\\infty(c, [a, b]) - h - k` (:func:`point_segment_linf`), exactly.
+
+    Parameters
+    ----------
+    start, end : sequence of float
+        The square's centre at the two ends ``x, y`` (mm).
+    half : float
+        Its half side (mm).
+    boxes : ndarray, shape (m, 3)
+        Boxes as ``x, y, half side`` (mm).
+
+    Returns
+    -------
+    ndarray, shape (m,)
+        Gaps, mm (negative when the swept square overlaps a box).
+    """
+    way = np.array([[start[0], start[1], end[0], end[1]]], dtype=float)
+    gaps: NDArray[np.float64] = point_segment_linf(boxes[:, :2], way)[:, 0] - half - boxes[:, 2]
+    return gaps

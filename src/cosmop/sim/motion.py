@@ -21,7 +21,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from cosmop.control.geometry import box_gaps, point_segment_linf
+from cosmop.control.geometry import box_gaps, point_segment_linf, swept_box_gaps
 from cosmop.control.paths import GlobalPath, plan_path, straight_path
 from cosmop.control.safety import is_safe, stopping_horizon
 from cosmop.planning.plan_types import Pose
@@ -269,10 +269,7 @@ def crawl(world: World, agent: Agent) -> Action | None:
     others = np.delete(world.robot_boxes(), i, axis=0)
     if world.walkers:
         others = np.vstack([others, world.people_boxes()])
-    way = np.array([[*xy, *target]])
-    if (
-        point_segment_linf(others[:, :2], way)[:, 0] - world.robot_half[i] - others[:, 2] < 2 * s.dwa.standoff
-    ).any():
+    if (swept_box_gaps(xy, target, float(world.robot_half[i]), others) < 2 * s.dwa.standoff).any():
         return None
     pose = (target[0], target[1], math.degrees(math.atan2(target[1] - xy[1], target[0] - xy[0])))
     return ("dock", pose) if creep_is_safe(world, agent, pose) else None
@@ -404,10 +401,7 @@ def creep_is_safe(world: World, agent: Agent, target: Pose | None = None) -> boo
             return bool(np.all(is_safe(point_segment_linf(xy, world.walls) - half, speed, 0.0, dyn)))
         return True
     path = xy[None, :] + np.linspace(0.0, 1.0, 12)[:, None] * (np.asarray(target[:2]) - xy)[None, :]
-    # the square swept along the segment, exactly: its gap to a box is the box centre's
-    # L-infinity distance to the segment less both half sides
-    way = np.array([[*xy, *target[:2]]], dtype=float)
-    if still and (point_segment_linf(boxes[still, :2], way)[:, 0] - half - boxes[still, 2] < -1e-6).any():
+    if still and (swept_box_gaps(xy, target[:2], half, boxes[still]) < -1e-6).any():  # exact
         return False
     if len(world.walls):
         return bool((point_segment_linf(path, world.walls) - half >= -1e-6).all())
