@@ -1,9 +1,11 @@
-"""Robots the scene starts closer than the clearance: they may leave, not come back that close.
+"""Robots the scene parks closer than the clearance: they may leave, and come home that close.
 
 The conflict rule grows robots by the 100 mm the simulator keeps between them; two robots
 parked side by side at the start (touching) would then overlap from instant 0, and no order
 could ever let either leave.  Where one of them stands at its start, the other standing at or
-driving off its own keeps only the gap the scene gave them.
+driving off its own keeps only the gap the scene gave them; likewise where one stands at its
+home at the end and the other stands at or drives into its own, and a robot re-planned around
+another parked there keeps out of it by that gap only.
 """
 
 from __future__ import annotations
@@ -79,9 +81,38 @@ def test_only_the_starts_keep_the_smaller_gap(planned):
     assert len(grown) == 1
 
 
-def test_robots_that_come_back_closer_than_the_clearance_are_held_to_it():
+def test_robots_parked_touching_come_home_touching_again():
+    """Both return: each home is where the scene parked it, at the gap the scene gave (touching);
+    the plans keep that gap there, and in the run the second one home creeps up to it."""
     data = copy.deepcopy(SIDE_BY_SIDE)
     data["mission"]["tasks"] = {r: [*tasks, "return"] for r, tasks in data["mission"]["tasks"].items()}
-    result = plan_team(parse_scenario(data), workers=1)
-    assert not result.plans.feasible
-    assert "R1 and R2" in result.plans.reason and "standing at" in result.plans.reason
+    scenario = parse_scenario(data)
+    result = plan_team(scenario, workers=1)
+    assert result.plans.feasible, result.plans.reason
+    assert check_plan(scenario, result.plans).ok
+    plans = result.plans.robots
+    order = Precedence({r: p.horizon for r, p in plans.items()}, message_links(plans))
+    items, _ = occupancies(scenario.scene, plans, order, ConflictSettings())
+    homes = [o for o in items if o.start is not None and o.last is None]
+    assert sorted(o.what for o in homes) == ["R1", "R2"]  # each robot's rest at home, for good
+    run = simulate(scenario, result.plans)
+    assert run.completed and run.contacts_while_moving == 0
+    assert not footprint_overlaps(scenario.scene, run)
+
+
+def test_a_robot_parked_for_good_beside_another_is_driven_around_at_the_scene_gap():
+    """R1 never moves; R2, parked touching it, must pass it: its re-plan keeps out of R1's
+    square only by the gap the scene gave them (the clearance would wall R2 in where it stands)."""
+    data = copy.deepcopy(SIDE_BY_SIDE)
+    data["scene"]["objects"]["O2"]["position"] = [3000, -2000]  # below R1's row: R2 goes past R1
+    data["mission"]["tasks"] = {"R2": ["pick O2", "drop O2 at W2", "return"]}
+    scenario = parse_scenario(data)
+    result = plan_team(scenario, workers=1)
+    assert result.plans.feasible, result.plans.reason
+    assert any("R2 re-planned around" in why for why in result.replans)
+    assert check_plan(scenario, result.plans).ok
+    first = result.plans.robots["R2"].steps[0].robot
+    assert first[1] - 200 >= 200 - 1e-6  # R2's first drive keeps its square above R1's (y <= 200)
+    run = simulate(scenario, result.plans)
+    assert run.completed and run.contacts_while_moving == 0
+    assert not footprint_overlaps(scenario.scene, run)

@@ -361,7 +361,8 @@ def creep_to(world: World, agent: Agent, point: tuple[float, float], heading: fl
 def creep_is_safe(world: World, agent: Agent, target: Pose | None = None) -> bool:
     """Passive safety of a slow docking creep, with the gripper's object left out.
 
-    Moving obstacles (robots, people) need the paper's ``safe`` at the creep speed.  Towards a
+    Moving obstacles (robots, people; not a robot that has finished, which stands for good)
+    need the paper's ``safe`` at the creep speed.  Towards a
     docking `target` (``x, y`` mm, ...) the creep is a straight move that stops exactly on it,
     so walls and resting objects only need to stay clear of that short segment (touching
     allowed: a docking pose may touch a wall, as the plan allows).  Without a target, the
@@ -384,7 +385,13 @@ def creep_is_safe(world: World, agent: Agent, target: Pose | None = None) -> boo
         skip.add(world.object_ids[agent.gripped])
     agents = sensed.agents
     assert agents is not None  # the world's obstacles say which boxes are robots or people
-    movers = [b for b, n in enumerate(names) if n not in skip and (speeds[b] > 0 or agents[b])]
+    # a robot that has finished stands for good: like a resting object, it may be touched
+    skip_agents = {a.id for a in world.agents if a.done}
+    movers = [
+        b
+        for b, n in enumerate(names)
+        if n not in skip and (speeds[b] > 0 or (agents[b] and n not in skip_agents))
+    ]
     still = [b for b, n in enumerate(names) if n not in skip and b not in movers]
     dyn = world.limits[i]  # this robot's limits
     speed = world.creep_speed(i)
@@ -409,12 +416,17 @@ def creep_is_safe(world: World, agent: Agent, target: Pose | None = None) -> boo
 
 
 def creep_onto_goal(world: World, agent: Agent, goal: tuple[float, ...], dist: float) -> Action | None:
-    """The last few millimetres onto a final pose beside a wall or resting object: creep there.
+    """The last few millimetres onto a final pose beside a wall, a resting object or a robot that
+    has finished: creep there.
 
     The dynamic window stops a braking distance short of what it approaches, and a pose that
-    touches something (a docking pose, a home against a wall) lies right there; within
-    ``dock_tolerance`` of it (`dist`, mm) the docking creep, straight and exact, takes over
-    when its way is clear (``None`` otherwise: the window drives on).
+    touches something (a docking pose, a home against a wall, a home the scene put against
+    another robot's) lies right there; within ``dock_tolerance`` of it (`dist`, mm) the
+    docking creep, straight and exact, takes over when its way is clear (``None`` otherwise:
+    the window drives on).  Where the way onto the pose itself is not clear, the creep stops
+    short of what it would touch, if that is within ``goal_tolerance`` of the pose: a robot
+    that came home first stands anywhere within that tolerance of its home, perhaps a few
+    millimetres towards this one's.
 
     Parameters
     ----------
@@ -429,12 +441,38 @@ def creep_onto_goal(world: World, agent: Agent, goal: tuple[float, ...], dist: f
     """
     s = world.settings
     i = agent.index
-    if dist > s.dock_tolerance or float(world.static_gaps(goal[:2], world.robot_half[i])[0]) >= s.leave_gap:
+    if dist > s.dock_tolerance or not _beside_for_good(world, agent, goal):
         return None
-    pose = (goal[0], goal[1], math.degrees(float(world.pose[i, 2])))
-    if not creep_is_safe(world, agent, pose):
-        return None
+    heading = math.degrees(float(world.pose[i, 2]))
+    xy, aim = world.pose[i, :2].astype(float), np.asarray(goal[:2], dtype=float)
+    if not creep_is_safe(world, agent, (aim[0], aim[1], heading)):
+        # the creep is safe up to some fraction of the way (a shorter creep sweeps less)
+        lo, hi = 0.0, 1.0
+        for _ in range(12):
+            mid = (lo + hi) / 2
+            q = xy + mid * (aim - xy)
+            lo, hi = (mid, hi) if creep_is_safe(world, agent, (q[0], q[1], heading)) else (lo, mid)
+        aim = xy + lo * (aim - xy)
+        if lo == 0.0 or math.dist(aim, goal[:2]) > s.goal_tolerance:
+            return None
+    pose = (float(aim[0]), float(aim[1]), heading)
     return brake(world, i) if world.v[i] > 0 else ("dock", pose)
+
+
+def _beside_for_good(world: World, agent: Agent, goal: tuple[float, ...]) -> bool:
+    """Whether the pose `goal` lies beside something that stands for good: a wall or resting
+    object within ``leave_gap``, or a robot that has finished within the standoff (it never
+    moves again, like a wall: robots the scene parks closer than the standoff come home to
+    that gap, as their plans allow, :mod:`cosmop.team.conflicts`)."""
+    s = world.settings
+    half = float(world.robot_half[agent.index])
+    if float(world.static_gaps(goal[:2], half)[0]) < s.leave_gap:
+        return True
+    finished = [a.index for a in world.agents if a.done and a is not agent]
+    if not finished:
+        return False
+    gaps = box_gaps(np.asarray(goal[:2], dtype=float), half, world.robot_boxes()[finished])
+    return bool((gaps < s.dwa.standoff).any())
 
 
 def back_onto_segment(world: World, agent: Agent) -> Action | None:

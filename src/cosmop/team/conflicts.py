@@ -57,9 +57,11 @@ __all__ = [
     "detours",
     "fixed_places",
     "is_ordered",
+    "kept_out",
     "occupancies",
     "ranked_detours",
     "replan_rank",
+    "scene_gap",
 ]
 
 
@@ -137,8 +139,10 @@ class Occupancy:
     units : {"mm", "m"}, optional
         The units its words show lengths in: the scenario file's (``Scene.units``).
     start : shapely geometry, optional
-        A robot's occupancy at its start: its square there (no clearance), when it stands at
-        its start from instant 0 or is its first drive, off it; else ``None``.
+        A robot's occupancy where the scene placed it: its square there (no clearance), when
+        it stands at its start from instant 0 or is its first drive, off it (the square at its
+        start), or when it stands at its home for good at the end of its plan or is the drive
+        there (the square at its home); else ``None``.
     """
 
     what: str
@@ -237,6 +241,9 @@ def _robot_occupancies(
     party = frozenset((robot,))
     bare = square(poses[0][0], poses[0][1], side - grow)  # its body at its start
     first_drive = next((k for k, s in enumerate(plan.steps, 1) if s.primitive == Primitive.GOTO), 0)
+    # home again at the end: the gap the scene gave it there holds again (see `conflicts`)
+    homing = _homing_drive(plan, poses, home)
+    at_home = square(home[0], home[1], side - grow)
     out: list[Occupancy] = []
     k = 0
     while k <= K:
@@ -264,7 +271,7 @@ def _robot_occupancies(
                 square(x, y, side - grow + 2 * rest),
                 units,
                 (k, end),
-                start=bare if k == 0 else None,
+                start=bare if k == 0 else at_home if homing is not None and k == homing else None,
             )
         )
         k = end + 1
@@ -284,10 +291,22 @@ def _robot_occupancies(
                     swept_square(p, q, side - grow),
                     units,
                     (k - 1, k),
-                    start=bare if k == first_drive else None,
+                    start=bare if k == first_drive else at_home if k == homing else None,
                 )
             )
     return out
+
+
+def _homing_drive(plan: RobotPlan, poses: Sequence[Sequence[float]], home: Sequence[float]) -> int | None:
+    """The instant `k` of the GoTo that brings the robot home for good (its plan keeps that pose
+    from instant `k` to the end), or ``None`` when the plan does not end at `home` after a drive."""
+    K = plan.horizon
+    if K == 0 or not at_pose(poses[K], home):
+        return None
+    k = K
+    while k > 0 and plan.steps[k - 1].primitive != Primitive.GOTO:
+        k -= 1
+    return k or None
 
 
 def _object_occupancies(
@@ -483,8 +502,9 @@ def conflicts(items: Sequence[Occupancy], clearance: float | None = None) -> lis
 
     `clearance` (mm; default :attr:`ConflictSettings.clearance`) is the one the robots'
     regions were grown by: two robots that start closer than that keep only their start gap
-    where one stands at its start and the other stands at or drives off its own
-    (:func:`_given_gap`).
+    where one stands at its start and the other stands at or drives off its own, and likewise
+    where one stands at its home at the end and the other stands at or drives into its own
+    (:func:`_given_gap`): a scene that parks two robots touching gets them back parked so.
 
     Parameters
     ----------
@@ -521,14 +541,12 @@ def conflicts(items: Sequence[Occupancy], clearance: float | None = None) -> lis
 
 
 def _given_gap(a: Occupancy, b: Occupancy, clearance: float) -> bool:
-    """Whether the overlap of `a` and `b` (robots' occupancies at their starts, one standing) is
-    only the clearance the scene's start poses already break: their bare shapes, grown by half
-    the gap between the two starts (L-infinity, mm), do not overlap."""
-    if a.start is None or b.start is None or (a.is_drive and b.is_drive):
-        return False
-    (ax0, ay0, ax1, ay1), (bx0, by0, bx1, by1) = a.start.bounds, b.start.bounds
-    gap = max(bx0 - ax1, ax0 - bx1, by0 - ay1, ay0 - by1)
-    if gap >= clearance:
+    """Whether the overlap of `a` and `b` (robots' occupancies where the scene placed them, one
+    standing: :attr:`Occupancy.start`) is only the clearance the scene's poses already break:
+    their bare shapes, grown by half the gap between those two places (L-infinity, mm), do
+    not overlap."""
+    gap = scene_gap(a, b, clearance)
+    if gap is None:
         return False
     shapes = []
     for o in (a, b):
@@ -536,6 +554,24 @@ def _given_gap(a: Occupancy, b: Occupancy, clearance: float) -> bool:
         assert shape is not None  # a drive has its body, and both have their start
         shapes.append(shape.buffer(max(gap, 0.0) / 2, join_style="mitre"))
     return not _overlap(_geometries(shapes), [0], [1])[0]
+
+
+def scene_gap(a: Occupancy, b: Occupancy, clearance: float) -> float | None:
+    """The gap (L-infinity, mm) the scene gave two robots where `a` and `b` have them, when it
+    is below `clearance` and one of them stands (:attr:`Occupancy.start`); else ``None``.
+
+    Parameters
+    ----------
+    a, b : Occupancy
+        Two robots' occupancies.
+    clearance : float
+        The clearance robots keep otherwise, mm.
+    """
+    if a.start is None or b.start is None or (a.is_drive and b.is_drive):
+        return None
+    (ax0, ay0, ax1, ay1), (bx0, by0, bx1, by1) = a.start.bounds, b.start.bounds
+    gap = max(bx0 - ax1, ax0 - bx1, by0 - ay1, ay0 - by1)
+    return gap if gap < clearance else None
 
 
 def _overlap(shapes: np.ndarray, first: list[int], second: list[int]) -> list[bool]:
@@ -613,16 +649,54 @@ def ranked_detours(
         already grown (:func:`fixed_places`).
     """
     out: list[tuple[int, str, Occupancy]] = []
+    clearance = ConflictSettings().clearance
     for mover, keep in ((conflict.a, conflict.b), (conflict.b, conflict.a)):
         if not mover.movable or mover.first is None:
             continue
         robot = mover.what if mover.what in mover.parties else mover.first[0]
         places = _geometries(list(fixed.get(robot, ())))
-        if (shapely.area(shapely.intersection(keep.region, places)) > 1e-9).any():
+        avoid = kept_out(robot, keep, fixed, clearance)
+        if avoid is not None:  # kept out by the gap the scene gave, bodies against bodies
+            places = shapely.buffer(places, -clearance / 2, join_style="mitre")
+        if (shapely.area(shapely.intersection(keep.region if avoid is None else avoid, places)) > 1e-9).any():
             continue
         drive = mover.is_drive
         out.append((0 if drive and keep.last is None else 1 if drive else 2, robot, keep))
     return sorted(out, key=lambda o: o[0])
+
+
+def kept_out(
+    robot: str, keep: Occupancy, fixed: Mapping[str, Sequence[BaseGeometry]], clearance: float
+) -> BaseGeometry | None:
+    """Where `robot`'s body must stay to keep clear of `keep` when the scene allows less than
+    the clearance: ``None`` when the clearance holds (a re-plan keeps out of `keep`'s region
+    grown by the other half of it).
+
+    A robot the scene placed (`keep` stands at its start or home, or drives off or into it:
+    :attr:`Occupancy.start`) closer than `clearance` to one of `robot`'s fixed places (its
+    start, home or the poses it picks from, `fixed`, grown by the clearance) is kept out of
+    only by the least such gap (L-infinity, mm): the bare square of `keep` grown by it.  A
+    robot parked touching another may then drive past it, as it may leave it.
+
+    Parameters
+    ----------
+    robot : str
+        The robot that is re-planned.
+    keep : Occupancy
+        What it keeps clear of.
+    fixed : Mapping[str, sequence of shapely geometry]
+        Each robot's fixed places, grown by the clearance (:func:`fixed_places`).
+    clearance : float
+        The clearance robots keep from each other, mm.
+    """
+    if keep.start is None or not fixed.get(robot):
+        return None
+    x0, y0, x1, y1 = keep.start.bounds
+    bare = shapely.bounds(shapely.buffer(_geometries(list(fixed[robot])), -clearance / 2, join_style="mitre"))
+    gap = np.max([bare[:, 0] - x1, x0 - bare[:, 2], bare[:, 1] - y1, y0 - bare[:, 3]], axis=0).min()
+    if gap >= clearance:
+        return None
+    return keep.start.buffer(max(float(gap), 0.0), join_style="mitre")
 
 
 def fixed_places(items: Sequence[Occupancy]) -> dict[str, list[BaseGeometry]]:

@@ -11,17 +11,18 @@ around what it waits for.
 from __future__ import annotations
 
 import time
-from collections.abc import Hashable, Iterable, Mapping
+from collections.abc import Hashable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
 import shapely
+from shapely.geometry.base import BaseGeometry
 
 from cosmop.events import Event
 from cosmop.planning.plan_types import RobotPlan
 from cosmop.planning.synthesis import Synthesis
 from cosmop.scene import Scene, Wall
 from cosmop.team.aside import handover_spot
-from cosmop.team.conflicts import Conflict, ConflictSettings, Occupancy
+from cosmop.team.conflicts import Conflict, ConflictSettings, Occupancy, kept_out
 from cosmop.team.lanes import lanes
 from cosmop.team.planner import Planner, Window, goods_at
 from cosmop.team.safe_plans import TeamSafety, Wait, make_team_safe
@@ -122,12 +123,12 @@ def make_safe(
             why = f"no order or re-plan keeps {' and '.join(conflict.robots)} apart: {conflict.describe()}"
             return MadeSafe(results, safety, tuple(replans), (why,))
         moves = _give_way(safety, safety.unresolved)
-        step = _detour(planner, current, moves, settings)
+        step = _detour(planner, current, moves, settings, safety.fixed)
         fresh, failed = dict(step.results), step.failed
         replans.extend(step.replans)
         instead = _give_way(safety, [c for r in failed for c, _ in moves[r]], set(failed))
         if instead:  # the other side of their conflicts gives way instead, where it can
-            again = _detour(planner, current, instead, settings)
+            again = _detour(planner, current, instead, settings, safety.fixed)
             fresh.update(again.results)
             replans.extend(again.replans)
             failed = again.failed
@@ -232,16 +233,17 @@ class _Detoured:
 
 
 def _detour(
-    planner: Planner, current: Mapping[str, tuple[Event, ...]], moves: _Moves, settings: ConflictSettings
+    planner: Planner,
+    current: Mapping[str, tuple[Event, ...]],
+    moves: _Moves,
+    settings: ConflictSettings,
+    fixed: Mapping[str, Sequence[BaseGeometry]],
 ) -> _Detoured:
-    """Re-plan every robot in `moves` around its spaces; a robot that fails gets its walls back."""
+    """Re-plan every robot in `moves` around its spaces (`fixed`: each robot's fixed places,
+    :func:`~cosmop.team.conflicts.fixed_places`); a robot that fails gets its walls back."""
     saved = dict(planner.obstacles)
     walls = {
-        robot: tuple(
-            w
-            for _, keep in items
-            for w in walls_around(keep.region, settings.clearance, f"the space of {keep.label}")
-        )
+        robot: tuple(w for _, keep in items for w in _keep_out(robot, keep, fixed, settings.clearance))
         for robot, items in moves.items()
     }
     replans = tuple(
@@ -258,6 +260,16 @@ def _detour(
                 del planner.obstacles[robot]
             del fresh[robot]
     return _Detoured(fresh, replans, failed)
+
+
+def _keep_out(
+    robot: str, keep: Occupancy, fixed: Mapping[str, Sequence[BaseGeometry]], clearance: float
+) -> tuple[Wall, ...]:
+    """The walls that keep `robot` out of `keep`: the clearance away from it, or only the gap
+    the scene gave where it placed the robots closer (:func:`~cosmop.team.conflicts.kept_out`)."""
+    label = f"the space of {keep.label}"
+    avoid = kept_out(robot, keep, fixed, clearance)
+    return walls_around(keep.region, clearance, label) if avoid is None else walls_around(avoid, 0.0, label)
 
 
 def _replan_within(
@@ -382,9 +394,7 @@ def _ways_around(wait: Wait, safety: TeamSafety, scene: Scene, settings: Conflic
             out.append((key, why, walls))
     for _, mover, keep_out in safety.detours(wait.conflict):
         if mover == robot:
-            walls = {
-                robot: walls_around(keep_out.region, settings.clearance, f"the space of {keep_out.label}")
-            }
+            walls = {robot: _keep_out(robot, keep_out, safety.fixed, settings.clearance)}
             why = (
                 f"{robot} re-planned around the space of {keep_out.label} instead of waiting "
                 f"{wait.seconds:.1f} s"
