@@ -668,9 +668,9 @@ def ranked_detours(
 def kept_out(
     robot: str, keep: Occupancy, fixed: Mapping[str, Sequence[BaseGeometry]], clearance: float
 ) -> BaseGeometry | None:
-    """Where `robot`'s body must stay to keep clear of `keep` when the scene allows less than
-    the clearance: ``None`` when the clearance holds (a re-plan keeps out of `keep`'s region
-    grown by the other half of it).
+    """The region `robot`'s body must stay out of to keep clear of `keep` when the scene allows
+    less than the clearance; ``None`` when the clearance holds (a re-plan then keeps out of
+    `keep`'s region grown by the other half of it).
 
     A robot the scene placed (`keep` stands at its start or home, or drives off or into it:
     :attr:`Occupancy.start`) closer than `clearance` to one of `robot`'s fixed places (its
