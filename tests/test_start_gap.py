@@ -14,6 +14,7 @@ import copy
 
 import pytest
 
+from cosmop.lifelong import FleetSettings, run_fleet
 from cosmop.planning.realisation import message_links
 from cosmop.scenario import parse_scenario
 from cosmop.sim import footprint_overlaps, simulate
@@ -116,3 +117,20 @@ def test_a_robot_parked_for_good_beside_another_is_driven_around_at_the_scene_ga
     run = simulate(scenario, result.plans)
     assert run.completed and run.contacts_while_moving == 0
     assert not footprint_overlaps(scenario.scene, run)
+
+
+def test_a_lifelong_fleet_parked_touching_serves_its_orders():
+    """Idle robots are obstacles to a new order's plan, grown by the clearance only where the
+    robots do not already stand closer: else a robot parked touching another could plan nothing
+    from where it stands."""
+    data = copy.deepcopy(SIDE_BY_SIDE)
+    del data["mission"]
+    data["orders"] = [
+        {"at": 0, "object": "O1", "to": "W1", "by": "R1"},
+        {"at": 1, "object": "O2", "to": "W2", "by": "R2"},
+    ]
+    result = run_fleet(parse_scenario(data), fleet=FleetSettings(until=120.0))
+    summary = result.summary()
+    assert summary["orders"]["delivered"] == 2 and summary["orders"]["lost"] == 0
+    assert [e["accepted"] for e in summary["dispatch_log"]] == [True, True]
+    assert result.contacts_while_moving == 0

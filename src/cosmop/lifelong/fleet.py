@@ -36,13 +36,14 @@ from typing import Any
 
 import numpy as np
 
+from cosmop.control.geometry import box_gaps
 from cosmop.lifelong.dispatch import OrderState, choose_robot, delivery_events
 from cosmop.lifelong.fleet_result import FleetResult
 from cosmop.planning.plan_types import PlanSet, RobotPlan
 from cosmop.scene import Order, Scenario
 from cosmop.sim.recoordinate import recoordinate_world
 from cosmop.sim.recording import Recorder
-from cosmop.sim.replan import replan, start_state
+from cosmop.sim.replan import replan, robot_room, start_state
 from cosmop.sim.result import SimSettings
 from cosmop.sim.simulation import advance
 from cosmop.sim.world import Agent, World
@@ -293,18 +294,18 @@ def _hand_over(run: _Run, agent: Agent, state: OrderState, goods: tuple[float, .
 
 def _standing(run: _Run, agent: Agent) -> list[tuple[float, float, float]]:
     """The robots that stand still for now (idle or failed) as boxes ``x, y, half side`` (mm),
-    grown by the clearance the plans keep between robots: the new plan goes around them."""
+    grown by the room the plans keep between robots (:func:`~cosmop.sim.replan.robot_room`:
+    the clearance, or the gap they already stand at): the new plan goes around them."""
     world = run.world
-    room = ConflictSettings().clearance
-    return [
-        (
-            float(world.pose[a.index, 0]),
-            float(world.pose[a.index, 1]),
-            float(world.robot_half[a.index]) + room,
-        )
+    i = agent.index
+    standing = [
+        a.index
         for a in world.agents
         if a is not agent and (a.id in run.failed or (a.done and a.id not in run.busy))
     ]
+    boxes = world.robot_boxes()[standing]
+    gaps = box_gaps(world.pose[i, :2], world.robot_half[i], boxes)
+    return [(float(x), float(y), float(h) + robot_room(g)) for (x, y, h), g in zip(boxes, gaps, strict=True)]
 
 
 def _deliveries(run: _Run) -> None:

@@ -31,7 +31,7 @@ from cosmop.team.conflicts import ConflictSettings
 if TYPE_CHECKING:
     from cosmop.sim.world import Agent, World
 
-__all__ = ["replan", "replan_stalled", "route", "sensed_scene", "start_state"]
+__all__ = ["replan", "replan_stalled", "robot_room", "route", "sensed_scene", "start_state"]
 
 _PERSON_ROOM = 10.0  # mm added around a sensed person (a robot gets the standoff)
 
@@ -192,20 +192,35 @@ def route(agent: Agent, start: Sequence[float]) -> dict[str, Any]:
 
 def _sensed(world: World, agent: Agent) -> list[tuple[float, float, float]]:
     """The robots and people `agent` senses, as boxes ``x, y, half side`` (mm) grown by the
-    room to keep: robots the clearance the team-safety layer checks, people a little.  A robot
+    room to keep: robots the clearance the team-safety layer checks (:func:`robot_room`),
+    people a little.  A robot
     that has finished stays where it is for good: sensed however far."""
     s = world.settings
     i = agent.index
-    room = ConflictSettings().clearance
     sensed = world.obstacles()
     boxes, names = sensed.boxes, list(sensed.names)
     gaps = box_gaps(world.pose[i, :2], world.robot_half[i], boxes)
     finished = {a.id for a in world.agents if a.done}
     return [
-        (float(b[0]), float(b[1]), float(b[2]) + (room if n in world.robot_ids else _PERSON_ROOM))
+        (float(b[0]), float(b[1]), float(b[2]) + (robot_room(g) if n in world.robot_ids else _PERSON_ROOM))
         for b, n, g in zip(boxes, names, gaps, strict=True)
         if n != agent.id and n not in world.object_ids and (g < s.sense_range or n in finished)
     ]
+
+
+def robot_room(gap: float) -> float:
+    """The room (mm) a re-plan keeps around another robot whose square is `gap` mm (L-infinity)
+    from the re-planning robot's: the clearance the team-safety layer checks, or less where
+    the two already stand closer (robots parked touching may leave each other, as the plans
+    allow, :mod:`cosmop.team.conflicts`), 1 mm short of touching so that the start, rounded to
+    the millimetre, is never inside it.
+
+    Parameters
+    ----------
+    gap : float
+        The gap between the two robots' squares now, mm.
+    """
+    return float(min(ConflictSettings().clearance, max(gap - 1.0, 0.0)))
 
 
 def start_state(world: World, agent: Agent, picks: AbstractSet[str | None] = frozenset()) -> State:
