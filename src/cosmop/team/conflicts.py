@@ -40,6 +40,7 @@ import shapely
 from shapely import STRtree
 from shapely.geometry.base import BaseGeometry
 
+from cosmop.control.geometry import rect_gaps
 from cosmop.events import Node, Primitive
 from cosmop.planning.plan_types import RobotPlan, State
 from cosmop.planning.primitive_effects import initial_state
@@ -271,7 +272,7 @@ def _robot_occupancies(
                 square(x, y, side - grow + 2 * rest),
                 units,
                 (k, end),
-                start=bare if k == 0 else at_home if homing is not None and k == homing else None,
+                start=bare if k == 0 else at_home if k == homing else None,
             )
         )
         k = end + 1
@@ -693,10 +694,10 @@ def kept_out(
         return None
     x0, y0, x1, y1 = keep.start.bounds
     bare = shapely.bounds(shapely.buffer(_geometries(list(fixed[robot])), -clearance / 2, join_style="mitre"))
-    gap = np.max([bare[:, 0] - x1, x0 - bare[:, 2], bare[:, 1] - y1, y0 - bare[:, 3]], axis=0).min()
+    gap = float(rect_gaps(np.array([x0, y0]), np.array([x1, y1]), bare[:, :2], bare[:, 2:]).min())
     if gap >= clearance:
         return None
-    return keep.start.buffer(max(float(gap), 0.0), join_style="mitre")
+    return keep.start.buffer(gap, join_style="mitre")
 
 
 def fixed_places(items: Sequence[Occupancy]) -> dict[str, list[BaseGeometry]]:
