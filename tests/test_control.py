@@ -19,6 +19,7 @@ from cosmop.control import (
     point_segment_linf,
     segment_array,
 )
+from cosmop.control.geometry import swept_wall_gaps
 from cosmop.planning import overlaps, swept_square
 from cosmop.planning.checker import square
 from cosmop.scene import Dynamics, Human
@@ -65,6 +66,31 @@ def test_linf_distance_to_segment_matches_sampling(px, py, seg):
     sampled = np.maximum(np.abs(x1 + t * (x2 - x1) - px), np.abs(y1 + t * (y2 - y1) - py)).min()
     assert exact <= sampled + 1e-6
     assert exact >= sampled - np.hypot(x2 - x1, y2 - y1) / 20000 - 1e-6
+
+
+@given(
+    way=st.tuples(*[st.floats(-2000, 2000)] * 4),
+    wall=st.tuples(*[st.floats(-2000, 2000)] * 4),
+    half=st.floats(0, 300),
+)
+def test_a_swept_square_is_as_far_from_a_wall_as_its_nearest_sample(way, wall, half):
+    # exact where sampling the sweep is not: a square swept diagonally past a wall's end can cut
+    # the corner between two samples
+    x1, y1, x2, y2 = way
+    exact = float(swept_wall_gaps((x1, y1), (x2, y2), half, np.array([wall]))[0])
+    t = np.linspace(0.0, 1.0, 4001)[:, None]
+    centres = np.array([x1, y1]) + t * np.array([x2 - x1, y2 - y1])
+    sampled = float(point_segment_linf(centres, np.array([wall])).min()) - half
+    assert exact <= sampled + 1e-6
+    assert exact >= sampled - np.hypot(x2 - x1, y2 - y1) / 4000 - 1e-6
+
+
+def test_a_square_swept_past_a_walls_end_touches_it_where_its_samples_do_not():
+    walls = np.array([[6800.0, -3000.0, 7800.0, -3000.0], [7800.0, -3000.0, 7800.0, 3000.0]])
+    start, end = (8000.6, -3197.6), (7920.6, -3226.3)  # 200 mm robot squares, 1 mm from the corner
+    ends = point_segment_linf(np.array([start, end]), walls).min() - 200.0
+    assert ends > 0
+    assert swept_wall_gaps(start, end, 200.0, walls).min() < -1.0
 
 
 def test_a_set_per_row_measures_each_row_against_its_own_set_and_padding_is_infinitely_far():

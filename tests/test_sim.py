@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import multiprocessing
 from dataclasses import replace
 from pathlib import Path
@@ -16,9 +17,11 @@ from typer.testing import CliRunner
 from cosmop.cli import app
 from cosmop.control.geometry import box_gaps, point_segment_linf
 from cosmop.control.paths import GlobalPath
-from cosmop.events import parse_event
+from cosmop.events import Primitive, parse_event
 from cosmop.planning import PlanSet
+from cosmop.planning.plan_types import Pose, RobotPlan
 from cosmop.scenario import load_scenario, parse_scenario
+from cosmop.scene import Mission
 from cosmop.sim import SIM_FORMAT, TRACE_FORMAT, SimSettings, simulate, time_limit
 from cosmop.sim.motion import crawl, creep_is_safe
 from cosmop.sim.world import World
@@ -533,3 +536,40 @@ def test_a_robot_stuck_in_a_tight_aisle_creeps_along_its_path_and_not_into_a_rob
     # a robot 60 mm from the way: it waits for it as before, it does not creep up to it
     near = _aisle_world((1854, 1008.6))
     assert crawl(near, near.agents[0]) is None
+
+
+def _cut_drives(plan: RobotPlan, start: Pose, pieces: int) -> RobotPlan:
+    """`plan` with every GoTo longer than a metre cut into `pieces` collinear GoTos (what the
+    team's cuts at shared places do to a drive)."""
+    steps, here = [], start
+    for step in plan.steps:
+        length = math.dist(here[:2], step.robot[:2])
+        if step.primitive == Primitive.GOTO and length > 1000.0:
+            for k in range(1, pieces):
+                s = k / pieces
+                point = (here[0] + s * (step.robot[0] - here[0]), here[1] + s * (step.robot[1] - here[1]))
+                steps.append(replace(step, robot=(*point, step.robot[2])))
+        steps.append(step)
+        here = step.robot
+    return RobotPlan.from_steps(plan.mission, steps)
+
+
+def test_a_drive_cut_into_collinear_pieces_is_driven_at_the_pace_of_the_whole():
+    # cuts at the places robots share add waypoints on the same straight segment; a robot that
+    # passes them (nothing to wait for) aims past each one and keeps its speed
+    scenario = load_scenario(EXAMPLES / "02_warehouse_10x10" / "scenario.yaml")
+    alone = replace(
+        scenario,
+        scene=replace(scenario.scene, robots={"R1": scenario.scene.robots["R1"]}),
+        mission=Mission(tasks={"R1": scenario.mission.tasks["R1"]}),
+    )
+    plans = plan_team(alone).plans
+    cut = replace(
+        plans,
+        itinerary=None,
+        robots={"R1": _cut_drives(plans.robots["R1"], alone.scene.robots["R1"].pose, 6)},
+    )
+    assert cut.robots["R1"].horizon >= plans.robots["R1"].horizon + 10
+    whole, pieces = simulate(alone, plans), simulate(alone, cut)
+    _assert_done(pieces, alone, cut)
+    assert pieces.sim_time_s <= 1.05 * whole.sim_time_s, (pieces.sim_time_s, whole.sim_time_s)

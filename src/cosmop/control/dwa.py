@@ -14,6 +14,9 @@ extended in the paper):
    (only :math:`v - b\\varepsilon` when braking), predicts each for ``horizon`` seconds, and
 4. scores them by progress towards a look-ahead point on the global path, heading towards it,
    clearance along the arc (moving obstacles pessimistically grown by :math:`V_o t`) and speed.
+   A robot that stops at its target (its speed capped so that it can) counts an arc that the
+   horizon carries past the target as reaching it: it brakes on the way, and does not close in
+   at ever lower speed.
 
 The safety of step 2 does not depend on the score: the score only chooses *where* to go among
 arcs the safety rule admits.  Everything is vectorised over robots, arcs and obstacles.
@@ -684,11 +687,14 @@ def _score(
     d_now = np.hypot(target[:, 0] - xy[:, 0], target[:, 1] - xy[:, 1])
     dx, dy = target[:, None, 0] - end[..., 0], target[:, None, 1] - end[..., 1]  # end to target
     d_end = np.hypot(dx, dy)
-    # Progress relative to the best the window allows, so that it also decides at low speed.
-    progress = (d_now[:, None] - d_end) / np.maximum(high * settings.horizon, 1.0)[:, None]
     bearing = np.arctan2(dy, dx)
     heading = 1.0 - np.abs(np.angle(np.exp(1j * (bearing - end_heading)))) / np.pi
     heading = np.where(d_end < 1.0, 1.0, heading)
+    passing = _passing(drivers, pts, d_now, d_end)
+    if passing is not None:  # a robot stopping at its target: an arc carried past it gets there
+        d_end, heading = np.minimum(d_end, passing), np.where(passing < d_end, 1.0, heading)
+    # Progress relative to the best the window allows, so that it also decides at low speed.
+    progress = (d_now[:, None] - d_end) / np.maximum(high * settings.horizon, 1.0)[:, None]
     R = len(drivers.v)
     cap = (
         np.full(R, settings.clearance)
@@ -707,6 +713,33 @@ def _score(
     # An arc that would touch something within the horizon is taken only if every arc would.
     scored: NDArray[np.float64] = np.where(clear > 0, score, score - 1e3 + clear / 1e3)
     return scored
+
+
+def _passing(
+    drivers: Drivers, pts: NDArray[np.float64], d_now: NDArray[np.float64], d_end: NDArray[np.float64]
+) -> NDArray[np.float64] | None:
+    r"""For a robot whose target is where it stops, each arc's least distance to the target
+    ``(R, K)`` (``inf`` for the other robots); ``None`` when no robot stops at its target.
+
+    The window caps such a robot's speed so that it can stop at the target
+    (:math:`\sqrt{b\,d}`, :func:`_window`), so an arc whose horizon carries it past the target
+    is one it brakes on before: scored by where it ends, it would look like overshooting, and
+    the robot would close in at the speed that covers the rest in one horizon, slower and
+    slower (a tail of seconds at every stop).  Measured to the arc's polyline (the robot, then
+    the predicted points), it counts as reaching the target.
+    """
+    # the target is where it stops when no nearer than the stop (a corner on the way is not)
+    stops = np.isfinite(drivers.stop_distance) & (d_now >= drivers.stop_distance - 1.0)
+    if not stops.any():
+        return None
+    xy, target = drivers.pose[:, None, None, :2], drivers.target[:, None, None, :]
+    R, K = pts.shape[:2]
+    line = np.concatenate([np.broadcast_to(xy, (R, K, 1, 2)), pts], axis=2)  # (R, K, S+1, 2)
+    a, ab = line[:, :, :-1], np.diff(line, axis=2)
+    t = np.clip(np.sum((target - a) * ab, axis=-1) / np.maximum(np.sum(ab * ab, axis=-1), 1e-12), 0.0, 1.0)
+    gap = target - (a + t[..., None] * ab)
+    nearest = np.hypot(gap[..., 0], gap[..., 1]).min(axis=2)
+    return np.where(stops[:, None], nearest, np.inf)
 
 
 def _keep(near: NDArray[np.float64], movers: NDArray[np.bool_], settings: DwaSettings) -> NDArray[np.float64]:

@@ -7,7 +7,8 @@ the specification's :data:`~cosmop.planning.specification.ENCODINGS` is); each r
 
 ``GoTo``
     drives to the step's waypoint (:func:`cosmop.sim.motion.drive`).  A waypoint followed by
-    another ``GoTo`` is passed within ``pass_tolerance``; the last one of a run is reached
+    another ``GoTo`` is passed within ``pass_tolerance``, aiming past it where the next drives
+    continue its straight segment (:func:`_straight_on`); the last one of a run is reached
     within ``goal_tolerance`` and turned to its heading within ``heading_tolerance``, and so is
     one from which the plan approaches a pose that touches something (not turned).
 ``PickUp`` / ``DropOff``
@@ -39,7 +40,7 @@ from cosmop.control.safety import stopping_margin
 from cosmop.docking import docking_pose, in_front
 from cosmop.events import Primitive
 from cosmop.planning.plan_types import Pose, Step
-from cosmop.sim.motion import HOLD, REPLANNED, brake, creep_is_safe, creep_out, drive, halt
+from cosmop.sim.motion import HOLD, REPLANNED, StraightOn, brake, creep_is_safe, creep_out, drive, halt
 from cosmop.sim.world import TOUCH, Action, Agent, World
 
 __all__ = [
@@ -53,6 +54,8 @@ __all__ = [
     "send_message",
     "wait_for_message",
 ]
+
+_COLLINEAR = 0.01  # a waypoint this far off the line per mm along it (0.6 degrees) continues it
 
 Executor = Callable[[World, Agent, Step], Action | None]
 """Executes one step for one cycle: the robot's action, or ``None`` once the step is done."""
@@ -134,9 +137,49 @@ def go_to(world: World, agent: Agent, step: Step) -> Action | None:
         action = creep_out(world, agent, goal)
         if action is not None:
             return action
-    action = drive(world, agent, goal, stop, heading=last, origin=origin)
+    # the segment's start: the previous waypoint, or where the robot stands on its first drive
+    x, y = (float(c) for c in world.pose[agent.index, :2])
+    start: Pose = origin or (x, y, 0.0)
+    ahead = None if stop else _straight_on(world, agent, k, start, after)
+    action = drive(world, agent, goal, stop, heading=last, origin=origin, ahead=ahead)
     agent.through = action is None and not stop
     return action
+
+
+def _straight_on(world: World, agent: Agent, k: int, origin: Pose, after: int | None) -> StraightOn | None:
+    """How far the robot drives on in a straight line past step `k`'s waypoint: the farthest
+    waypoint of the GoTos that continue the segment `origin` -> waypoint in its direction and
+    that it passes without stopping (messages come, nothing held), and whether it stops there.
+
+    A drive cut where it enters and leaves places shared with other robots is a run of short
+    collinear steps; aiming only at the next cut, the window would slow the robot at every one
+    of them although it drives straight on (:func:`cosmop.sim.motion.drive`).  ``None`` when
+    the next drive turns.
+    """
+    start, end = np.asarray(origin[:2], dtype=float), np.asarray(agent.steps[k].robot[:2], dtype=float)
+    direction = end - start
+    length = float(np.hypot(*direction))
+    if length <= 0.0:
+        return None
+    direction /= length
+    far: tuple[float, float] | None = None
+    stops = False
+    n = after
+    while n is not None:
+        point = np.asarray(agent.steps[n].robot[:2], dtype=float)
+        leg = point - end
+        along = float(leg @ direction)
+        if along <= 0.0 or abs(float(leg[0] * direction[1] - leg[1] * direction[0])) > _COLLINEAR * along:
+            break
+        far, end = (float(point[0]), float(point[1])), point
+        n = _next_drive(world, agent, n)
+        stops = n is None or bool(
+            world.static_gaps(agent.steps[n].robot[:2], world.robot_half[agent.index])[0]
+            < world.settings.leave_gap
+        )
+        if stops:
+            break
+    return None if far is None else StraightOn(far, stops)
 
 
 def _next_drive(world: World, agent: Agent, k: int) -> int | None:

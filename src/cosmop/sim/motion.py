@@ -17,11 +17,12 @@ Each function returns the robot's :data:`~cosmop.sim.world.Action` for this cycl
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
-from cosmop.control.geometry import box_gaps, point_segment_linf, swept_box_gaps
+from cosmop.control.geometry import box_gaps, point_segment_linf, swept_box_gaps, swept_wall_gaps
 from cosmop.control.paths import GlobalPath, plan_path, straight_path
 from cosmop.control.safety import is_safe, stopping_horizon
 from cosmop.planning.plan_types import Pose
@@ -31,6 +32,7 @@ from cosmop.sim.world import TOUCH, Action, Agent, World
 __all__ = [
     "HOLD",
     "REPLANNED",
+    "StraightOn",
     "back_onto_segment",
     "brake",
     "crawl",
@@ -55,6 +57,22 @@ _GRAZE = 1.0  # mm: a straight way closer than this to an obstacle is not truste
 _EXIT_HEADINGS = np.radians(np.arange(0.0, 360.0, 5.0))  # directions a way out is looked for in
 _EXIT_REACH = 80  # mm: how far a way out is looked for
 _REJOIN_AHEAD = (4000.0, 8000.0, 16000.0)  # mm along the path: where a detour may rejoin it
+
+
+@dataclass(frozen=True)
+class StraightOn:
+    """Where a robot that passes its waypoint drives on to in a straight line.
+
+    Attributes
+    ----------
+    far : (float, float)
+        The farthest waypoint on the drive's line the robot passes to without stopping, mm.
+    stops : bool
+        Whether it stops there (a message it must wait for, or its last drive).
+    """
+
+    far: tuple[float, float]
+    stops: bool
 
 
 REACH = 1.25
@@ -138,6 +156,7 @@ def drive(
     final: bool,
     heading: bool,
     origin: Pose | None = None,
+    ahead: StraightOn | None = None,
 ) -> Action | None:
     """Drive towards `goal` (mm, mm, degrees); ``None`` once it is reached (and turned to, if
     `heading`).  A `final` goal is reached within ``goal_tolerance`` and the robot stops there;
@@ -158,6 +177,9 @@ def drive(
         Whether it turns to the goal's heading there.
     origin : (float, float, float), optional
         The start of the plan's segment to `goal`.
+    ahead : StraightOn, optional
+        Where a robot that passes `goal` drives on to in a straight line: the window's target
+        may lie beyond `goal` on that line (and the robot can stop where the run stops).
     """
     s = world.settings
     i = agent.index
@@ -201,7 +223,36 @@ def drive(
             if action is not None:
                 return action
     stop = left if final else math.inf
+    if ahead is not None and not final and _on_line(agent.path, target, ahead, xy, s.pass_tolerance / 2):
+        target, stop = _beyond(goal, ahead, reach - left, left)
     return ("drive", (target, stop, agent.goal_clearance))
+
+
+def _on_line(
+    path: GlobalPath, target: tuple[float, float], ahead: StraightOn, xy: NDArray[np.float64], aside: float
+) -> bool:
+    """Whether the target is the path's end, its last leg points on to ``ahead.far`` (within
+    about 11 degrees: a robot that passed the last waypoint a few mm aside comes back onto the
+    line; a path round an obstacle that meets the goal from aside does not), and the robot at
+    `xy` is at most `aside` mm off that line (so that, aiming past the goal, it still passes
+    within ``pass_tolerance`` of it)."""
+    end, before = path.points[-1], path.points[-2] if len(path.points) > 1 else path.points[-1]
+    if math.dist(target, end) > 1.0:
+        return False
+    ux, uy = end[0] - before[0], end[1] - before[1]
+    vx, vy = ahead.far[0] - end[0], ahead.far[1] - end[1]
+    dot = ux * vx + uy * vy
+    off = abs((float(xy[0]) - end[0]) * vy - (float(xy[1]) - end[1]) * vx) / max(math.hypot(vx, vy), 1e-9)
+    return dot > 0 and abs(ux * vy - uy * vx) <= 0.2 * dot and off <= aside
+
+
+def _beyond(goal: Pose, ahead: StraightOn, extra: float, left: float) -> tuple[tuple[float, float], float]:
+    """The window's target `extra` mm past `goal` on the line on to ``ahead.far`` (at most
+    there), and the distance to stop in (mm): to ``ahead.far`` if the robot stops there."""
+    dx, dy = ahead.far[0] - goal[0], ahead.far[1] - goal[1]
+    length = math.hypot(dx, dy)
+    s = min(extra, length) / length if length > 0 else 0.0
+    return (goal[0] + s * dx, goal[1] + s * dy), (left + length if ahead.stops else math.inf)
 
 
 def _start_drive(world: World, agent: Agent, goal: Pose, origin: Pose | None) -> None:
@@ -407,11 +458,10 @@ def creep_is_safe(world: World, agent: Agent, target: Pose | None = None) -> boo
         if len(world.walls):
             return bool(np.all(is_safe(point_segment_linf(xy, world.walls) - half, speed, 0.0, dyn)))
         return True
-    path = xy[None, :] + np.linspace(0.0, 1.0, 12)[:, None] * (np.asarray(target[:2]) - xy)[None, :]
     if still and (swept_box_gaps(xy, target[:2], half, boxes[still]) < -1e-6).any():  # exact
         return False
-    if len(world.walls):
-        return bool((point_segment_linf(path, world.walls) - half >= -1e-6).all())
+    if len(world.walls):  # exact too: samples along the way miss a wall's end cut diagonally
+        return bool((swept_wall_gaps(xy, target[:2], float(half), world.walls) >= -1e-6).all())
     return True
 
 

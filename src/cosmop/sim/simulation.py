@@ -6,7 +6,9 @@ control cycle :math:`\\varepsilon` (the scenario's ``dynamics.cycle``):
 ``GoTo``
     drives with the passive-safe dynamic window (:mod:`cosmop.control.dwa`) along a global path
     (:mod:`cosmop.control.paths`) to the step's waypoint.  A waypoint followed by another
-    ``GoTo`` is passed within ``pass_tolerance``; the last one of a run is reached within
+    ``GoTo`` is passed within ``pass_tolerance`` (where the next ones continue the same straight
+    segment, as the team's cuts at shared places do, the window aims past it, up to where the
+    robot must stop); the last one of a run is reached within
     ``goal_tolerance`` and turned to its heading within ``heading_tolerance``, and so is one
     from which the plan approaches a pose that touches something (not turned).  A plan may
     start or end a motion touching a wall or resting object (never slide along one:
