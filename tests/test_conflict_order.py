@@ -18,6 +18,8 @@ import random
 import numpy as np
 import pytest
 import shapely
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from cosmop.events import Link, message
 from cosmop.team import conflict_order
@@ -214,6 +216,39 @@ def test_an_implied_conflict_is_ordered_by_every_way_of_the_one_that_implies_it(
     # what is left out is implied by something kept
     kept = {id(c) for c in needed}
     assert all(any(id(d) in kept for d in implied.by(c)) for c in found if id(c) not in kept)
+
+
+@given(st.data())
+@settings(max_examples=150, deadline=None)
+def test_conflicts_imply_each_other_exactly_as_their_ways_do(data):
+    """`_implications` against its definition: d implies c when each way of d that exists
+    implies some way of c that exists (the same robots in the same roles, i_d >= i_c, j_d <= j_c)."""
+    m = data.draw(st.integers(1, 7))
+    robots = data.draw(st.lists(st.integers(0, 4), min_size=2, max_size=2, unique=True))
+    present = np.zeros((1, m, 2), dtype=bool)
+    ends = np.zeros((1, m, 2, 4), dtype=np.int64)
+    for n in range(m):
+        x, y = robots if data.draw(st.booleans()) else robots[::-1]
+        for w, (first, then) in enumerate(((x, y), (y, x))):
+            if data.draw(st.integers(0, 4)):  # one way in five is missing
+                present[0, n, w] = True
+                ends[0, n, w] = (first, data.draw(st.integers(1, 5)), then, data.draw(st.integers(1, 5)))
+
+    def implies(way, other):
+        return way[0] == other[0] and way[2] == other[2] and way[1] >= other[1] and way[3] <= other[3]
+
+    expected = [
+        [
+            all(
+                any(present[0, c, v] and implies(ends[0, d, w], ends[0, c, v]) for v in (0, 1))
+                for w in (0, 1)
+                if present[0, d, w]
+            )
+            for c in range(m)
+        ]
+        for d in range(m)
+    ]
+    assert conflict_order._implications(present, ends)[0].tolist() == expected
 
 
 @pytest.mark.parametrize("seed", range(20))

@@ -360,17 +360,30 @@ def _implications(present: np.ndarray, ends: np.ndarray) -> np.ndarray:
     """``[..., d, c]``: whether each way of conflict *d* implies a way of *c*
     (:class:`_Dominance`), for conflicts between the same two robots: `present` ``(..., m, 2)``
     says which ways they have, `ends` ``(..., m, 2, 4)`` each way as ``(A, i, B, j)`` with the
-    robots numbered (leading axes: groups of conflicts, each on its own)."""
-    # [..., d, c, d's way, c's way, field]
-    d, c = ends[..., :, None, :, None, :], ends[..., None, :, None, :, :]
-    match = (
-        present[..., None, :, None, :]
-        & (d[..., 0] == c[..., 0])
-        & (d[..., 2] == c[..., 2])
-        & (d[..., 1] >= c[..., 1])
-        & (d[..., 3] <= c[..., 3])
-    )
-    implies: np.ndarray = (match.any(axis=-1) | ~present[..., :, None, :]).all(axis=-1)
+    robots numbered (leading axes: groups of conflicts, each on its own).
+
+    A way implies only the way of the other conflict that lets the same robot go first, so the
+    ways are first put side by side by direction (the lower-numbered robot first, then the
+    other): *d* implies *c* when, in each direction, *d* has no way or *c* has one that it
+    implies (:math:`i_d \\ge i_c`, :math:`j_d \\le j_c`).
+    """
+    # each conflict's two robots, read from a way it has (way 1 lets the other robot first)
+    a = np.where(present[..., 0], ends[..., 0, 0], ends[..., 1, 2])
+    b = np.where(present[..., 0], ends[..., 0, 2], ends[..., 1, 0])
+    first = (a > b).astype(np.int64)  # the way that lets the lower-numbered robot go first
+    by_direction = np.stack([first, 1 - first], axis=-1)  # (..., m, 2)
+    has = np.take_along_axis(present, by_direction, axis=-1)
+    i = np.take_along_axis(ends[..., 1], by_direction, axis=-1)
+    j = np.take_along_axis(ends[..., 3], by_direction, axis=-1)
+    implies = np.ones(present.shape[:-1] + present.shape[-2:-1], dtype=bool)
+    for k in (0, 1):
+        i_k, j_k, has_k = i[..., k], j[..., k], has[..., k]
+        implied = (
+            has_k[..., None, :]
+            & (i_k[..., :, None] >= i_k[..., None, :])
+            & (j_k[..., :, None] <= j_k[..., None, :])
+        )
+        implies &= ~has_k[..., :, None] | implied
     return implies
 
 

@@ -21,6 +21,7 @@ import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
+import numpy as np
 import shapely
 from shapely.geometry.base import BaseGeometry
 
@@ -461,10 +462,11 @@ def _entry_exit(
     """Where a square of half side `half` moving from `p` to `q` starts and stops overlapping the
     convex `region`: fractions of the way in (0, 1), rounded outwards to the cut grain; the
     exit lies `passing` mm beyond (:attr:`~cosmop.team.conflicts.ConflictSettings.passing`)."""
-    corners = [
-        (x + dx, y + dy) for x, y in region.exterior.coords for dx in (-half, half) for dy in (-half, half)
-    ]
-    reach = shapely.MultiPoint(corners).convex_hull  # the Minkowski sum: centres that overlap it
+    # the region's corners moved by the square's, in the order (-h, -h), (-h, h), (h, -h), (h, h)
+    coords = shapely.get_coordinates(region.exterior)
+    shifts = np.array([(-half, -half), (-half, half), (half, -half), (half, half)])
+    corners = (coords[:, None, :] + shifts[None, :, :]).reshape(-1, 2)
+    reach = shapely.convex_hull(shapely.multipoints(corners))  # the Minkowski sum: centres that overlap it
     inside = shapely.LineString([p[:2], q[:2]]).intersection(reach)
     if inside.is_empty:
         return ()
