@@ -19,6 +19,7 @@ from cosmop.control.geometry import box_gaps, point_segment_linf
 from cosmop.control.paths import GlobalPath
 from cosmop.events import Primitive, parse_event
 from cosmop.planning import PlanSet
+from cosmop.planning.messages import cut_drives
 from cosmop.planning.plan_types import Pose, RobotPlan
 from cosmop.scenario import load_scenario, parse_scenario
 from cosmop.scene import Mission
@@ -538,20 +539,15 @@ def test_a_robot_stuck_in_a_tight_aisle_creeps_along_its_path_and_not_into_a_rob
     assert crawl(near, near.agents[0]) is None
 
 
-def _cut_drives(plan: RobotPlan, start: Pose, pieces: int) -> RobotPlan:
-    """`plan` with every GoTo longer than a metre cut into `pieces` collinear GoTos (what the
-    team's cuts at shared places do to a drive)."""
-    steps, here = [], start
-    for step in plan.steps:
-        length = math.dist(here[:2], step.robot[:2])
-        if step.primitive == Primitive.GOTO and length > 1000.0:
-            for k in range(1, pieces):
-                s = k / pieces
-                point = (here[0] + s * (step.robot[0] - here[0]), here[1] + s * (step.robot[1] - here[1]))
-                steps.append(replace(step, robot=(*point, step.robot[2])))
-        steps.append(step)
+def _cut_into(plan: RobotPlan, start: Pose, pieces: int) -> RobotPlan:
+    """`plan` with every GoTo longer than a metre cut into `pieces` collinear GoTos, as the
+    team cuts a drive at the places robots share (:func:`cosmop.planning.messages.cut_drives`)."""
+    cuts, here = {}, start
+    for k, step in enumerate(plan.steps, 1):
+        if step.primitive == Primitive.GOTO and math.dist(here[:2], step.robot[:2]) > 1000.0:
+            cuts[k] = [n / pieces for n in range(1, pieces)]
         here = step.robot
-    return RobotPlan.from_steps(plan.mission, steps)
+    return cut_drives(plan, start, cuts)
 
 
 def test_a_drive_cut_into_collinear_pieces_is_driven_at_the_pace_of_the_whole():
@@ -567,7 +563,7 @@ def test_a_drive_cut_into_collinear_pieces_is_driven_at_the_pace_of_the_whole():
     cut = replace(
         plans,
         itinerary=None,
-        robots={"R1": _cut_drives(plans.robots["R1"], alone.scene.robots["R1"].pose, 6)},
+        robots={"R1": _cut_into(plans.robots["R1"], alone.scene.robots["R1"].pose, 6)},
     )
     assert cut.robots["R1"].horizon >= plans.robots["R1"].horizon + 10
     whole, pieces = simulate(alone, plans), simulate(alone, cut)
