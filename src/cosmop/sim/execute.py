@@ -137,26 +137,28 @@ def go_to(world: World, agent: Agent, step: Step) -> Action | None:
         action = creep_out(world, agent, goal)
         if action is not None:
             return action
-    # the segment's start: the previous waypoint, or where the robot stands on its first drive
-    x, y = (float(c) for c in world.pose[agent.index, :2])
-    start: Pose = origin or (x, y, 0.0)
-    ahead = None if stop else _straight_on(world, agent, k, start, after)
+    ahead = None if stop else _straight_on(world, agent, k, origin, after)
     action = drive(world, agent, goal, stop, heading=last, origin=origin, ahead=ahead)
     agent.through = action is None and not stop
     return action
 
 
-def _straight_on(world: World, agent: Agent, k: int, origin: Pose, after: int | None) -> StraightOn | None:
+def _straight_on(
+    world: World, agent: Agent, k: int, origin: Pose | None, after: int | None
+) -> StraightOn | None:
     """How far the robot drives on in a straight line past step `k`'s waypoint: the farthest
-    waypoint of the GoTos that continue the segment `origin` -> waypoint in its direction and
-    that it passes without stopping (messages come, nothing held), and whether it stops there.
+    waypoint of the GoTos that continue the segment from `origin` (``None``: where the robot
+    stands) to the waypoint in its direction and that it passes without stopping (messages
+    come, nothing held), and whether it stops there.
 
     A drive cut where it enters and leaves places shared with other robots is a run of short
     collinear steps; aiming only at the next cut, the window would slow the robot at every one
     of them although it drives straight on (:func:`cosmop.sim.motion.drive`).  ``None`` when
     the next drive turns.
     """
-    start, end = np.asarray(origin[:2], dtype=float), np.asarray(agent.steps[k].robot[:2], dtype=float)
+    # the segment's start: the previous waypoint, or where the robot stands on its first drive
+    start = np.asarray(origin[:2] if origin else world.pose[agent.index, :2], dtype=float)
+    end = np.asarray(agent.steps[k].robot[:2], dtype=float)
     direction = end - start
     length = float(np.hypot(*direction))
     if length <= 0.0:
