@@ -10,6 +10,13 @@ Conflicts no order can resolve (a robot parked for good where another must pass,
 orders that would wait on each other) are returned, for the caller to re-plan one robot around
 the other's space.
 
+Drives are cut where they enter and leave the places other robots use, so that a robot waits
+only for the shared piece (:func:`_cut_where_shared`).  A cut is also a place to stand, and a
+robot waiting there may be in the way of another and close a cycle of waits.  When a robot
+stands at a cut in every conflict left unresolved, only those drives are made whole again;
+otherwise (or when that leaves no fewer unresolved) every drive of the robots in them, then of
+every robot.
+
 Expected times come from :mod:`cosmop.team.timing`, so the orders follow what is likely to
 happen first and the team's makespan stays low.
 """
@@ -279,20 +286,79 @@ def make_team_safe(
     cut = (
         _cut_where_shared(scene, plans, settings, starts, positions, walls, about) if settings.cut else plans
     )
-    best = None
+    best, joined, before = None, dict[str, set[tuple[float, float]]](), math.inf
     while True:
-        attempt = _order(context, {r: p if r in uncut else cut[r] for r, p in plans.items()}, waypoints)
+        tried = {r: p if r in uncut else _joined(cut[r], joined.get(r, set())) for r, p in plans.items()}
+        attempt = _order(context, tried, waypoints)
         if best is None or len(attempt.unresolved) < len(best.unresolved):
             best = attempt
         if attempt.safe or uncut == frozenset(plans):
             break
-        # a cut leaves a place to stand in the middle of a drive, and standing there may close
-        # a cycle: drives of the robots in unresolved conflicts are ordered whole, then all are
+        # standing at a cut may close a cycle (module docstring): the drives robots stand in
+        # are made whole while that helps, then the robots' plans, then everyone's
+        stands = _stands_at_cuts(attempt.unresolved, tried, waypoints)
+        if stands is not None and len(attempt.unresolved) < before and _adds(stands, joined):
+            before = len(attempt.unresolved)
+            for r, points in stands.items():
+                joined.setdefault(r, set()).update(points)
+            continue
         involved = {r for c in attempt.unresolved for r in c.robots} - uncut
         uncut = uncut | involved if involved else frozenset(plans)
     if used is not None:  # each attempt named its messages in a copy; the kept one's are taken
         used |= {m.event for m in best.messages}
     return replace(best, time_s=time.perf_counter() - t0)
+
+
+def _stands_at_cuts(
+    unresolved: Sequence[Conflict],
+    plans: Mapping[str, RobotPlan],
+    waypoints: Mapping[str, set[tuple[float, float]]],
+) -> dict[str, set[tuple[float, float]]] | None:
+    """The cuts of the drives at whose cuts a robot stands in the `unresolved` conflicts
+    (cuts: the points of `plans` not among the robots' own `waypoints`), ``robot -> {(x, y)}``;
+    ``None`` when some conflict has no robot standing at a cut."""
+    out: dict[str, set[tuple[float, float]]] = {}
+    for conflict in unresolved:
+        found = False
+        for side in (conflict.a, conflict.b):
+            robot = side.what
+            if robot not in plans or robot not in side.parties or side.is_drive or not side.states:
+                continue  # goods, a drive, or not a robot of these plans
+            cuts = _drive_cuts(plans[robot], side.states[0], waypoints[robot])
+            out.setdefault(robot, set()).update(cuts)
+            found = found or bool(cuts)
+        if not found:
+            return None
+    return out
+
+
+def _adds(
+    points: Mapping[str, set[tuple[float, float]]], joined: Mapping[str, set[tuple[float, float]]]
+) -> bool:
+    """Whether `points` holds a cut not yet in `joined`."""
+    return any(p - joined.get(r, set()) for r, p in points.items())
+
+
+def _drive_cuts(plan: RobotPlan, k: int, waypoints: set[tuple[float, float]]) -> set[tuple[float, float]]:
+    """The cuts of the drive a robot stands in at instant `k` of `plan`: where the pieces of
+    that drive meet (points not among the robot's own `waypoints`); empty when the robot stands
+    at one of its waypoints (or its start) at instant `k`."""
+    points = [(s.robot[0], s.robot[1]) for s in plan.steps]
+    if not 1 <= k < len(points) or points[k - 1] in waypoints:
+        return set()
+    first, last = k, k
+    while first > 1 and points[first - 2] not in waypoints:
+        first -= 1
+    while last < len(points) - 1 and points[last] not in waypoints:
+        last += 1
+    return set(points[first - 1 : last])
+
+
+def _joined(plan: RobotPlan, points: set[tuple[float, float]]) -> RobotPlan:
+    """`plan` with its drives joined again at the cuts `points` (:func:`merge_drives`)."""
+    if not points:
+        return plan
+    return merge_drives(plan, {(s.robot[0], s.robot[1]) for s in plan.steps} - points)
 
 
 def _order(
