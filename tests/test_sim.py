@@ -20,7 +20,8 @@ from cosmop.control.paths import GlobalPath
 from cosmop.events import Primitive, parse_event
 from cosmop.planning import PlanSet
 from cosmop.planning.messages import cut_drives
-from cosmop.planning.plan_types import Pose, RobotPlan
+from cosmop.planning.plan_file import load_plan
+from cosmop.planning.plan_types import Pose, RobotPlan, Step
 from cosmop.scenario import load_scenario, parse_scenario
 from cosmop.scene import Mission
 from cosmop.sim import SIM_FORMAT, TRACE_FORMAT, SimSettings, simulate, time_limit
@@ -31,6 +32,7 @@ from cosmop.traces import Trace, TraceError, _rounded, as_trace, load_trace
 from team_checks import assert_complete_word, assert_no_overlap
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+DATA = Path(__file__).resolve().parent / "data"
 runner = CliRunner()
 
 
@@ -537,6 +539,32 @@ def test_a_robot_stuck_in_a_tight_aisle_creeps_along_its_path_and_not_into_a_rob
     # a robot 60 mm from the way: it waits for it as before, it does not creep up to it
     near = _aisle_world((1854, 1008.6))
     assert crawl(near, near.agents[0]) is None
+
+
+def test_a_robot_beside_one_that_waits_for_its_message_creeps_on():
+    # the robot 60 mm from the way stands waiting for a message nobody has sent (R1's, say): it
+    # cannot move before the message comes, so creeping past it crowds no one that may move
+    near = _aisle_world((1854, 1008.6))
+    waiter = near.agents[1]
+    event = parse_event("msg(R1,R2,clear1)")
+    waiter.steps = [Step(Primitive.REQ, None, (1854.0, 1008.6, 0.0), {}, event)]
+    waiter.waiting = True
+    assert near.held(waiter)
+    kind, pose = crawl(near, near.agents[0])
+    assert kind == "dock" and pose[:2] == pytest.approx((1851.0, 1549.0))
+    near.sent_messages.add(event)  # the message came: it may leave at any moment
+    assert not near.held(waiter) and crawl(near, near.agents[0]) is None
+
+
+def test_a_robot_stopped_at_a_wall_end_beside_one_waiting_for_it_goes_on_without_a_replan():
+    # R1 stops touching the end of a wall (the plan passes it 9 mm off) while R4 stands 96 mm
+    # from its way waiting for R1's message: R1 creeps along its path instead of standing until
+    # it replans a long way round (82.4 s instead of 63.9 s for the plans before)
+    scenario = load_scenario(DATA / "wall_end" / "scenario.yaml")
+    plans = load_plan(DATA / "wall_end" / "plan.json")
+    result = simulate(scenario, plans)
+    _assert_done(result, scenario, plans)
+    assert result.replans == 0 and result.sim_time_s < 75.0
 
 
 def _cut_into(plan: RobotPlan, start: Pose, pieces: int) -> RobotPlan:

@@ -300,7 +300,9 @@ def crawl(world: World, agent: Agent) -> Action | None:
     same path.  The docking creep (straight, slow, exact) takes it up to ``dock_tolerance``
     along the path, never past a vertex (never round a corner), turned along the way, when that
     move is passively safe and no robot or person is within twice the window's standoff of it:
-    a robot held by another waits for it as before (creeping up to it would crowd it).
+    a robot held by another waits for it as before (creeping up to it would crowd it).  A robot
+    that stands waiting for a message not yet sent does not count: it cannot move before the
+    message comes (and may wait for this very robot to pass), nor leave while crowded.
 
     Parameters
     ----------
@@ -317,7 +319,8 @@ def crawl(world: World, agent: Agent) -> Action | None:
     target, _ = agent.path.lookahead(xy, s.dock_tolerance, corner=0.0)
     if math.dist(target, xy) <= 1e-6:
         return None
-    others = np.delete(world.robot_boxes(), i, axis=0)
+    movable = [a.index for a in world.agents if a is not agent and not world.held(a)]
+    others = world.robot_boxes()[movable]
     if world.walkers:
         others = np.vstack([others, world.people_boxes()])
     if (swept_box_gaps(xy, target, float(world.robot_half[i]), others) < 2 * s.dwa.standoff).any():

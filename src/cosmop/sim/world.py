@@ -539,14 +539,21 @@ class World:
         gaps[i] = np.inf
         parked = self.parked()
         for agent in self.agents:
-            if agent.done or (parked[agent.index] and (agent.index > i or self._held(agent))):
+            if agent.done or (parked[agent.index] and (agent.index > i or self.held(agent))):
                 gaps[agent.index] = np.inf
         return bool((gaps < self.settings.dwa.standoff).any())
 
-    def _held(self, agent: Agent) -> bool:
-        """Whether `agent` waits for a message that has not been sent."""
-        step = agent.step
-        return agent.waiting and step.primitive == Primitive.REQ and not self.received(agent, step)
+    def held(self, agent: Agent) -> bool:
+        """Whether `agent` waits for a message that has not been sent: it cannot move before.
+
+        Parameters
+        ----------
+        agent : Agent
+            A robot.
+        """
+        if not agent.waiting or agent.done:
+            return False
+        return agent.step.primitive == Primitive.REQ and not self.received(agent, agent.step)
 
     # -- messages and mission events ---------------------------------------------------------------
 
