@@ -42,7 +42,17 @@ def cosmop_row(data: dict, until: float, timeout: float) -> dict:
         scenario, summary = Path(tmp) / "s.yaml", Path(tmp) / "summary.json"
         emit_scenario(data, scenario)
         t = time.perf_counter()
-        cmd = ["cosmop", "run", str(scenario), "--until", str(until), "--summary", str(summary)]
+        cmd = [
+            sys.executable,
+            "-m",
+            "cosmop",
+            "run",
+            str(scenario),
+            "--until",
+            str(until),
+            "--summary",
+            str(summary),
+        ]
         try:
             proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
         except subprocess.TimeoutExpired:
