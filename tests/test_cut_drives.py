@@ -14,6 +14,7 @@ from pathlib import Path
 import pytest
 
 import cosmop.team.safe_plans as safe_plans
+from cosmop.events import Primitive
 from cosmop.planning.messages import cut_drives
 from cosmop.planning.realisation import message_links
 from cosmop.scenario import load_scenario
@@ -38,9 +39,9 @@ def warehouse():
 def _two_drives_cut(scenario, plans):
     """A robot whose plan has two drives, each cut in three pieces, and its own waypoints."""
     robot, plan = next(
-        (r, p) for r, p in plans.items() if sum(s.primitive.name == "GOTO" for s in p.steps) >= 2
+        (r, p) for r, p in plans.items() if sum(s.primitive == Primitive.GOTO for s in p.steps) >= 2
     )
-    drives = [k for k, s in enumerate(plan.steps, 1) if s.primitive.name == "GOTO"][:2]
+    drives = [k for k, s in enumerate(plan.steps, 1) if s.primitive == Primitive.GOTO][:2]
     cut = cut_drives(plan, start_pose(scenario.scene, robot, None), {k: [0.25, 0.5] for k in drives})
     return robot, plan, cut, set(_points(plan))
 
