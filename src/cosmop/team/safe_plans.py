@@ -272,7 +272,7 @@ def make_team_safe(
     """
     t0 = time.perf_counter()
     settings = settings or ConflictSettings()
-    waypoints = {r: {(s.robot[0], s.robot[1]) for s in p.steps} for r, p in plans.items()}
+    waypoints = {r: set(_points(p)) for r, p in plans.items()}
     walls = shapely.MultiLineString([[w.start, w.end] for w in scene.obstacles]) if scene.obstacles else None
     plans = {
         r: split_drives(
@@ -343,7 +343,7 @@ def _drive_cuts(plan: RobotPlan, k: int, waypoints: set[tuple[float, float]]) ->
     """The cuts of the drive a robot stands in at instant `k` of `plan`: where the pieces of
     that drive meet (points not among the robot's own `waypoints`); empty when the robot stands
     at one of its waypoints (or its start) at instant `k`."""
-    points = [(s.robot[0], s.robot[1]) for s in plan.steps]
+    points = _points(plan)
     if not 1 <= k < len(points) or points[k - 1] in waypoints:
         return set()
     first, last = k, k
@@ -358,7 +358,12 @@ def _joined(plan: RobotPlan, points: set[tuple[float, float]]) -> RobotPlan:
     """`plan` with its drives joined again at the cuts `points` (:func:`merge_drives`)."""
     if not points:
         return plan
-    return merge_drives(plan, {(s.robot[0], s.robot[1]) for s in plan.steps} - points)
+    return merge_drives(plan, set(_points(plan)) - points)
+
+
+def _points(plan: RobotPlan) -> list[tuple[float, float]]:
+    """Where each step of `plan` leaves the robot's centre, ``(x, y)`` mm, step by step."""
+    return [(s.robot[0], s.robot[1]) for s in plan.steps]
 
 
 def _order(
