@@ -263,3 +263,61 @@ def test_the_retreat_steps_away_else_aside_farther_from_the_box_else_stays(per_r
     out = _open_retreat(xy, np.full(4, 100.0), away, delta, walls, 200.0)
     # free: away; blocked: aside, the side the robot already stands off the box first; else put
     np.testing.assert_array_equal(out, [[200.0, 0.0], [0.0, 5200.0], [0.0, 4800.0], [0.0, 10000.0]])
+
+
+def _aisle_driver(heading_deg: float, v: float):
+    """A robot of 500 mm at `v` in a 1 m aisle along x, between goods of 200 mm on both
+    shelf faces: 50 mm to each side, its target 2 m ahead on the aisle's centre line."""
+    from cosmop.control.dwa import Drivers, Obstacles
+    from cosmop.control.safety import Limits
+
+    walls = segment_array([((-5000.0, 500.0), (5000.0, 500.0)), ((-5000.0, -500.0), (5000.0, -500.0))])
+    goods = np.array([[x, side * 400.0, 100.0] for x in range(-3000, 3001, 500) for side in (1, -1)])
+    drivers = Drivers(
+        pose=np.array([[0.0, 0.0, np.radians(heading_deg)]]),
+        v=np.array([v]),
+        half=np.array([250.0]),
+        limits=Limits.of([Dynamics()]),
+        target=np.array([[2000.0, 0.0]]),
+        stop_distance=np.array([np.inf]),
+    )
+    return drivers, Obstacles(walls, goods, np.zeros(len(goods)))
+
+
+@pytest.mark.parametrize("heading", [0.0, 3.0, -5.0])
+def test_a_robot_keeps_its_speed_along_an_aisle_lined_with_goods(heading):
+    # 50 mm from goods on both sides, safe (any direction) allows about 160 mm/s; braking
+    # straight on along the aisle keeps clear, so the window keeps the top speed, and a heading
+    # a few degrees off is turned back within the cycle instead of braking
+    from cosmop.control.dwa import dwa_commands
+
+    drivers, obstacles = _aisle_driver(heading, 750.0)
+    cmd = dwa_commands(drivers, obstacles)
+    assert not cmd.safe[0]
+    assert cmd.v[0] > 750.0 - Dynamics().braking * Dynamics().cycle  # not braking
+    assert np.sign(cmd.w[0]) == -np.sign(heading)  # back towards the aisle's axis (0: straight)
+
+
+def test_a_robot_heading_into_the_goods_beside_an_aisle_brakes():
+    # 20 degrees off, braking straight on from the top speed would reach the goods: no arc of
+    # the window turns it back in one cycle, so it brakes
+    from cosmop.control.dwa import dwa_commands
+
+    drivers, obstacles = _aisle_driver(20.0, 750.0)
+    cmd = dwa_commands(drivers, obstacles)
+    assert cmd.v[0] == pytest.approx(750.0 - Dynamics().braking * Dynamics().cycle)
+
+
+def test_the_standoff_sends_a_robot_away_from_robots_not_from_goods_it_passes():
+    from cosmop.control.dwa import DwaSettings, Obstacles, _retreat
+
+    drivers, _ = _aisle_driver(0.0, 300.0)
+    box = np.array([[0.0, 390.0, 100.0]])  # 40 mm beside the robot, within the 50 mm standoff
+    gap = np.array([[40.0]])
+    unsafe = np.array([True])
+    goods = Obstacles(np.zeros((0, 4)), box, np.zeros(1)).per_driver(1)
+    resting = _retreat(drivers, goods, gap, unsafe, DwaSettings())
+    np.testing.assert_array_equal(resting.target, drivers.target)  # goods: on along the aisle
+    robot = Obstacles(np.zeros((0, 4)), box, np.zeros(1), agents=np.array([True])).per_driver(1)
+    moved = _retreat(drivers, robot, gap, unsafe, DwaSettings())
+    assert moved.target[0, 1] < 0.0  # a robot there: away from it first

@@ -42,7 +42,6 @@ def _crowd(seed: int, side: float = 40_000.0) -> tuple[Drivers, Obstacles, np.nd
         limits=limits,
         target=xy + rng.uniform(-2000, 2000, (R, 2)),
         stop_distance=rng.choice([np.inf, 300.0], R),  # 300 mm: the stop caps the window's speed
-        w=rng.uniform(-0.5, 0.5, R),
         room_cap=rng.uniform(20, 200, R),
     )
     objects = np.column_stack([rng.uniform(0, side, (n_objects, 2)), np.full(n_objects, 150.0)])
@@ -251,7 +250,6 @@ def _small_scene(rng: np.random.Generator) -> tuple[Drivers, Obstacles, np.ndarr
         limits=Limits.of([Dynamics()] * R),
         target=xy + rng.uniform(-3000, 3000, (R, 2)),
         stop_distance=np.full(R, np.inf),
-        w=np.zeros(R),
     )
     ignore = rng.random((R, M)) < 0.3
     grip = (rng.random((R, M)) < 0.1) if rng.random() < 0.5 else None
@@ -273,7 +271,7 @@ def test_small_arrays_drop_far_obstacles_without_changing_a_command(monkeypatch)
 
 
 @pytest.mark.parametrize(
-    ("seed", "side", "batch"), [(2, 8_000.0, dwa._ESCAPE_BATCH), (2, 20_000.0, 3), (0, 20_000.0, 1)]
+    ("seed", "side", "batch"), [(2, 8_000.0, dwa._ESCAPE_BATCH), (2, 20_000.0, 3), (3, 20_000.0, 1)]
 )
 def test_the_best_escape_is_the_best_scored_admitted_arc(seed, side, batch, monkeypatch):
     # checking the arcs a few at a time, best first, must find what checking all of them finds

@@ -7,8 +7,9 @@ extended in the paper):
    (:math:`V_o = 0`), other robots and people (their top speeds);
 2. decides passive safety (:mod:`cosmop.control.safety`): if ``safe`` holds it may pick any
    acceleration in :math:`[-b, A]`; otherwise it may take only arcs whose own worst case
-   (held for a cycle, then braking along the arc) provably keeps clear of every obstacle --
-   typically arcs leading away -- and else brakes with :math:`-b` along its current arc;
+   (held for a cycle, then braking straight on, as every brake is) provably keeps clear of
+   every obstacle -- arcs along a wall or leading away -- and else brakes with :math:`-b`
+   straight on, the brake the last cycle's check covered;
 3. samples arcs :math:`(v, \\omega)` in the dynamic window
    :math:`[v - b\\varepsilon, \\min(v + A\\varepsilon, v_{top})] \\times [-\\Omega, \\Omega]`
    (only :math:`v - b\\varepsilon` when braking), predicts each for ``horizon`` seconds, and
@@ -398,8 +399,6 @@ class Drivers:
     stop_distance : ndarray, shape (R,)
         Distance left to the goal along the path (mm): the speed is capped so that the robot
         can stop there.
-    w : ndarray, shape (R,), optional
-        Current turn rates (rad/s): a robot with no admissible arc brakes along its arc.
     room_cap : ndarray, shape (R,), optional
         The most clearance that scores (mm; default ``DwaSettings.clearance``).  Set it to the
         gap at the goal so that a goal close to an obstacle (a docking pose) does not repel its
@@ -412,7 +411,6 @@ class Drivers:
     limits: Limits
     target: NDArray[np.float64]
     stop_distance: NDArray[np.float64]
-    w: NDArray[np.float64] | None = None
     room_cap: NDArray[np.float64] | None = None
 
     def __getitem__(self, rows: NDArray[np.intp] | NDArray[np.bool_]) -> Drivers:
@@ -424,7 +422,6 @@ class Drivers:
             self.limits[rows],
             self.target[rows],
             self.stop_distance[rows],
-            None if self.w is None else self.w[rows],
             None if self.room_cap is None else self.room_cap[rows],
         )
 
@@ -466,8 +463,8 @@ def dwa_commands(
     safe = _passive_safety(drivers, obstacles, wall_gap, box_gap, settings)
     min_gap = np.minimum(wall_gap.min(axis=1, initial=np.inf), box_gap.min(axis=1, initial=np.inf))
     if not safe.all() and obstacles.boxes.shape[-2]:
-        # Not safe: head away from the nearest box along the axis of its L-infinity gap first,
-        # out of the standoff; the path is taken up again once safe holds.
+        # Not safe: head away from the nearest robot or person along the axis of its L-infinity
+        # gap first, out of the standoff; the path is taken up again once safe holds.
         drivers = _retreat(drivers, obstacles, box_gap, ~safe, settings)
     low, high, V, W = _window(drivers, settings)
     t, pts, th = _arcs(drivers, V, W, settings)
@@ -477,7 +474,7 @@ def dwa_commands(
     w_out = np.zeros(len(drivers.v))
     if not safe.all():
         # Not safe: only arcs whose own braking path provably keeps clear (checked below), else
-        # brake along the previous arc -- the one the last cycle's check covered.
+        # brake straight on -- the brake the last cycle's check covered.
         rows = np.flatnonzero(~safe)
         pick, found = _best_escapes(
             drivers[rows],
@@ -491,8 +488,6 @@ def dwa_commands(
         admitted = np.full((len(rows), V.shape[1]), -np.inf)  # the best escape arc alone
         admitted[found, pick[found]] = score[rows[found], pick[found]]
         score[rows] = admitted
-        fallback = rows[~found]
-        w_out[fallback] = (np.zeros(len(drivers.v)) if drivers.w is None else drivers.w)[fallback]
     best = np.argmax(score, axis=1)
     rows_all = np.arange(len(drivers.v))
     finite = np.isfinite(score[rows_all, best])
@@ -531,12 +526,15 @@ def _retreat(
     unsafe: NDArray[np.bool_],
     settings: DwaSettings,
 ) -> Drivers:
-    """`drivers` with the unsafe ones inside a box's standoff aimed at a point away from it,
-    and no stop distance (they leave at once)."""
+    """`drivers` with the unsafe ones inside the standoff of a robot or person aimed at a point
+    away from it, and no stop distance (they leave at once)."""
     rows = np.flatnonzero(unsafe)
     xy, boxes = drivers.pose[:, :2], obstacles.boxes
-    near = np.argmin(np.where(np.isinf(box_gap[rows]), np.inf, box_gap[rows]), axis=1)
-    close = box_gap[rows, near] < settings.standoff
+    # the standoff is kept from movers only: a robot that passes close by a resting object
+    # (goods on a shelf face) drives on along it, not away sideways
+    gap = np.where(obstacles.movers[rows], box_gap[rows], np.inf)
+    near = np.argmin(gap, axis=1)
+    close = gap[np.arange(len(rows)), near] < settings.standoff
     delta = xy[rows] - boxes[rows, near, :2]
     along_x = np.abs(delta[:, 0]) >= np.abs(delta[:, 1])
     away = np.where(along_x[:, None], [[1.0, 0.0]], [[0.0, 1.0]]) * np.sign(delta).clip(-1, 1)
@@ -886,7 +884,7 @@ def _far_for_escape(
 ) -> tuple[Obstacles, NDArray[np.bool_] | None, NDArray[np.float64]]:
     """`obstacles` (with `skip` and `keep`) without the boxes that pass every sample of every
     escape arc (:func:`_escape_ok`; `pts` ``(U, P, 2)`` its samples, `longest` ``(U,)`` the
-    boxes' horizon, at least every arc's time to a stop, `slack` ``(U, K, 1)``).
+    boxes' horizon, at least every arc's time to a stop, `slack` ``(U, K, n)``).
 
     A sample at time :math:`t` passes a box when its gap exceeds :math:`V_o t` plus the slack;
     its gap is at least the gap now less the sample's L-infinity offset from the robot (the
@@ -907,6 +905,64 @@ def _far_for_escape(
     return kept, (None if skip is None else taken[1]), taken[0]
 
 
+_CYCLE_SAMPLES = 4  # points of the cycle's own arc: the simulator's sub-steps (sim.unicycle)
+
+
+def _brake_path(
+    pose: NDArray[np.float64],
+    v: NDArray[np.float64],
+    V: NDArray[np.float64],
+    W: NDArray[np.float64],
+    brk: NDArray[np.float64],
+    eps: NDArray[np.float64],
+    steps: int,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    r"""Where each arc's worst case takes the robot: one cycle at ``(V, W)``, then a straight stop.
+
+    During the cycle the robot turns at :math:`W` and changes speed as the simulator moves it
+    (a ramp up to :math:`V`, or braking at :math:`-b` until :math:`V` and holding it), its
+    position taken at the ends of :data:`_CYCLE_SAMPLES` sub-steps, each at its midpoint
+    heading.  Then it brakes at :math:`-b` on a straight line: :math:`V^2/2b` long, sampled at
+    `steps` points evenly spaced along it, at the times it passes them,
+    :math:`\varepsilon + (V - \sqrt{V^2 - 2bs})/b`.
+
+    Returns the sample times ``t``, positions ``x`` and ``y`` and the path length from the
+    sample before ``slack`` (each ``(U, K, n)``, n = :data:`_CYCLE_SAMPLES` + `steps`): every
+    point of the path lies within its sample's slack of it, and is passed no later.
+    """
+    n1 = _CYCLE_SAMPLES
+    e = eps[:, None, None]
+    frac = np.arange(1, n1 + 1) / n1  # (n1,)
+    tc = e * frac  # (U, 1, n1)
+    v0, v1 = v[:, None, None], V[:, :, None]
+    b = brk[:, None, None]
+    reached = np.where(v1 < v0, (v0 - v1) / b, e)
+    tb = np.minimum(tc, reached)
+    braked = v0 * tb - b * tb * tb / 2.0 + v1 * np.maximum(tc - reached, 0.0)
+    ramp = v0 * tc + (v1 - v0) * tc * tc / (2.0 * e)
+    covered = np.where(v1 < v0, braked, ramp)  # (U, K, n1) from the cycle's start
+    step1 = np.diff(covered, axis=2, prepend=0.0)
+    turn = W[:, :, None] * e / n1
+    heading = pose[:, 2, None, None] + turn * (np.arange(n1) + 0.5)  # each sub-step's midpoint
+    x1 = pose[:, 0, None, None] + np.cumsum(step1 * np.cos(heading), axis=2)
+    y1 = pose[:, 1, None, None] + np.cumsum(step1 * np.sin(heading), axis=2)
+    # then straight on at the cycle's last heading, braking to a stop
+    final = pose[:, 2, None, None] + W[:, :, None] * e
+    length = v1 * v1 / (2.0 * b)  # (U, K, 1)
+    s = length * (np.arange(1, steps + 1) / steps)  # (U, K, steps)
+    t2 = e + (v1 - np.sqrt(np.maximum(v1 * v1 - 2.0 * b * s, 0.0))) / b
+    x2 = x1[:, :, -1:] + s * np.cos(final)
+    y2 = y1[:, :, -1:] + s * np.sin(final)
+    slack2 = np.broadcast_to(length / steps, s.shape)
+    t = np.concatenate([np.broadcast_to(tc, step1.shape), t2], axis=2)
+    return (
+        t,
+        np.concatenate([x1, x2], axis=2),
+        np.concatenate([y1, y2], axis=2),
+        np.concatenate([step1, slack2], axis=2),
+    )
+
+
 def _escape_ok(
     drivers: Drivers,
     V: NDArray[np.float64],
@@ -914,14 +970,17 @@ def _escape_ok(
     obstacles: Obstacles,
     skip: NDArray[np.bool_] | None,
     keep: NDArray[np.float64],
-    steps: int = 8,
+    steps: int = 16,
     longest: NDArray[np.float64] | None = None,
 ) -> NDArray[np.bool_]:
     """Whether each arc's worst case keeps clear: held for one cycle, then braking to a stop.
 
-    The robot reaches speed ``V`` linearly within :math:`\\varepsilon`, then brakes with
-    :math:`-b` with the turn rate held; at every sampled instant :math:`t` its square must be
-    farther from each obstacle than :math:`V_o t` plus the distance it covers between samples.
+    The robot moves one cycle on the arc, then brakes with :math:`-b` straight on
+    (:func:`_brake_path`, `steps` samples on the straight part); at every sample, passed at
+    :math:`t`, its square must be farther from each obstacle than :math:`V_o t` plus the path
+    length from the sample before.  Turning only within the cycle, a robot driving along a
+    narrow aisle can keep its heading there at speed (held for the whole stop, any turn would
+    curve into the aisle's side).
     This is passive safety checked directly along one arc, used when ``safe`` (which covers
     every arc at once) fails, so that a robot standing close to something can still leave.
     ``keep`` (shape ``(U, M)``, mm): the gap to each box may not end below it (``-inf``: no
@@ -938,32 +997,20 @@ def _escape_ok(
     )
     total = eps[:, None] + V / brk[:, None]  # (U, K): time until standing still
     longest = total.max(axis=1) if longest is None else longest  # (U,): the boxes' horizon
-    dt = total / steps
-    t = dt[:, :, None] * np.arange(1, steps + 1)[None, None, :]  # (U, K, n)
-    e = eps[:, None, None]
-    speed = np.where(
-        t <= e,
-        v[:, None, None] + (V[:, :, None] - v[:, None, None]) * t / e,
-        np.maximum(V[:, :, None] - brk[:, None, None] * (t - e), 0.0),
-    )
-    theta = pose[:, 2, None, None] + W[:, :, None] * t
-    step = speed * dt[:, :, None]
-    x = pose[:, 0, None, None] + np.cumsum(step * np.cos(theta), axis=2)
-    y = pose[:, 1, None, None] + np.cumsum(step * np.sin(theta), axis=2)
-    slack = step.max(axis=2, initial=0.0)[:, :, None]
+    t, x, y, slack = _brake_path(pose, v, V, W, brk, eps, steps)
     pts = np.stack([x, y], axis=-1).reshape(U, -1, 2)
     obstacles, skip, keep = _far_for_escape(drivers, pts, longest, slack, obstacles, skip, keep)
     walls, boxes = obstacles.walls, obstacles.boxes
     ok = np.ones((U, K), dtype=bool)
     if walls.shape[-2]:
-        gap = (point_segment_linf(pts, walls) - half[:, None, None]).reshape(U, K, steps, -1)
+        gap = (point_segment_linf(pts, walls) - half[:, None, None]).reshape(U, K, t.shape[-1], -1)
         now_gap = point_segment_linf(pose[:, :2], walls) - half[:, None]  # (U, W)
         # moving away never closes a gap, even one already (numerically) shut: it must open
         opens = gap > np.minimum(now_gap, 0.0)[:, None, None, :]
         fine = (gap > slack[..., None]) | ((gap >= now_gap[:, None, None, :] - 1e-9) & opens)
         ok &= fine.all(axis=(2, 3))
     if boxes.shape[-2]:
-        gap = box_gaps(pts, half[:, None, None], boxes).reshape(U, K, steps, -1)
+        gap = box_gaps(pts, half[:, None, None], boxes).reshape(U, K, t.shape[-1], -1)
         bound = obstacles.speed_bound(longest[:, None])  # (U, M)
         reach = t[..., None] * bound[:, None, None, :]
         fine = gap > reach + slack[..., None]

@@ -22,11 +22,12 @@ gaps capped from above:
   robot and a box moves at most :math:`\\bar V h` meanwhile, and gaps above the clearance cap
   (walls, objects) or the personal space (robots, people) score as if infinite.  A farther
   obstacle is never the minimum that counts, nor below zero.
-* An escape arc (checked only when ``safe`` fails) is held for a cycle and then brakes: its
-  points stay within :math:`\\bar v T` of the robot, a box moves :math:`\\bar V T`, and the
-  slack between samples is below :math:`\\bar v T`; a farther obstacle passes every sample.
-* The retreat steps away from the nearest box when it is within the standoff, checking the
-  walls twice the standoff away; both are within reach.
+* An escape arc (checked only when ``safe`` fails) is held for a cycle and then brakes
+  straight on: its points stay within :math:`\\bar v T` of the robot, a box moves
+  :math:`\\bar V T`, and the slack between samples is below :math:`\\bar v T`; a farther
+  obstacle passes every sample.
+* The retreat steps away from the nearest robot or person when it is within the standoff,
+  checking the walls twice the standoff away; both are within reach.
 
 :func:`reach` adds these terms (walls with :math:`\\bar V = 0`) with a margin of one standoff,
 so each driver's group sees a superset of its neighbourhood.  The obstacles a group keeps are

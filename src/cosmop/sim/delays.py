@@ -11,8 +11,8 @@ and without them.  Every second draws for every robot, whatever the robots do, s
 stops when is fixed by the seed alone; a draw that finds its robot finished, or already stopped,
 is let go.
 
-A stopped robot brakes with :math:`-b` along its current arc (the arc the dynamic window's
-last check covered, so passive safety holds) and stands; it may be struck anywhere in its plan
+A stopped robot brakes with :math:`-b` straight on (the brake the dynamic window's last
+check covered, so passive safety holds) and stands; it may be struck anywhere in its plan
 -- driving, docking, its gripper working, waiting for a message or about to send one -- since
 braking is always safe and a standing robot does nothing.  Its stop includes its braking; it
 then carries on with its step where it left it.  The simulator does the rest

@@ -40,7 +40,7 @@ from cosmop.control.safety import stopping_margin
 from cosmop.docking import docking_pose, in_front
 from cosmop.events import Primitive
 from cosmop.planning.plan_types import Pose, Step
-from cosmop.sim.motion import HOLD, REPLANNED, StraightOn, brake, creep_is_safe, creep_out, drive, halt
+from cosmop.sim.motion import HOLD, REPLANNED, StraightOn, brake, creep_is_safe, creep_out, drive
 from cosmop.sim.world import TOUCH, Action, Agent, World
 
 __all__ = [
@@ -67,7 +67,7 @@ def decide(world: World, agent: Agent) -> Action:
 
     Steps that are done at once (a message sent, a drive already at its goal) are completed in
     the same cycle; a robot that has finished brakes.  A robot a delay has stopped
-    (:mod:`cosmop.sim.delays`) brakes along its arc and stands, its step left as it was.
+    (:mod:`cosmop.sim.delays`) brakes straight on and stands, its step left as it was.
 
     Parameters
     ----------
@@ -77,7 +77,7 @@ def decide(world: World, agent: Agent) -> Action:
         The robot deciding.
     """
     if agent.stopped_until is not None:
-        return halt(world, agent.index)
+        return brake(world, agent.index)
     while not agent.done:
         step = agent.step
         action = EXECUTORS[step.primitive](world, agent, step)

@@ -43,7 +43,6 @@ __all__ = [
     "detour",
     "drive",
     "find_way_out",
-    "halt",
     "route",
 ]
 
@@ -81,7 +80,10 @@ REACH = 1.25
 
 
 def brake(world: World, i: int) -> Action:
-    """Robot `i`'s command to brake with :math:`-b` (the always-safe choice), not turning.
+    """Robot `i`'s command to brake with :math:`-b` straight on, the always-safe choice.
+
+    Every brake is straight: the dynamic window admits an arc only when one cycle on it, then
+    this brake, keeps clear (:mod:`cosmop.control.dwa`).
 
     Parameters
     ----------
@@ -91,23 +93,6 @@ def brake(world: World, i: int) -> Action:
         The robot's index.
     """
     return ("move", (max(0.0, world.v[i] - world.limits.braking[i] * world.dt), 0.0))
-
-
-def halt(world: World, i: int) -> Action:
-    """Robot `i`'s command to brake with :math:`-b` along its current arc, and stand.
-
-    The arc is the one the dynamic window chose last cycle, whose braking its safety check
-    covered (:mod:`cosmop.control.dwa`); standing, it stops turning too.
-
-    Parameters
-    ----------
-    world : World
-        The running simulation.
-    i : int
-        The robot's index.
-    """
-    v = float(world.v[i])
-    return ("move", (max(0.0, v - world.limits.braking[i] * world.dt), float(world.w[i]) if v > 0 else 0.0))
 
 
 def route(

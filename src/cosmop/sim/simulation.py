@@ -276,7 +276,6 @@ def _dynamic_window(world: World, sensed: Obstacles, commands: _Commands) -> Non
         limits=world.limits[idx],
         target=np.array(commands.targets, dtype=float),
         stop_distance=np.array(commands.stops, dtype=float),
-        w=world.w[idx],
         room_cap=np.array(commands.rooms, dtype=float),
     )
     window = dwa_commands_near if world.settings.neighbourhood else dwa_commands
