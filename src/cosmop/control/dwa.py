@@ -40,7 +40,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cosmop.control.geometry import box_gaps, point_segment_linf
-from cosmop.control.safety import Limits, obstacle_speed, own_margin, stopping_horizon
+from cosmop.control.safety import Limits, cycle_distance, obstacle_speed, own_margin, stopping_horizon
 
 _Scalar = TypeVar("_Scalar", bound=np.generic)
 
@@ -934,13 +934,8 @@ def _brake_path(
     e = eps[:, None, None]
     frac = np.arange(1, n1 + 1) / n1  # (n1,)
     tc = e * frac  # (U, 1, n1)
-    v0, v1 = v[:, None, None], V[:, :, None]
-    b = brk[:, None, None]
-    reached = np.where(v1 < v0, (v0 - v1) / b, e)
-    tb = np.minimum(tc, reached)
-    braked = v0 * tb - b * tb * tb / 2.0 + v1 * np.maximum(tc - reached, 0.0)
-    ramp = v0 * tc + (v1 - v0) * tc * tc / (2.0 * e)
-    covered = np.where(v1 < v0, braked, ramp)  # (U, K, n1) from the cycle's start
+    v1, b = V[:, :, None], brk[:, None, None]
+    covered = cycle_distance(v[:, None, None], v1, tc, b, e)  # (U, K, n1) from the cycle's start
     step1 = np.diff(covered, axis=2, prepend=0.0)
     turn = W[:, :, None] * e / n1
     heading = pose[:, 2, None, None] + turn * (np.arange(n1) + 0.5)  # each sub-step's midpoint

@@ -48,6 +48,7 @@ from cosmop.scene import Dynamics
 __all__ = [
     "Limits",
     "admissible_speed",
+    "cycle_distance",
     "is_safe",
     "obstacle_speed",
     "own_margin",
@@ -222,3 +223,45 @@ def admissible_speed(gap: _Real, speed_bound: _Real, dynamics: Dynamics | Limits
     gap = np.asarray(gap, dtype=float)
     root = np.sqrt(np.maximum((a / b + 1.0) * eps**2 + (speed_bound / b) ** 2 + 2.0 * gap / b, 0.0))
     return b * root - b * eps * (a / b + 1.0) - speed_bound
+
+
+def cycle_distance(v0: _Real, v1: _Real, t: _Real, braking: _Real, cycle: _Real) -> NDArray[np.float64]:
+    r"""How far a robot has driven `t` seconds into a control cycle that takes it from `v0` to `v1`.
+
+    Speeding up, the speed ramps at a constant acceleration over the cycle,
+    :math:`v_0 t + (v_1 - v_0) t^2 / 2\varepsilon`; slowing down, it brakes at :math:`-b`
+    until :math:`v_1` is reached, at :math:`(v_0 - v_1)/b`, and holds it (the control passive
+    safety assumes).  The simulator moves robots so (:func:`cosmop.sim.unicycle.integrate`),
+    and the dynamic window's check of an arc follows it (:mod:`cosmop.control.dwa`).
+
+    Parameters
+    ----------
+    v0, v1 : float or ndarray
+        The speeds at the start and the end of the cycle, mm/s.
+    t : float or ndarray
+        Time into the cycle, s (``0 <= t <= cycle``).
+    braking : float or ndarray
+        :math:`b`, mm/s².
+    cycle : float or ndarray
+        :math:`\varepsilon`, s.
+
+    Returns
+    -------
+    ndarray
+        The distance, mm (the arguments broadcast).
+
+    Examples
+    --------
+    >>> round(float(cycle_distance(0.0, 30.0, 0.1, 500.0, 0.1)), 9)
+    1.5
+    >>> round(float(cycle_distance(100.0, 50.0, 0.05, 500.0, 0.1)), 9)  # braking all the cycle
+    4.375
+    """
+    v0, v1, t = np.asarray(v0), np.asarray(v1), np.asarray(t)
+    slowing = v1 < v0
+    reached = np.where(slowing, (v0 - v1) / np.maximum(braking, 1e-9), cycle)  # when v1 is reached, s
+    ramp = v0 * t + (v1 - v0) * t * t / (2.0 * cycle)
+    tb = np.minimum(t, reached)
+    braked = v0 * tb - braking * tb * tb / 2.0 + v1 * np.maximum(t - reached, 0.0)
+    out: NDArray[np.float64] = np.where(slowing, braked, ramp)
+    return out

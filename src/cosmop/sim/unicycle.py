@@ -15,6 +15,7 @@ from functools import lru_cache
 import numpy as np
 from numpy.typing import NDArray
 
+from cosmop.control.safety import cycle_distance
 from cosmop.planning.plan_types import Pose
 from cosmop.sim.world import World, wrap_angle
 
@@ -55,17 +56,10 @@ def integrate(
     v0 = world.v
     v1 = np.minimum(np.maximum(v_cmd, np.maximum(0.0, v0 - brk * dt)), v0 + acc * dt)  # np.clip, cheaper
     v1 = np.minimum(v1, world.limits.max_speed)
-    slowing = v1 < v0
-    reached = np.where(slowing, (v0 - v1) / np.maximum(brk, 1e-9), dt)  # when v1 is reached, s
-
     # distance from the cycle's start to each sub-step's end, (n + 1, R): a ramp, or braking
     # at -b until v1 is reached and holding it after
     n = _SUBSTEPS
-    t = _instants(dt, n)
-    ramp = v0 * t + (v1 - v0) * t * t / (2.0 * dt)
-    tb = np.minimum(t, reached)
-    braked = v0 * tb - brk * tb * tb / 2.0 + v1 * np.maximum(t - reached, 0.0)
-    covered = np.where(slowing, braked, ramp)
+    covered = cycle_distance(v0, v1, _instants(dt, n), brk, dt)
     steps = covered[1:] - covered[:-1]
     start = world.pose[:, :2].copy()
     half_turn, turn = w_cmd * dt / (2 * n), w_cmd * dt / n

@@ -78,7 +78,8 @@ class ConflictSettings:
         a little off still passes where the plans let it).
     segment : float
         Drives longer than this (mm) are cut into pieces before ordering, so that a robot waits
-        only until another has passed the place they share (default 1500).
+        only until another has passed the place they share (default ``inf``: not cut; the
+        cuts where drives enter and leave shared places, ``cut``, do most of that).
     rest : float
         How far (mm) a standing robot may be off its planned pose (the simulator stops within
         its goal tolerance, 15 mm): goods another robot moves keep this from where it stands.
