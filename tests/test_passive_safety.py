@@ -90,7 +90,8 @@ def test_an_arc_taken_when_safe_fails_brakes_to_a_stop_without_touching(scene):
     drivers = Drivers(pose, v, np.array([HALF]), LIMITS, np.array([scene["target"]]), np.array([math.inf]))
     cmd = dwa_commands(drivers, Obstacles(walls, boxes, np.zeros(len(boxes))), DwaSettings())
     assume(not cmd.safe[0])  # the property is about the case where safe fails
-    event("escape arc" if cmd.w[0] != 0.0 or cmd.v[0] > v[0] - 50.0 + 1e-9 else "brake straight on")
+    braked = max(0.0, v[0] - LIMITS.braking[0] * LIMITS.cycle[0])  # the fallback's speed
+    event("escape arc" if cmd.w[0] != 0.0 or cmd.v[0] > braked + 1e-9 else "brake straight on")
     path = _trajectory(pose[0], v[0], float(cmd.v[0]), float(cmd.w[0]))
     wall_gap = point_segment_linf(path, walls) - HALF  # (n, W)
     assert (wall_gap > 0.0).all(), f"the arc touches a wall: {wall_gap.min():.3f} mm"
