@@ -27,8 +27,8 @@ def _data(orders=None) -> dict:
     del data["mission"]
     data["name"] = "lifelong-2x2"
     data["orders"] = orders or [
-        {"at": 5, "object": "O2", "to": ["W2", "W1"]},
         {"at": 0, "object": "O1", "to": "W1"},
+        {"at": 5, "object": "O2", "to": ["W2", "W1"]},
     ]
     return data
 
@@ -39,7 +39,7 @@ def _run(failures: tuple[Failure, ...] = (), until: float = 150.0):
     return scenario, run_fleet(scenario, fleet=FleetSettings(until=until), failures=failures)
 
 
-def test_a_scenario_may_hold_only_orders_sorted_by_release():
+def test_a_scenario_may_hold_only_orders():
     scenario = parse_scenario(_data())
     assert scenario.mission is None
     assert [(o.at, o.object, o.to, o.by) for o in scenario.orders] == [
@@ -61,6 +61,11 @@ def test_a_scenario_may_hold_only_orders_sorted_by_release():
             "orders[1].object",
             "O1 is already ordered by orders[0]",
         ),
+        (
+            [{"at": 5, "object": "O1", "to": "W1"}, {"at": 2.5, "object": "O2", "to": "W2"}],
+            "orders[1].at",
+            "expected a release time >= 5 s, the time of orders[0] before it",
+        ),
     ],
 )
 def test_a_bad_order_names_its_field(orders, field, words):
@@ -79,7 +84,7 @@ def test_neither_mission_nor_orders_is_refused():
 def test_an_orders_file_is_read_against_the_scene(tmp_path):
     scenario = load_scenario(EXAMPLE)
     path = tmp_path / "orders.yaml"
-    path.write_text("orders:\n  - {at: 3, object: O2, to: W2}\n  - {at: 1.5, object: O1, to: W1, by: R1}\n")
+    path.write_text("orders:\n  - {at: 1.5, object: O1, to: W1, by: R1}\n  - {at: 3, object: O2, to: W2}\n")
     assert [(o.at, o.object, o.by) for o in load_orders(path, scenario)] == [
         (1.5, "O1", ("R1",)),
         (3.0, "O2", ("R1", "R2")),

@@ -166,11 +166,21 @@ class _Builder:
         )
 
     def build_orders(self, models: list[OrderModel], scene: Scene) -> tuple[Order, ...]:
-        """The orders with their ids checked against the scene, by release time (stable)."""
+        """The orders with their ids checked against the scene, listed by release time.
+
+        A stream is written in the order it is released: a time that goes backwards is more
+        likely a typing slip than a wish, so it is refused rather than sorted.
+        """
         out: list[Order] = []
         first: dict[str, int] = {}
         for index, model in enumerate(models):
             path = ("orders", index)
+            if out and float(model.at) < out[-1].at:
+                self.fail(
+                    (*path, "at"),
+                    f"expected a release time >= {out[-1].at:g} s, the time of orders[{index - 1}] "
+                    f"before it (orders are listed as they are released), got {model.at:g}",
+                )
             if model.object not in scene.objects:
                 self.fail(
                     (*path, "object"), f"unknown object {model.object!r}; {_known('objects', scene.objects)}"
@@ -191,7 +201,7 @@ class _Builder:
                     self.fail((*path, "by", k), f"unknown robot {robot!r}; {_known('robots', scene.robots)}")
             by = tuple(dict.fromkeys(model.by)) if model.by else tuple(scene.robots)
             out.append(Order(float(model.at), model.object, tuple(dict.fromkeys(model.to)), by))
-        return tuple(sorted(out, key=lambda order: order.at))
+        return tuple(out)
 
     def build_scene(self, model: SceneModel) -> Scene:
         owner_of_id: dict[str, tuple[str, str, str]] = {}  # id -> ("scene", group, id)
