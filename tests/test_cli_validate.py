@@ -18,6 +18,7 @@ from cosmop.io import write_atomic
 EXAMPLE_DIR = Path(__file__).resolve().parents[1] / "examples" / "01_warehouse_2x2"
 TASKS_FILE = EXAMPLE_DIR / "scenario.yaml"
 DFA_FILE = EXAMPLE_DIR / "scenario_dfa.yaml"
+LIFELONG_FILE = EXAMPLE_DIR.parent / "13_lifelong" / "scenario.yaml"
 
 runner = CliRunner()
 
@@ -155,6 +156,14 @@ def test_usage_errors_exit_2() -> None:
             ["simulate", str(TASKS_FILE), "--max-time", "-1"],
             "cosmop simulate: Invalid value for '--max-time'",
         ),
+        (
+            ["simulate", str(TASKS_FILE), "--max-time", "inf"],
+            "cosmop simulate: Invalid value for '--max-time': expected a finite number, got inf",
+        ),
+        (
+            ["run", str(LIFELONG_FILE), "--until", "inf"],
+            "cosmop run: Invalid value for '--until': expected a finite number, got inf",
+        ),
         (["simulate", str(TASKS_FILE), "--seed", "-1"], "cosmop simulate: Invalid value for '--seed'"),
         (["plan", str(TASKS_FILE), "-o", "p.json", "--wrkers", "2"], "cosmop plan: No such option: --wrkers"),
         (["plan", str(TASKS_FILE)], "cosmop plan: Missing option '-o'"),
@@ -165,6 +174,8 @@ def test_usage_errors_exit_2() -> None:
     ids=[
         "workers-0",
         "max-time-negative",
+        "max-time-infinite",
+        "until-infinite",
         "seed-negative",
         "unknown-option",
         "missing-option",

@@ -9,6 +9,7 @@ status 2; Ctrl-C is the program's (:mod:`cosmop._entry`).  Commands load their s
 from __future__ import annotations
 
 import inspect
+import math
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any, NoReturn, cast
@@ -22,7 +23,7 @@ from cosmop.errors import CosmopInputError, EventSyntaxError, ScenarioError
 from cosmop.scenario import load_scenario
 from cosmop.scene import Scenario
 
-__all__ = ["EXIT_INPUT_ERROR", "ScenarioArgument", "app", "load", "stderr", "stdout"]
+__all__ = ["EXIT_INPUT_ERROR", "ScenarioArgument", "app", "finite", "load", "stderr", "stdout"]
 
 EXIT_INPUT_ERROR = 2
 """Exit status for bad input (also the status of command-line usage errors)."""
@@ -36,6 +37,14 @@ if TYPE_CHECKING:
         exit_code: int
 
         def format_message(self) -> str: ...
+
+
+def finite(value: float | None) -> float | None:
+    """A number option's check (a typer ``callback``): ``inf`` passes a lower bound, yet no run
+    lasts for ever and no rate is infinite."""
+    if value is not None and not math.isfinite(value):
+        raise typer.BadParameter(f"expected a finite number, got {value}")
+    return value
 
 
 # click's error base class, from typer's own BadParameter (typer may bundle its own click)

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 from rich.text import Text
 
-from cosmop.cli._app import load, stdout
+from cosmop.cli._app import finite, load, stdout
 from cosmop.io import check_writable, write_atomic
 
 if TYPE_CHECKING:
@@ -212,9 +212,13 @@ def write_bag_and_report(
 
 RateOption = Annotated[
     float | None,
-    typer.Option(help="Poses and /tf per second (Hz) \\[default: every frame of the trace]", min=1e-6),
+    typer.Option(
+        help="Poses and /tf per second (Hz) \\[default: every frame of the trace]", min=1e-6, callback=finite
+    ),
 ]
-SceneRateOption = Annotated[float, typer.Option(help="/scene marker arrays per second (Hz).", min=1e-6)]
+SceneRateOption = Annotated[
+    float, typer.Option(help="/scene marker arrays per second (Hz).", min=1e-6, callback=finite)
+]
 
 
 def export(

@@ -10,7 +10,7 @@ import typer
 from rich.table import Table
 from rich.text import Text
 
-from cosmop.cli._app import EXIT_INPUT_ERROR, ScenarioArgument, load, stderr, stdout
+from cosmop.cli._app import EXIT_INPUT_ERROR, ScenarioArgument, finite, load, stderr, stdout
 from cosmop.cli.simulate import parse_delays
 from cosmop.io import check_writable, uninterrupted
 from cosmop.lifelong import Failure, FleetResult, FleetSettings, run_fleet
@@ -31,7 +31,7 @@ def _parse_failure(text: str) -> Failure:
 
 def run(
     scenario: ScenarioArgument,
-    until: Annotated[float, typer.Option(help="Simulated seconds the run lasts.", min=1.0)],
+    until: Annotated[float, typer.Option(help="Simulated seconds the run lasts.", min=1.0, callback=finite)],
     orders: Annotated[
         Path | None,
         typer.Option(

@@ -11,7 +11,7 @@ import typer
 from rich.table import Table
 from rich.text import Text
 
-from cosmop.cli._app import EXIT_INPUT_ERROR, ScenarioArgument, load, stderr, stdout
+from cosmop.cli._app import EXIT_INPUT_ERROR, ScenarioArgument, finite, load, stderr, stdout
 from cosmop.cli.ecosystem import check_bag_target, write_bag_and_report
 from cosmop.cli.plan import SchedulerOption, WorkersOption, check_engine, plan_with_progress
 from cosmop.io import check_writable, uninterrupted
@@ -100,6 +100,7 @@ def simulate(
             help="Simulated seconds before giving up \\[default: three times the planned makespan, "
             "at least 900 s]",
             min=1.0,
+            callback=finite,
         ),
     ] = None,
     replan: Annotated[bool, typer.Option(help="Stalled robots replan their remaining mission.")] = True,
