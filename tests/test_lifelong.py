@@ -135,6 +135,34 @@ def test_a_robot_failing_before_it_picks_returns_the_order_to_the_pool():
     assert len(tries) >= 2 and tries[0]["robot"] == "R2"  # given again after R2 failed
 
 
+LIFELONG = EXAMPLE.parents[1] / "13_lifelong" / "scenario.yaml"
+
+
+@lru_cache(maxsize=2)
+def _run_lifelong_example(failure: Failure):
+    return run_fleet(load_scenario(LIFELONG), fleet=FleetSettings(until=200.0), failures=(failure,))
+
+
+def test_goods_beside_a_robot_that_failed_at_them_are_delivered_by_another():
+    # R2 fails at the pose where it picks O2 (its order since 10 s), touching the goods: its
+    # grown box must not cover them, nor its standing there make them unpickable
+    result = _run_lifelong_example(Failure("R2", 20.0))
+    failure = result.failures["R2"]
+    assert failure["carrying"] == [] and failure["at"] == pytest.approx([1650.0, -2000.0], abs=1.0)
+    o2 = next(o for o in result.orders if o.object == "O2")
+    assert o2.delivered is not None and o2.robot == "R1"
+    assert result.lost == 0 and result.contacts_while_moving == 0
+
+
+def test_an_order_only_failed_robots_may_serve_says_so():
+    result = _run_lifelong_example(Failure("R2", 3.0))
+    o4 = next(o for o in result.orders if o.object == "O4")  # by: R2 in the example
+    assert o4.delivered is None and o4.lost is None
+    assert o4.refused == "no robot may serve it: only R2 may, and R2 failed at 3.0 s"
+    assert all(o.delivered is not None for o in result.orders if o is not o4)
+    assert not any(e["order"] == o4.index for e in result.dispatch_log)  # never handed over
+
+
 def test_cosmop_run_writes_the_summary_and_refuses_bad_options(tmp_path):
     scenario = tmp_path / "s.yaml"
     scenario.write_text(yaml.safe_dump(_data()))

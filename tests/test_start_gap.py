@@ -11,6 +11,7 @@ another parked there keeps out of it by that gap only.
 from __future__ import annotations
 
 import copy
+from dataclasses import replace
 
 import pytest
 
@@ -134,3 +135,33 @@ def test_a_lifelong_fleet_parked_touching_serves_its_orders():
     assert summary["orders"]["delivered"] == 2 and summary["orders"]["lost"] == 0
     assert [e["accepted"] for e in summary["dispatch_log"]] == [True, True]
     assert result.contacts_while_moving == 0
+
+
+def test_a_robot_that_starts_beside_goods_another_moves_lets_them_be_picked():
+    """R2 starts 10 mm from O1, which R1 picks: a standing robot's body is grown by the 20 mm it
+    may stop off its pose (``ConflictSettings.rest``), but one that has not moved yet is exactly
+    where the scene put it, beside goods that lie where the scene put them: no order of the plans
+    could change that, so it is no conflict (it was refused as one).  Goods coming to rest that
+    close later still conflict."""
+    data = copy.deepcopy(SIDE_BY_SIDE)
+    data["scene"]["robots"]["R2"]["pose"] = [-3000, -2260, 90]  # 10 mm below O1's square
+    data["mission"]["tasks"] = {"R1": ["pick O1", "drop O1 at W1", "return"], "R2": ["pick O2", "return"]}
+    scenario = parse_scenario(data)
+    result = plan_team(scenario, workers=1)
+    assert result.plans.feasible, result.plans.reason
+    assert check_plan(scenario, result.plans).ok
+    run = simulate(scenario, result.plans)
+    assert run.completed and run.contacts_while_moving == 0
+    plans = result.plans.robots
+    order = Precedence({r: p.horizon for r, p in plans.items()}, message_links(plans))
+    items, _ = occupancies(scenario.scene, plans, order, ConflictSettings())
+    start = next(o for o in items if o.what == "R2" and o.first is None and not o.is_drive)
+    o1 = next(o for o in items if o.what == "O1" and o.first is None)
+    assert start.body.intersects(o1.region) and not start.start.intersects(o1.region.buffer(-1e-6))
+    assert not conflicts([start, o1])
+    # goods brought that close later conflict with R2 standing there from the start, and R2
+    # coming home that close to the goods still lying there conflicts too (ordered: R1 takes
+    # them first)
+    assert conflicts([start, replace(o1, first=("R1", 1))])
+    home = next(o for o in items if o.what == "R2" and o.first is not None and o.last is None)
+    assert conflicts([home, o1]) and result.plans.feasible

@@ -129,6 +129,8 @@ def run(
     console.print(_robots_table(result))
     ok = result.contacts_while_moving == 0 and result.lost == 0
     console.print(Text(_verdict(result), style="green" if ok else "red"))
+    for line in _undelivered(result):
+        console.print(Text(line), soft_wrap=True)
     for path in (summary, trace, plot):
         if path is not None:
             console.print(Text(f"wrote {path}"), soft_wrap=True)
@@ -190,6 +192,19 @@ def _robots_table(result: FleetResult) -> Table:
         )
         table.add_row(rid, str(done.get(rid, 0)), f"{100 * result.utilisation[rid]:.0f} %", Text(failed))
     return table
+
+
+def _undelivered(result: FleetResult, shown: int = 5) -> list[str]:
+    """The orders lost, and those still waiting after a refusal, each with its reason (the
+    first `shown`; the summary has them all)."""
+    lines = [
+        f"{o.object} (released at {o.at:g} s) "
+        + (f"lost: {o.lost}" if o.lost else f"not delivered: {o.refused}")
+        for o in result.orders
+        if o.delivered is None and (o.lost or o.refused)
+    ]
+    more = len(lines) - shown
+    return lines[:shown] + ([f"... and {more} more orders (see --summary)"] if more > 0 else [])
 
 
 def _verdict(result: FleetResult) -> str:

@@ -43,7 +43,7 @@ from cosmop.planning.plan_types import PlanSet, RobotPlan
 from cosmop.scene import Order, Scenario
 from cosmop.sim.recoordinate import recoordinate_world
 from cosmop.sim.recording import Recorder
-from cosmop.sim.replan import replan, robot_room, start_state
+from cosmop.sim.replan import Rectangle, grown, replan, robot_room, start_state
 from cosmop.sim.result import SimSettings
 from cosmop.sim.simulation import advance
 from cosmop.sim.world import Agent, World
@@ -226,6 +226,10 @@ def _dispatch(run: _Run, at_dock: Agent | None = None) -> None:
             return
         if state.retry_at > world.t:
             continue
+        if all(robot in run.failed for robot in state.order.by):
+            # said once, in the order's record; it stays in the pool, never served
+            state.refused = state.refused or _unservable(run, state.order.by)
+            continue
         goods = _goods_at_rest(world, state)
         if goods is None:
             continue
@@ -239,6 +243,12 @@ def _dispatch(run: _Run, at_dock: Agent | None = None) -> None:
             continue
         _hand_over(run, idle[robot], state, goods)
         del idle[robot]  # given the order, or refused: one plan tried per robot and dispatch
+
+
+def _unservable(run: _Run, robots: Sequence[str]) -> str:
+    """Why an order that only failed `robots` may serve waits for good."""
+    failed = ", ".join(f"{r} failed at {run.failed[r]['t']:.1f} s" for r in robots)
+    return f"no robot may serve it: {'only ' if len(robots) == 1 else ''}{'/'.join(robots)} may, and {failed}"
 
 
 def _goods_at_rest(world: World, state: OrderState) -> tuple[float, ...] | None:
@@ -292,10 +302,11 @@ def _hand_over(run: _Run, agent: Agent, state: OrderState, goods: tuple[float, .
     run.busy_since.setdefault(agent.id, world.t)  # a robot given work at a dock stays busy
 
 
-def _standing(run: _Run, agent: Agent) -> list[tuple[float, float, float]]:
-    """The robots that stand still for now (idle or failed) as boxes ``x, y, half side`` (mm),
-    grown by the room the plans keep between robots (:func:`~cosmop.sim.replan.robot_room`:
-    the clearance, or the gap they already stand at): the new plan goes around them."""
+def _standing(run: _Run, agent: Agent) -> list[Rectangle]:
+    """The robots that stand still for now (idle or failed) as rectangles ``x0, y0, x1, y1``
+    (mm), grown by the room the plans keep between robots (:func:`~cosmop.sim.replan.robot_room`:
+    the clearance, or the gap they already stand at) short of the goods beside them
+    (:func:`~cosmop.sim.replan.grown`): the new plan goes around them."""
     world = run.world
     i = agent.index
     standing = [
@@ -305,7 +316,8 @@ def _standing(run: _Run, agent: Agent) -> list[tuple[float, float, float]]:
     ]
     boxes = world.robot_boxes()[standing]
     gaps = box_gaps(world.pose[i, :2], world.robot_half[i], boxes)
-    return [(float(x), float(y), float(h) + robot_room(g)) for (x, y, h), g in zip(boxes, gaps, strict=True)]
+    goods = world.resting_boxes()
+    return [grown(box, robot_room(g), goods) for box, g in zip(boxes, gaps, strict=True)]
 
 
 def _deliveries(run: _Run) -> None:

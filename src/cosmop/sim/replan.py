@@ -3,7 +3,7 @@
 The paper (end of Section IV): when the environment is not fair and a robot cannot go on, it
 stays safe, and "we can update the scene description and search for new plans at the current
 state in a receding horizon strategy".  :func:`replan` builds that scene -- the scenario's
-walls plus every sensed obstacle as a square of four walls -- and solves the robot's remaining
+walls plus every sensed obstacle as a rectangle of four walls -- and solves the robot's remaining
 mission events with :func:`cosmop.planning.synthesis.synthesize` from the robot's current state
 (integer mm and degrees), without new requests (a new request would need the top-down layer to
 re-verify the team).  The new plan must pass the exact plan checker, like every plan the tool
@@ -19,6 +19,9 @@ from collections.abc import Set as AbstractSet
 from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+from numpy.typing import NDArray
+
 from cosmop.control.geometry import box_gaps
 from cosmop.events import Event, Primitive
 from cosmop.planning.checker import check_robot_plan
@@ -31,26 +34,82 @@ from cosmop.team.conflicts import ConflictSettings
 if TYPE_CHECKING:
     from cosmop.sim.world import Agent, World
 
-__all__ = ["replan", "replan_stalled", "robot_room", "route", "sensed_scene", "start_state"]
+__all__ = [
+    "Rectangle",
+    "grown",
+    "replan",
+    "replan_stalled",
+    "robot_room",
+    "route",
+    "sensed_scene",
+    "start_state",
+]
 
 _PERSON_ROOM = 10.0  # mm added around a sensed person (a robot gets the standoff)
 
 
-def sensed_scene(scene: Scene, boxes: Iterable[tuple[float, float, float]]) -> Scene:
-    """The scene with each sensed box ``(x, y, half side)`` (mm) added as four walls.
+Rectangle = tuple[float, float, float, float]
+"""An axis-aligned rectangle ``x0, y0, x1, y1`` (mm)."""
+
+
+def sensed_scene(scene: Scene, rectangles: Iterable[Rectangle]) -> Scene:
+    """The scene with each sensed rectangle ``(x0, y0, x1, y1)`` (mm) added as four walls.
 
     Parameters
     ----------
     scene : Scene
         The scene as planned.
-    boxes : iterable of (float, float, float)
-        The sensed boxes ``x, y, half side``, mm.
+    rectangles : iterable of (float, float, float, float)
+        The sensed obstacles, grown by the room to keep (:func:`grown`), mm.
     """
     walls = list(scene.obstacles)
-    for x, y, h in boxes:
-        corners = [(x - h, y - h), (x + h, y - h), (x + h, y + h), (x - h, y + h)]
+    for x0, y0, x1, y1 in rectangles:
+        corners = [(x0, y0), (x1, y0), (x1, y1), (x0, y1)]
         walls += [Wall(corners[i], corners[(i + 1) % 4]) for i in range(4)]
     return replace(scene, obstacles=tuple(walls))
+
+
+def grown(box: Sequence[float], room: float, goods: NDArray[np.float64]) -> Rectangle:
+    """The square `box` ``(x, y, half side)`` grown by `room` on each side, except where that
+    would cover resting goods: a side stops 1 mm short of the goods beyond it.
+
+    A robot that stands (or failed) beside goods, say where it was about to pick them, would
+    otherwise have them inside its grown square, as walls through them, and nobody could pick
+    them.  Plans are still held to the clearance between robots by the exact checks; the room
+    only steers the new route clear of them where it can.
+
+    Parameters
+    ----------
+    box : sequence of float
+        The sensed square ``x, y, half side``, mm.
+    room : float
+        The room to keep around it, mm (>= 0).
+    goods : ndarray, shape (m, 3)
+        The resting goods as boxes ``x, y, half side``, mm.
+
+    Returns
+    -------
+    tuple of float
+        ``x0, y0, x1, y1``, mm.
+
+    Examples
+    --------
+    >>> grown((0.0, 0.0, 200.0), 100.0, np.array([[250.0, 0.0, 50.0]]))
+    (-300.0, -300.0, 200.0, 300.0)
+    """
+    x, y, h = (float(v) for v in box)
+    # the growth of each side: west, south, east, north
+    grow = [room] * 4
+    near = (
+        goods[np.max(np.abs(goods[:, :2] - (x, y)), axis=1) - goods[:, 2] < h + room] if len(goods) else goods
+    )
+    for gx, gy, gh in near:
+        # how far the good lies beyond each side of the square (negative: not beyond it)
+        beyond = [(x - h) - (gx + gh), (y - h) - (gy + gh), (gx - gh) - (x + h), (gy - gh) - (y + h)]
+        side = int(np.argmax(beyond))
+        if beyond[side] >= 0.0:  # a good that overlaps the square itself cannot be kept out
+            grow[side] = min(grow[side], max(beyond[side] - 1.0, 0.0))
+    return (x - h - grow[0], y - h - grow[1], x + h + grow[2], y + h + grow[3])
 
 
 def replan(
@@ -58,12 +117,12 @@ def replan(
     robot: str,
     events: Sequence[Event],
     start: State,
-    sensed: Iterable[tuple[float, float, float]] = (),
+    sensed: Iterable[Rectangle] = (),
     *,
     max_horizon: int = 12,
     rlimit: int = 50_000_000,
 ) -> RobotPlan | None:
-    """The shortest plan of `events` from `start` among the walls and the sensed boxes.
+    """The shortest plan of `events` from `start` among the walls and the sensed obstacles.
 
     Parameters
     ----------
@@ -74,8 +133,9 @@ def replan(
         The mission events not done yet, in order.
     start : State
         The robot's pose and the objects as it knows them now, in integers (mm, degrees).
-    sensed : iterable of (float, float, float)
-        Obstacles sensed around the robot, as boxes ``x, y, half side`` (mm).
+    sensed : iterable of (float, float, float, float)
+        Obstacles sensed around the robot, as rectangles ``x0, y0, x1, y1`` (mm), grown by
+        the room to keep (:func:`grown`).
     max_horizon, rlimit : int
         Bounds of the solver (see :func:`~cosmop.planning.synthesis.synthesize`).
 
@@ -190,19 +250,19 @@ def route(agent: Agent, start: Sequence[float]) -> dict[str, Any]:
     }
 
 
-def _sensed(world: World, agent: Agent) -> list[tuple[float, float, float]]:
-    """The robots and people `agent` senses, as boxes ``x, y, half side`` (mm) grown by the
-    room to keep: robots the clearance the team-safety layer checks (:func:`robot_room`),
-    people a little.  A robot
-    that has finished stays where it is for good: sensed however far."""
+def _sensed(world: World, agent: Agent) -> list[Rectangle]:
+    """The robots and people `agent` senses, as rectangles grown by the room to keep
+    (:func:`grown`): robots the clearance the team-safety layer checks (:func:`robot_room`),
+    people a little.  A robot that has finished stays where it is for good: sensed however far."""
     s = world.settings
     i = agent.index
     sensed = world.obstacles()
     boxes, names = sensed.boxes, list(sensed.names)
     gaps = box_gaps(world.pose[i, :2], world.robot_half[i], boxes)
     finished = {a.id for a in world.agents if a.done}
+    goods = world.resting_boxes()
     return [
-        (float(b[0]), float(b[1]), float(b[2]) + (robot_room(g) if n in world.robot_ids else _PERSON_ROOM))
+        grown(b, robot_room(g) if n in world.robot_ids else _PERSON_ROOM, goods)
         for b, n, g in zip(boxes, names, gaps, strict=True)
         if n != agent.id and n not in world.object_ids and (g < s.sense_range or n in finished)
     ]

@@ -538,8 +538,22 @@ def conflicts(items: Sequence[Occupancy], clearance: float | None = None) -> lis
     return [
         Conflict(a, b)
         for (a, b), real in zip(pairs, overlap, strict=True)
-        if real and not _given_gap(a, b, clearance)
+        if real and not _given_gap(a, b, clearance) and not _placed_so(a, b)
     ]
+
+
+def _placed_so(a: Occupancy, b: Occupancy) -> bool:
+    """Whether `a` and `b` are a robot standing where it starts and goods resting where they
+    start, apart: the overlap is only the room (:attr:`ConflictSettings.rest`) a robot that has
+    stopped may be off its pose, and a robot that has not moved yet is exactly where it stands.
+    The scene, or the running world when a lifelong run re-plans (a robot that failed beside
+    the goods it was about to pick), put them so; no order of the plans could change it."""
+    robot, goods = (a, b) if a.states is not None else (b, a)
+    if robot.states is None or goods.states is not None:
+        return False  # not a robot and goods
+    if robot.first is not None or robot.is_drive or goods.first is not None or robot.start is None:
+        return False  # one of them is not where the scene (or the world) put it
+    return not _overlap(_geometries([robot.start, goods.region]), [0], [1])[0]
 
 
 def _given_gap(a: Occupancy, b: Occupancy, clearance: float) -> bool:
