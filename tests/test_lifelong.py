@@ -13,6 +13,7 @@ from typer.testing import CliRunner
 
 from cosmop.cli import app
 from cosmop.errors import ScenarioError
+from cosmop.events import Event, Primitive
 from cosmop.lifelong import Failure, FleetSettings, run_fleet
 from cosmop.scenario import load_orders, load_scenario, parse_scenario
 from cosmop.traces import Trace
@@ -225,3 +226,31 @@ def test_refused_hand_overs_keep_the_order_and_wait_longer_each_time(monkeypatch
         order.refused is not None and order.refused.startswith("R1 at ") and "a test refusal" in order.refused
     )
     assert [e["accepted"] for e in result.dispatch_log] == [False, False, False, True]
+
+
+def test_a_new_order_that_would_make_a_robot_at_speed_wait_before_it_can_stop_is_refused():
+    # a hand-over re-orders every robot's rest; a wait added within the stopping distance of a
+    # robot driving at speed cannot be kept: it brakes past it, into a place the plans give
+    # another, and creeping back it can box in a robot that waits for it (a stall found in an
+    # hour-long run)
+    from cosmop.planning.plan_types import PlanMessage, PlanSet, RobotPlan, Step
+    from cosmop.sim.recoordinate import Recoordination, _too_late_to_stop
+    from cosmop.sim.result import SimSettings
+    from cosmop.sim.world import World
+
+    scenario = load_scenario(LIFELONG)
+    world = World(scenario, PlanSet(scenario.name, True, {}), 0, SimSettings())
+    i = world.robot_ids.index("R1")
+    world.pose[i] = (-2000.0, -1000.0, 0.0)
+    new = Event("msg", "R1", responder="R2", tag="c1")
+    drive = Step(Primitive.GOTO, None, (-1700.0, -1000.0, 0.0), {})
+    wait = Step(Primitive.REQ, None, (-1700.0, -1000.0, 0.0), {}, message=new)
+    plans = {"R1": RobotPlan.from_steps((new,), (drive, wait)), "R2": RobotPlan.from_steps((), ())}
+    result = Recoordination(True, plans, (PlanMessage(new, "conflict", "a test"),), ())
+    world.v[i] = 0.0  # standing: any wait will do
+    assert _too_late_to_stop(world, result) is None
+    world.v[i] = 750.0  # at top speed it needs 685 mm to stop (the window's worst case): 300 is too close
+    why = _too_late_to_stop(world, result)
+    assert why is not None and why.startswith("R1, driving at 750 mm/s, would have to wait 300 mm ahead")
+    world.pose[i] = (-3000.0, -1000.0, 0.0)  # 1300 mm ahead: it can stop
+    assert _too_late_to_stop(world, result) is None

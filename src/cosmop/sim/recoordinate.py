@@ -13,6 +13,9 @@ the rest of every robot's plan, from where each robot is now, is ordered again b
 * the orders the mission itself requires (``away`` answers, order messages) are kept.
 
 If some conflict cannot be ordered, the new plan is refused and the robot keeps its old one.
+It is refused too when the new order makes a robot that is driving wait at a place it reaches
+before it can stop (:func:`wait_ahead`): braking past it, the robot would stand where the plans
+give the place to another, and creeping back into it, it could box in a robot that waits for it.
 :func:`recoordinate_world` does this for a running simulation and installs the new rests in
 its robots' executors.
 """
@@ -24,6 +27,7 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from cosmop.control.safety import own_margin
 from cosmop.events import Event, Primitive
 from cosmop.planning.plan_types import PlanMessage, RobotPlan, State, Step
 from cosmop.planning.primitive_effects import initial_state
@@ -35,7 +39,7 @@ from cosmop.team.safe_plans import make_team_safe
 if TYPE_CHECKING:
     from cosmop.sim.world import Agent, World
 
-__all__ = ["Recoordination", "Remaining", "recoordinate", "recoordinate_world"]
+__all__ = ["Recoordination", "Remaining", "recoordinate", "recoordinate_world", "wait_ahead"]
 
 
 @dataclass(frozen=True)
@@ -209,6 +213,9 @@ def recoordinate_world(
     )
     if not result.accepted:
         return False, result.reason or "", []
+    too_late = _too_late_to_stop(world, result)
+    if too_late:
+        return False, too_late, []
     for other in world.agents:
         _install(other, result.plans[other.id], splits[other.id][0], new=other is agent)
         if other is agent:  # its new plan starts where it stood, rounded to the millimetre
@@ -216,6 +223,59 @@ def recoordinate_world(
     added = [m.event for m in result.messages]
     world.conflict_messages |= set(added)
     return True, "", added
+
+
+def wait_ahead(start: tuple[float, float], steps: Iterable[Step], messages: set[Event]) -> float | None:
+    """How far (mm, along the drives) a robot at `start` goes through `steps` before it first
+    waits for one of `messages`; ``None`` if it never does.
+
+    Parameters
+    ----------
+    start : tuple of float
+        Where the robot is, ``x, y`` mm.
+    steps : iterable of Step
+        The rest of its plan, from the step it executes now.
+    messages : set of Event
+        The messages whose waits count (those a re-coordination has just added).
+
+    Examples
+    --------
+    >>> new = Event("msg", "R2", responder="R1", tag="c1")
+    >>> drive = Step(Primitive.GOTO, None, (300.0, 400.0, 0.0), {})
+    >>> wait = Step(Primitive.REQ, None, (300.0, 400.0, 0.0), {}, message=new)
+    >>> wait_ahead((0.0, 0.0), [drive, wait], {new})
+    500.0
+    >>> wait_ahead((0.0, 0.0), [drive, wait], set()) is None
+    True
+    """
+    x, y = start
+    gone = 0.0
+    for step in steps:
+        if step.primitive == Primitive.REQ and step.message in messages:
+            return gone
+        if step.primitive == Primitive.GOTO:
+            gone += math.hypot(step.robot[0] - x, step.robot[1] - y)
+            x, y = step.robot[0], step.robot[1]
+    return None
+
+
+def _too_late_to_stop(world: World, result: Recoordination) -> str | None:
+    """Why the new order cannot be kept: a robot driving now would reach a new wait before it
+    can stop (its own stopping distance, :func:`~cosmop.control.safety.own_margin`)."""
+    added = {m.event for m in result.messages}
+    for other in world.agents:
+        v = float(world.v[other.index])
+        if v <= 0.0 or other.id not in result.plans:
+            continue
+        xy = (float(world.pose[other.index, 0]), float(world.pose[other.index, 1]))
+        ahead = wait_ahead(xy, result.plans[other.id].steps, added)
+        stop = float(own_margin(v, world.limits[other.index]))
+        if ahead is not None and ahead < stop:
+            return (
+                f"{other.id}, driving at {v:.0f} mm/s, would have to wait {ahead:.0f} mm ahead and "
+                f"needs {stop:.0f} mm to stop"
+            )
+    return None
 
 
 def _install(agent: Agent, plan: RobotPlan, done: list[Event], *, new: bool) -> None:
