@@ -8,6 +8,7 @@ SIGINT goes to the whole group, as a terminal's Ctrl-C does (the worker processe
 
 from __future__ import annotations
 
+import json
 import multiprocessing
 import os
 import random
@@ -101,3 +102,18 @@ def test_an_interrupt_inside_the_planner_leaves_no_worker_and_no_thread():
     assert time.perf_counter() - start < 60
     assert multiprocessing.active_children() == []
     assert set(threading.enumerate()) <= threads
+
+
+@pytest.mark.parametrize("at", MOMENTS[1:], ids=lambda at: f"{at:.1f}s")
+def test_ctrl_c_during_a_lifelong_run_writes_what_was_delivered_so_far(tmp_path, at):
+    # issue 37: "interrupted", 130, and the summary of the run so far written whole, also when
+    # Ctrl-C comes inside a hand-over's call to Z3 (it is answered at the next cycle)
+    summary, trace = tmp_path / "summary.json", tmp_path / "trace.json"
+    scenario = EXAMPLES / "13_lifelong" / "scenario.yaml"
+    command = [sys.executable, "-m", "cosmop", "run", str(scenario), "--until", "1000000"]
+    row = interrupt([*command, "--summary", str(summary), "--trace", str(trace)], [summary, trace], at)
+    _clean(row)
+    data = json.loads(summary.read_text())
+    assert data["interrupted"] is True and 0 < data["until_s"] < 1_000_000
+    assert data["orders"]["released"] == sum(o["at"] <= data["until_s"] for o in data["order_log"])
+    assert json.loads(trace.read_text())["frames"]  # the trace of the same run so far

@@ -9,7 +9,7 @@ import os
 import shutil
 import stat
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from types import FrameType
 from typing import Any
@@ -23,6 +23,7 @@ __all__ = [
     "check_writable",
     "collector_paused",
     "compact_json",
+    "interrupt_at_safe_points",
     "read_bytes",
     "read_text",
     "uninterrupted",
@@ -58,6 +59,46 @@ def uninterrupted() -> Iterator[None]:
                 old(*pressed[0])
             elif old == signal.SIG_DFL:  # (Python's default handler is callable: called above)
                 raise KeyboardInterrupt
+
+
+@contextlib.contextmanager
+def interrupt_at_safe_points() -> Iterator[Callable[[], None]]:
+    """Hold Ctrl-C (SIGINT) back until the block calls the function it is given (a safe point,
+    such as between two cycles of a run), which then gives it to the previous handler (which
+    raises KeyboardInterrupt).
+
+    Inside a call into a C library (Z3, through ctypes) Python turns KeyboardInterrupt into
+    another exception, which says nothing of the interrupt; at a safe point it is a plain
+    KeyboardInterrupt that the caller can answer (a run writes what it did so far).  A second
+    Ctrl-C before the next safe point goes to the previous handler at once.  Outside the main
+    thread, or where Ctrl-C is ignored, the block runs as it is.
+    """
+    import signal
+    import threading
+
+    old = signal.getsignal(signal.SIGINT)
+    if threading.current_thread() is not threading.main_thread() or old == signal.SIG_IGN:
+        yield lambda: None
+        return
+    pressed: list[tuple[int, FrameType | None]] = []
+
+    def note(number: int, frame: FrameType | None) -> None:
+        if pressed and callable(old):
+            signal.signal(signal.SIGINT, old)
+            old(number, frame)
+        pressed.append((number, frame))
+
+    def safe_point() -> None:
+        if pressed:  # the previous handler takes it now, as if Ctrl-C came here
+            if callable(old):
+                old(*pressed[0])
+            raise KeyboardInterrupt
+
+    signal.signal(signal.SIGINT, note)
+    try:
+        yield safe_point
+    finally:
+        signal.signal(signal.SIGINT, old)
 
 
 def check_writable(path: str | os.PathLike[str] | None, option: str, *, folder: bool = False) -> None:

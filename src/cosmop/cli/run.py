@@ -12,8 +12,8 @@ from rich.text import Text
 
 from cosmop.cli._app import EXIT_INPUT_ERROR, ScenarioArgument, finite, load, stderr, stdout
 from cosmop.cli.simulate import parse_delays
-from cosmop.io import check_writable, uninterrupted
-from cosmop.lifelong import Failure, FleetResult, FleetSettings, run_fleet
+from cosmop.io import check_writable, interrupt_at_safe_points, uninterrupted
+from cosmop.lifelong import Failure, FleetInterrupted, FleetResult, FleetSettings, run_fleet
 from cosmop.scenario import load_orders
 from cosmop.scene import Order, Scenario
 from cosmop.sim import Delays, SimSettings
@@ -117,12 +117,13 @@ def run(
         if failure.robot not in loaded.scene.robots:
             typer.echo(f"error: --fail: {failure.robot} is not a robot of {loaded.name}", err=True)
             raise typer.Exit(EXIT_INPUT_ERROR)
-    result = _run_with_progress(loaded, stream, until, seed, SimSettings(delays=delays), tuple(fail or ()))
-    with uninterrupted():  # the summary and its trace: both or neither
-        if trace is not None:
-            result.trace().save(trace)
-        if summary is not None:
-            result.save_summary(summary)
+    settings = SimSettings(delays=delays)
+    try:
+        result = _run_with_progress(loaded, stream, until, seed, settings, tuple(fail or ()))
+    except FleetInterrupted as stop:  # Ctrl-C: what was delivered so far, written whole
+        _save(stop.result, summary, trace)
+        raise KeyboardInterrupt from None
+    _save(result, summary, trace)
     if plot is not None:
         result.save_plot(plot)
     console = stdout()
@@ -135,6 +136,15 @@ def run(
         if path is not None:
             console.print(Text(f"wrote {path}"), soft_wrap=True)
     raise typer.Exit(0 if ok else 1)
+
+
+def _save(result: FleetResult, summary: Path | None, trace: Path | None) -> None:
+    """The summary and its trace: both or neither, whatever Ctrl-C does meanwhile."""
+    with uninterrupted():
+        if trace is not None:
+            result.trace().save(trace)
+        if summary is not None:
+            result.save_summary(summary)
 
 
 def _run_with_progress(
@@ -156,8 +166,17 @@ def _run_with_progress(
         ),
         TimeElapsedColumn(),
     )
-    with Progress(*columns, console=stderr(), transient=True) as progress:
+    # Ctrl-C is answered between two cycles, where the run can say what it did so far
+    with (
+        interrupt_at_safe_points() as safe_point,
+        Progress(*columns, console=stderr(), transient=True) as progress,
+    ):
         task = progress.add_task("running", total=until, released=0, delivered=0)
+
+        def on_cycle(t: float, delivered: int, released: int) -> None:
+            progress.update(task, completed=t, delivered=delivered, released=released)
+            safe_point()
+
         return run_fleet(
             loaded,
             stream,
@@ -165,9 +184,7 @@ def _run_with_progress(
             seed=seed,
             settings=settings,
             failures=failures,
-            on_cycle=lambda t, delivered, released: progress.update(
-                task, completed=t, delivered=delivered, released=released
-            ),
+            on_cycle=on_cycle,
         )
 
 

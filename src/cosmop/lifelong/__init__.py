@@ -5,12 +5,22 @@ scenario's ``orders`` or a file of their own, :func:`cosmop.scenario.load_orders
 over time: a dispatcher gives each to an idle robot (:mod:`.dispatch`), whose next mission is
 planned from where it stands and ordered against the plans the others have committed to, with
 the same messages, exact checks and deadlock proof as a planned team, while the others keep
-moving (:mod:`.fleet`); robots may fail for good (:class:`Failure`).  :class:`FleetResult`
+moving (:mod:`.fleet`); robots may fail for good (:class:`Failure`); Ctrl-C ends the run with
+what it did so far (:class:`FleetInterrupted`).  :class:`FleetResult`
 reports throughput, waits, utilisation and safety (:mod:`.fleet_result`).
 """
 
 from cosmop.lifelong.dispatch import OrderState
-from cosmop.lifelong.fleet import Failure, FleetSettings, run_fleet
+from cosmop.lifelong.fleet import Failure, FleetInterrupted, FleetSettings, run_fleet
 from cosmop.lifelong.fleet_result import RUN_FORMAT, FleetResult, OrderRecord
 
-__all__ = ["RUN_FORMAT", "Failure", "FleetResult", "FleetSettings", "OrderRecord", "OrderState", "run_fleet"]
+__all__ = [
+    "RUN_FORMAT",
+    "Failure",
+    "FleetInterrupted",
+    "FleetResult",
+    "FleetSettings",
+    "OrderRecord",
+    "OrderState",
+    "run_fleet",
+]

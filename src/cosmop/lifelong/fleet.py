@@ -49,7 +49,7 @@ from cosmop.sim.simulation import advance
 from cosmop.sim.world import Agent, World
 from cosmop.team.conflicts import ConflictSettings
 
-__all__ = ["Failure", "FleetSettings", "run_fleet"]
+__all__ = ["Failure", "FleetInterrupted", "FleetSettings", "run_fleet"]
 
 
 @dataclass(frozen=True)
@@ -188,25 +188,57 @@ def run_fleet(
     recorder.record(world)
     due = sorted(failures, key=lambda f: f.at)
     released, next_dispatch = 0, 0.0
-    for _ in range(math.ceil(fleet.until / world.dt)):
-        while released < len(run.states) and run.states[released].order.at <= world.t:
-            run.pool.append(run.states[released])
-            released += 1
-        while due and due[0].at <= world.t:
-            _fail(run, due.pop(0).robot)
-        if world.t >= next_dispatch:
-            _dispatch(run)
-            next_dispatch = world.t + fleet.dispatch_every
-        advance(world)
-        _deliveries(run)  # before the frame is recorded: delivered goods are gone from it
-        _idle_again(run)
-        recorder.record(world)
-        if on_cycle is not None:
-            on_cycle(world.t, run.delivered, released)
+    try:
+        for _ in range(math.ceil(fleet.until / world.dt)):
+            while released < len(run.states) and run.states[released].order.at <= world.t:
+                run.pool.append(run.states[released])
+                released += 1
+            while due and due[0].at <= world.t:
+                _fail(run, due.pop(0).robot)
+            if world.t >= next_dispatch:
+                _dispatch(run)
+                next_dispatch = world.t + fleet.dispatch_every
+            advance(world)
+            _deliveries(run)  # before the frame is recorded: delivered goods are gone from it
+            _idle_again(run)
+            recorder.record(world)
+            if on_cycle is not None:
+                on_cycle(world.t, run.delivered, released)
+    except KeyboardInterrupt:
+        raise FleetInterrupted(_result(run, recorder, interrupted=True)) from None
+    return _result(run, recorder)
+
+
+class FleetInterrupted(KeyboardInterrupt):
+    """Ctrl-C during :func:`run_fleet`: the run up to the last whole cycle, in :attr:`result`
+    (``interrupted`` set, ``until`` the time reached), so that what was delivered can still be
+    reported.
+
+    Attributes
+    ----------
+    result : FleetResult
+    """
+
+    def __init__(self, result: FleetResult) -> None:
+        super().__init__("interrupted")
+        self.result = result
+
+
+def _result(run: _Run, recorder: Recorder, *, interrupted: bool = False) -> FleetResult:
+    """What the run did up to now (each robot still busy counted busy until now)."""
+    world = run.world
+    busy = dict(run.busy_time)
     for rid, since in run.busy_since.items():
-        run.busy_time[rid] += world.t - since
+        busy[rid] += world.t - since
     return FleetResult.of(
-        scenario, world, recorder.frames(world), run.states, run.busy_time, run.failed, run.log
+        world.scenario,
+        world,
+        recorder.frames(world),
+        run.states,
+        busy,
+        run.failed,
+        run.log,
+        interrupted=interrupted,
     )
 
 

@@ -120,6 +120,8 @@ class FleetResult:
     robot_ids, human_ids, object_ids : tuple of str
     dt : float
     scene : Scene or None
+    interrupted : bool
+        Whether Ctrl-C ended the run before its time (`until` is then the time reached).
     """
 
     scenario: str
@@ -137,6 +139,7 @@ class FleetResult:
     object_ids: tuple[str, ...] = ()
     dt: float = 0.1
     scene: Scene | None = field(default=None, repr=False, compare=False)
+    interrupted: bool = False
 
     @classmethod
     def of(
@@ -148,6 +151,8 @@ class FleetResult:
         busy: Mapping[str, float],
         failed: Mapping[str, Mapping[str, Any]],
         log: Sequence[Mapping[str, Any]],
+        *,
+        interrupted: bool = False,
     ) -> FleetResult:
         """The result of a finished run (:func:`cosmop.lifelong.run_fleet` calls it).
 
@@ -167,6 +172,8 @@ class FleetResult:
             Per failed robot, its record (``t``, ``at``, ``carrying``, ``recoordinated``, ``why``).
         log : sequence of Mapping
             The dispatcher's log, one record per plan handed over or refused.
+        interrupted : bool
+            Whether Ctrl-C ended the run before its time.
 
         Returns
         -------
@@ -203,6 +210,7 @@ class FleetResult:
             object_ids=world.object_ids,
             dt=world.dt,
             scene=scenario.scene,
+            interrupted=interrupted,
         )
 
     # -- what the operator watches ---------------------------------------------------------------
@@ -245,6 +253,7 @@ class FleetResult:
             "scenario": self.scenario,
             "units": dict(INTERNAL_UNITS),
             "until_s": round(self.until, 6),
+            "interrupted": self.interrupted,
             "orders": {
                 "released": self.released,
                 "delivered": self.delivered,
