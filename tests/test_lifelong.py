@@ -229,8 +229,8 @@ def test_refused_hand_overs_keep_the_order_and_wait_longer_each_time(monkeypatch
 
 
 def test_a_new_order_that_would_make_a_robot_at_speed_wait_before_it_can_stop_is_refused():
-    # a hand-over re-orders every robot's rest; a wait added within the stopping distance of a
-    # robot driving at speed cannot be kept: it brakes past it, into a place the plans give
+    # a hand-over re-orders every robot's rest; a wait added (or moved closer) within the stopping
+    # distance of a robot driving at speed cannot be kept: it brakes past it, into a place the plans give
     # another, and creeping back it can box in a robot that waits for it (a stall found in an
     # hour-long run)
     from cosmop.planning.plan_types import PlanMessage, PlanSet, RobotPlan, Step
@@ -252,5 +252,10 @@ def test_a_new_order_that_would_make_a_robot_at_speed_wait_before_it_can_stop_is
     world.v[i] = 750.0  # at top speed it needs 685 mm to stop (the window's worst case): 300 is too close
     why = _too_late_to_stop(world, result)
     assert why is not None and why.startswith("R1, driving at 750 mm/s, would have to wait 300 mm ahead")
+    agent = world.agents[i]
+    agent.steps = [drive, wait]  # a wait it already had there: it is braking for it already
+    assert _too_late_to_stop(world, result) is None
+    agent.steps = [Step(Primitive.GOTO, None, (-1000.0, -1000.0, 0.0), {}), wait]  # had it 1 m ahead
+    assert _too_late_to_stop(world, result) == why  # the new cuts moved it closer: refused
     world.pose[i] = (-3000.0, -1000.0, 0.0)  # 1300 mm ahead: it can stop
     assert _too_late_to_stop(world, result) is None

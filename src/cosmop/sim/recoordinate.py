@@ -23,7 +23,7 @@ its robots' executors.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -225,9 +225,11 @@ def recoordinate_world(
     return True, "", added
 
 
-def wait_ahead(start: tuple[float, float], steps: Iterable[Step], messages: set[Event]) -> float | None:
-    """How far (mm, along the drives) a robot at `start` goes through `steps` before it first
-    waits for one of `messages`; ``None`` if it never does.
+def wait_ahead(
+    start: tuple[float, float], steps: Iterable[Step], waits: Callable[[Step], bool]
+) -> float | None:
+    """How far (mm, along the drives) a robot at `start` goes through `steps` before the first
+    step it waits at; ``None`` if it never waits.
 
     Parameters
     ----------
@@ -235,23 +237,23 @@ def wait_ahead(start: tuple[float, float], steps: Iterable[Step], messages: set[
         Where the robot is, ``x, y`` mm.
     steps : iterable of Step
         The rest of its plan, from the step it executes now.
-    messages : set of Event
-        The messages whose waits count (those a re-coordination has just added).
+    waits : callable
+        Whether the robot waits at a step (a ``Req`` whose message has not come).
 
     Examples
     --------
     >>> new = Event("msg", "R2", responder="R1", tag="c1")
     >>> drive = Step(Primitive.GOTO, None, (300.0, 400.0, 0.0), {})
     >>> wait = Step(Primitive.REQ, None, (300.0, 400.0, 0.0), {}, message=new)
-    >>> wait_ahead((0.0, 0.0), [drive, wait], {new})
+    >>> wait_ahead((0.0, 0.0), [drive, wait], lambda step: step.message == new)
     500.0
-    >>> wait_ahead((0.0, 0.0), [drive, wait], set()) is None
+    >>> wait_ahead((0.0, 0.0), [drive, wait], lambda step: False) is None
     True
     """
     x, y = start
     gone = 0.0
     for step in steps:
-        if step.primitive == Primitive.REQ and step.message in messages:
+        if step.primitive == Primitive.REQ and waits(step):
             return gone
         if step.primitive == Primitive.GOTO:
             gone += math.hypot(step.robot[0] - x, step.robot[1] - y)
@@ -260,17 +262,23 @@ def wait_ahead(start: tuple[float, float], steps: Iterable[Step], messages: set[
 
 
 def _too_late_to_stop(world: World, result: Recoordination) -> str | None:
-    """Why the new order cannot be kept: a robot driving now would reach a new wait before it
-    can stop (its own stopping distance, :func:`~cosmop.control.safety.own_margin`)."""
-    added = {m.event for m in result.messages}
+    """Why the new order cannot be kept: a robot driving now would have to wait, sooner than
+    its old rest had it wait, at a place it reaches before it can stop (its own stopping
+    distance, :func:`~cosmop.control.safety.own_margin`): a new message, or an old one whose
+    wait the new cuts of its drive moved closer."""
     for other in world.agents:
         v = float(world.v[other.index])
         if v <= 0.0 or other.id not in result.plans:
             continue
+
+        def waits(step: Step, other: Agent = other) -> bool:
+            return step.message is not None and not world.received(other, step)
+
         xy = (float(world.pose[other.index, 0]), float(world.pose[other.index, 1]))
-        ahead = wait_ahead(xy, result.plans[other.id].steps, added)
+        ahead = wait_ahead(xy, result.plans[other.id].steps, waits)
+        before = wait_ahead(xy, other.steps[other.step_index :], waits)
         stop = float(own_margin(v, world.limits[other.index]))
-        if ahead is not None and ahead < stop:
+        if ahead is not None and ahead < stop and (before is None or ahead < before - 1.0):
             return (
                 f"{other.id}, driving at {v:.0f} mm/s, would have to wait {ahead:.0f} mm ahead and "
                 f"needs {stop:.0f} mm to stop"
