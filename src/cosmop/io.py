@@ -83,9 +83,11 @@ def interrupt_at_safe_points() -> Iterator[Callable[[], None]]:
     pressed: list[tuple[int, FrameType | None]] = []
 
     def note(number: int, frame: FrameType | None) -> None:
-        if pressed and callable(old):
+        if pressed:  # a second one: at once
             signal.signal(signal.SIGINT, old)
-            old(number, frame)
+            if callable(old):
+                old(number, frame)
+            raise KeyboardInterrupt
         pressed.append((number, frame))
 
     def safe_point() -> None:

@@ -175,6 +175,8 @@ def run_fleet(
     ------
     ValueError
         For a failure naming no robot of the scene.
+    FleetInterrupted
+        On Ctrl-C (KeyboardInterrupt), with the run up to then.
     """
     for failure in failures:
         if failure.robot not in scenario.scene.robots:
