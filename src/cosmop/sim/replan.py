@@ -100,8 +100,10 @@ def grown(box: Sequence[float], room: float, goods: NDArray[np.float64]) -> Rect
     x, y, h = (float(v) for v in box)
     # the growth of each side: west, south, east, north
     grow = [room] * 4
-    near = (
-        goods[np.max(np.abs(goods[:, :2] - (x, y)), axis=1) - goods[:, 2] < h + room] if len(goods) else goods
+    near = (  # the goods within `room` of the square
+        goods[box_gaps(goods[:, :2], goods[:, 2:3], np.array([[x, y, h]]))[:, 0] < room]
+        if len(goods)
+        else goods
     )
     for gx, gy, gh in near:
         # how far the good lies beyond each side of the square (negative: not beyond it)
