@@ -144,10 +144,19 @@ def _run_lifelong_example(failure: Failure):
     return run_fleet(load_scenario(LIFELONG), fleet=FleetSettings(until=200.0), failures=(failure,))
 
 
+def _picking(robot: str, pose: tuple[float, float]) -> float:
+    """The middle of the time `robot` stands at `pose` in the example's run without failures (s)."""
+    run = run_fleet(load_scenario(LIFELONG), fleet=FleetSettings(until=60.0))
+    xy = run.frames["pose"][:, run.robot_ids.index(robot), :2]
+    there = np.flatnonzero(np.hypot(*(xy - np.asarray(pose)).T) < 1.0)
+    assert there.size, f"{robot} never stands at {pose}"
+    return float(run.frames["t"][there].mean())
+
+
 def test_goods_beside_a_robot_that_failed_at_them_are_delivered_by_another():
     # R2 fails at the pose where it picks O2 (its order since 10 s), touching the goods: its
     # grown box must not cover them, nor its standing there make them unpickable
-    result = _run_lifelong_example(Failure("R2", 20.0))
+    result = _run_lifelong_example(Failure("R2", _picking("R2", (1650.0, -2000.0))))
     failure = result.failures["R2"]
     assert failure["carrying"] == [] and failure["at"] == pytest.approx([1650.0, -2000.0], abs=1.0)
     o2 = next(o for o in result.orders if o.object == "O2")

@@ -210,3 +210,20 @@ def test_a_word_the_hands_cannot_do_is_refused_without_the_solver(small, word, w
     result = synthesize(small.scene, "R1", word)
     assert not result.feasible and why in result.reason
     assert result.horizon is None
+
+
+def test_among_the_shortest_plans_the_route_is_made_shorter(big):
+    # the solver's first plan of K steps may drive a long way round; asking for a shorter route
+    # keeps K and the requests, and on the 10x10 shortens several robots' routes
+    shorter = 0
+    for robot, word in big.mission.tasks.items():
+        first = synthesize(big.scene, robot, word, route_rounds=0)
+        best = synthesize(big.scene, robot, word)
+        assert (best.horizon, best.requests) == (first.horizon, first.requests)
+        assert 0 < best.route_mm <= first.route_mm
+        poses = [big.scene.robots[robot].pose, *(step.robot for step in best.plan.steps)]
+        manhattan = sum(abs(q[0] - p[0]) + abs(q[1] - p[1]) for p, q in zip(poses, poses[1:]))
+        assert best.route_mm == pytest.approx(manhattan)
+        assert check_robot_plan(big.scene, robot, best.plan) == []
+        shorter += best.route_mm < first.route_mm
+    assert shorter >= 3

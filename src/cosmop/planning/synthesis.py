@@ -6,7 +6,11 @@ grows (:class:`cosmop.logic.IncrementalUnrolling`, the horizon chosen by an assu
 a fresh solver per K (:class:`cosmop.logic.Unrolling`).  The first
 satisfiable K is the shortest plan length; unsatisfiability at K - 1 is part of the result.
 Among the plans of that length, the number of Req steps is then minimised by tightening a
-bound until unsat (a request costs another robot's time: it must come and move the goods).
+bound until unsat (a request costs another robot's time: it must come and move the goods), and
+then, with as few requests, the length of the route, for a few rounds (:func:`_shortest_route`):
+the solver's first model is any plan of K steps, and one of them may drive a long way round
+where another of the same K drives straight, which the robot, and every robot waiting for it,
+would pay for.
 If no K up to the bound works, the mission is searched prefix by prefix for the first event
 that cannot be reached.  An unsat core over the specification's named parts, at the bound,
 names what blocks it.
@@ -30,6 +34,7 @@ quarter slower than in a local worker process.
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -62,6 +67,8 @@ from cosmop.planning.specification import (
 from cosmop.scene import MAX_TASK_EVENTS, Scene
 
 DEFAULT_RLIMIT = 50_000_000
+ROUTE_ROUNDS = 4
+"""How many times the route of a shortest plan is asked to be shorter (:func:`_shortest_route`)."""
 
 
 @dataclass(frozen=True)
@@ -94,6 +101,9 @@ class Synthesis:
         non-return event).
     admitted : int
         Obstacles the lazy geometry added to the solver after a plan broke them.
+    route_mm : float
+        The plan's route length in the Manhattan metric, mm (:func:`_shortest_route`; 0 when
+        infeasible).
     """
 
     robot: str
@@ -107,6 +117,7 @@ class Synthesis:
     checks: int = field(default=0, repr=False)
     unsat_horizons: tuple[int, ...] = ()
     admitted: int = field(default=0, repr=False)
+    route_mm: float = field(default=0.0, repr=False)
 
 
 def _solver(rlimit: int, ctx: z3.Context) -> z3.Solver:
@@ -190,6 +201,7 @@ def synthesize(
     lazy: bool = True,
     spots: tuple[tuple[Event, tuple[float, float]], ...] = (),
     min_horizon: int = 0,
+    route_rounds: int = ROUTE_ROUNDS,
 ) -> Synthesis:
     """The shortest safe plan of motion primitives for one robot's local mission.
 
@@ -233,6 +245,9 @@ def synthesize(
         A length below which the caller knows that no plan exists (the robot re-planned with
         more walls than a plan of this length had): the search starts there, and
         ``unsat_horizons`` lists only the horizons searched.
+    route_rounds : int
+        How many times a shorter route is asked for among the shortest plans with the fewest
+        requests (:func:`_shortest_route`; 0: the solver's first such plan).
 
     Returns
     -------
@@ -257,7 +272,7 @@ def synthesize(
         margin=margin,
         spots=spots,
     )
-    found = _shortest_plan(p, max(m.lower, min_horizon), max_horizon, rlimit, incremental, lazy)
+    found = _shortest_plan(p, max(m.lower, min_horizon), max_horizon, rlimit, incremental, lazy, route_rounds)
     if found.plan is not None:
         return found.synthesis(robot, t0, plan=_place_messages(p, found.plan, m.full))
     if found.gave_up is not None:  # the solver could not decide a horizon: claim nothing beyond
@@ -486,6 +501,8 @@ class _Search:
         The horizons proved unsatisfiable.
     admitted : int
         Obstacles the lazy geometry added after a plan broke them.
+    route_mm : float
+        The plan's route length (Manhattan metric), mm.
     """
 
     plan: RobotPlan | None = None
@@ -495,6 +512,7 @@ class _Search:
     checks: int = 0
     unsat: tuple[int, ...] = ()
     admitted: int = 0
+    route_mm: float = 0.0
 
     def synthesis(
         self,
@@ -518,16 +536,24 @@ class _Search:
             checks=self.checks,
             unsat_horizons=self.unsat,
             admitted=self.admitted,
+            route_mm=self.route_mm,
         )
 
 
 def _shortest_plan(
-    p: RobotProblem, lower: int, max_horizon: int, rlimit: int, incremental: bool, lazy: bool
+    p: RobotProblem,
+    lower: int,
+    max_horizon: int,
+    rlimit: int,
+    incremental: bool,
+    lazy: bool,
+    route_rounds: int = ROUTE_ROUNDS,
 ) -> _Search:
     """The first satisfiable horizon from `lower` to `max_horizon`, and its plan.
 
     Each horizon is checked in turn; at the first satisfiable one the number of requests is
-    minimised (:func:`_fewest_requests`).  A horizon the solver cannot decide within `rlimit`
+    minimised (:func:`_fewest_requests`), then the route (:func:`_shortest_route`, `route_rounds`
+    rounds).  A horizon the solver cannot decide within `rlimit`
     ends the search with ``gave_up`` set.  With `lazy`, obstacles join the solver as plans
     break them (:class:`~cosmop.planning.obstacles.Geometry`).
     """
@@ -547,8 +573,12 @@ def _shortest_plan(
             unsat.append(h.K)
             continue
         model, more = _fewest_requests(p, h, geometry, model)
+        model, route, shorter = _shortest_route(p, h, geometry, model, route_rounds)
         plan, asked = _plan(p, h.unrolling, model)
-        return _Search(plan, h.K, asked, checks=checks + more, unsat=tuple(unsat), admitted=geometry.admitted)
+        checks += more + shorter
+        return _Search(
+            plan, h.K, asked, checks=checks, unsat=tuple(unsat), admitted=geometry.admitted, route_mm=route
+        )
     return _Search(checks=checks, unsat=tuple(unsat), admitted=geometry.admitted)
 
 
@@ -571,6 +601,65 @@ def _fewest_requests(
                 break
             model, best = better, better.eval(count, model_completion=True).as_long()
     return model, checks
+
+
+def _route_length(unrolling: Unrolling | IncrementalUnrolling) -> z3.ArithRef | None:
+    """The route's length in the Manhattan metric, ``sum_k |x_k - x_(k-1)| + |y_k - y_(k-1)|``
+    (mm), or None when the position never varies (no step, or a robot that cannot move).
+
+    A linear term (the solver's arithmetic is linear), equal to the Euclidean length on the
+    axis-parallel drives of aisles and grids, and never below it elsewhere.
+    """
+    terms = []
+    for k in range(1, unrolling.K + 1):
+        for axis in ("x", "y"):
+            d = unrolling[axis, k] - unrolling[axis, k - 1]
+            if z3.is_expr(d):  # a constant position moves nowhere
+                terms.append(z3.If(d >= 0, d, -d))
+    return z3.Sum(terms) if terms else None
+
+
+def _number(value: Any) -> Fraction:
+    """A model's integer or rational value, exactly."""
+    if z3.is_int_value(value):
+        return Fraction(value.as_long())
+    return Fraction(value.numerator_as_long(), value.denominator_as_long())
+
+
+def _shortest_route(
+    p: RobotProblem, h: _Horizon, geometry: Geometry, model: z3.ModelRef, rounds: int
+) -> tuple[z3.ModelRef, float, int]:
+    """A model of `h` with as few requests as `model` and a shorter route, if one is found.
+
+    Up to `rounds` times the route length ``L`` (:func:`_route_length`) is bounded below the
+    best found, ``L <= best - max(250 mm, 3 % of best)``, each bound for one check only; the
+    first unsat (or undecided, within the resource limit) check ends the search.  So the
+    route is within a step of the shortest of its K steps only when the rounds did not run out:
+    a few rounds take most of what there is (the first model's detours) at a bounded cost.
+
+    Returns
+    -------
+    model, its route length (mm), checks made
+    """
+    length = _route_length(h.unrolling)
+    if length is None:
+        return model, 0.0, 0
+    best = _number(model.eval(length, model_completion=True))
+    keep: list[z3.BoolRef] = []
+    if request_codes(p):  # no more requests than the fewest found
+        count = _count_requests(p, h.unrolling)
+        keep.append(count <= model.eval(count, model_completion=True))
+    checks = 0
+    for _ in range(rounds):
+        bound = math.floor(best - max(Fraction(250), best * Fraction(3, 100)))
+        if bound < 0:
+            break
+        _, better, made = h.check(geometry, length <= bound, *keep)
+        checks += made
+        if better is None:
+            break
+        model, best = better, _number(better.eval(length, model_completion=True))
+    return model, float(best), checks
 
 
 def _place_messages(p: RobotProblem, plan: RobotPlan, full: tuple[Event, ...]) -> RobotPlan:
