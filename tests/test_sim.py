@@ -21,7 +21,7 @@ from cosmop.events import Primitive, parse_event
 from cosmop.planning import PlanSet
 from cosmop.planning.messages import cut_drives
 from cosmop.planning.plan_file import load_plan
-from cosmop.planning.plan_types import Pose, RobotPlan, Step
+from cosmop.planning.plan_types import ObjectState, Pose, RobotPlan, Step
 from cosmop.scenario import load_scenario, parse_scenario
 from cosmop.scene import Mission
 from cosmop.sim import SIM_FORMAT, TRACE_FORMAT, SimSettings, simulate, time_limit
@@ -608,3 +608,43 @@ def test_a_robot_drives_an_aisle_lined_with_goods_at_the_planned_pace():
     result = simulate(scenario, plans)
     _assert_done(result, scenario, plans)
     assert result.sim_time_s <= 1.05 * plans.itinerary.makespan, (result.sim_time_s, plans.itinerary.makespan)
+
+
+def test_two_robots_docked_side_by_side_both_put_their_goods_down():
+    # Each robot drops goods 30 mm from the other robot, which the plan allows (goods and robot
+    # bodies apart).  Goods may not appear within the standoff of a robot that may move, so
+    # each waited for the other to park or leave: neither ever dropped.  A robot docked on its
+    # pose stays there until its gripper has worked: it is parked, and both drop.
+    from cosmop.sim.execute import decide
+
+    hr, ho, gap = 250.0, 100.0, 30.0
+    poses = {"A": (0.0, 0.0, 0.0), "B": (2 * hr + 2 * ho + gap, hr + ho + gap, 180.0)}
+    spots = {"A": (hr + ho, 0.0), "B": (hr + ho + gap, hr + ho + gap)}
+    data = {
+        "name": "side-by-side",
+        "scene": {
+            "robots": {r: {"size": 2 * hr, "pose": list(p)} for r, p in poses.items()},
+            "objects": {f"O{r}": {"size": 2 * ho, "position": [-3000.0, 3000.0 * k]} for k, r in enumerate("AB")},
+            "workspaces": {f"W{r}": {"x": [s[0] - ho, s[0] + ho], "y": [s[1] - ho, s[1] + ho]} for r, s in spots.items()},
+        },
+        "mission": {"tasks": {r: [f"pick O{r}", f"drop O{r} at W{r}"] for r in poses}},
+    }
+    scenario = parse_scenario(data)
+    plans = {
+        r: RobotPlan.from_steps(
+            [parse_event(f"drop({r},O{r},W{r})")],
+            [Step("DropOff", f"O{r}", poses[r], {f"O{r}": ObjectState(spots[r], False, False)})],
+        )
+        for r in poses
+    }
+    world = World(scenario, PlanSet(scenario.name, True, plans), 0, SimSettings())
+    for agent in world.agents:
+        world.carried_by[world.object_ids.index(f"O{agent.id}")] = agent.index
+    world.v[:] = 0.0
+    for _ in range(int(world.settings.handling_time / world.dt) + 5):
+        for agent in world.agents:
+            kind, command = decide(world, agent)
+            assert (kind, command) == ("move", (0.0, 0.0))  # both stand where they docked
+    assert all(agent.done for agent in world.agents)
+    assert (world.carried_by < 0).all()  # both goods put down
+    assert [tuple(world.object_xy[world.object_ids.index(f"O{r}")]) for r in poses] == list(spots.values())

@@ -282,7 +282,8 @@ def _dock_and_handle(
     Stages (``agent.dock_stage``): *approach* -- drive to the pose when the robot is farther
     than ``dock_tolerance`` from it; *dock* -- brake, then creep onto it (the gripper touches
     object `grip` from now on, if given); blocked within `reach` (mm) of the pose, the gripper
-    works from there; it also waits until `clear` allows; *handle* -- stand ``handling_time``
+    works from there; *docked* -- it stands there for good (parked, :meth:`World.parked`) and
+    waits until `clear` allows; *handle* -- stand ``handling_time``
     (and while another robot crowds it: a parked robot keeps its promise), then `handle` once
     `clear` allows again (another robot may have come close during the handling).
     """
@@ -308,6 +309,10 @@ def _dock_and_handle(
             return ("dock", dock)
         if not there and (offset > reach or error > math.radians(s.heading_tolerance)):
             return HOLD  # blocked: wait (the gripper cannot reach from here)
+        # on its pose until the gripper has worked: parked, so that a robot docked beside it
+        # may put its goods down (were both to wait for the other to park, neither would drop)
+        agent.dock_stage = "docked"
+    if agent.dock_stage == "docked":
         if clear is not None and not clear():
             return HOLD
         agent.dock_stage = "handle"

@@ -72,7 +72,8 @@ class Agent:
         self.step_began = 0.0  # when the current step started, s
         self.step_log: list[tuple[int | None, str, float, float]] = []  # done: instant, label, start, end
         self.drive_phase = "start"  # of a drive: start (no path yet), drive, turn (onto the heading)
-        self.dock_stage: str | None = None  # of a pick or drop: approach, dock, handle (None: not begun)
+        # of a pick or drop: approach, dock, docked, handle (None: not begun)
+        self.dock_stage: str | None = None
         self.path: GlobalPath | None = None  # the global path being followed
         self.reseat_point: tuple[float, float] | None = None  # the plan's segment start to creep back to
         self.replan_start: tuple[int, Pose] | None = None  # (step, pose): where a replan starts that step
@@ -512,13 +513,17 @@ class World:
     def parked(self) -> np.ndarray:
         """Which robots are parked: standing and promising not to move (their V is 0).
 
-        A robot that has finished, waits for a message or lets its gripper work stands still,
-        and it leaves that state only when no other robot is within the standoff
-        (:meth:`crowded`).  The others may therefore treat it like a wall: come close, dock
-        beside it, and leave again -- two robots that touch could otherwise never part.
+        A robot that has finished, waits for a message, stands docked on the pose it picks or
+        drops from, or lets its gripper work stands still, and it leaves that state only when
+        no other robot is within the standoff (:meth:`crowded`).  The others may therefore
+        treat it like a wall: come close, dock beside it, and leave again -- two robots that
+        touch could otherwise never part.
         """
         return np.array(
-            [(a.done or a.waiting or a.dock_stage == "handle") and self.v[a.index] == 0 for a in self.agents],
+            [
+                (a.done or a.waiting or a.dock_stage in ("docked", "handle")) and self.v[a.index] == 0
+                for a in self.agents
+            ],
             dtype=bool,
         )
 
