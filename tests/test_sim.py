@@ -624,8 +624,12 @@ def test_two_robots_docked_side_by_side_both_put_their_goods_down():
         "name": "side-by-side",
         "scene": {
             "robots": {r: {"size": 2 * hr, "pose": list(p)} for r, p in poses.items()},
-            "objects": {f"O{r}": {"size": 2 * ho, "position": [-3000.0, 3000.0 * k]} for k, r in enumerate("AB")},
-            "workspaces": {f"W{r}": {"x": [s[0] - ho, s[0] + ho], "y": [s[1] - ho, s[1] + ho]} for r, s in spots.items()},
+            "objects": {
+                f"O{r}": {"size": 2 * ho, "position": [-3000.0, 3000.0 * k]} for k, r in enumerate(poses)
+            },
+            "workspaces": {
+                f"W{r}": {"x": [x - ho, x + ho], "y": [y - ho, y + ho]} for r, (x, y) in spots.items()
+            },
         },
         "mission": {"tasks": {r: [f"pick O{r}", f"drop O{r} at W{r}"] for r in poses}},
     }

@@ -11,13 +11,14 @@ from any side R1 needs no request at all.
 
 from __future__ import annotations
 
+import itertools
 from pathlib import Path
 
 import pytest
 
 from cosmop.planning.checker import check_robot_plan
 from cosmop.planning.specification import RobotProblem, events_of, specification
-from cosmop.planning.synthesis import synthesize
+from cosmop.planning.synthesis import ROUTE_ROUNDS, synthesize
 from cosmop.scenario import load_scenario
 from paper_rules import west_only
 
@@ -217,12 +218,12 @@ def test_among_the_shortest_plans_the_route_is_made_shorter(big):
     # keeps K and the requests, and on the 10x10 shortens several robots' routes
     shorter = 0
     for robot, word in big.mission.tasks.items():
-        first = synthesize(big.scene, robot, word, route_rounds=0)
-        best = synthesize(big.scene, robot, word)
+        first = synthesize(big.scene, robot, word)
+        best = synthesize(big.scene, robot, word, route_rounds=ROUTE_ROUNDS)
         assert (best.horizon, best.requests) == (first.horizon, first.requests)
         assert 0 < best.route_mm <= first.route_mm
         poses = [big.scene.robots[robot].pose, *(step.robot for step in best.plan.steps)]
-        manhattan = sum(abs(q[0] - p[0]) + abs(q[1] - p[1]) for p, q in zip(poses, poses[1:]))
+        manhattan = sum(abs(q[0] - p[0]) + abs(q[1] - p[1]) for p, q in itertools.pairwise(poses))
         assert best.route_mm == pytest.approx(manhattan)
         assert check_robot_plan(big.scene, robot, best.plan) == []
         shorter += best.route_mm < first.route_mm

@@ -6,11 +6,14 @@ grows (:class:`cosmop.logic.IncrementalUnrolling`, the horizon chosen by an assu
 a fresh solver per K (:class:`cosmop.logic.Unrolling`).  The first
 satisfiable K is the shortest plan length; unsatisfiability at K - 1 is part of the result.
 Among the plans of that length, the number of Req steps is then minimised by tightening a
-bound until unsat (a request costs another robot's time: it must come and move the goods), and
-then, with as few requests, the length of the route, for a few rounds (:func:`_shortest_route`):
-the solver's first model is any plan of K steps, and one of them may drive a long way round
-where another of the same K drives straight, which the robot, and every robot waiting for it,
-would pay for.
+bound until unsat (a request costs another robot's time: it must come and move the goods).
+Asked (``route_rounds``), the length of the route is then made shorter, with as few requests,
+for a few rounds (:func:`_shortest_route`): the solver's first model is any plan of K steps,
+and one may drive a long way round where another of the same K drives straight.  A robot
+re-planned among others already moving (:func:`cosmop.sim.replan.replan`: a lifelong hand-over,
+a stall) asks for it.  A team planned robot by robot does not: there the routes are only a
+start for the conflict step, and shortest ones, measured on aisle warehouses, run more robots
+through the same aisles (ten scenes: six planned later, three sooner).
 If no K up to the bound works, the mission is searched prefix by prefix for the first event
 that cannot be reached.  An unsat core over the specification's named parts, at the bound,
 names what blocks it.
@@ -68,7 +71,7 @@ from cosmop.scene import MAX_TASK_EVENTS, Scene
 
 DEFAULT_RLIMIT = 50_000_000
 ROUTE_ROUNDS = 4
-"""How many times the route of a shortest plan is asked to be shorter (:func:`_shortest_route`)."""
+"""How many times a re-planned robot asks for a shorter route (:func:`_shortest_route`)."""
 
 
 @dataclass(frozen=True)
@@ -201,7 +204,7 @@ def synthesize(
     lazy: bool = True,
     spots: tuple[tuple[Event, tuple[float, float]], ...] = (),
     min_horizon: int = 0,
-    route_rounds: int = ROUTE_ROUNDS,
+    route_rounds: int = 0,
 ) -> Synthesis:
     """The shortest safe plan of motion primitives for one robot's local mission.
 
@@ -247,7 +250,8 @@ def synthesize(
         ``unsat_horizons`` lists only the horizons searched.
     route_rounds : int
         How many times a shorter route is asked for among the shortest plans with the fewest
-        requests (:func:`_shortest_route`; 0: the solver's first such plan).
+        requests (:func:`_shortest_route`; 0, the default: the solver's first such plan;
+        :data:`ROUTE_ROUNDS` for a robot re-planned among others moving).
 
     Returns
     -------
@@ -547,7 +551,7 @@ def _shortest_plan(
     rlimit: int,
     incremental: bool,
     lazy: bool,
-    route_rounds: int = ROUTE_ROUNDS,
+    route_rounds: int = 0,
 ) -> _Search:
     """The first satisfiable horizon from `lower` to `max_horizon`, and its plan.
 

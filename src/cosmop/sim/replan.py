@@ -124,7 +124,9 @@ def replan(
     max_horizon: int = 12,
     rlimit: int = 50_000_000,
 ) -> RobotPlan | None:
-    """The shortest plan of `events` from `start` among the walls and the sensed obstacles.
+    """The shortest plan of `events` from `start` among the walls and the sensed obstacles,
+    its route made shorter among those (:data:`~cosmop.planning.synthesis.ROUTE_ROUNDS`: a
+    robot among others that move drives the shortest way it finds, measured in lifelong runs).
 
     Parameters
     ----------
@@ -148,7 +150,7 @@ def replan(
         ``None`` when there is none within the bound.
     """
     # the solver (and Z3) load only when a robot replans: most runs never do
-    from cosmop.planning.synthesis import synthesize
+    from cosmop.planning.synthesis import ROUTE_ROUNDS, synthesize
 
     world = sensed_scene(scene, sensed)
     result = synthesize(
@@ -160,6 +162,7 @@ def replan(
         rlimit=rlimit,
         start=start,
         explain=False,
+        route_rounds=ROUTE_ROUNDS,
     )
     if not result.feasible or result.plan is None:
         return None
