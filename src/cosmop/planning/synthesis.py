@@ -557,8 +557,8 @@ def _shortest_plan(
 
     Each horizon is checked in turn; at the first satisfiable one the number of requests is
     minimised (:func:`_fewest_requests`), then the route (:func:`_shortest_route`, `route_rounds`
-    rounds).  A horizon the solver cannot decide within `rlimit`
-    ends the search with ``gave_up`` set.  With `lazy`, obstacles join the solver as plans
+    rounds).  A horizon the solver cannot decide within `rlimit` ends the search with
+    ``gave_up`` set.  With `lazy`, obstacles join the solver as plans
     break them (:class:`~cosmop.planning.obstacles.Geometry`).
     """
     geometry = Geometry(p, None, lazy)

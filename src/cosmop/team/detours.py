@@ -385,9 +385,10 @@ def _ways_around(wait: Wait, safety: TeamSafety, scene: Scene, settings: Conflic
         keep = lanes(scene, {other: first, robot: then}, shared, settings.clearance, safety.fixed)
         if keep is None:
             continue
+        pair = list(keep)  # the two robots; each keeps out of the other's lane
         walls = {
-            r: walls_around(region, settings.clearance, f"the lane {o} keeps to")
-            for (r, region), o in zip(keep.items(), reversed(keep), strict=True)
+            r: walls_around(region, settings.clearance, f"the lane {pair[1 - n]} keeps to")
+            for n, (r, region) in enumerate(keep.items())
         }
         key = ("lanes", *sorted((r, tuple(round(v) for v in region.bounds)) for r, region in keep.items()))
         why = (
