@@ -269,26 +269,3 @@ def test_goods_shipped_on_drop_still_need_their_drop_spot_free_while_dropped():
     found = conflicts(occupancies(scene, safe, precedence, shipped)[0])
     assert any({c.a.what, c.b.what} == {"O2", "R1"} for c in found)
     assert precedence.complete and all(is_ordered(c, precedence) for c in found)
-
-
-def test_robots_meeting_head_on_are_offered_lanes_where_the_critical_wait_is_elsewhere():
-    # The passing example with each robot's shortest route: both drive down the middle of the
-    # aisle, and the wait that ends the team last is at the aisle's east end, between two
-    # robots standing at cuts of their drives.  The lanes through the aisle, where the two meet
-    # head-on, are offered for it (once only for a wait between two drives).
-    from cosmop.planning.synthesis import ROUTE_ROUNDS, synthesize
-    from cosmop.team.detours import _ways_around
-
-    scenario = load_scenario(EXAMPLES / "11_passing" / "scenario.yaml")
-    plans = {
-        r: synthesize(scenario.scene, r, word, route_rounds=ROUTE_ROUNDS).plan
-        for r, word in scenario.mission.tasks.items()
-    }
-    safety = make_team_safe(scenario.scene, plans)
-    critical = [w for w in safety.waits if w.critical]
-    assert critical and all(not (w.first.is_drive and w.then.is_drive) for w in critical)
-    ways = [way for w in critical for way in _ways_around(w, safety, scenario.scene, ConflictSettings())]
-    lanes = [(key, walls) for key, _, walls in ways if key[0] == "lanes"]
-    assert lanes and set(lanes[0][1]) == {"R1", "R2"}
-    # each lane runs the aisle's length (x in [-3000, 3000]): its bounds, (x0, y0, x1, y1)
-    assert all(b[0] <= -3000 and b[2] >= 3000 for _, b in lanes[0][0][1:])

@@ -10,7 +10,6 @@ around what it waits for.
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Hashable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
@@ -24,9 +23,9 @@ from cosmop.planning.synthesis import Synthesis
 from cosmop.scene import Scene, Wall
 from cosmop.team.aside import handover_spot
 from cosmop.team.conflicts import Conflict, ConflictSettings, Occupancy, kept_out
-from cosmop.team.lanes import HEAD_ON, Segment, lanes
+from cosmop.team.lanes import lanes
 from cosmop.team.planner import Planner, Window, goods_at
-from cosmop.team.safe_plans import TeamSafety, Wait, make_team_safe, straight_drives
+from cosmop.team.safe_plans import TeamSafety, Wait, make_team_safe
 from cosmop.team.walls import walls_around
 from cosmop.units import show_point
 
@@ -368,34 +367,31 @@ def _ways_around(wait: Wait, safety: TeamSafety, scene: Scene, settings: Conflic
     """The ways around one wait, to try in order: ``(key, why, robot -> walls)``.
 
     Two robots that drive head-on through a place wide enough for both pass each other in
-    lanes (:func:`cosmop.team.lanes.lanes`): where the wait is, or, for a wait on the critical
-    path, wherever else the two meet head-on (the wait is often the consequence of an order
-    there: the robot that gave way at one end of an aisle waits for the other later); the
-    waiting robot can keep out of what it waits for, where that leaves its fixed places free
-    (:meth:`TeamSafety.detours`).
+    lanes (:func:`cosmop.team.lanes.lanes`); the waiting robot can keep out of what it
+    waits for, where that leaves its fixed places free (:meth:`TeamSafety.detours`).
     """
-    robot, other = wait.robot, wait.other
-    meetings = []
-    if wait.drives is not None:
-        meetings.append((wait.drives[0], wait.drives[1], wait.first.region.intersection(wait.then.region)))
-    if wait.critical:
-        meetings += _head_on(safety, scene, other, robot, settings.clearance)
     out: list[_Way] = []
-    for first, then, shared in meetings:
-        keep = lanes(scene, {other: first, robot: then}, shared, settings.clearance, safety.fixed)
-        if keep is None:
-            continue
-        pair = list(keep)  # the two robots; each keeps out of the other's lane
-        walls = {
-            r: walls_around(region, settings.clearance, f"the lane {pair[1 - n]} keeps to")
-            for n, (r, region) in enumerate(keep.items())
-        }
-        key = ("lanes", *sorted((r, tuple(round(v) for v in region.bounds)) for r, region in keep.items()))
-        why = (
-            f"{robot} and {other} re-planned to pass each other in lanes instead of {robot} waiting "
-            f"{wait.seconds:.1f} s where {wait.conflict.describe()}"
-        )
-        out.append((key, why, walls))
+    robot, other = wait.robot, wait.other
+    if wait.drives is not None:
+        shared = wait.first.region.intersection(wait.then.region)
+        drives = {other: wait.drives[0], robot: wait.drives[1]}
+        keep = lanes(scene, drives, shared, settings.clearance, safety.fixed)
+        if keep is not None:
+            walls = {
+                r: walls_around(
+                    region, settings.clearance, f"the lane {next(o for o in keep if o != r)} keeps to"
+                )
+                for r, region in keep.items()
+            }
+            key = (
+                "lanes",
+                *sorted((r, tuple(round(v) for v in region.bounds)) for r, region in keep.items()),
+            )
+            why = (
+                f"{robot} and {other} re-planned to pass each other in lanes instead of {robot} waiting "
+                f"{wait.seconds:.1f} s where {wait.conflict.describe()}"
+            )
+            out.append((key, why, walls))
     for _, mover, keep_out in safety.detours(wait.conflict):
         if mover == robot:
             walls = {robot: _keep_out(robot, keep_out, safety.fixed, settings.clearance)}
@@ -406,41 +402,3 @@ def _ways_around(wait: Wait, safety: TeamSafety, scene: Scene, settings: Conflic
             out.append((("around", robot, keep_out.label), why, walls))
             break
     return out
-
-
-def _head_on(
-    safety: TeamSafety, scene: Scene, a: str, b: str, clearance: float
-) -> list[tuple[Segment, Segment, BaseGeometry]]:
-    """Where the straight drives of robots `a` and `b` meet head-on: ``(a's drive, b's drive,
-    the place they share)``, the longest shared place first.
-
-    A drive's place is its centre line grown by half the robot's side and half the clearance
-    (flat ends: the two robots' bodies, `clearance` apart, touch its edge).
-    """
-    ends = straight_drives(scene, {r: safety.plans[r] for r in (a, b)})
-    drives = {r: sorted({d for (who, _), d in ends.items() if who == r}) for r in (a, b)}
-    out = []
-    for da in drives[a]:
-        for db in drives[b]:
-            if not _opposed(da, db):
-                continue
-            shared = _swept(da, scene.robots[a].size, clearance).intersection(
-                _swept(db, scene.robots[b].size, clearance)
-            )
-            if shared.area > 0.0:
-                out.append((da, db, shared))
-    return sorted(out, key=lambda m: -m[2].area)
-
-
-def _opposed(da: Segment, db: Segment) -> bool:
-    """Whether two drives run head-on (:data:`cosmop.team.lanes.HEAD_ON`)."""
-    (pa, qa), (pb, qb) = da, db
-    u = (qa[0] - pa[0], qa[1] - pa[1])
-    v = (qb[0] - pb[0], qb[1] - pb[1])
-    norms = math.hypot(*u) * math.hypot(*v)
-    return norms > 0.0 and (u[0] * v[0] + u[1] * v[1]) / norms < HEAD_ON
-
-
-def _swept(drive: Segment, size: float, clearance: float) -> BaseGeometry:
-    """The place a drive sweeps, grown by half the clearance (flat ends)."""
-    return shapely.LineString(drive).buffer(size / 2.0 + clearance / 2.0, cap_style="flat")

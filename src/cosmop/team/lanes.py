@@ -29,7 +29,7 @@ from shapely.geometry.base import BaseGeometry
 from cosmop.planning.specification import MOTION_MARGIN
 from cosmop.scene import Scene
 
-__all__ = ["HEAD_ON", "Segment", "lanes"]
+__all__ = ["HEAD_ON", "lanes"]
 
 HEAD_ON = math.cos(math.radians(135.0))
 """Two drives are head-on when the cosine of the angle between their directions is below this

@@ -51,9 +51,9 @@ from cosmop.team.conflicts import (
     ranked_detours,
 )
 from cosmop.team.precedence import Precedence
-from cosmop.team.timing import collinear, durations, start_pose
+from cosmop.team.timing import durations, start_pose
 
-__all__ = ["TeamSafety", "Wait", "make_team_safe", "straight_drives"]
+__all__ = ["TeamSafety", "Wait", "make_team_safe"]
 
 _Drive = tuple[tuple[float, float], tuple[float, float]]
 """The centres (mm) at the two ends of a drive."""
@@ -93,9 +93,8 @@ class Wait:
     first, then : Occupancy
         The occupancy that goes first (`other`'s side) and the one that waits for it.
     drives : tuple or None
-        When both sides are robots driving or standing where a drive brought them:
-        ``((p, q), (p', q'))``, the centres (mm) at the two ends of the first's straight drive
-        and of the waiting one's (a drive cut where it meets others counted whole).
+        When both sides are drives: ``((p, q), (p', q'))``, the centres (mm) at the two ends of
+        the first's drive and of the waiting one's.
     critical : bool
         Whether the wait lies on the path of waits and steps that ends the team's itinerary
         last: only such a wait, made shorter, can end the team sooner.
@@ -411,51 +410,22 @@ def _order(
         fixed,
         len(chosen),
         _flipped(chosen, precedence),
-        _waits(new_plans, final, placed, kept, straight_drives(scene, plans, starts)),
+        _waits(new_plans, final, placed, kept, _drive_ends(scene, plans, starts)),
     )
 
 
-def straight_drives(
-    scene: Scene, plans: Mapping[str, RobotPlan], starts: Mapping[str, State] | None = None
+def _drive_ends(
+    scene: Scene, plans: Mapping[str, RobotPlan], starts: Mapping[str, State] | None
 ) -> dict[Node, _Drive]:
-    """The centres at the two ends of the straight drive every GoTo step of `plans` is a piece
-    of: ``(robot, k) -> (p, q)``.  A drive cut where it meets others' places (messages between
-    its pieces) is one drive: its pieces map to its whole length.
-
-    Parameters
-    ----------
-    scene : Scene
-        The robots' start poses.
-    plans : Mapping[str, RobotPlan]
-        The plans, by robot.
-    starts : Mapping[str, State], optional
-        Where robots start, if not at the scene's poses.
-    """
+    """The centres at the two ends of every GoTo step of `plans`: ``(robot, k) -> (p, q)``."""
     out: dict[Node, _Drive] = {}
     for robot, plan in plans.items():
         pose = start_pose(scene, robot, starts)
-        run: list[tuple[int, tuple[float, ...]]] = []  # the pieces of one straight drive: (k, from)
         for k, step in enumerate(plan.steps, 1):
             if step.primitive == Primitive.GOTO:
-                if run and not collinear(run[-1][1], pose, step.robot):
-                    run = []
-                run.append((k, pose))
-                whole = ((run[0][1][0], run[0][1][1]), (step.robot[0], step.robot[1]))
-                out.update({(robot, j): whole for j, _ in run})
-            elif step.primitive not in (Primitive.REQ, Primitive.RES) or step.message is None:
-                run = []  # a pick or a drop ends the drive; a message on the way does not
+                out[(robot, k)] = ((pose[0], pose[1]), (step.robot[0], step.robot[1]))
             pose = step.robot
     return out
-
-
-def _drive_of(occupancy: Occupancy, ends: Mapping[Node, _Drive]) -> _Drive | None:
-    """The straight drive of a robot's occupancy: its own, or, for a robot standing where a
-    drive brought it, that drive; ``None`` for goods and for a robot that has not driven yet."""
-    if occupancy.is_drive:
-        return ends.get(occupancy.first)  # type: ignore[arg-type]
-    if occupancy.states is None or occupancy.states[0] < 1:
-        return None
-    return ends.get((occupancy.what, occupancy.states[0]))
 
 
 def _waits(
@@ -469,7 +439,7 @@ def _waits(
 
     `placed` and `kept` pair each message with its conflict (`plans` wait for it at their
     ``Req`` of it); `ends` gives the drives of the plans the conflicts were found on
-    (:func:`straight_drives`).
+    (:func:`_drive_ends`).
     """
     critical = _critical_waits(plans, order)
     out = []
@@ -479,8 +449,10 @@ def _waits(
         k = next(k for k, s in enumerate(plans[robot].steps, 1) if s.message == event)
         first, then = (conflict.a, conflict.b) if conflict.a.last == first_step else (conflict.b, conflict.a)
         seconds = float(order.finish[robot][k] - order.finish[robot][k - 1])
-        mine, theirs = _drive_of(first, ends), _drive_of(then, ends)
-        drives = (mine, theirs) if mine is not None and theirs is not None else None
+        drives: tuple[_Drive, ...] | None = None
+        if first.is_drive and then.is_drive:
+            assert first.first is not None and then.first is not None  # (a drive has its step)
+            drives = (ends[first.first], ends[then.first])
         out.append(Wait(seconds, robot, other, event, conflict, first, then, drives, (robot, k) in critical))
     return tuple(sorted(out, key=lambda w: (-w.seconds, w.message.name)))
 

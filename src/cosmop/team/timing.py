@@ -141,7 +141,7 @@ def step_durations(
     pose = tuple(start)
     run: list[_Piece] = []  # pieces of one straight drive: (index, from, to)
     for step in plan.steps:
-        if step.primitive == Primitive.GOTO and run and not collinear(run[-1][1], run[-1][2], step.robot):
+        if step.primitive == Primitive.GOTO and run and not _collinear(run[-1][1], run[-1][2], step.robot):
             _close(run, out, dynamics)
             run = []
         out.append(0.0)
@@ -158,15 +158,8 @@ def step_durations(
     return out
 
 
-def collinear(a: Sequence[float], b: Sequence[float], c: Sequence[float]) -> bool:
-    """Whether going on from `b` to `c` continues the drive from `a` to `b` (within 1 degree):
-    the pieces of one straight drive, cut where it meets others' places.
-
-    Parameters
-    ----------
-    a, b, c : sequence of float
-        Three centres ``(x, y, ...)``, mm.
-    """
+def _collinear(a: Sequence[float], b: Sequence[float], c: Sequence[float]) -> bool:
+    """Whether going on from `b` to `c` continues the drive from `a` to `b` (within 1 degree)."""
     u = (b[0] - a[0], b[1] - a[1])
     v = (c[0] - b[0], c[1] - b[1])
     nu, nv = math.hypot(*u), math.hypot(*v)
