@@ -55,10 +55,19 @@ def uninterrupted() -> Iterator[None]:
     finally:
         signal.signal(signal.SIGINT, old)
         if pressed:
-            if callable(old):
-                old(*pressed[0])
-            elif old == signal.SIG_DFL:  # (Python's default handler is callable: called above)
-                raise KeyboardInterrupt
+            _pass_on(old, *pressed[0])
+
+
+def _pass_on(handler: Any, number: int, frame: FrameType | None) -> None:
+    """Give a Ctrl-C that was held back to the SIGINT `handler` it was held from: call it, or,
+    for the system's default, raise KeyboardInterrupt (an ignored one is dropped).  Python's own
+    default handler is callable and raises it itself."""
+    import signal
+
+    if callable(handler):
+        handler(number, frame)
+    elif handler == signal.SIG_DFL:
+        raise KeyboardInterrupt
 
 
 @contextlib.contextmanager
@@ -85,15 +94,13 @@ def interrupt_at_safe_points() -> Iterator[Callable[[], None]]:
     def note(number: int, frame: FrameType | None) -> None:
         if pressed:  # a second one: at once
             signal.signal(signal.SIGINT, old)
-            if callable(old):
-                old(number, frame)
+            _pass_on(old, number, frame)
             raise KeyboardInterrupt
         pressed.append((number, frame))
 
     def safe_point() -> None:
         if pressed:  # the previous handler takes it now, as if Ctrl-C came here
-            if callable(old):
-                old(*pressed[0])
+            _pass_on(old, *pressed[0])
             raise KeyboardInterrupt
 
     signal.signal(signal.SIGINT, note)
