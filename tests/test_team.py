@@ -7,6 +7,7 @@ executed word of mission events is a complete word of the global mission.
 
 from __future__ import annotations
 
+import functools
 from pathlib import Path
 
 import numpy as np
@@ -15,14 +16,17 @@ import yaml
 from typer.testing import CliRunner
 
 from cosmop.cli import app
-from cosmop.events import message, parse_event
+from cosmop.events import Primitive, message, parse_event
 from cosmop.missions.mission import GlobalMission
 from cosmop.planning import PlanSet, plan_from_actions
 from cosmop.planning.plan_file import load_plan
+from cosmop.planning.plan_types import RobotPlan, Step
 from cosmop.planning.realisation import message_links
 from cosmop.scenario import load_scenario, parse_scenario
 from cosmop.sim import simulate
-from cosmop.sim.recoordinate import Remaining, recoordinate
+from cosmop.sim.recoordinate import Remaining, orders_lost, recoordinate, unordered_now
+from cosmop.sim.result import SimSettings
+from cosmop.sim.world import World
 from cosmop.team.conflicts import ConflictSettings, conflicts, is_ordered, occupancies
 from cosmop.team.loop import plan_team
 from cosmop.team.precedence import Precedence
@@ -175,6 +179,88 @@ def test_a_replan_mid_run_is_ordered_again(corridor):
     assert precedence.complete
     items, _ = occupancies(scene, outcome.plans, precedence)
     assert all(is_ordered(c, precedence) for c in conflicts(items))
+
+
+def _relay_of_orders():
+    """R1 crosses the room on y = 0, then tells R2; R2 drives, then tells R3; R3 then crosses
+    R1's path on x = 0.  Only the chain through R2 orders R1's drive before R3's."""
+    scenario = parse_scenario(
+        {
+            "name": "relay",
+            "scene": {
+                "obstacles": [],
+                "robots": {
+                    "R1": {"size": 400, "pose": [-3000, 0, 0]},
+                    "R2": {"size": 400, "pose": [0, 4000, 0]},
+                    "R3": {"size": 400, "pose": [0, -3000, 90]},
+                },
+                "objects": {},
+                "workspaces": {},
+            },
+            "mission": {"tasks": {"R1": ["return"], "R2": ["return"], "R3": ["return"]}},
+        }
+    )
+    m1, m2 = message("R1", "R2", "clear1"), message("R2", "R3", "clear2")
+    go = functools.partial(Step, Primitive.GOTO, None, objects={})
+    plans = {
+        "R1": RobotPlan.from_steps(
+            (m1,), (go((3000.0, 0.0, 0.0)), Step(Primitive.RES, None, (3000.0, 0.0, 0.0), {}, message=m1))
+        ),
+        "R2": RobotPlan.from_steps(
+            (m1, m2),
+            (
+                Step(Primitive.REQ, None, (0.0, 4000.0, 0.0), {}, message=m1),
+                go((2000.0, 4000.0, 0.0)),
+                Step(Primitive.RES, None, (2000.0, 4000.0, 0.0), {}, message=m2),
+            ),
+        ),
+        "R3": RobotPlan.from_steps(
+            (m2,), (Step(Primitive.REQ, None, (0.0, -3000.0, 90.0), {}, message=m2), go((0.0, 2000.0, 90.0)))
+        ),
+    }
+    return scenario, plans, {m1, m2}
+
+
+def test_a_replan_keeps_the_orders_between_others_that_passed_through_it():
+    # R2 replans (a drive west, no message): its messages go, and with them the only order
+    # between R1's drive and R3's, which cross at the origin; they are ordered again
+    scenario, plans, names = _relay_of_orders()
+    scene = scenario.scene
+    starts = {r: _initial(scenario, r) for r in plans}
+    old = {r: Remaining(p.steps, p.mission, starts[r]) for r, p in plans.items()}
+    new = RobotPlan.from_steps((), (Step(Primitive.GOTO, None, (-2000.0, 4000.0, 0.0), {}),))
+    lost = orders_lost(scene, plans, names, "R2", starts=starts, positions={})
+    assert lost == {("R1", "R3")}
+    outcome = recoordinate(
+        scene,
+        {**old, "R2": Remaining(new.steps, new.mission, starts["R2"])},
+        "R2",
+        sent=(),
+        conflict_messages=names,
+        used=set(names),
+        positions={},
+        replaced=old["R2"],
+    )
+    assert outcome.accepted and set(outcome.dropped) == names
+    assert {frozenset(m.event.owners) for m in outcome.messages} == {frozenset({"R1", "R3"})}
+    precedence = Precedence({r: p.horizon for r, p in outcome.plans.items()}, message_links(outcome.plans))
+    items, _ = occupancies(scene, outcome.plans, precedence, starts=starts)
+    found = conflicts(items)
+    assert any(c.robots == ("R1", "R3") for c in found)
+    assert all(is_ordered(c, precedence) for c in found)
+    # a replan whose messages order nothing between the others loses nothing
+    assert orders_lost(scene, plans, {message("R2", "R3", "x")}, "R2", starts=starts, positions={}) == set()
+
+
+def test_a_running_world_is_audited_for_unordered_conflicts():
+    # the relay's plans as committed: every conflict ordered; without their messages, R1's
+    # drive and R3's cross unordered (what an audit of a lifelong run looks for)
+    scenario, plans, _ = _relay_of_orders()
+    world = World(scenario, PlanSet(scenario.name, True, plans), 0, SimSettings())
+    assert unordered_now(world) == []
+    bare = {r: RobotPlan.from_steps((), [s for s in p.steps if s.message is None]) for r, p in plans.items()}
+    world = World(scenario, PlanSet(scenario.name, True, bare), 0, SimSettings())
+    assert [c.robots for c in unordered_now(world)] == [("R1", "R3")]
 
 
 def _initial(scenario, robot):

@@ -9,7 +9,10 @@ the rest of every robot's plan, from where each robot is now, is ordered again b
 * the messages that kept the robot's old plan apart from the others and have not been sent yet
   are dropped (they protected places its new plan may no longer share) and its conflicts with
   the others are ordered afresh, proved free of deadlock, with new message names; the others'
-  orders among themselves stay as they were;
+  orders among themselves stay as they were, except those that passed through the robot: an
+  order between two others that only a chain of the dropped messages kept (A tells the robot,
+  which then tells B) is lost with them, so the conflicts it ordered are ordered again
+  (:func:`orders_lost`);
 * the orders the mission itself requires (``away`` answers, order messages) are kept.
 
 If some conflict cannot be ordered, the new plan is refused and the robot keeps its old one.
@@ -24,22 +27,35 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Set as AbstractSet
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
+
+import numpy as np
 
 from cosmop.control.safety import own_margin
 from cosmop.events import Event, Primitive
 from cosmop.planning.plan_types import PlanMessage, RobotPlan, State, Step
 from cosmop.planning.primitive_effects import initial_state
+from cosmop.planning.realisation import message_links
 from cosmop.scene import Scene
 from cosmop.sim.realised_times import carry_instants
-from cosmop.team.conflicts import ConflictSettings
+from cosmop.team.conflicts import Conflict, ConflictSettings, conflicts, is_ordered, occupancies
+from cosmop.team.precedence import Precedence
 from cosmop.team.safe_plans import make_team_safe
 
 if TYPE_CHECKING:
     from cosmop.sim.world import Agent, World
 
-__all__ = ["Recoordination", "Remaining", "recoordinate", "recoordinate_world", "wait_ahead"]
+__all__ = [
+    "Recoordination",
+    "Remaining",
+    "orders_lost",
+    "recoordinate",
+    "recoordinate_world",
+    "unordered_now",
+    "wait_ahead",
+]
 
 
 @dataclass(frozen=True)
@@ -114,6 +130,7 @@ def recoordinate(
     used: set[Event],
     positions: Mapping[str, tuple[float, float] | None],
     settings: ConflictSettings | None = None,
+    replaced: Remaining | None = None,
 ) -> Recoordination:
     """Order the rest of every robot's plan again (module docstring).
 
@@ -133,6 +150,9 @@ def recoordinate(
     positions : Mapping[str, tuple or None]
         Where every object is now (``None``: carried).
     settings : ConflictSettings, optional
+    replaced : Remaining, optional
+        The rest of `robot`'s plan that the new one replaces, with its messages (default: its
+        entry of `rests`); the orders between the others that passed through it are kept.
 
     Returns
     -------
@@ -144,8 +164,17 @@ def recoordinate(
     drop = sent | pending
     plans = {r: _without(rest, drop) for r, rest in rests.items()}
     starts = {r: rest.start for r, rest in rests.items()}
+    before = {r: _without(rest, sent) for r, rest in {**rests, robot: replaced or rests[robot]}.items()}
+    also = orders_lost(scene, before, pending, robot, starts=starts, positions=positions, settings=settings)
     safety = make_team_safe(
-        scene, plans, settings=settings, used=used, starts=starts, positions=positions, about=robot
+        scene,
+        plans,
+        settings=settings,
+        used=used,
+        starts=starts,
+        positions=positions,
+        about=robot,
+        also=also,
     )
     if not safety.safe:
         return Recoordination(
@@ -156,6 +185,83 @@ def recoordinate(
             f"the new plans share a place no order resolves: {safety.unresolved[0].describe()}",
         )
     return Recoordination(True, safety.plans, safety.messages, dropped)
+
+
+def orders_lost(
+    scene: Scene,
+    plans: Mapping[str, RobotPlan],
+    dropped: AbstractSet[Event],
+    robot: str,
+    *,
+    starts: Mapping[str, State],
+    positions: Mapping[str, tuple[float, float] | None],
+    settings: ConflictSettings | None = None,
+) -> frozenset[tuple[str, ...]]:
+    """The parties of the conflicts between robots other than `robot` that `plans` order only
+    through the messages `dropped`.
+
+    The ordering step drops every order that others imply (a transitive reduction), so an
+    order between A and B may hold only through `robot`: A sends it a message that it awaits
+    before it sends one to B.  Without those messages A and B are no longer ordered.  The
+    conflict ``(a, b)`` is lost when one of its occupancies ends before the other starts in
+    the order of all the `plans`' messages, and in neither way once the `dropped` ones are
+    removed (their ``Req`` steps then wait for nothing, so the steps keep their instants).
+
+    Parameters
+    ----------
+    scene : Scene
+    plans : Mapping[str, RobotPlan]
+        Every robot's rest of plan with all its messages still to come (none sent yet),
+        `robot`'s old one included.
+    dropped : set of Event
+        The messages of `robot` that are dropped.
+    robot : str
+        The robot that replanned (its own conflicts are ordered anyway).
+    starts, positions
+        The robots' states and the objects' places now (see :func:`recoordinate`).
+    settings : ConflictSettings, optional
+
+    Returns
+    -------
+    frozenset of tuple of str
+        :attr:`~cosmop.team.conflicts.Conflict.robots` of every conflict lost.
+    """
+    settings = settings or ConflictSettings()
+    horizons = {r: p.horizon for r, p in plans.items()}
+    links = message_links(plans)
+    kept = [link for link in links if link.event not in dropped]
+    if len(kept) == len(links):
+        return frozenset()
+    order, without = Precedence(horizons, links), Precedence(horizons, kept)
+    if not order.complete:  # `robot`'s old rest is not known: order all that is unordered
+        order, losing = without, set(plans)
+    else:
+        losing = _others_losing(order, without, robot)
+    if not losing:
+        return frozenset()
+    items, _ = occupancies(scene, plans, order, settings, starts, positions)
+    return frozenset(
+        c.robots
+        for c in conflicts([i for i in items if i.parties & losing], settings.clearance)
+        if robot not in c.robots and (order is without or is_ordered(c, order)) and not is_ordered(c, without)
+    )
+
+
+def _others_losing(order: Precedence, without: Precedence, robot: str) -> set[str]:
+    """The robots other than `robot` whose steps no longer always start after, or no longer
+    always complete before, another's (not `robot`'s) once the dropped links are gone (`order`
+    -> `without`, the same steps).  Most re-plans lose only orders with `robot` itself, and
+    then no conflict needs looking at."""
+    mine = np.zeros(order.size, dtype=bool)
+    mine[order.offsets[robot] : order.offsets[robot] + order.horizons[robot] + 2] = True
+    others = np.packbits(~mine, bitorder="little")  # the bit set of the others' steps
+    lost = order.begin_bits & ~without.begin_bits & others[: order.begin_bits.shape[1]]
+    lost[mine] = 0
+    later = np.flatnonzero(lost.any(axis=1))  # steps that lost some order
+    earlier = np.flatnonzero(np.unpackbits(np.bitwise_or.reduce(lost, axis=0), bitorder="little"))
+    rows = np.concatenate([later, earlier[earlier < order.size]])
+    offsets = np.array([order.offsets[r] for r in order.robots])  # increasing
+    return {order.robots[i] for i in np.unique(np.searchsorted(offsets, rows, side="right") - 1)}
 
 
 # ----------------------------------------------------------------------------------------------
@@ -195,12 +301,7 @@ def recoordinate_world(
             rests[other.id] = Remaining(
                 tuple(other.steps[other.step_index :]), tuple(todo), _state_now(world, other)
             )
-    positions = {
-        oid: None
-        if world.carried_by[j] >= 0 or world.shipped[j]
-        else (float(world.object_xy[j][0]), float(world.object_xy[j][1]))
-        for j, oid in enumerate(world.object_ids)
-    }
+    positions = _positions(world)
     result = recoordinate(
         world.scenario.scene,
         rests,
@@ -210,6 +311,7 @@ def recoordinate_world(
         used=world.used_messages,
         positions=positions,
         settings=settings or world.conflict_settings,
+        replaced=Remaining(tuple(agent.steps[agent.step_index :]), tuple(splits[agent.id][1]), start),
     )
     if not result.accepted:
         return False, result.reason or "", []
@@ -223,6 +325,56 @@ def recoordinate_world(
     added = [m.event for m in result.messages]
     world.conflict_messages |= set(added)
     return True, "", added
+
+
+def unordered_now(world: World, depth: float = 1.0) -> list[Conflict]:
+    """The conflicts between the robots' committed rests that no message orders, now: the
+    exact checker's conflict rule on every robot's steps from its current one, from where it
+    stands, with the messages already sent done (an audit of a running fleet).
+
+    A robot a little off its plan's line (it tracks it within centimetres) may make slivers of
+    new overlap that no plan made; only conflicts whose shared space is at least `depth` mm
+    across both ways are returned (1 mm by default: a re-planned robot plans from its pose
+    rounded to the millimetre).
+
+    Parameters
+    ----------
+    world : World
+        The running simulation.
+    depth : float
+        The smallest width and height of the shared space counted, mm.
+
+    Returns
+    -------
+    list of Conflict
+        Empty when every conflict is ordered.  A deadlock (which the ordering proves cannot
+        happen) raises instead.
+
+    Raises
+    ------
+    ValueError
+        When the committed messages can deadlock.
+    """
+    rests = {
+        a.id: Remaining(
+            tuple(a.steps[a.step_index :]), tuple(a.split_mission(world.scenario)[1]), _state_now(world, a)
+        )
+        for a in world.agents
+    }
+    plans = {r: _without(rest, set(world.sent_messages)) for r, rest in rests.items()}
+    order = Precedence({r: p.horizon for r, p in plans.items()}, message_links(plans))
+    if not order.complete:
+        raise ValueError(f"the committed plans can deadlock: {order.stuck}")
+    positions = _positions(world)
+    settings = world.conflict_settings or ConflictSettings()
+    starts = {r: rest.start for r, rest in rests.items()}
+    items, _ = occupancies(world.scenario.scene, plans, order, settings, starts, positions)
+    out = []
+    for conflict in conflicts(items, settings.clearance):
+        x0, y0, x1, y1 = conflict.place
+        if min(x1 - x0, y1 - y0) >= depth and not is_ordered(conflict, order):
+            out.append(conflict)
+    return out
 
 
 def wait_ahead(
@@ -301,6 +453,16 @@ def _install(agent: Agent, plan: RobotPlan, done: list[Event], *, new: bool) -> 
     agent.mission = list(done) + list(plan.mission)
     if new or (k < len(agent.steps) and agent.steps[k] != current):
         agent.restart_step()
+
+
+def _positions(world: World) -> dict[str, tuple[float, float] | None]:
+    """Where every object is now, mm (``None``: carried or shipped)."""
+    return {
+        oid: None
+        if world.carried_by[j] >= 0 or world.shipped[j]
+        else (float(world.object_xy[j][0]), float(world.object_xy[j][1]))
+        for j, oid in enumerate(world.object_ids)
+    }
 
 
 def _state_now(world: World, agent: Agent) -> State:

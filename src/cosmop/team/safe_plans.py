@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -71,8 +71,9 @@ _Context = tuple[
     Mapping[str, tuple[float, float] | None] | None,
     str | None,
     set[Event] | None,
+    frozenset[tuple[str, ...]],
 ]
-"""What every ordering attempt shares: ``(scene, settings, starts, positions, about, used)``."""
+"""What every ordering attempt shares: ``(scene, settings, starts, positions, about, used, also)``."""
 
 
 @dataclass(frozen=True)
@@ -245,6 +246,7 @@ def make_team_safe(
     starts: Mapping[str, State] | None = None,
     positions: Mapping[str, tuple[float, float] | None] | None = None,
     about: str | None = None,
+    also: Collection[tuple[str, ...]] = (),
 ) -> TeamSafety:
     """Order every conflict between `plans` by messages (see the module docstring).
 
@@ -265,6 +267,10 @@ def make_team_safe(
     about : str, optional
         Order only the conflicts of this robot's plan (the others' plans are already ordered
         among themselves: a robot that replanned mid-run).
+    also : collection of tuple of str
+        With `about`: the parties (as :attr:`Conflict.robots` names them) whose conflicts are
+        ordered too where the plans no longer order them (the robot's old messages ordered
+        them, passing through it: :func:`cosmop.sim.recoordinate.recoordinate`).
 
     Returns
     -------
@@ -280,7 +286,7 @@ def make_team_safe(
         )
         for r, p in plans.items()
     }
-    context: _Context = (scene, settings, starts, positions, about, used)
+    context: _Context = (scene, settings, starts, positions, about, used, frozenset(also))
     uncut = frozenset() if settings.cut else frozenset(plans)
     # each robot's cuts depend on the others' whole drives only: made once, undone robot by robot
     cut = (
@@ -371,7 +377,7 @@ def _order(
 ) -> TeamSafety:
     """One ordering of every conflict between `plans` (already cut; `waypoints` are the
     robots' own, where pieces are joined again after), its time not yet set."""
-    scene, settings, starts, positions, about, used = context
+    scene, settings, starts, positions, about, used, also = context
     horizons = {r: p.horizon for r, p in plans.items()}
     links = message_links(plans)
     times = durations(scene, plans, starts=starts)
@@ -380,7 +386,11 @@ def _order(
         raise ValueError("the plans' own messages deadlock; order them before the conflicts")
     alone = max((sum(d) for d in times.values()), default=0.0)
     items, _ = occupancies(scene, plans, precedence, settings, starts, positions)
-    found = [c for c in conflicts(items, settings.clearance) if about is None or about in c.robots]
+    found = [
+        c
+        for c in conflicts(items, settings.clearance)
+        if about is None or about in c.robots or (c.robots in also and not is_ordered(c, precedence))
+    ]
     ordered = sum(1 for c in found if is_ordered(c, precedence))
     fixed = fixed_places(items)
     chosen, unresolved = order_conflicts(found, horizons, links, [], times, fixed=fixed)
