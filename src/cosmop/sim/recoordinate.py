@@ -248,10 +248,10 @@ def orders_lost(
 
 
 def _others_losing(order: Precedence, without: Precedence, robot: str) -> set[str]:
-    """The robots other than `robot` whose steps no longer always start after, or no longer
-    always complete before, another's (not `robot`'s) once the dropped links are gone (`order`
-    -> `without`, the same steps).  Most re-plans lose only orders with `robot` itself, and
-    then no conflict needs looking at."""
+    """The robots other than `robot` on either side of an order lost between their steps:
+    a step that no longer always starts after another robot's step (not `robot`'s) once the
+    dropped links are gone (`order` -> `without`, the same steps), and that other step's robot.
+    Most re-plans lose only orders with `robot` itself, and then no conflict needs looking at."""
     mine = np.zeros(order.size, dtype=bool)
     mine[order.offsets[robot] : order.offsets[robot] + order.horizons[robot] + 2] = True
     others = np.packbits(~mine, bitorder="little")  # the bit set of the others' steps
@@ -347,13 +347,12 @@ def unordered_now(world: World, depth: float = 1.0) -> list[Conflict]:
     Returns
     -------
     list of Conflict
-        Empty when every conflict is ordered.  A deadlock (which the ordering proves cannot
-        happen) raises instead.
+        Empty when every conflict is ordered.
 
     Raises
     ------
     ValueError
-        When the committed messages can deadlock.
+        When the committed messages can deadlock (which the ordering proves cannot happen).
     """
     rests = {
         a.id: Remaining(
