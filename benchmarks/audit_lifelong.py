@@ -37,19 +37,34 @@ from orders_gen import orders_warehouse
 def audited(depth: float, report: dict) -> object:
     """`recoordinate_world` with the audit around it, counting into `report`."""
 
-    def pairs(world: object) -> set[tuple[str, ...]]:
-        return {c.robots for c in unordered_now(world, depth)}  # type: ignore[arg-type]
+    def pairs(world: object) -> dict[tuple[str, ...], float]:
+        """Each unordered pair with its deepest overlap (mm, the smaller side of the box)."""
+        out: dict[tuple[str, ...], float] = {}
+        for c in unordered_now(world, depth):
+            x0, y0, x1, y1 = c.place
+            out[c.robots] = max(out.get(c.robots, 0.0), min(x1 - x0, y1 - y0))
+        return out
 
-    def wrapper(world, agent, new, start, settings=None):  # type: ignore[no-untyped-def]
+    def wrapper(world, agent, new, start, settings=None):
         before = pairs(world)
         accepted, why, added = recoordinate_world(world, agent, new, start, settings)
         if accepted:
             after = pairs(world)
-            broken = sorted(after - before)
+            broken = sorted(after.keys() - before.keys())
             report["audited"] += 1
-            report["standing"] += len(after & before)
+            report["standing"] += len(after.keys() & before.keys())
+            report["deepest_standing_mm"] = max(
+                [report["deepest_standing_mm"], *(after[k] for k in after.keys() & before.keys())]
+            )
             for robots in broken:
-                report["broken"].append({"t": round(world.t, 1), "replanned": agent.id, "pair": list(robots)})
+                report["broken"].append(
+                    {
+                        "t": round(world.t, 1),
+                        "replanned": agent.id,
+                        "pair": list(robots),
+                        "mm": round(after[robots], 1),
+                    }
+                )
                 print(f"  {world.t:7.1f} s: {agent.id}'s new plan leaves {'/'.join(robots)} unordered")
         return accepted, why, added
 
@@ -67,15 +82,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", default=None)
     args = parser.parse_args(argv)
     scenario = parse_scenario(orders_warehouse(args.robots, args.seed, args.rate, args.until / 3600.0 + 0.1))
-    report: dict = {"audited": 0, "standing": 0, "broken": []}
+    report: dict = {"audited": 0, "standing": 0, "deepest_standing_mm": 0.0, "broken": []}
     wrapper = audited(args.depth, report)
-    fleet_module.recoordinate_world = wrapper  # type: ignore[assignment]
-    replan_module.recoordinate_world = wrapper  # type: ignore[assignment]
+    fleet_module.recoordinate_world = wrapper
+    replan_module.recoordinate_world = wrapper
     if args.segment is not None:
         settings = fleet_module.ConflictSettings
-        fleet_module.ConflictSettings = lambda **kw: dataclasses.replace(  # type: ignore[misc,assignment]
-            settings(**kw), segment=args.segment
-        )
+        fleet_module.ConflictSettings = lambda **kw: dataclasses.replace(settings(**kw), segment=args.segment)
     began = time.perf_counter()
     result = run_fleet(scenario, fleet=FleetSettings(until=args.until), seed=args.seed)
     row = {
@@ -90,13 +103,16 @@ def main(argv: list[str] | None = None) -> int:
         "pairs_broken": len(report["broken"]),
         "broken": report["broken"],
         "unordered_pairs_standing": report["standing"],
+        "deepest_standing_mm": round(report["deepest_standing_mm"], 1),
         "wall_s": round(time.perf_counter() - began, 1),
     }
     by_robot = Counter(b["replanned"] for b in report["broken"])
     print(
         f"N={args.robots}, {args.until:g} s: {report['audited']} re-coordinations audited, "
         f"{len(report['broken'])} left a pair unordered ({dict(by_robot)}), "
-        f"{report['standing']} unordered pairs already there; {result.delivered} delivered"
+        f"{report['standing']} unordered pairs already there "
+        f"(deepest {report['deepest_standing_mm']:.1f} mm); "
+        f"{result.delivered} delivered"
     )
     if args.out:
         print(save_results(args.out, [row]))
