@@ -292,15 +292,8 @@ def recoordinate_world(
         How conflicts are found (default: the world's).
     """
     splits = {a.id: a.split_mission(world.scenario) for a in world.agents}
-    rests = {}
-    for other in world.agents:
-        if other is agent:
-            rests[other.id] = Remaining(new.steps, new.mission, start)
-        else:
-            todo = splits[other.id][1]
-            rests[other.id] = Remaining(
-                tuple(other.steps[other.step_index :]), tuple(todo), _state_now(world, other)
-            )
+    now = {a.id: _rest_now(world, a, splits[a.id][1]) for a in world.agents}
+    rests = {**now, agent.id: Remaining(new.steps, new.mission, start)}
     positions = _positions(world)
     result = recoordinate(
         world.scenario.scene,
@@ -311,7 +304,7 @@ def recoordinate_world(
         used=world.used_messages,
         positions=positions,
         settings=settings or world.conflict_settings,
-        replaced=Remaining(tuple(agent.steps[agent.step_index :]), tuple(splits[agent.id][1]), start),
+        replaced=now[agent.id],
     )
     if not result.accepted:
         return False, result.reason or "", []
@@ -354,12 +347,7 @@ def unordered_now(world: World, depth: float = 1.0) -> list[Conflict]:
     ValueError
         When the committed messages can deadlock (which the ordering proves cannot happen).
     """
-    rests = {
-        a.id: Remaining(
-            tuple(a.steps[a.step_index :]), tuple(a.split_mission(world.scenario)[1]), _state_now(world, a)
-        )
-        for a in world.agents
-    }
+    rests = {a.id: _rest_now(world, a, a.split_mission(world.scenario)[1]) for a in world.agents}
     plans = {r: _without(rest, set(world.sent_messages)) for r, rest in rests.items()}
     order = Precedence({r: p.horizon for r, p in plans.items()}, message_links(plans))
     if not order.complete:
@@ -370,9 +358,10 @@ def unordered_now(world: World, depth: float = 1.0) -> list[Conflict]:
     items, _ = occupancies(world.scenario.scene, plans, order, settings, starts, positions)
     out = []
     for conflict in conflicts(items, settings.clearance):
-        x0, y0, x1, y1 = conflict.place
-        if min(x1 - x0, y1 - y0) >= depth and not is_ordered(conflict, order):
-            out.append(conflict)
+        if not is_ordered(conflict, order):  # (cheap; the shared space is an intersection)
+            x0, y0, x1, y1 = conflict.place
+            if min(x1 - x0, y1 - y0) >= depth:
+                out.append(conflict)
     return out
 
 
@@ -462,6 +451,12 @@ def _positions(world: World) -> dict[str, tuple[float, float] | None]:
         else (float(world.object_xy[j][0]), float(world.object_xy[j][1]))
         for j, oid in enumerate(world.object_ids)
     }
+
+
+def _rest_now(world: World, agent: Agent, todo: Iterable[Event]) -> Remaining:
+    """What is left of `agent`'s committed plan, from where its robot is now; `todo`: the
+    mission events it has still to do (:meth:`~cosmop.sim.world.Agent.split_mission`)."""
+    return Remaining(tuple(agent.steps[agent.step_index :]), tuple(todo), _state_now(world, agent))
 
 
 def _state_now(world: World, agent: Agent) -> State:
