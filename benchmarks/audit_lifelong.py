@@ -1,7 +1,8 @@
 """An audit of a lifelong run: does any hand-over leave two robots' committed plans unordered?
 
 Every hand-over (and stall re-plan, and failure) replaces one robot's plan and orders it with
-the rests the others have committed to.  This runs a stream (``orders_gen.py``: the MovingAI
+the rests the others have committed to; every re-ordering of a robot that waits long orders its
+conflicts again.  This runs a stream (``orders_gen.py``: the MovingAI
 warehouse, N robots, a Poisson stream) in-process and, around every accepted re-coordination,
 applies the exact conflict rule to every robot's committed rest
 (:func:`cosmop.sim.recoordinate.unordered_now`) before and after it.  A pair of robots with an
@@ -30,12 +31,13 @@ import cosmop.sim.replan as replan_module
 from _harness import save_results
 from cosmop.lifelong import FleetSettings, run_fleet
 from cosmop.scenario import parse_scenario
-from cosmop.sim.recoordinate import recoordinate_world, unordered_now
+from cosmop.sim.recoordinate import recoordinate_world, reorder_world, unordered_now
 from orders_gen import orders_warehouse
 
 
-def audited(depth: float, report: dict) -> object:
-    """`recoordinate_world` with the audit around it, counting into `report`."""
+def audited(call, depth: float, report: dict) -> object:
+    """`call` (`recoordinate_world` or `reorder_world`) with the audit around it, counting into
+    `report`."""
 
     def pairs(world: object) -> dict[tuple[str, ...], float]:
         """Each unordered pair with its deepest overlap (mm, the smaller side of the box)."""
@@ -45,9 +47,9 @@ def audited(depth: float, report: dict) -> object:
             out[c.robots] = max(out.get(c.robots, 0.0), min(x1 - x0, y1 - y0))
         return out
 
-    def wrapper(world, agent, new, start, settings=None):
+    def wrapper(world, agent, *args, **kwargs):
         before = pairs(world)
-        accepted, why, added = recoordinate_world(world, agent, new, start, settings)
+        accepted, why, added = call(world, agent, *args, **kwargs)
         if accepted:
             after = pairs(world)
             broken = sorted(after.keys() - before.keys())
@@ -65,7 +67,7 @@ def audited(depth: float, report: dict) -> object:
                         "mm": round(after[robots], 1),
                     }
                 )
-                print(f"  {world.t:7.1f} s: {agent.id}'s new plan leaves {'/'.join(robots)} unordered")
+                print(f"  {world.t:7.1f} s: {agent.id}'s new order leaves {'/'.join(robots)} unordered")
         return accepted, why, added
 
     return wrapper
@@ -83,14 +85,16 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     scenario = parse_scenario(orders_warehouse(args.robots, args.seed, args.rate, args.until / 3600.0 + 0.1))
     report: dict = {"audited": 0, "standing": 0, "deepest_standing_mm": 0.0, "broken": []}
-    wrapper = audited(args.depth, report)
+    wrapper = audited(recoordinate_world, args.depth, report)
     fleet_module.recoordinate_world = wrapper
     replan_module.recoordinate_world = wrapper
+    fleet_module.reorder_world = audited(reorder_world, args.depth, report)
     if args.segment is not None:
         settings = fleet_module.ConflictSettings
         fleet_module.ConflictSettings = lambda **kw: dataclasses.replace(settings(**kw), segment=args.segment)
     began = time.perf_counter()
     result = run_fleet(scenario, fleet=FleetSettings(until=args.until), seed=args.seed)
+    reorders = result.summary()["reorders"]
     row = {
         "robots": args.robots,
         "rate": args.rate,
@@ -99,6 +103,7 @@ def main(argv: list[str] | None = None) -> int:
         "segment": args.segment,
         "depth_mm": args.depth,
         "delivered": result.delivered,
+        "reorders_accepted": reorders["accepted"],
         "re_coordinations_audited": report["audited"],
         "pairs_broken": len(report["broken"]),
         "broken": report["broken"],

@@ -77,6 +77,7 @@ def cosmop_row(data: dict, until: float, timeout: float) -> dict:
             [e["plan_wall_s"] for e in s["dispatch_log"] if "plan_wall_s" in e]
         ),
         "handovers_refused": sum(1 for e in s["dispatch_log"] if not e["accepted"]),
+        "reorders": s.get("reorders"),  # waits ordered again (tried, accepted, wall time)
         "utilisation_mean": round(sum(s["utilisation"].values()) / max(len(s["utilisation"]), 1), 3),
     }
 

@@ -268,3 +268,26 @@ def test_a_new_order_that_would_make_a_robot_at_speed_wait_before_it_can_stop_is
     assert _too_late_to_stop(world, result) == why  # the new cuts moved it closer: refused
     world.pose[i] = (-3000.0, -1000.0, 0.0)  # 1300 mm ahead: it can stop
     assert _too_late_to_stop(world, result) is None
+
+
+def test_a_robot_that_stands_long_for_a_message_has_its_conflicts_ordered_again():
+    # the fleet notes since when each robot stands for a conflict message; past
+    # `reorder_after` seconds its conflicts are ordered again from the times expected now
+    from cosmop.lifelong.fleet import _note_waits, _reorder_long_waits, _Run
+    from cosmop.sim.simulation import advance
+    from stale_order import stale_order_world
+
+    for after, reordered in ((5.0, True), (None, False)):
+        world = stale_order_world()
+        run = _Run(world, [], FleetSettings(until=60.0, reorder_after=after))
+        for _ in range(40):  # 4 s: R2 stands for R1's message, not yet long enough
+            advance(world)
+            _note_waits(run)
+        _reorder_long_waits(run)
+        assert run.waits == {"R2": (0, pytest.approx(0.1))} and run.reorders == []
+        for _ in range(20):
+            advance(world)
+            _note_waits(run)
+        _reorder_long_waits(run)
+        assert [(r["robot"], r["accepted"]) for r in run.reorders] == ([("R2", True)] if reordered else [])
+        assert world.agents[1].waiting is not reordered  # the new order lets it go at once

@@ -24,7 +24,14 @@ from cosmop.planning.plan_types import RobotPlan, Step
 from cosmop.planning.realisation import message_links
 from cosmop.scenario import load_scenario, parse_scenario
 from cosmop.sim import simulate
-from cosmop.sim.recoordinate import Remaining, orders_lost, recoordinate, unordered_now
+from cosmop.sim.recoordinate import (
+    Remaining,
+    message_due_in,
+    orders_lost,
+    recoordinate,
+    reorder_world,
+    unordered_now,
+)
 from cosmop.sim.result import SimSettings
 from cosmop.sim.world import World
 from cosmop.team.conflicts import ConflictSettings, conflicts, is_ordered, occupancies
@@ -32,6 +39,7 @@ from cosmop.team.loop import plan_team
 from cosmop.team.precedence import Precedence
 from cosmop.team.safe_plans import make_team_safe
 from handmade_plans import R2_ACTIONS, R2_MISSION
+from stale_order import run_out, stale_order_world
 from team_checks import assert_complete_word, assert_no_overlap
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -261,6 +269,27 @@ def test_a_running_world_is_audited_for_unordered_conflicts():
     bare = {r: RobotPlan.from_steps((), [s for s in p.steps if s.message is None]) for r, p in plans.items()}
     world = World(scenario, PlanSet(scenario.name, True, bare), 0, SimSettings())
     assert [c.robots for c in unordered_now(world)] == [("R1", "R3")]
+
+
+def test_a_robot_held_back_by_a_stale_order_goes_first_when_reordered():
+    kept, world = stale_order_world(), stale_order_world()
+    waiting = world.agents[1]
+    due = message_due_in(world, waiting)  # R1's drives to its message, at the expected times
+    assert message_due_in(world, world.agents[0]) is None  # R1 waits for nothing
+    accepted, why, added = reorder_world(world, waiting)
+    assert accepted, why
+    # the robot at the crossing first goes first: R1 now waits before its drive across
+    assert [(m.sender, m.receiver) for m in added] == [("R2", "R1")]
+    assert Primitive.REQ not in [s.primitive for s in waiting.steps]
+    assert any(s.primitive == Primitive.REQ and s.message == added[0] for s in world.agents[0].steps)
+    assert unordered_now(world) == []
+    run_out(kept)
+    run_out(world)
+    ends = {w: {a.id: a.step_log[-1][3] for a in w.agents} for w in (kept, world)}
+    assert ends[world]["R2"] < ends[kept]["R2"] - 10.0  # R2 no longer waits for R1's long drive
+    assert due == pytest.approx(kept.agents[1].step_log[0][3], abs=3.0)  # as long as it waited
+    assert max(ends[world].values()) <= max(ends[kept].values()) + 1.0
+    assert not world.contacts
 
 
 def _initial(scenario, robot):

@@ -244,5 +244,13 @@ def _verdict(result: FleetResult) -> str:
         f"({result.deliveries_per_hour:.1f} per hour; "
         f"{pending} pending, {result.lost} lost); {waits}; contacts {len(result.contacts)}, while moving "
         f"{result.contacts_while_moving}; messages {len(result.messages)}; replans {result.replans}"
-        f"{handovers}"
+        f"{_reordered(result)}{handovers}"
     )
+
+
+def _reordered(result: FleetResult) -> str:
+    """How many robots that stood long for a message had their conflicts ordered again."""
+    if not result.reorders:
+        return ""
+    turned = sum(1 for r in result.reorders if r["accepted"])
+    return f"; waits re-ordered {turned} of {len(result.reorders)} tried"

@@ -16,9 +16,16 @@ cycle (:func:`cosmop.sim.simulation.advance`), and between cycles it
    An order whose plan is refused stays in the pool and waits ``retry_after`` seconds, twice
    as long after each refusal up to ``max_retry_after``: in a world that moves, a refusal
    says "not now", never "never", so refusals alone do not lose an order;
-3. ships delivered goods: once the drop is recorded the goods leave the world, so docks do not
+3. every ``dispatch_every`` seconds too, orders again the conflicts of the robots that have
+   stood longest for another's conflict message (``reorder_after`` seconds; at most
+   ``max_reorders`` a dispatch): an order chosen at a hand-over from the times expected then
+   may hold a robot back for one still far from the shared place, and ordered again from the
+   times expected now, the robot that gets there first goes first
+   (:func:`cosmop.sim.recoordinate.reorder_world`, the same checks as a hand-over; a refusal
+   keeps the order);
+4. ships delivered goods: once the drop is recorded the goods leave the world, so docks do not
    fill up (:meth:`cosmop.sim.world.World.ship`);
-4. fails robots (:class:`Failure`): a failed robot stands for good, its order returns to the
+5. fails robots (:class:`Failure`): a failed robot stands for good, its order returns to the
    pool unless it carries the goods (then the order is lost, and the goods are reported where
    they stand), and the others are ordered again around it.
 
@@ -41,7 +48,7 @@ from cosmop.lifelong.dispatch import OrderState, choose_robot, delivery_events
 from cosmop.lifelong.fleet_result import FleetResult
 from cosmop.planning.plan_types import PlanSet, RobotPlan
 from cosmop.scene import Order, Scenario
-from cosmop.sim.recoordinate import recoordinate_world
+from cosmop.sim.recoordinate import message_due_in, recoordinate_world, reorder_world
 from cosmop.sim.recording import Recorder
 from cosmop.sim.replan import Rectangle, grown, replan, robot_room, start_state
 from cosmop.sim.result import SimSettings
@@ -111,6 +118,13 @@ class FleetSettings:
         Longest plan of one order (steps).
     rlimit : int
         The solver's resource limit per plan.
+    reorder_after : float or None
+        Seconds a robot stands waiting for another's conflict message before its conflicts are
+        ordered again from the times expected then (:func:`~cosmop.sim.recoordinate.reorder_world`),
+        and again at most this often; ``None``: orders are kept as handed over.
+    max_reorders : int
+        Most robots ordered again at one dispatch, the longest waiting first (each costs an
+        ordering of the team, like a hand-over).
     """
 
     until: float
@@ -119,6 +133,8 @@ class FleetSettings:
     max_retry_after: float = 60.0
     max_horizon: int = 16
     rlimit: int = 50_000_000
+    reorder_after: float | None = 15.0
+    max_reorders: int = 2
 
 
 @dataclass
@@ -134,6 +150,9 @@ class _Run:
     busy_time: dict[str, float] = field(default_factory=dict)
     failed: dict[str, dict[str, Any]] = field(default_factory=dict)  # JSON records of the summary
     log: list[dict[str, Any]] = field(default_factory=list)
+    reorders: list[dict[str, Any]] = field(default_factory=list)  # JSON records of the summary
+    waits: dict[str, tuple[int, float]] = field(default_factory=dict)  # robot: (step, since), s
+    reordered_at: dict[str, float] = field(default_factory=dict)
     seen_events: int = 0
     delivered: int = 0
 
@@ -199,10 +218,12 @@ def run_fleet(
                 _fail(run, due.pop(0).robot)
             if world.t >= next_dispatch:
                 _dispatch(run)
+                _reorder_long_waits(run)
                 next_dispatch = world.t + fleet.dispatch_every
             advance(world)
             _deliveries(run)  # before the frame is recorded: delivered goods are gone from it
             _idle_again(run)
+            _note_waits(run)
             recorder.record(world)
             if on_cycle is not None:
                 on_cycle(world.t, run.delivered, released)
@@ -240,6 +261,7 @@ def _result(run: _Run, recorder: Recorder, *, interrupted: bool = False) -> Flee
         busy,
         run.failed,
         run.log,
+        reorders=run.reorders,
         interrupted=interrupted,
     )
 
@@ -336,6 +358,60 @@ def _hand_over(run: _Run, agent: Agent, state: OrderState, goods: tuple[float, .
     run.busy_since.setdefault(agent.id, world.t)  # a robot given work at a dock stays busy
 
 
+def _note_waits(run: _Run) -> None:
+    """Since when each robot stands for a conflict message at its current step."""
+    world = run.world
+    for agent in world.agents:
+        k = agent.step_index
+        step = agent.steps[k] if agent.waiting and k < len(agent.steps) else None
+        if step is None or step.message not in world.conflict_messages or world.received(agent, step):
+            run.waits.pop(agent.id, None)
+        elif run.waits.get(agent.id, (None,))[0] != k:
+            run.waits[agent.id] = (k, world.t)
+
+
+def _reorder_long_waits(run: _Run) -> None:
+    """Order again the conflicts of the robots that have stood longest for a conflict message
+    (``FleetSettings.reorder_after``; at most ``max_reorders``): an order chosen at a hand-over,
+    from the times expected then, may hold a robot back for one still far from the place
+    (module docstring, step 3).  Only a robot whose message is expected no sooner than
+    ``reorder_after`` seconds from now (:func:`~cosmop.sim.recoordinate.message_due_in`) is
+    tried: a message that comes soon leaves little to gain."""
+    world, after = run.world, run.fleet.reorder_after
+    if after is None:
+        return
+    agents = {a.id: a for a in world.agents}
+    due = sorted(
+        (since, rid)
+        for rid, (_, since) in run.waits.items()
+        if world.t - since >= after and world.t - run.reordered_at.get(rid, -math.inf) >= after
+    )
+    tried = 0
+    for since, rid in due:
+        if tried == run.fleet.max_reorders:
+            return
+        agent = agents[rid]
+        due_in = message_due_in(world, agent)
+        if due_in is None or due_in < after:  # the message comes soon: little to gain
+            continue
+        tried += 1
+        began = time.perf_counter()
+        accepted, why, added = reorder_world(world, agent)
+        run.reordered_at[rid] = world.t
+        run.reorders.append(
+            {
+                "t": round(world.t, 6),
+                "robot": rid,
+                "waited_s": round(world.t - since, 3),
+                "due_in_s": round(due_in, 3),  # expected then, had the order stayed
+                "accepted": accepted,
+                "why": why or None,
+                "messages": len(added),
+                "wall_s": round(time.perf_counter() - began, 3),
+            }
+        )
+
+
 def _standing(run: _Run, agent: Agent) -> list[Rectangle]:
     """The robots that stand still for now (idle or failed) as rectangles ``x0, y0, x1, y1``
     (mm), grown by the room the plans keep between robots (:func:`~cosmop.sim.replan.robot_room`:
@@ -387,7 +463,7 @@ def _idle_again(run: _Run) -> None:
 
 
 def _fail(run: _Run, robot: str) -> None:
-    """`robot` stops for good (module docstring, step 4)."""
+    """`robot` stops for good (module docstring, step 5)."""
     world = run.world
     agent = next(a for a in world.agents if a.id == robot)
     if robot in run.failed:

@@ -122,6 +122,10 @@ class FleetResult:
     scene : Scene or None
     interrupted : bool
         Whether Ctrl-C ended the run before its time (`until` is then the time reached).
+    reorders : tuple of Mapping
+        Every robot whose conflicts were ordered again while it stood for a message: ``t``,
+        ``robot``, ``waited_s``, ``due_in_s`` (when its message was expected, the order kept),
+        ``accepted``, ``why`` not, ``messages`` added, ``wall_s``.
     """
 
     scenario: str
@@ -140,6 +144,7 @@ class FleetResult:
     dt: float = 0.1
     scene: Scene | None = field(default=None, repr=False, compare=False)
     interrupted: bool = False
+    reorders: tuple[Mapping[str, Any], ...] = ()
 
     @classmethod
     def of(
@@ -152,6 +157,7 @@ class FleetResult:
         failed: Mapping[str, Mapping[str, Any]],
         log: Sequence[Mapping[str, Any]],
         *,
+        reorders: Sequence[Mapping[str, Any]] = (),
         interrupted: bool = False,
     ) -> FleetResult:
         """The result of a finished run (:func:`cosmop.lifelong.run_fleet` calls it).
@@ -172,6 +178,8 @@ class FleetResult:
             Per failed robot, its record (``t``, ``at``, ``carrying``, ``recoordinated``, ``why``).
         log : sequence of Mapping
             The dispatcher's log, one record per plan handed over or refused.
+        reorders : sequence of Mapping
+            One record per robot whose conflicts were ordered again while it waited.
         interrupted : bool
             Whether Ctrl-C ended the run before its time.
 
@@ -201,6 +209,7 @@ class FleetResult:
             utilisation={rid: round(min(1.0, busy[rid] / span), 4) for rid in world.robot_ids},
             failures=dict(failed),
             dispatch_log=tuple(log),
+            reorders=tuple(reorders),
             contacts=tuple(world.contacts),
             messages=tuple(world.messages),
             replans=world.replans,
@@ -269,8 +278,14 @@ class FleetResult:
             "contacts_while_moving": self.contacts_while_moving,
             "messages": len(self.messages),
             "replans": self.replans,
+            "reorders": {
+                "tried": len(self.reorders),
+                "accepted": sum(1 for r in self.reorders if r["accepted"]),
+                "wall_s": _spread([r["wall_s"] for r in self.reorders]),
+            },
             "order_log": [o.to_dict() for o in self.orders],
             "dispatch_log": [dict(e) for e in self.dispatch_log],
+            "reorder_log": [dict(r) for r in self.reorders],
             "contact_log": [c.to_dict() for c in self.contacts],
         }
 

@@ -43,6 +43,7 @@ from cosmop.sim.realised_times import carry_instants
 from cosmop.team.conflicts import Conflict, ConflictSettings, conflicts, is_ordered, occupancies
 from cosmop.team.precedence import Precedence
 from cosmop.team.safe_plans import make_team_safe
+from cosmop.team.timing import step_durations
 
 if TYPE_CHECKING:
     from cosmop.sim.world import Agent, World
@@ -50,9 +51,11 @@ if TYPE_CHECKING:
 __all__ = [
     "Recoordination",
     "Remaining",
+    "message_due_in",
     "orders_lost",
     "recoordinate",
     "recoordinate_world",
+    "reorder_world",
     "unordered_now",
     "wait_ahead",
 ]
@@ -293,7 +296,82 @@ def recoordinate_world(
     """
     splits = {a.id: a.split_mission(world.scenario) for a in world.agents}
     now = {a.id: _rest_now(world, a, splits[a.id][1]) for a in world.agents}
-    rests = {**now, agent.id: Remaining(new.steps, new.mission, start)}
+    return _order_again(world, agent, now, Remaining(new.steps, new.mission, start), splits, settings)
+
+
+def reorder_world(
+    world: World, agent: Agent, settings: ConflictSettings | None = None
+) -> tuple[bool, str, list[Event]]:
+    """Order `agent`'s conflicts again from now, its plan as it is: who goes first is chosen
+    anew by the times expected from here.
+
+    An order is chosen when a plan is handed over, from the times expected then; robots are
+    later delayed, wait, or are given new work, and an order may then make a robot stand for
+    a long time at a place that another, still far away, will pass only later.  Like a
+    *switchable* edge of an action dependency graph, a conflict order between two robots'
+    steps that have not begun can be turned round while the team stays safe: the robot's
+    unsent conflict messages are dropped and its conflicts ordered again exactly as for a new
+    plan (:func:`recoordinate`: the robot expected at a shared place first goes first, the
+    orders between the others kept, the team proved free of deadlock), and refused on the same
+    terms (a conflict no order resolves, a robot driving now that could not stop for a new
+    wait).  Messages already sent stay sent.  Returns ``(accepted, why not, messages added)``.
+
+    Parameters
+    ----------
+    world : World
+        The running simulation; its robots' executors take their new rests when accepted.
+    agent : Agent
+        The robot whose conflicts are ordered again (typically one standing for a message).
+    settings : ConflictSettings, optional
+        How conflicts are found (default: the world's).
+    """
+    splits = {a.id: a.split_mission(world.scenario) for a in world.agents}
+    now = {a.id: _rest_now(world, a, splits[a.id][1]) for a in world.agents}
+    return _order_again(world, agent, now, None, splits, settings)
+
+
+def message_due_in(world: World, agent: Agent) -> float | None:
+    """Expected seconds until the message `agent` waits for at its current step is sent: the
+    sender's own steps up to its ``Res``, from where it is now, at the expected times of
+    :func:`~cosmop.team.timing.step_durations` (its own waits not counted: a lower bound).
+    ``None`` when `agent` waits for no message or its sender's plan no longer sends it.
+
+    Parameters
+    ----------
+    world : World
+        The running simulation.
+    agent : Agent
+        A robot standing at a ``Req`` step.
+    """
+    k = agent.step_index
+    message = agent.steps[k].message if k < len(agent.steps) else None
+    if message is None or message.sender is None:
+        return None
+    sender = world.agents[world.robot_ids.index(message.sender)]
+    rest = sender.steps[sender.step_index :]
+    sends = next(
+        (n for n, step in enumerate(rest) if step.primitive == Primitive.RES and step.message == message),
+        None,
+    )
+    if sends is None:
+        return None
+    x, y, h = (float(v) for v in world.pose[sender.index])
+    plan = RobotPlan.from_steps((), rest[: sends + 1])
+    dynamics = world.scenario.scene.robots[sender.id].dynamics
+    return sum(step_durations(plan, (x, y, math.degrees(h)), dynamics))
+
+
+def _order_again(
+    world: World,
+    agent: Agent,
+    now: Mapping[str, Remaining],
+    new: Remaining | None,
+    splits: Mapping[str, tuple[list[Event], list[Event]]],
+    settings: ConflictSettings | None,
+) -> tuple[bool, str, list[Event]]:
+    """:func:`recoordinate` the rests `now` with `agent`'s replaced by `new` (``None``: kept,
+    only re-ordered) and install the result in the robots' executors when accepted."""
+    rests = {**now, agent.id: new or now[agent.id]}
     positions = _positions(world)
     result = recoordinate(
         world.scenario.scene,
@@ -312,9 +390,9 @@ def recoordinate_world(
     if too_late:
         return False, too_late, []
     for other in world.agents:
-        _install(other, result.plans[other.id], splits[other.id][0], new=other is agent)
-        if other is agent:  # its new plan starts where it stood, rounded to the millimetre
-            other.replan_start = (other.step_index, start.robot)
+        _install(other, result.plans[other.id], splits[other.id][0], new=new is not None and other is agent)
+        if new is not None and other is agent:  # its new plan starts where it stood, to the millimetre
+            other.replan_start = (other.step_index, new.start.robot)
     added = [m.event for m in result.messages]
     world.conflict_messages |= set(added)
     return True, "", added
