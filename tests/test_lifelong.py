@@ -183,12 +183,15 @@ def test_cosmop_run_writes_the_summary_and_refuses_bad_options(tmp_path):
     assert ran.exit_code == 0, ran.output
     data = json.loads(summary.read_text())
     assert data["format"] == "cosmop.run/1" and data["orders"]["delivered"] == 2
+    assert data["reorders"]["tried"] == len(data["reorder_log"])  # waits re-ordered, if any
     assert {"p50", "p95", "max"} <= set(data["wait_s"]) and "deliveries_per_hour" in data
     assert "2 of 2 orders delivered" in " ".join(ran.stdout.split())
     view = runner.invoke(app, ["view", str(scenario), "--trace", str(trace), "-o", str(tmp_path / "v.html")])
     assert view.exit_code == 0, view.output
     bad = runner.invoke(app, ["run", str(scenario), "--until", "60", "--fail", "R1-600"])
     assert bad.exit_code == 2 and "ROBOT@SECONDS" in bad.stderr
+    negative = runner.invoke(app, ["run", str(scenario), "--until", "60", "--reorder-after", "-1"])
+    assert negative.exit_code == 2 and "--reorder-after" in negative.stderr
     unknown = runner.invoke(app, ["run", str(scenario), "--until", "60", "--fail", "R9@6"])
     assert unknown.exit_code == 2 and "R9 is not a robot" in unknown.stderr
     plan = runner.invoke(app, ["plan", str(scenario), "-o", str(tmp_path / "p.json")])

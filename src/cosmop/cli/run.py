@@ -57,6 +57,15 @@ def run(
             show_default=False,
         ),
     ] = None,
+    reorder_after: Annotated[
+        float,
+        typer.Option(
+            help="Order again the conflicts of a robot that has waited this long for a message "
+            "another will send only later (s; 0: keep orders as handed over).",
+            min=0.0,
+            callback=finite,
+        ),
+    ] = 15.0,
     summary: Annotated[
         Path | None, typer.Option(help="Write the summary (cosmop.run/1 JSON) here.", show_default=False)
     ] = None,
@@ -93,6 +102,9 @@ def run(
     delays : Delays or None
         ``--delays P:MIN:MAX``: every simulated second each robot stops with probability P for
         MIN to MAX s (None: no delays).
+    reorder_after : float
+        ``--reorder-after``: seconds a robot waits for a message before its conflicts are
+        ordered again (``FleetSettings.reorder_after``; 0: never).
     summary : pathlib.Path or None
         ``--summary``: write the summary (``cosmop.run/1`` JSON) here.
     trace : pathlib.Path or None
@@ -119,7 +131,8 @@ def run(
             raise typer.Exit(EXIT_INPUT_ERROR)
     settings = SimSettings(delays=delays)
     try:
-        result = _run_with_progress(loaded, stream, until, seed, settings, tuple(fail or ()))
+        fleet = FleetSettings(until=until, reorder_after=reorder_after or None)
+        result = _run_with_progress(loaded, stream, fleet, seed, settings, tuple(fail or ()))
     except FleetInterrupted as stop:  # Ctrl-C: what was delivered so far, written whole
         _save(stop.result, summary, trace)
         raise KeyboardInterrupt from None
@@ -150,7 +163,7 @@ def _save(result: FleetResult, summary: Path | None, trace: Path | None) -> None
 def _run_with_progress(
     loaded: Scenario,
     stream: Sequence[Order],
-    until: float,
+    fleet: FleetSettings,
     seed: int,
     settings: SimSettings,
     failures: Sequence[Failure],
@@ -171,7 +184,7 @@ def _run_with_progress(
         interrupt_at_safe_points() as safe_point,
         Progress(*columns, console=stderr(), transient=True) as progress,
     ):
-        task = progress.add_task("running", total=until, released=0, delivered=0)
+        task = progress.add_task("running", total=fleet.until, released=0, delivered=0)
 
         def on_cycle(t: float, delivered: int, released: int) -> None:
             progress.update(task, completed=t, delivered=delivered, released=released)
@@ -180,7 +193,7 @@ def _run_with_progress(
         return run_fleet(
             loaded,
             stream,
-            fleet=FleetSettings(until=until),
+            fleet=fleet,
             seed=seed,
             settings=settings,
             failures=failures,
