@@ -371,7 +371,7 @@ def _order_again(
 ) -> tuple[bool, str, list[Event]]:
     """:func:`recoordinate` the rests `now` with `agent`'s replaced by `new` (``None``: kept,
     only re-ordered) and install the result in the robots' executors when accepted."""
-    rests = {**now, agent.id: new or now[agent.id]}
+    rests = {**now, agent.id: new if new is not None else now[agent.id]}
     positions = _positions(world)
     result = recoordinate(
         world.scenario.scene,
