@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -499,7 +499,13 @@ def occupancies(
     return out + objects, problems
 
 
-def conflicts(items: Sequence[Occupancy], clearance: float | None = None) -> list[Conflict]:
+def conflicts(
+    items: Sequence[Occupancy],
+    clearance: float | None = None,
+    *,
+    about: str | None = None,
+    also: Collection[tuple[str, ...]] = (),
+) -> list[Conflict]:
     """Pairs of occupancies of disjoint parties whose regions' interiors overlap.
 
     `clearance` (mm; default :attr:`ConflictSettings.clearance`) is the one the robots'
@@ -514,6 +520,12 @@ def conflicts(items: Sequence[Occupancy], clearance: float | None = None) -> lis
         The team's occupancies (:func:`occupancies`).
     clearance : float, optional
         The clearance the robots' regions were grown by (mm).
+    about : str, optional
+        Only the pairs one of whose parties is this robot, and those of the parties in `also`
+        (as :attr:`Conflict.robots` names them): a robot ordered again among plans already
+        ordered needs no other pair's overlap measured.
+    also : collection of tuple of str
+        With `about`, the further parties whose pairs are wanted.
     """
     if not items:
         return []
@@ -529,6 +541,10 @@ def conflicts(items: Sequence[Occupancy], clearance: float | None = None) -> lis
         a, b = items[i], items[j]
         if a.accounts_for(b):
             continue
+        if about is not None:
+            parties = a.parties | b.parties
+            if about not in parties and tuple(sorted(parties)) not in also:
+                continue
         robots = a.what in a.parties and b.what in b.parties
         pairs.append((a, b))
         first.append(i if robots else len(items) + i)

@@ -388,7 +388,7 @@ def _order(
     items, _ = occupancies(scene, plans, precedence, settings, starts, positions)
     found = [
         c
-        for c in conflicts(items, settings.clearance)
+        for c in conflicts(items, settings.clearance, about=about, also=also)
         if about is None or about in c.robots or (c.robots in also and not is_ordered(c, precedence))
     ]
     ordered = sum(1 for c in found if is_ordered(c, precedence))
