@@ -294,9 +294,7 @@ def recoordinate_world(
     settings : ConflictSettings, optional
         How conflicts are found (default: the world's).
     """
-    splits = {a.id: a.split_mission(world.scenario) for a in world.agents}
-    now = {a.id: _rest_now(world, a, splits[a.id][1]) for a in world.agents}
-    return _order_again(world, agent, now, Remaining(new.steps, new.mission, start), splits, settings)
+    return _order_again(world, agent, Remaining(new.steps, new.mission, start), settings)
 
 
 def reorder_world(
@@ -325,9 +323,7 @@ def reorder_world(
     settings : ConflictSettings, optional
         How conflicts are found (default: the world's).
     """
-    splits = {a.id: a.split_mission(world.scenario) for a in world.agents}
-    now = {a.id: _rest_now(world, a, splits[a.id][1]) for a in world.agents}
-    return _order_again(world, agent, now, None, splits, settings)
+    return _order_again(world, agent, None, settings)
 
 
 def message_due_in(world: World, agent: Agent) -> float | None:
@@ -362,15 +358,13 @@ def message_due_in(world: World, agent: Agent) -> float | None:
 
 
 def _order_again(
-    world: World,
-    agent: Agent,
-    now: Mapping[str, Remaining],
-    new: Remaining | None,
-    splits: Mapping[str, tuple[list[Event], list[Event]]],
-    settings: ConflictSettings | None,
+    world: World, agent: Agent, new: Remaining | None, settings: ConflictSettings | None
 ) -> tuple[bool, str, list[Event]]:
-    """:func:`recoordinate` the rests `now` with `agent`'s replaced by `new` (``None``: kept,
-    only re-ordered) and install the result in the robots' executors when accepted."""
+    """:func:`recoordinate` every robot's committed rest, now, with `agent`'s replaced by `new`
+    (``None``: kept, only re-ordered), and install the result in the robots' executors when
+    accepted."""
+    splits = {a.id: a.split_mission(world.scenario) for a in world.agents}
+    now = {a.id: _rest_now(world, a, splits[a.id][1]) for a in world.agents}
     rests = {**now, agent.id: new if new is not None else now[agent.id]}
     positions = _positions(world)
     result = recoordinate(
