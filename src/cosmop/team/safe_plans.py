@@ -389,7 +389,8 @@ def _order(
     found = [
         c
         for c in conflicts(items, settings.clearance, about=about, also=also)
-        if about is None or about in c.robots or (c.robots in also and not is_ordered(c, precedence))
+        # with `about`, the rest are the pairs of `also`: ordered again only where no order holds
+        if about is None or about in c.robots or not is_ordered(c, precedence)
     ]
     ordered = sum(1 for c in found if is_ordered(c, precedence))
     fixed = fixed_places(items)
