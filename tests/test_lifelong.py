@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import itertools
 import json
+from dataclasses import replace
 from functools import lru_cache
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,7 +17,10 @@ from cosmop.cli import app
 from cosmop.errors import ScenarioError
 from cosmop.events import Event, Primitive
 from cosmop.lifelong import Failure, FleetSettings, run_fleet
+from cosmop.lifelong.dispatch import delivery_events
+from cosmop.planning.primitive_effects import initial_state
 from cosmop.scenario import load_orders, load_scenario, parse_scenario
+from cosmop.sim.replan import grown, replan, why_no_plan
 from cosmop.traces import Trace
 from run_2x2 import EXAMPLE
 
@@ -102,6 +107,12 @@ def test_an_orders_file_is_read_against_the_scene(tmp_path):
 
 def test_the_fleet_delivers_the_stream_safely_and_ships_the_goods():
     _, result = _run()
+    # each delivery's events are a word of its order's delivery mission (issue 37's check)
+    assert [[e.name for e in o.word] for o in result.orders] == [
+        ["pick(R1,O1)", "drop(R1,O1,W1)"],
+        ["pick(R2,O2)", "drop(R2,O2,W2)"],
+    ]
+    assert all(o.as_ordered for o in result.orders) and not result.not_as_ordered
     summary = result.summary()
     assert summary["orders"] == {"released": 2, "delivered": 2, "lost": 0, "pending": 0}
     assert summary["contacts_while_moving"] == 0 and summary["messages"] > 0  # ordered by messages
@@ -136,7 +147,7 @@ def test_a_robot_failing_before_it_picks_returns_the_order_to_the_pool():
     assert len(tries) >= 2 and tries[0]["robot"] == "R2"  # given again after R2 failed
 
 
-LIFELONG = EXAMPLE.parents[1] / "13_lifelong" / "scenario.yaml"
+LIFELONG = Path(__file__).resolve().parent / "data" / "lifelong_2x2.yaml"  # the small example of 2026-11
 
 
 @lru_cache(maxsize=2)
@@ -294,3 +305,85 @@ def test_a_robot_that_stands_long_for_a_message_has_its_conflicts_ordered_again(
         _reorder_long_waits(run)
         assert [(r["robot"], r["accepted"]) for r in run.reorders] == ([("R2", True)] if reordered else [])
         assert world.agents[1].waiting is not reordered  # the new order lets it go at once
+
+
+def test_a_delivery_that_breaks_its_order_is_not_as_ordered():
+    # the check can fail: the goods dropped by another robot than picked them, at a dock the
+    # order does not name, by a robot it does not allow, or picked and never dropped
+    _, result = _run()
+    good = result.orders[0]
+    pick, drop = good.word
+    other = Event("drop", "R2", obj="O1", workspace="W1")
+    elsewhere = Event("drop", "R1", obj="O1", workspace="W2")
+    for word, by in [
+        ((pick, other), ("R1", "R2")),
+        ((pick, elsewhere), ("R1", "R2")),
+        ((pick, drop), ("R2",)),
+        ((pick,), ("R1", "R2")),
+        ((pick, drop, Event("pick", "R2", obj="O1")), ("R1", "R2")),
+    ]:
+        assert replace(good, word=word, by=by).as_ordered is False, word
+    assert replace(good, delivered=None).as_ordered is None  # not delivered: nothing to check
+    broken = replace(result, orders=(replace(good, word=(pick, other)), *result.orders[1:]))
+    assert broken.not_as_ordered == (broken.orders[0],)
+    assert broken.summary()["as_ordered"] == {"checked": 2, "broken": 1}
+
+
+def _walled_data() -> dict:
+    """R1 beside the goods but behind a wall with one gap at its far end; R2 farther, in the open."""
+    return {
+        "name": "walled",
+        "scene": {
+            "obstacles": [
+                [[-3000, -2000], [3000, -2000]],
+                [[3000, -2000], [3000, 2000]],
+                [[3000, 2000], [-3000, 2000]],
+                [[-3000, 2000], [-3000, -2000]],
+                [[0, -2000], [0, 1400]],
+            ],
+            "robots": {
+                "R1": {"size": 400, "pose": [-500, -1500, 0]},
+                "R2": {"size": 400, "pose": [2400, 1400, 0]},
+            },
+            "objects": {"O1": {"size": 100, "position": [700, -1500]}},
+            "workspaces": {"W1": {"x": [2000, 2600], "y": [-1800, -1200]}},
+        },
+        "orders": [{"at": 0, "object": "O1", "to": "W1"}],
+    }
+
+
+def test_an_order_a_robot_cannot_plan_goes_to_another_and_the_refusal_says_why():
+    # the dispatcher's estimate (L1) puts R1 nearest, but within 7 steps R1 cannot go round the
+    # wall and back: it says why once, and the order goes to R2 instead of R1 over and over
+    scenario = parse_scenario(_walled_data())
+    result = run_fleet(scenario, fleet=FleetSettings(until=60.0, max_horizon=7))
+    tries = [(e["robot"], e["accepted"]) for e in result.dispatch_log]
+    assert tries == [("R1", False), ("R2", True)]
+    why = result.dispatch_log[0]["why"]
+    assert why.startswith("R1 cannot reach") and "within 7 steps" in why
+    order = result.orders[0]
+    assert order.robot == "R2" and order.delivered is not None and order.as_ordered
+    assert result.contacts_while_moving == 0
+
+
+def test_a_failed_robot_is_named_in_the_reason_no_plan_is_found():
+    data = _walled_data()
+    data["scene"]["obstacles"][4] = [[0, -1200], [1500, -1200]]  # a shelf over the goods
+    scenario = parse_scenario(data)
+    scene, order = scenario.scene, scenario.orders[0]
+    events = delivery_events(scene, "R2", order, scene.objects["O1"].position)
+    start = initial_state(scene, "R2")
+    # R1 failed off the goods' south-west corner, its box grown past their west face (as the
+    # growth did before it stopped short of both sides): R2 can stand east of the goods but not
+    # reach them from there, the box's top side between its gripper and them
+    box, label = [(100.0, -2000.0, 749.0, -1551.0)], ["R1, failed at 3.0 s"]
+    assert replan(scene, "R2", events, start, box, labels=label) is None
+    why = why_no_plan(scene, "R2", events, start, box, labels=label)
+    assert why.startswith("R2 cannot reach pick(R2,O1)") and "gripper clear of R1, failed at 3.0 s" in why
+
+
+def test_a_robot_grown_round_goods_off_its_corner_leaves_them_reachable_from_the_far_sides():
+    # goods diagonally beyond the square's north-east corner: both sides stop short of them,
+    # else the east side's growth runs below the goods and walls off their east face
+    box = grown((0.0, 0.0, 200.0), 100.0, np.array([[251.0, 313.0, 50.0]]))
+    assert box == (-300.0, -300.0, 200.0, 262.0)

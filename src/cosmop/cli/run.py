@@ -84,8 +84,9 @@ def run(
     the others' committed plans while they keep moving.
 
     Prints a live progress line, a table per robot and the totals (deliveries per hour, each
-    order's wait, contacts).  Exit status 0 when no contact happened while a robot moved and no
-    order was lost, 1 otherwise, 2 on bad input.
+    order's wait, contacts, whether each delivery did what its order asked).  Exit status 0 when
+    no contact happened while a robot moved, no order was lost and every delivered order's
+    events are a word of its delivery mission, 1 otherwise, 2 on bad input.
 
     Parameters
     ----------
@@ -141,7 +142,7 @@ def run(
         result.save_plot(plot)
     console = stdout()
     console.print(_robots_table(result))
-    ok = result.contacts_while_moving == 0 and result.lost == 0
+    ok = result.contacts_while_moving == 0 and result.lost == 0 and not result.not_as_ordered
     console.print(Text(_verdict(result), style="green" if ok else "red"))
     for line in _undelivered(result):
         console.print(Text(line), soft_wrap=True)
@@ -257,8 +258,17 @@ def _verdict(result: FleetResult) -> str:
         f"({result.deliveries_per_hour:.1f} per hour; "
         f"{pending} pending, {result.lost} lost); {waits}; contacts {len(result.contacts)}, while moving "
         f"{result.contacts_while_moving}; messages {len(result.messages)}; replans {result.replans}"
-        f"{_reordered(result)}{handovers}"
+        f"{_reordered(result)}{handovers}; {_as_ordered(result)}"
     )
+
+
+def _as_ordered(result: FleetResult) -> str:
+    """Whether every delivery did what its order asked (its events a word of its mission)."""
+    broken = result.not_as_ordered
+    if not broken:
+        return f"all {result.delivered} deliveries as ordered (each a word of its delivery mission)"
+    words = "; ".join(f"{o.object}: {' '.join(e.name for e in o.word)}" for o in broken[:3])
+    return f"{len(broken)} of {result.delivered} deliveries NOT as ordered ({words})"
 
 
 def _reordered(result: FleetResult) -> str:

@@ -6,13 +6,15 @@ to the goods and from the goods to the nearest of the order's docks (mm).  A rob
 competes again as soon as it has dropped its goods (from the dock, its way home still ahead)
 or is idle, so among busy robots the one whose order is done soonest is served first.  The
 mission handed over is the order's delivery and the way home: ``pick``, ``drop`` at that dock,
-``return``; the way home is replaced by the next order when one is given at the dock.
+``return``; the way home is replaced by the next order when one is given at the dock.  A robot
+that found no plan for an order from where it stood is passed over for it while another idle
+robot may serve it (:attr:`OrderState.no_plan_by`).
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from cosmop.events import Event
 from cosmop.scene import Order, Scene
@@ -43,6 +45,9 @@ class OrderState:
         Plans tried for it that were not handed over.
     refused : str or None
         The last refusal: which robot, when, and why (an order still pending says so).
+    no_plan_by : dict of str to float
+        The robots that found no plan for it from where they stood, each with when it first
+        did, s: the order goes to another idle robot first.
     retry_at : float
         Not tried again before this time, s.
     """
@@ -56,6 +61,7 @@ class OrderState:
     lost: str | None = None
     tries: int = 0
     refused: str | None = None
+    no_plan_by: dict[str, float] = field(default_factory=dict)
     retry_at: float = 0.0
 
 

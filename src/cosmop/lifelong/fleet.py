@@ -15,7 +15,9 @@ cycle (:func:`cosmop.sim.simulation.advance`), and between cycles it
    only then is it handed over.  The robots not involved keep their plans and keep moving.
    An order whose plan is refused stays in the pool and waits ``retry_after`` seconds, twice
    as long after each refusal up to ``max_retry_after``: in a world that moves, a refusal
-   says "not now", never "never", so refusals alone do not lose an order;
+   says "not now", never "never", so refusals alone do not lose an order.  A robot that
+   finds no plan says why once (:func:`cosmop.sim.replan.why_no_plan`, the robots standing
+   named), and the order goes to another idle robot first;
 3. every ``dispatch_every`` seconds too, orders again the conflicts of the robots that have
    stood longest for another's conflict message (``reorder_after`` seconds; at most
    ``max_reorders`` a dispatch): an order chosen at a hand-over from the times expected then
@@ -50,7 +52,7 @@ from cosmop.planning.plan_types import PlanSet, RobotPlan
 from cosmop.scene import Order, Scenario
 from cosmop.sim.recoordinate import message_due_in, recoordinate_world, reorder_world
 from cosmop.sim.recording import Recorder
-from cosmop.sim.replan import Rectangle, grown, replan, robot_room, start_state
+from cosmop.sim.replan import Rectangle, grown, replan, robot_room, start_state, why_no_plan
 from cosmop.sim.result import SimSettings
 from cosmop.sim.simulation import advance
 from cosmop.sim.world import Agent, World
@@ -289,10 +291,14 @@ def _dispatch(run: _Run, at_dock: Agent | None = None) -> None:
         goods = _goods_at_rest(world, state)
         if goods is None:
             continue
+        # a robot that found no plan for the order from where it stood is tried again only when
+        # no other idle robot may serve it (a refusal of its order with the others, a matter of
+        # timing, is tried again with the same robot: the nearest)
+        fresh = {r: a for r, a in idle.items() if r not in state.no_plan_by and r in state.order.by}
         robot = choose_robot(
             world.scenario.scene,
             state.order,
-            ((r, tuple(world.pose[a.index, :2])) for r, a in idle.items()),
+            ((r, tuple(world.pose[a.index, :2])) for r, a in (fresh or idle).items()),
             goods,
         )
         if robot is None:
@@ -323,19 +329,17 @@ def _hand_over(run: _Run, agent: Agent, state: OrderState, goods: tuple[float, .
     began = time.perf_counter()  # the hand-over's wall time: dispatch, plan, coordinate, check
     events = delivery_events(scene, agent.id, state.order, goods)
     start = start_state(world, agent, {state.order.object})
-    plan = replan(
-        scene,
-        agent.id,
-        events,
-        start,
-        _standing(run, agent),
-        max_horizon=fleet.max_horizon,
-        rlimit=fleet.rlimit,
-    )
+    sensed, labels = _standing(run, agent)
+    bounds = {"max_horizon": fleet.max_horizon, "rlimit": fleet.rlimit}
+    plan = replan(scene, agent.id, events, start, sensed, labels=labels, **bounds)
     planned = time.perf_counter()
-    accepted, why = False, "no plan from where it stands"
     if plan is not None:
         accepted, why, _ = recoordinate_world(world, agent, plan, start)
+    elif agent.id in state.no_plan_by:  # explained the first time this robot found none
+        accepted, why = False, f"no plan from where it stands (as at {state.no_plan_by[agent.id]:.1f} s)"
+    else:  # the reason, once per robot: explaining costs another search
+        accepted, why = False, why_no_plan(scene, agent.id, events, start, sensed, labels=labels, **bounds)
+        state.no_plan_by[agent.id] = world.t
     run.log.append(
         {
             "t": round(world.t, 6),
@@ -412,22 +416,27 @@ def _reorder_long_waits(run: _Run) -> None:
         )
 
 
-def _standing(run: _Run, agent: Agent) -> list[Rectangle]:
+def _standing(run: _Run, agent: Agent) -> tuple[list[Rectangle], list[str]]:
     """The robots that stand still for now (idle or failed) as rectangles ``x0, y0, x1, y1``
     (mm), grown by the room the plans keep between robots (:func:`~cosmop.sim.replan.robot_room`:
     the clearance, or the gap they already stand at) short of the goods beside them
-    (:func:`~cosmop.sim.replan.grown`): the new plan goes around them."""
+    (:func:`~cosmop.sim.replan.grown`): the new plan goes around them.  With each, what it is
+    in words, for a reason that names it."""
     world = run.world
     i = agent.index
     standing = [
-        a.index
+        a
         for a in world.agents
         if a is not agent and (a.id in run.failed or (a.done and a.id not in run.busy))
     ]
-    boxes = world.robot_boxes()[standing]
+    boxes = world.robot_boxes()[[a.index for a in standing]]
     gaps = box_gaps(world.pose[i, :2], world.robot_half[i], boxes)
     goods = world.resting_boxes()
-    return [grown(box, robot_room(g), goods) for box, g in zip(boxes, gaps, strict=True)]
+    labels = [
+        f"{a.id}, failed at {run.failed[a.id]['t']:.1f} s" if a.id in run.failed else f"{a.id}, standing idle"
+        for a in standing
+    ]
+    return [grown(box, robot_room(g), goods) for box, g in zip(boxes, gaps, strict=True)], labels
 
 
 def _deliveries(run: _Run) -> None:

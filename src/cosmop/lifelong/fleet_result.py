@@ -4,7 +4,9 @@
 (:data:`RUN_FORMAT`, what ``cosmop run --summary`` writes) holds the orders (released,
 delivered, lost, and each one's record), the deliveries per hour, the waits from release to
 delivery (p50, p95, max), each robot's utilisation (the share of the run it served an order),
-failures, the dispatcher's log, messages, replans and contacts.  Its trace is a
+failures, the dispatcher's log, messages, replans and contacts.  Each delivered order's word
+(the events the robots did with its goods, :attr:`OrderRecord.word`) is checked against its
+delivery mission (:attr:`OrderRecord.as_ordered`).  Its trace is a
 ``cosmop.trace/1`` file (:mod:`cosmop.traces`), so ``cosmop view`` and ``cosmop export`` read it;
 :meth:`FleetResult.plot` draws the deliveries over time.  Units: mm, degrees, seconds.
 """
@@ -12,6 +14,7 @@ failures, the dispatcher's log, messages, replans and contacts.  Its trace is a
 from __future__ import annotations
 
 import json
+import math
 import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -19,8 +22,10 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from cosmop.events import Event
 from cosmop.io import write_atomic
-from cosmop.scene import Scenario, Scene
+from cosmop.missions.mission import GlobalMission
+from cosmop.scene import Delivery, Mission, Scenario, Scene
 from cosmop.sim.result import Contact, Message, frames_trace
 from cosmop.traces import Trace
 from cosmop.units import INTERNAL_UNITS
@@ -56,6 +61,11 @@ class OrderRecord:
         Why it will never be delivered.
     refused : str or None
         Its last refused hand-over: which robot, when and why (why a pending order waits).
+    by : tuple of str
+        The robots that may serve it.
+    word : tuple of Event
+        What the robots did with its goods from its release to its delivery, in time order
+        (picks and drops of its object, as the simulated world recorded them).
     """
 
     index: int
@@ -67,11 +77,30 @@ class OrderRecord:
     delivered: float | None
     lost: str | None
     refused: str | None = None
+    by: tuple[str, ...] = ()
+    word: tuple[Event, ...] = ()
 
     @property
     def wait(self) -> float | None:
         """Release to delivery, s."""
         return None if self.delivered is None else self.delivered - self.at
+
+    @property
+    def as_ordered(self) -> bool | None:
+        r"""Whether the order was served as ordered: its :attr:`word` is a complete word of its
+        delivery mission (None while it is not delivered).
+
+        The delivery mission is the deliveries form of the order,
+        :math:`K = \{\mathit{pick}(r, o)\,\mathit{drop}(r, o, w) : r \in by, w \in to\}`
+        (:meth:`cosmop.missions.mission.GlobalMission.from_mission`): the goods picked once,
+        by a robot that may serve the order, and dropped by the same robot in one of its docks,
+        with nothing else done with them.
+        """
+        if self.delivered is None:
+            return None
+        mission = Mission(deliveries=(Delivery(self.object, self.to, self.by),))
+        language = GlobalMission.from_mission(mission, self.by)
+        return language.is_complete_word([e.name for e in self.word])
 
     def to_dict(self) -> dict[str, Any]:
         """The record as the summary writes it."""
@@ -88,6 +117,9 @@ class OrderRecord:
             **rounded,
             "lost": self.lost,
             "refused": self.refused,
+            "by": list(self.by),
+            "word": [e.name for e in self.word],
+            "as_ordered": self.as_ordered,
         }
 
 
@@ -198,6 +230,8 @@ class FleetResult:
                 s.delivered,
                 s.lost,
                 s.refused,
+                s.order.by,
+                _word(world.events, s),
             )
             for s in states
         )
@@ -246,6 +280,12 @@ class FleetResult:
     def contacts_while_moving(self) -> int:
         return sum(1 for c in self.contacts if c.moving)
 
+    @property
+    def not_as_ordered(self) -> tuple[OrderRecord, ...]:
+        """The delivered orders whose word is not a word of their delivery mission
+        (:attr:`OrderRecord.as_ordered`; empty when every delivery kept its order)."""
+        return tuple(o for o in self.orders if o.as_ordered is False)
+
     def wait_s(self) -> dict[str, float | None]:
         """Release to delivery of the delivered orders, s: median, 95th percentile, maximum."""
         return _spread([o.wait for o in self.orders if o.wait is not None])
@@ -270,6 +310,7 @@ class FleetResult:
                 "pending": self.released - self.delivered - self.lost,
             },
             "deliveries_per_hour": round(self.deliveries_per_hour, 3),
+            "as_ordered": {"checked": self.delivered, "broken": len(self.not_as_ordered)},
             "wait_s": self.wait_s(),
             "handover_wall_s": self.handover_wall_s(),
             "utilisation": dict(self.utilisation),
@@ -345,6 +386,16 @@ class FleetResult:
         buffer = io.BytesIO()
         self.plot().savefig(buffer, format="png")
         write_atomic(path, buffer.getvalue())
+
+
+def _word(events: Sequence[tuple[float, str, Event]], state: OrderState) -> tuple[Event, ...]:
+    """The mission events about `state`'s goods from its release to its delivery (or now)."""
+    end = math.inf if state.delivered is None else state.delivered
+    return tuple(
+        event
+        for t, _, event in events
+        if event.obj == state.order.object and not event.is_message and state.order.at <= t <= end
+    )
 
 
 def _spread(values: Sequence[float]) -> dict[str, float | None]:

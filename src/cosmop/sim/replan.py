@@ -43,6 +43,7 @@ __all__ = [
     "route",
     "sensed_scene",
     "start_state",
+    "why_no_plan",
 ]
 
 _PERSON_ROOM = 10.0  # mm added around a sensed person (a robot gets the standoff)
@@ -52,7 +53,7 @@ Rectangle = tuple[float, float, float, float]
 """An axis-aligned rectangle ``x0, y0, x1, y1`` (mm)."""
 
 
-def sensed_scene(scene: Scene, rectangles: Iterable[Rectangle]) -> Scene:
+def sensed_scene(scene: Scene, rectangles: Iterable[Rectangle], labels: Sequence[str] = ()) -> Scene:
     """The scene with each sensed rectangle ``(x0, y0, x1, y1)`` (mm) added as four walls.
 
     Parameters
@@ -61,17 +62,22 @@ def sensed_scene(scene: Scene, rectangles: Iterable[Rectangle]) -> Scene:
         The scene as planned.
     rectangles : iterable of (float, float, float, float)
         The sensed obstacles, grown by the room to keep (:func:`grown`), mm.
+    labels : sequence of str
+        What each rectangle is, in words ("R1, failed at 150.0 s"), so that a reason names it
+        (:attr:`cosmop.scene.Wall.label`); unnamed ones are "a sensed obstacle".
     """
     walls = list(scene.obstacles)
-    for x0, y0, x1, y1 in rectangles:
+    for k, (x0, y0, x1, y1) in enumerate(rectangles):
         corners = [(x0, y0), (x1, y0), (x1, y1), (x0, y1)]
-        walls += [Wall(corners[i], corners[(i + 1) % 4]) for i in range(4)]
+        label = labels[k] if k < len(labels) else "a sensed obstacle"
+        walls += [Wall(corners[i], corners[(i + 1) % 4], label) for i in range(4)]
     return replace(scene, obstacles=tuple(walls))
 
 
 def grown(box: Sequence[float], room: float, goods: NDArray[np.float64]) -> Rectangle:
     """The square `box` ``(x, y, half side)`` grown by `room` on each side, except where that
-    would cover resting goods: a side stops 1 mm short of the goods beyond it.
+    would cover resting goods: a side stops 1 mm short of the goods beyond it (of a good off a
+    corner, both sides do).
 
     A robot that stands (or failed) beside goods, say where it was about to pick them, would
     otherwise have them inside its grown square, as walls through them, and nobody could pick
@@ -106,11 +112,15 @@ def grown(box: Sequence[float], room: float, goods: NDArray[np.float64]) -> Rect
         else goods
     )
     for gx, gy, gh in near:
-        # how far the good lies beyond each side of the square (negative: not beyond it)
+        # how far the good lies beyond each side of the square (negative: not beyond it); a good
+        # that overlaps the square itself (beyond no side) cannot be kept out
         beyond = [(x - h) - (gx + gh), (y - h) - (gy + gh), (gx - gh) - (x + h), (gy - gh) - (y + h)]
-        side = int(np.argmax(beyond))
-        if beyond[side] >= 0.0:  # a good that overlaps the square itself cannot be kept out
-            grow[side] = min(grow[side], max(beyond[side] - 1.0, 0.0))
+        for side, gap in enumerate(beyond):
+            # every side it lies beyond, not only the farthest: a good off a corner would
+            # otherwise have the other side's growth run along its face, a wall between it and
+            # a robot picking it from beside that face
+            if gap >= 0.0:
+                grow[side] = min(grow[side], max(gap - 1.0, 0.0))
     return (x - h - grow[0], y - h - grow[1], x + h + grow[2], y + h + grow[3])
 
 
@@ -121,6 +131,7 @@ def replan(
     start: State,
     sensed: Iterable[Rectangle] = (),
     *,
+    labels: Sequence[str] = (),
     max_horizon: int = 12,
     rlimit: int = 50_000_000,
 ) -> RobotPlan | None:
@@ -140,6 +151,8 @@ def replan(
     sensed : iterable of (float, float, float, float)
         Obstacles sensed around the robot, as rectangles ``x0, y0, x1, y1`` (mm), grown by
         the room to keep (:func:`grown`).
+    labels : sequence of str
+        What each sensed rectangle is, in words (:func:`sensed_scene`).
     max_horizon, rlimit : int
         Bounds of the solver (see :func:`~cosmop.planning.synthesis.synthesize`).
 
@@ -147,12 +160,12 @@ def replan(
     -------
     RobotPlan or None
         A plan that passes :func:`~cosmop.planning.checker.check_robot_plan` from `start`, or
-        ``None`` when there is none within the bound.
+        ``None`` when there is none within the bound (:func:`why_no_plan` says why).
     """
     # the solver (and Z3) load only when a robot replans: most runs never do
     from cosmop.planning.synthesis import ROUTE_ROUNDS, synthesize
 
-    world = sensed_scene(scene, sensed)
+    world = sensed_scene(scene, sensed, labels)
     result = synthesize(
         world,
         robot,
@@ -169,6 +182,51 @@ def replan(
     if check_robot_plan(world, robot, result.plan, start=start):
         return None  # unsound plans are never executed
     return result.plan
+
+
+def why_no_plan(
+    scene: Scene,
+    robot: str,
+    events: Sequence[Event],
+    start: State,
+    sensed: Iterable[Rectangle] = (),
+    *,
+    labels: Sequence[str] = (),
+    max_horizon: int = 12,
+    rlimit: int = 50_000_000,
+) -> str:
+    """Why :func:`replan` found no plan, in the user's words: the first event out of reach and
+    what blocks it (the scenario's walls and goods, the sensed obstacles by their `labels`).
+
+    It searches again and explains (unsatisfiable cores: dearer than the plan), so a caller
+    asks once per refusal it reports.  The parameters are :func:`replan`'s.
+
+    Parameters
+    ----------
+    scene : Scene
+    robot : str
+    events : sequence of Event
+    start : State
+    sensed : iterable of (float, float, float, float)
+    labels : sequence of str
+    max_horizon, rlimit : int
+    """
+    from cosmop.planning.synthesis import synthesize
+
+    world = sensed_scene(scene, sensed, labels)
+    result = synthesize(
+        world,
+        robot,
+        tuple(events),
+        requests=False,
+        max_horizon=max_horizon,
+        rlimit=rlimit,
+        start=start,
+        explain=True,
+    )
+    if result.feasible:  # a plan the exact checker refused (never seen): say so plainly
+        return f"{robot}'s plan from where it stands failed the exact checker"
+    return result.reason or f"{robot} has no plan within {max_horizon} steps from where it stands"
 
 
 # ----------------------------------------------------------------------------------------------
