@@ -20,6 +20,7 @@ from cosmop.lifelong import Failure, FleetSettings, run_fleet
 from cosmop.lifelong.dispatch import delivery_events
 from cosmop.planning.primitive_effects import initial_state
 from cosmop.scenario import load_orders, load_scenario, parse_scenario
+from cosmop.scene import Order
 from cosmop.sim.replan import grown, replan, why_no_plan
 from cosmop.traces import Trace
 from run_2x2 import EXAMPLE
@@ -147,7 +148,8 @@ def test_a_robot_failing_before_it_picks_returns_the_order_to_the_pool():
     assert len(tries) >= 2 and tries[0]["robot"] == "R2"  # given again after R2 failed
 
 
-LIFELONG = Path(__file__).resolve().parent / "data" / "lifelong_2x2.yaml"  # the small example of 2026-11
+LIFELONG = Path(__file__).resolve().parent / "data" / "lifelong_2x2.yaml"
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"  # the small example of 2026-11
 
 
 @lru_cache(maxsize=2)
@@ -387,3 +389,26 @@ def test_a_robot_grown_round_goods_off_its_corner_leaves_them_reachable_from_the
     # else the east side's growth runs below the goods and walls off their east face
     box = grown((0.0, 0.0, 200.0), 100.0, np.array([[251.0, 313.0, 50.0]]))
     assert box == (-300.0, -300.0, 200.0, 262.0)
+
+
+def test_robots_whose_routes_run_through_a_failed_robot_are_replanned_round_it():
+    # found by benchmarks/sweep_lifelong.py, seed 5: R4 fails at 74 s in the aisle R1's route
+    # runs through; no order keeps them apart, and R1, R2 and R3 stood for R4's messages for
+    # the rest of the run.  Now the others are ordered round R4 once it has braked to a stop,
+    # R1 and R2 re-planned around it (and each other's homes), its messages dropped
+    scenario = load_scenario(EXAMPLES / "13_lifelong" / "scenario.yaml")
+    orders = [
+        Order(0.0, "O23", ("W2",), ("R1", "R2", "R3", "R4")),
+        Order(39.9, "O14", ("W3",), ("R1", "R2", "R3", "R4")),
+        Order(43.3, "O10", ("W1",), ("R1", "R2", "R3", "R4")),
+        Order(49.3, "O22", ("W1",), ("R1", "R2", "R3", "R4")),
+    ]
+    result = run_fleet(scenario, orders, fleet=FleetSettings(until=120.0), failures=[Failure("R4", 74.0)])
+    failure = result.failures["R4"]
+    assert failure["recoordinated"] is True and failure["carrying"] == ["O22"]
+    assert failure["replanned"] == ["R1", "R2"]  # the nearest first, until the fleet could be ordered
+    final = result.frames["pose"][-1, result.robot_ids.index("R4"), :2]
+    assert failure["at"] == pytest.approx(final, abs=1e-3)  # where it came to rest, after braking
+    o10 = next(o for o in result.orders if o.object == "O10")
+    assert o10.robot == "R1" and o10.delivered is not None and o10.as_ordered
+    assert result.lost == 1 and result.contacts_while_moving == 0

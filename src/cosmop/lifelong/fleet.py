@@ -27,9 +27,11 @@ cycle (:func:`cosmop.sim.simulation.advance`), and between cycles it
    keeps the order);
 4. ships delivered goods: once the drop is recorded the goods leave the world, so docks do not
    fill up (:meth:`cosmop.sim.world.World.ship`);
-5. fails robots (:class:`Failure`): a failed robot stands for good, its order returns to the
-   pool unless it carries the goods (then the order is lost, and the goods are reported where
-   they stand), and the others are ordered again around it.
+5. fails robots (:class:`Failure`): a failed robot brakes and stands for good, its order
+   returns to the pool unless it carries the goods (then the order is lost, and the goods are
+   reported where they stand), and once it stands the others are ordered again around it;
+   where a committed route runs through it, the robots still to move are re-planned around
+   it, nearest first, until they can be (:func:`_settle_failures`).
 
 Units: mm, degrees, seconds.
 """
@@ -48,9 +50,15 @@ import numpy as np
 from cosmop.control.geometry import box_gaps
 from cosmop.lifelong.dispatch import OrderState, choose_robot, delivery_events
 from cosmop.lifelong.fleet_result import FleetResult
-from cosmop.planning.plan_types import PlanSet, RobotPlan
+from cosmop.planning.plan_types import PlanSet
 from cosmop.scene import Order, Scenario
-from cosmop.sim.recoordinate import message_due_in, recoordinate_world, reorder_world
+from cosmop.sim.recoordinate import (
+    Remaining,
+    message_due_in,
+    order_around_failure,
+    recoordinate_world,
+    reorder_world,
+)
 from cosmop.sim.recording import Recorder
 from cosmop.sim.replan import Rectangle, grown, replan, robot_room, start_state, why_no_plan
 from cosmop.sim.result import SimSettings
@@ -151,6 +159,7 @@ class _Run:
     busy_since: dict[str, float] = field(default_factory=dict)
     busy_time: dict[str, float] = field(default_factory=dict)
     failed: dict[str, dict[str, Any]] = field(default_factory=dict)  # JSON records of the summary
+    failure_retry: dict[str, float] = field(default_factory=dict)  # robot: next try to order around it, s
     log: list[dict[str, Any]] = field(default_factory=list)
     reorders: list[dict[str, Any]] = field(default_factory=list)  # JSON records of the summary
     waits: dict[str, tuple[int, float]] = field(default_factory=dict)  # robot: (step, since), s
@@ -219,6 +228,7 @@ def run_fleet(
             while due and due[0].at <= world.t:
                 _fail(run, due.pop(0).robot)
             if world.t >= next_dispatch:
+                _settle_failures(run)
                 _dispatch(run)
                 _reorder_long_waits(run)
                 next_dispatch = world.t + fleet.dispatch_every
@@ -416,12 +426,14 @@ def _reorder_long_waits(run: _Run) -> None:
         )
 
 
-def _standing(run: _Run, agent: Agent) -> tuple[list[Rectangle], list[str]]:
+def _standing(run: _Run, agent: Agent, homes: bool = False) -> tuple[list[Rectangle], list[str]]:
     """The robots that stand still for now (idle or failed) as rectangles ``x0, y0, x1, y1``
     (mm), grown by the room the plans keep between robots (:func:`~cosmop.sim.replan.robot_room`:
     the clearance, or the gap they already stand at) short of the goods beside them
-    (:func:`~cosmop.sim.replan.grown`): the new plan goes around them.  With each, what it is
-    in words, for a reason that names it."""
+    (:func:`~cosmop.sim.replan.grown`): the new plan goes around them.  With `homes`, also the
+    homes of the robots still to move, where they will rest in the end (so that two robots
+    re-planned at once do not each route through the other's home).  With each, what it is in
+    words, for a reason that names it."""
     world = run.world
     i = agent.index
     standing = [
@@ -430,13 +442,20 @@ def _standing(run: _Run, agent: Agent) -> tuple[list[Rectangle], list[str]]:
         if a is not agent and (a.id in run.failed or (a.done and a.id not in run.busy))
     ]
     boxes = world.robot_boxes()[[a.index for a in standing]]
-    gaps = box_gaps(world.pose[i, :2], world.robot_half[i], boxes)
-    goods = world.resting_boxes()
     labels = [
         f"{a.id}, failed at {run.failed[a.id]['t']:.1f} s" if a.id in run.failed else f"{a.id}, standing idle"
         for a in standing
     ]
-    return [grown(box, robot_room(g), goods) for box, g in zip(boxes, gaps, strict=True)], labels
+    if homes:
+        going = [a for a in world.agents if a is not agent and a not in standing]
+        at_home = [(*world.scenario.scene.robots[a.id].pose[:2], world.robot_half[a.index]) for a in going]
+        boxes = np.vstack([boxes, np.asarray(at_home, dtype=float).reshape(-1, 3)])
+        labels += [f"the home of {a.id}" for a in going]
+    gaps = box_gaps(world.pose[i, :2], world.robot_half[i], boxes)
+    goods = world.resting_boxes()
+    # a home it stands on now cannot be kept out of; a robot that stands there is sensed anyway
+    keep = [k for k, g in enumerate(gaps) if k < len(standing) or g > 0.0]
+    return [grown(boxes[k], robot_room(gaps[k]), goods) for k in keep], [labels[k] for k in keep]
 
 
 def _deliveries(run: _Run) -> None:
@@ -489,13 +508,82 @@ def _fail(run: _Run, robot: str) -> None:
         elif state.delivered is None:
             state.assigned = None
             run.pool.insert(0, state)  # back to the pool, before the orders released later
-    start = start_state(world, agent)
-    accepted, why, _ = recoordinate_world(world, agent, RobotPlan.from_steps((), ()), start)
-    pose = [round(float(v), 3) for v in world.pose[agent.index, :2]]
     run.failed[robot] = {
         "t": round(world.t, 6),
-        "at": pose,
+        "at": [round(float(v), 3) for v in world.pose[agent.index, :2]],
         "carrying": carrying,
-        "recoordinated": accepted,
-        "why": why or None,
+        "recoordinated": False,
+        "why": "not yet ordered around: it brakes",
     }
+    _settle_failures(run)
+
+
+FAILURE_RETRY = 5.0
+"""Seconds between two tries to order the fleet around a failed robot that the last refused."""
+
+FAILURE_REPLANS = 4
+"""Robots re-planned around a failed robot, at most, in one try (each costs a hand-over)."""
+
+
+def _settle_failures(run: _Run) -> None:
+    """Order the others around every failed robot that stands still and is not yet ordered
+    around (:func:`~cosmop.sim.recoordinate.order_around_failure`: its plan emptied, its
+    messages that will never come dropped).  Where no order keeps the others apart from it (a
+    committed route runs through it), the robots still to move are re-planned around it from
+    where they are, nearest first (:data:`FAILURE_REPLANS` at most), until the fleet can be
+    ordered around it; else it is tried again :data:`FAILURE_RETRY` seconds later.  Until
+    then the robots that wait for its messages wait: they are ordered, never unordered."""
+    world = run.world
+    for robot, record in run.failed.items():
+        agent = next(a for a in world.agents if a.id == robot)
+        if (
+            record["recoordinated"]
+            or world.v[agent.index] != 0
+            or world.t < run.failure_retry.get(robot, 0.0)
+        ):
+            continue
+        record["at"] = [round(float(v), 3) for v in world.pose[agent.index, :2]]  # where it came to rest
+        accepted, why, _ = order_around_failure(world, agent, {})
+        replanned: dict[str, Remaining] = {}
+        for other in [] if accepted else _in_the_way(run, agent)[:FAILURE_REPLANS]:
+            rest = _replanned(run, other)
+            if rest is None:
+                continue
+            replanned[other.id] = rest
+            accepted, why, _ = order_around_failure(world, agent, replanned)
+            if accepted:
+                break
+        record.update(
+            recoordinated=accepted, why=why or None, replanned=sorted(replanned) if accepted else []
+        )
+        run.failure_retry[robot] = world.t + FAILURE_RETRY
+
+
+def _in_the_way(run: _Run, failed: Agent) -> list[Agent]:
+    """The robots still to move (not done, not failed), nearest to `failed` first."""
+    world = run.world
+    moving = [a for a in world.agents if not a.done and a.id not in run.failed]
+    at = world.pose[failed.index, :2]
+    return sorted(moving, key=lambda a: (float(np.hypot(*(world.pose[a.index, :2] - at))), a.id))
+
+
+def _replanned(run: _Run, agent: Agent) -> Remaining | None:
+    """`agent`'s mission left, re-planned from where it stands around the robots that stand
+    (failed ones included), or None when it has no plan."""
+    world, fleet = run.world, run.fleet
+    _, todo = agent.split_mission(world.scenario)
+    # its own events and messages; the messages that kept plans apart are ordered afresh
+    remaining = [e for e in todo if e not in world.conflict_messages and e not in world.sent_messages]
+    start = start_state(world, agent, {e.obj for e in remaining if e.kind == "pick"})
+    sensed, labels = _standing(run, agent, homes=True)
+    plan = replan(
+        world.scenario.scene,
+        agent.id,
+        remaining,
+        start,
+        sensed,
+        labels=labels,
+        max_horizon=fleet.max_horizon,
+        rlimit=fleet.rlimit,
+    )
+    return None if plan is None else Remaining(plan.steps, plan.mission, start)

@@ -137,8 +137,9 @@ class FleetResult:
     utilisation : Mapping[str, float]
         Per robot, the share of the run it served an order (0 to 1).
     failures : Mapping[str, Mapping]
-        Per failed robot: when (``t``), where it stands (``at``), what it carries, and whether
-        the others could be ordered around it (``recoordinated``).
+        Per failed robot: when (``t``), where it came to rest (``at``), what it carries,
+        whether the others could be ordered around it (``recoordinated``, ``why`` not) and the
+        robots re-planned around it for that (``replanned``).
     dispatch_log : tuple of Mapping
         Every hand-over tried: ``t``, ``order``, ``robot``, ``accepted``, ``why`` not,
         ``wall_s``, the wall time it took (plan, coordinate, check), s, and ``plan_wall_s``, the

@@ -52,6 +52,7 @@ __all__ = [
     "Recoordination",
     "Remaining",
     "message_due_in",
+    "order_around_failure",
     "orders_lost",
     "recoordinate",
     "recoordinate_world",
@@ -355,6 +356,67 @@ def message_due_in(world: World, agent: Agent) -> float | None:
     plan = RobotPlan.from_steps((), rest[: sends + 1])
     dynamics = world.scenario.scene.robots[sender.id].dynamics
     return sum(step_durations(plan, (x, y, math.degrees(h)), dynamics))
+
+
+def order_around_failure(
+    world: World,
+    failed: Agent,
+    replanned: Mapping[str, Remaining],
+    settings: ConflictSettings | None = None,
+) -> tuple[bool, str, list[Event]]:
+    """Order every robot's rest again around a robot that failed, with some robots re-planned.
+
+    The failed robot's plan is emptied: it stands where it is for good, and the messages it
+    would have sent or awaited are dropped.  So are the unsent conflict messages of the robots
+    in `replanned`, whose rests are replaced by their new plans (planned around it: a route
+    through it is ordered by no message).  The conflicts of the whole team are then ordered
+    again (:func:`~cosmop.team.safe_plans.make_team_safe` over every rest, the orders already
+    kept between the others standing), the team proved free of deadlock, and the result
+    installed in the robots' executors, as :func:`recoordinate_world` does for one robot;
+    refused, for the same reasons, nothing changes.  Returns ``(accepted, why not, messages
+    added)``.
+
+    Parameters
+    ----------
+    world : World
+        The running simulation.
+    failed : Agent
+        The robot that failed (stopped for good).
+    replanned : Mapping[str, Remaining]
+        Robots re-planned around it: each one's new plan from where it stands.
+    settings : ConflictSettings, optional
+        How conflicts are found (default: the world's).
+    """
+    splits = {a.id: a.split_mission(world.scenario) for a in world.agents}
+    now = {a.id: _rest_now(world, a, splits[a.id][1]) for a in world.agents}
+    rests = {**now, failed.id: Remaining((), (), _state_now(world, failed)), **replanned}
+    changed = {failed.id, *replanned}
+    sent = set(world.sent_messages)
+    pending = {e for e in set(world.conflict_messages) - sent if changed & set(e.owners)}
+    drop = sent | pending
+    plans = {r: _without(rest, drop) for r, rest in rests.items()}
+    safety = make_team_safe(
+        world.scenario.scene,
+        plans,
+        settings=settings or world.conflict_settings,
+        used=world.used_messages,
+        starts={r: rest.start for r, rest in rests.items()},
+        positions=_positions(world),
+    )
+    if not safety.safe:
+        return False, f"the new plans share a place no order resolves: {safety.unresolved[0].describe()}", []
+    dropped = tuple(sorted(pending, key=lambda e: e.name))
+    result = Recoordination(True, safety.plans, safety.messages, dropped)
+    too_late = _too_late_to_stop(world, result)
+    if too_late:
+        return False, too_late, []
+    for other in world.agents:
+        _install(other, result.plans[other.id], splits[other.id][0], new=other.id in changed)
+        if other.id in replanned:  # its new plan starts where it stood, to the millimetre
+            other.replan_start = (other.step_index, replanned[other.id].start.robot)
+    added = [m.event for m in result.messages]
+    world.conflict_messages |= set(added)
+    return True, "", added
 
 
 def _order_again(
