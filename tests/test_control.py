@@ -199,6 +199,27 @@ def test_the_search_widens_until_it_finds_the_way_round():
     assert path.length > 40_000
 
 
+def test_a_goal_walled_in_is_refused_without_a_search(monkeypatch):
+    # a goal ringed by standing robots on a wide map of scattered obstacles: no route, and no
+    # search of every corner of the map to learn it (it took ten minutes on the MovingAI map)
+    start, _, walls, boxes = _scattered(0)
+    goal = (start[0] + 3000.0, start[1])
+    ring = [(goal[0] + dx, goal[1] + dy, 250.0) for dx in (-600, 0, 600) for dy in (-600, 0, 600) if dx or dy]
+    boxes = np.vstack([boxes, ring])
+
+    def no_search(*_):
+        raise AssertionError("searched a goal walled in")
+
+    monkeypatch.setattr(paths, "_a_star", no_search)
+    assert plan_path(start, goal, 200.0, walls, boxes) is None
+    # the same goal with one robot of the ring gone: one piece, searched and found
+    monkeypatch.undo()
+    opened = np.array([b for b in boxes if tuple(b) != (goal[0] + 600, goal[1], 250.0)])
+    assert len(opened) == len(boxes) - 1
+    path = plan_path(start, goal, 200.0, walls, opened)
+    assert path is not None and path.points[-1] == goal
+
+
 def test_a_goal_inside_an_obstacle_has_no_route():
     boxes = np.array([[5000.0, 0.0, 300.0]])
     assert plan_path((0, 0), (5100, 0), 200.0, np.zeros((0, 4)), boxes) is None
