@@ -98,8 +98,13 @@ class OrderRecord:
         """
         if self.delivered is None:
             return None
-        mission = Mission(deliveries=(Delivery(self.object, self.to, self.by),))
-        language = GlobalMission.from_mission(mission, self.by)
+        # only the allowed robots that took part: the others' factors see the empty word, which
+        # they accept, and a robot the order does not allow has no events in the alphabet
+        robots = tuple(r for r in self.by if any(r in e.owners for e in self.word))
+        if not robots:
+            return False
+        mission = Mission(deliveries=(Delivery(self.object, self.to, robots),))
+        language = GlobalMission.from_mission(mission, robots)
         return language.is_complete_word([e.name for e in self.word])
 
     def to_dict(self) -> dict[str, Any]:
