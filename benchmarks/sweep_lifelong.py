@@ -9,7 +9,10 @@ events are a word of its order's delivery mission, and the contacts while moving
 is one the failed robot carried; anything else lost, a delivery not as ordered or a contact
 while moving is a failure of the sweep (exit 1).
 
-    python benchmarks/sweep_lifelong.py --seeds 0:20 [--until 600] [--out NAME]
+    python benchmarks/sweep_lifelong.py --seeds 0:20 [--until 600] [--scene FILE] [--out NAME]
+
+``--scene`` takes the scene (robots, goods, docks) of any scenario file instead of the
+example's; its mission or orders are not used.
 
 Raw rows go to ``results/NAME.json`` (default ``sweep_lifelong``).
 """
@@ -77,10 +80,11 @@ def main() -> int:
     parser.add_argument("--seeds", default="0:20", help="first:last (exclusive)")
     parser.add_argument("--until", type=float, default=600.0)
     parser.add_argument("--gap", type=float, default=25.0, help="mean seconds between orders")
+    parser.add_argument("--scene", type=Path, default=EXAMPLE, help="a scenario file whose scene to use")
     parser.add_argument("--out", default="sweep_lifelong")
     args = parser.parse_args()
     first, last = (int(v) for v in args.seeds.split(":"))
-    scenario = load_scenario(EXAMPLE)
+    scenario = load_scenario(args.scene)
     rows = []
     for seed in range(first, last):
         row = run_one(scenario, seed, args.until, args.gap)
