@@ -32,6 +32,7 @@ from cosmop.sim.recoordinate import recoordinate_world
 from cosmop.team.conflicts import ConflictSettings
 
 if TYPE_CHECKING:
+    from cosmop.planning.synthesis import Synthesis
     from cosmop.sim.world import Agent, World
 
 __all__ = [
@@ -162,21 +163,8 @@ def replan(
         A plan that passes :func:`~cosmop.planning.checker.check_robot_plan` from `start`, or
         ``None`` when there is none within the bound (:func:`why_no_plan` says why).
     """
-    # the solver (and Z3) load only when a robot replans: most runs never do
-    from cosmop.planning.synthesis import ROUTE_ROUNDS, synthesize
-
     world = sensed_scene(scene, sensed, labels)
-    result = synthesize(
-        world,
-        robot,
-        tuple(events),
-        requests=False,
-        max_horizon=max_horizon,
-        rlimit=rlimit,
-        start=start,
-        explain=False,
-        route_rounds=ROUTE_ROUNDS,
-    )
+    result = _synthesize(world, robot, events, start, max_horizon, rlimit, explain=False)
     if not result.feasible or result.plan is None:
         return None
     if check_robot_plan(world, robot, result.plan, start=start):
@@ -211,10 +199,29 @@ def why_no_plan(
     labels : sequence of str
     max_horizon, rlimit : int
     """
-    from cosmop.planning.synthesis import synthesize
-
     world = sensed_scene(scene, sensed, labels)
-    result = synthesize(
+    result = _synthesize(world, robot, events, start, max_horizon, rlimit, explain=True)
+    if result.feasible:  # a plan the exact checker refused (never seen): say so plainly
+        return f"{robot}'s plan from where it stands failed the exact checker"
+    return result.reason or f"{robot} has no plan within {max_horizon} steps from where it stands"
+
+
+def _synthesize(
+    world: Scene,
+    robot: str,
+    events: Sequence[Event],
+    start: State,
+    max_horizon: int,
+    rlimit: int,
+    *,
+    explain: bool,
+) -> Synthesis:
+    """The robot's events from `start` in the sensed `world`, without new requests (a new
+    request would need the top-down layer); a plan's route made shorter, a refusal explained."""
+    # the solver (and Z3) load only when a robot replans: most runs never do
+    from cosmop.planning.synthesis import ROUTE_ROUNDS, synthesize
+
+    return synthesize(
         world,
         robot,
         tuple(events),
@@ -222,11 +229,9 @@ def why_no_plan(
         max_horizon=max_horizon,
         rlimit=rlimit,
         start=start,
-        explain=True,
+        explain=explain,
+        route_rounds=0 if explain else ROUTE_ROUNDS,
     )
-    if result.feasible:  # a plan the exact checker refused (never seen): say so plainly
-        return f"{robot}'s plan from where it stands failed the exact checker"
-    return result.reason or f"{robot} has no plan within {max_horizon} steps from where it stands"
 
 
 # ----------------------------------------------------------------------------------------------
