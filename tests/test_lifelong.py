@@ -148,8 +148,8 @@ def test_a_robot_failing_before_it_picks_returns_the_order_to_the_pool():
     assert len(tries) >= 2 and tries[0]["robot"] == "R2"  # given again after R2 failed
 
 
-LIFELONG = Path(__file__).resolve().parent / "data" / "lifelong_2x2.yaml"
-EXAMPLES = Path(__file__).resolve().parents[1] / "examples"  # the small example of 2026-11
+LIFELONG = Path(__file__).resolve().parent / "data" / "lifelong_2x2.yaml"  # the first example's scene
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 
 @lru_cache(maxsize=2)
