@@ -412,3 +412,17 @@ def test_robots_whose_routes_run_through_a_failed_robot_are_replanned_round_it()
     o10 = next(o for o in result.orders if o.object == "O10")
     assert o10.robot == "R1" and o10.delivered is not None and o10.as_ordered
     assert result.lost == 1 and result.contacts_while_moving == 0
+
+
+def test_a_robot_standing_in_the_only_way_is_named_as_what_separates():
+    # R9 (not of this scene: a label only) stands in the one gap of the wall between R1 and
+    # the goods: no plan at any horizon, and the reason names it, not "walls"
+    scenario = parse_scenario(_walled_data())
+    scene, order = scenario.scene, scenario.orders[0]
+    events = delivery_events(scene, "R1", order, scene.objects["O1"].position)
+    start = initial_state(scene, "R1")
+    box, label = [(-400.0, 1300.0, 400.0, 2100.0)], ["R9, failed at 3.0 s"]
+    why = why_no_plan(scene, "R1", events, start, box, labels=label, max_horizon=16)
+    assert why.startswith("R1 cannot reach pick(R1,O1) (event 1 of its mission) at any horizon: ")
+    assert "R9, failed at 3.0 s, separates its start (-500, -1500)" in why
+    assert why_no_plan(scene, "R1", events, start, max_horizon=7).startswith("R1 cannot reach")  # no label

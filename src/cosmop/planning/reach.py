@@ -21,6 +21,7 @@ feasible mission; it proves only what no plan can do.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import replace
 
 import shapely
 
@@ -87,9 +88,36 @@ def unreachable(
         if not component.intersects(where):
             return (
                 f"{robot} cannot reach {event.name} (event {i} of its mission) at any horizon: "
-                f"walls separate its start {show_point((x0, y0), scene.units)} from {what}"
+                f"{_separating(scene, half, (x0, y0), where)} its start "
+                f"{show_point((x0, y0), scene.units)} from {what}"
             )
     return None
+
+
+def _separating(scene: Scene, half: float, start: tuple[float, float], where: shapely.Geometry) -> str:
+    """What walls the robot off from `where`, with its verb: the walls the planner added and
+    labelled (a robot standing, a space kept clear) without which it would reach ("R1, failed
+    at 90.1 s, separates"), else "walls separate"."""
+    labels = sorted({w.label for w in scene.obstacles if w.label is not None})
+    if not labels or len(labels) > _MOST_LABELS_TRIED:
+        return "walls separate"
+
+    def reaches_without(dropped: set[str]) -> bool:
+        kept = tuple(w for w in scene.obstacles if w.label not in dropped)
+        component = free_component(replace(scene, obstacles=kept), half, start) if kept else None
+        return component is None or component.intersects(where)
+
+    alone = [label for label in labels if reaches_without({label})]
+    if len(alone) == 1:
+        return f"{alone[0]}, separates"
+    if alone:
+        return f"each of what the planner added ({'; '.join(alone)}) separates"
+    if reaches_without(set(labels)):
+        return f"walls and what the planner added ({'; '.join(labels)}) separate"
+    return "walls separate"
+
+
+_MOST_LABELS_TRIED = 8  # each label tried costs a free-space component of the scene
 
 
 def free_component(scene: Scene, half: float, start: tuple[float, float]) -> shapely.Polygon | None:
