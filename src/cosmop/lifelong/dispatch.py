@@ -13,7 +13,7 @@ robot may serve it (:attr:`OrderState.no_plan_by`).
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Collection, Iterable, Sequence
 from dataclasses import dataclass, field
 
 from cosmop.events import Event
@@ -103,9 +103,14 @@ def delivery_events(scene: Scene, robot: str, order: Order, goods: Sequence[floa
 
 
 def choose_robot(
-    scene: Scene, order: Order, idle: Iterable[tuple[str, Sequence[float]]], goods: Sequence[float]
+    scene: Scene,
+    order: Order,
+    idle: Iterable[tuple[str, Sequence[float]]],
+    goods: Sequence[float],
+    passed_over: Collection[str] = (),
 ) -> str | None:
-    """The idle robot with the least estimated work for `order`, or None when none may serve it.
+    """The idle robot with the least estimated work for `order`, or None when none may serve it;
+    a robot of `passed_over` only when no other idle robot may.
 
     Parameters
     ----------
@@ -117,6 +122,8 @@ def choose_robot(
         The idle robots and where they stand (mm).
     goods : (float, float)
         Where the order's goods lie (mm).
+    passed_over : collection of str
+        Robots tried last (those that found no plan for the order, :attr:`OrderState.no_plan_by`).
 
     Returns
     -------
@@ -124,4 +131,5 @@ def choose_robot(
     """
     dock = scene.workspaces[_dock(scene, order, goods)].center
     work = [(_l1(at, goods) + _l1(goods, dock), rid) for rid, at in idle if rid in order.by]
-    return min(work)[1] if work else None
+    fresh = [w for w in work if w[1] not in passed_over]
+    return min(fresh or work)[1] if work else None

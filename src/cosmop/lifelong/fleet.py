@@ -60,7 +60,15 @@ from cosmop.sim.recoordinate import (
     reorder_world,
 )
 from cosmop.sim.recording import Recorder
-from cosmop.sim.replan import Rectangle, grown, replan, robot_room, start_state, why_no_plan
+from cosmop.sim.replan import (
+    Rectangle,
+    grown,
+    mission_left,
+    replan,
+    robot_room,
+    start_state,
+    why_no_plan,
+)
 from cosmop.sim.result import SimSettings
 from cosmop.sim.simulation import advance
 from cosmop.sim.world import Agent, World
@@ -304,12 +312,12 @@ def _dispatch(run: _Run, at_dock: Agent | None = None) -> None:
         # a robot that found no plan for the order from where it stood is tried again only when
         # no other idle robot may serve it (a refusal of its order with the others, a matter of
         # timing, is tried again with the same robot: the nearest)
-        fresh = {r: a for r, a in idle.items() if r not in state.no_plan_by and r in state.order.by}
         robot = choose_robot(
             world.scenario.scene,
             state.order,
-            ((r, tuple(world.pose[a.index, :2])) for r, a in (fresh or idle).items()),
+            ((r, tuple(world.pose[a.index, :2])) for r, a in idle.items()),
             goods,
+            passed_over=state.no_plan_by,
         )
         if robot is None:
             continue
@@ -571,10 +579,7 @@ def _replanned(run: _Run, agent: Agent) -> Remaining | None:
     """`agent`'s mission left, re-planned from where it stands around the robots that stand
     (failed ones included), or None when it has no plan."""
     world, fleet = run.world, run.fleet
-    _, todo = agent.split_mission(world.scenario)
-    # its own events and messages; the messages that kept plans apart are ordered afresh
-    remaining = [e for e in todo if e not in world.conflict_messages and e not in world.sent_messages]
-    start = start_state(world, agent, {e.obj for e in remaining if e.kind == "pick"})
+    remaining, start = mission_left(world, agent)
     sensed, labels = _standing(run, agent, homes=True)
     plan = replan(
         world.scenario.scene,

@@ -42,7 +42,7 @@ from cosmop.scene import Scene
 from cosmop.sim.realised_times import carry_instants
 from cosmop.team.conflicts import Conflict, ConflictSettings, conflicts, is_ordered, occupancies
 from cosmop.team.precedence import Precedence
-from cosmop.team.safe_plans import make_team_safe
+from cosmop.team.safe_plans import TeamSafety, make_team_safe
 from cosmop.team.timing import step_durations
 
 if TYPE_CHECKING:
@@ -181,13 +181,7 @@ def recoordinate(
         also=also,
     )
     if not safety.safe:
-        return Recoordination(
-            False,
-            {},
-            (),
-            dropped,
-            f"the new plans share a place no order resolves: {safety.unresolved[0].describe()}",
-        )
+        return Recoordination(False, {}, (), dropped, _unresolved(safety))
     return Recoordination(True, safety.plans, safety.messages, dropped)
 
 
@@ -387,12 +381,11 @@ def order_around_failure(
     settings : ConflictSettings, optional
         How conflicts are found (default: the world's).
     """
-    splits = {a.id: a.split_mission(world.scenario) for a in world.agents}
-    now = {a.id: _rest_now(world, a, splits[a.id][1]) for a in world.agents}
-    rests = {**now, failed.id: Remaining((), (), _state_now(world, failed)), **replanned}
-    changed = {failed.id, *replanned}
+    splits, now = _rests_now(world)
+    new = {failed.id: Remaining((), (), now[failed.id].start), **replanned}
+    rests = {**now, **new}
     sent = set(world.sent_messages)
-    pending = {e for e in set(world.conflict_messages) - sent if changed & set(e.owners)}
+    pending = {e for e in set(world.conflict_messages) - sent if set(new) & set(e.owners)}
     drop = sent | pending
     plans = {r: _without(rest, drop) for r, rest in rests.items()}
     safety = make_team_safe(
@@ -404,19 +397,9 @@ def order_around_failure(
         positions=_positions(world),
     )
     if not safety.safe:
-        return False, f"the new plans share a place no order resolves: {safety.unresolved[0].describe()}", []
+        return False, _unresolved(safety), []
     dropped = tuple(sorted(pending, key=lambda e: e.name))
-    result = Recoordination(True, safety.plans, safety.messages, dropped)
-    too_late = _too_late_to_stop(world, result)
-    if too_late:
-        return False, too_late, []
-    for other in world.agents:
-        _install(other, result.plans[other.id], splits[other.id][0], new=other.id in changed)
-        if other.id in replanned:  # its new plan starts where it stood, to the millimetre
-            other.replan_start = (other.step_index, replanned[other.id].start.robot)
-    added = [m.event for m in result.messages]
-    world.conflict_messages |= set(added)
-    return True, "", added
+    return _take(world, Recoordination(True, safety.plans, safety.messages, dropped), splits, new)
 
 
 def _order_again(
@@ -425,8 +408,7 @@ def _order_again(
     """:func:`recoordinate` every robot's committed rest, now, with `agent`'s replaced by `new`
     (``None``: kept, only re-ordered), and install the result in the robots' executors when
     accepted."""
-    splits = {a.id: a.split_mission(world.scenario) for a in world.agents}
-    now = {a.id: _rest_now(world, a, splits[a.id][1]) for a in world.agents}
+    splits, now = _rests_now(world)
     rests = {**now, agent.id: new if new is not None else now[agent.id]}
     positions = _positions(world)
     result = recoordinate(
@@ -442,16 +424,39 @@ def _order_again(
     )
     if not result.accepted:
         return False, result.reason or "", []
+    return _take(world, result, splits, {} if new is None else {agent.id: new})
+
+
+def _rests_now(world: World) -> tuple[dict[str, tuple[list[Event], list[Event]]], dict[str, Remaining]]:
+    """Every robot's mission split into done and to do, and its committed rest from now."""
+    splits = {a.id: a.split_mission(world.scenario) for a in world.agents}
+    return splits, {a.id: _rest_now(world, a, splits[a.id][1]) for a in world.agents}
+
+
+def _take(
+    world: World,
+    result: Recoordination,
+    splits: Mapping[str, tuple[list[Event], list[Event]]],
+    new: Mapping[str, Remaining],
+) -> tuple[bool, str, list[Event]]:
+    """Install an accepted re-coordination in the robots' executors (the robots of `new` given
+    new plans from where they stood), unless a robot driving now could not stop for a wait it
+    adds: ``(accepted, why not, messages added)``."""
     too_late = _too_late_to_stop(world, result)
     if too_late:
         return False, too_late, []
     for other in world.agents:
-        _install(other, result.plans[other.id], splits[other.id][0], new=new is not None and other is agent)
-        if new is not None and other is agent:  # its new plan starts where it stood, to the millimetre
-            other.replan_start = (other.step_index, new.start.robot)
+        _install(other, result.plans[other.id], splits[other.id][0], new=other.id in new)
+        if other.id in new:  # its new plan starts where it stood, to the millimetre
+            other.replan_start = (other.step_index, new[other.id].start.robot)
     added = [m.event for m in result.messages]
     world.conflict_messages |= set(added)
     return True, "", added
+
+
+def _unresolved(safety: TeamSafety) -> str:
+    """Why a re-coordination is refused: the first conflict no order resolves."""
+    return f"the new plans share a place no order resolves: {safety.unresolved[0].describe()}"
 
 
 def unordered_now(world: World, depth: float = 1.0) -> list[Conflict]:

@@ -38,6 +38,7 @@ if TYPE_CHECKING:
 __all__ = [
     "Rectangle",
     "grown",
+    "mission_left",
     "replan",
     "replan_stalled",
     "robot_room",
@@ -257,10 +258,7 @@ def replan_stalled(world: World, agent: Agent) -> None:
     if not s.replan:
         return
     world.replan_attempts += 1
-    _, todo = agent.split_mission(world.scenario)
-    # the mission's own events and messages; messages that kept plans apart are ordered afresh
-    remaining = [e for e in todo if e not in world.conflict_messages and e not in world.sent_messages]
-    start = start_state(world, agent, {e.obj for e in remaining if e.kind == "pick"})
+    remaining, start = mission_left(world, agent)
     # A replan should not be much longer than what is left of the plan: bound the search there
     # (an infeasible replan -- a blocked doorway -- would otherwise search every horizon).
     horizon = min(s.max_horizon, len(agent.steps) - agent.step_index + 4)
@@ -349,6 +347,23 @@ def robot_room(gap: float) -> float:
         The gap between the two robots' squares now, mm.
     """
     return float(min(ConflictSettings().clearance, max(gap - 1.0, 0.0)))
+
+
+def mission_left(world: World, agent: Agent) -> tuple[list[Event], State]:
+    """What a re-plan of `agent` plans, and from where: the mission events it has still to do
+    with the mission's own messages (the messages that kept plans apart are dropped, to be
+    ordered afresh with the new plan), and its state now (:func:`start_state`).
+
+    Parameters
+    ----------
+    world : World
+        The running simulation.
+    agent : Agent
+        The robot re-planned.
+    """
+    _, todo = agent.split_mission(world.scenario)
+    remaining = [e for e in todo if e not in world.conflict_messages and e not in world.sent_messages]
+    return remaining, start_state(world, agent, {e.obj for e in remaining if e.kind == "pick"})
 
 
 def start_state(world: World, agent: Agent, picks: AbstractSet[str | None] = frozenset()) -> State:
