@@ -8,20 +8,23 @@ orders) is served twice, in one run:
   control; every hand-over planned, ordered and checked while the others move);
 * by a grid peer: pymapf's PIBT (the ``bench`` extra) stepping one cell per step at the robots'
   cruise speed (750 mm/s: 1.33 s per 1 m cell), each agent's goal replaced as it arrives
-  (rolling horizon: good, dock, home), with cosmop's dispatcher rule (the oldest order to the
-  idle agent with the least L1 work).  Picking and dropping take no time on the grid, and two
+  (rolling horizon: good, dock, home), with cosmop's dispatcher rule
+  (``cosmop.lifelong.dispatch.choose_assignment``: among the oldest ``reveal`` orders per
+  robot, each idle agent the order of least L1 work, an order passed over as often as the
+  window holds orders served next).  Picking and dropping take no time on the grid, and two
   agents may stand in neighbouring cells (cosmop keeps 100 mm between robots and docks in
   about 3 s).
 
 Both report deliveries per hour and the waits from release to delivery (p50, p95, max).
 ``python benchmarks/bench_lifelong.py [--sizes 20] [--rate 600] [--until 900] [--seed S]
-[--out NAME]`` prints a row per size and engine and writes ``results/NAME.json``.
+[--reveal R] [--out NAME]`` prints a row per size and engine and writes ``results/NAME.json``.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
 import random
 import statistics
 import subprocess
@@ -36,7 +39,7 @@ HERE = Path(__file__).resolve().parent
 CRUISE = 750.0  # mm/s, the robots' top speed
 
 
-def cosmop_row(data: dict, until: float, timeout: float) -> dict:
+def cosmop_row(data: dict, until: float, timeout: float, reveal: float = 1.0) -> dict:
     """``cosmop run`` on the workload in a fresh process, timed as a user feels it."""
     with tempfile.TemporaryDirectory() as tmp:
         scenario, summary = Path(tmp) / "s.yaml", Path(tmp) / "summary.json"
@@ -52,6 +55,8 @@ def cosmop_row(data: dict, until: float, timeout: float) -> dict:
             str(until),
             "--summary",
             str(summary),
+            "--reveal",
+            str(reveal),
         ]
         try:
             proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
@@ -86,16 +91,27 @@ def _median(values: list[float]) -> float | None:
     return round(statistics.median(values), 3) if values else None
 
 
+def _centre(cell: tuple[int, int]) -> tuple[float, float]:
+    """The centre of a grid cell in the scene's mm (the inverse of :func:`_cell`)."""
+    from movingai_gen import CELL, ROWS
+
+    row, col = cell
+    return ((col + 0.5) * CELL, (ROWS - 1 - row + 0.5) * CELL)
+
+
 def _cell(point) -> tuple[int, int]:
     from movingai_gen import CELL, ROWS
 
     return ROWS - 1 - int(point[1] // CELL), int(point[0] // CELL)
 
 
-def peer_row(data: dict, until: float, seed: int) -> dict:
+def peer_row(data: dict, until: float, seed: int, reveal: float = 1.0) -> dict:
     """The rolling PIBT on the grid (module docstring)."""
     import pymapf
     from pymapf.algorithms.pibt import distance_table, pibt_step
+
+    from cosmop.lifelong.dispatch import Offer, choose_assignment
+    from cosmop.scenario import parse_scenario
 
     sys.path.insert(0, str(HERE))
     from movingai_gen import CELL, COLS, ROWS, blocked_cells
@@ -109,7 +125,9 @@ def peer_row(data: dict, until: float, seed: int) -> dict:
         w: _cell(((v["x"][0] + v["x"][1]) / 2, (v["y"][0] + v["y"][1]) / 2))
         for w, v in scene["workspaces"].items()
     }
-    orders = sorted(data["orders"], key=lambda o: o["at"])
+    scenario = parse_scenario(data)  # the same orders and docks as cosmop's dispatcher sees
+    orders = sorted(scenario.orders, key=lambda o: o.at)
+    window = max(1, math.ceil(reveal * len(scene["robots"])))
     tables: dict = {}
 
     def dist(goal, cell):
@@ -122,25 +140,32 @@ def peer_row(data: dict, until: float, seed: int) -> dict:
     task: dict[str, dict | None] = {r: None for r in names}  # the order being served, and its leg
     priorities = {r: 0.0 for r in names}
     released = delivered = 0
-    pool, waits = [], []
+    pool: list[tuple[object, int]] = []  # (order, times passed over for younger ones)
+    waits: list[float] = []
     rng = random.Random(seed)
     step_s = CELL / CRUISE
     t0 = time.perf_counter()
     for k in range(int(until / step_s)):
         t = k * step_s
-        while released < len(orders) and orders[released]["at"] <= t:
-            pool.append(orders[released])
+        while released < len(orders) and orders[released].at <= t:
+            pool.append((orders[released], 0))
             released += 1
-        for order in list(pool):
-            idle = [r for r in names if task[r] is None and at[r] == home[r]]
-            if not idle:
+        while True:
+            idle = [(r, _centre(at[r])) for r in names if task[r] is None and at[r] == home[r]]
+            offers = [
+                Offer(o, tuple(scene["objects"][o.object]["position"]), overdue=n >= window)
+                for o, n in pool[:window]
+            ]
+            chosen = choose_assignment(scenario.scene, offers, idle) if idle and offers else None
+            if chosen is None:
                 break
-            g = goods[order["object"]]
-            dock = min(order["to"], key=lambda w: abs(docks[w][0] - g[0]) + abs(docks[w][1] - g[1]))
-            r = min(idle, key=lambda r: (abs(at[r][0] - g[0]) + abs(at[r][1] - g[1]), r))
+            j, r = chosen
+            order = offers[j].order
+            g = goods[order.object]
+            dock = min(order.to, key=lambda w: abs(docks[w][0] - g[0]) + abs(docks[w][1] - g[1]))
             task[r] = {"order": order, "leg": "good", "dock": docks[dock]}
             goal[r] = g
-            pool.remove(order)
+            pool = [(o, n + (i < j)) for i, (o, n) in enumerate(pool) if i != j]
         nxt = pibt_step(grid, names, at, goal, priorities, lambda name, cell: dist(goal[name], cell), rng=rng)
         if nxt is None:
             continue
@@ -154,7 +179,7 @@ def peer_row(data: dict, until: float, seed: int) -> dict:
                 job["leg"], goal[r] = "dock", job["dock"]
             elif job["leg"] == "dock":
                 delivered += 1
-                waits.append(t + step_s - job["order"]["at"])
+                waits.append(t + step_s - job["order"].at)
                 job["leg"], goal[r] = "home", home[r]
             else:
                 task[r] = None
@@ -182,6 +207,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--until", type=float, default=900.0, help="simulated seconds")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--timeout", type=float, default=3600.0)
+    parser.add_argument("--reveal", type=float, default=1.0, help="orders per robot dispatched among")
     parser.add_argument("--out", default="lifelong")
     args = parser.parse_args(argv)
     sys.path.insert(0, str(HERE))
@@ -190,8 +216,16 @@ def main(argv: list[str] | None = None) -> int:
     rows = []
     for n in map(int, args.sizes.split(",")):
         data = orders_warehouse(n, args.seed, args.rate, args.until / 3600.0)
-        for row in (cosmop_row(data, args.until, args.timeout), peer_row(data, args.until, args.seed)):
-            row = {"n": n, "rate_per_hour": args.rate, "until_s": args.until, "seed": args.seed, **row}
+        peer = peer_row(data, args.until, args.seed, args.reveal)
+        for row in (cosmop_row(data, args.until, args.timeout, args.reveal), peer):
+            row = {
+                "n": n,
+                "rate_per_hour": args.rate,
+                "until_s": args.until,
+                "seed": args.seed,
+                "reveal": args.reveal,
+                **row,
+            }
             rows.append(row)
             print(json.dumps(row), flush=True)
     print(f"wrote {save_results(args.out, rows)}")

@@ -17,7 +17,7 @@ from cosmop.cli import app
 from cosmop.errors import ScenarioError
 from cosmop.events import Event, Primitive
 from cosmop.lifelong import Failure, FleetSettings, run_fleet
-from cosmop.lifelong.dispatch import delivery_events
+from cosmop.lifelong.dispatch import Offer, choose_assignment, delivery_events
 from cosmop.planning.primitive_effects import initial_state
 from cosmop.scenario import load_orders, load_scenario, parse_scenario
 from cosmop.scene import Order
@@ -205,6 +205,9 @@ def test_cosmop_run_writes_the_summary_and_refuses_bad_options(tmp_path):
     assert bad.exit_code == 2 and "ROBOT@SECONDS" in bad.stderr
     negative = runner.invoke(app, ["run", str(scenario), "--until", "60", "--reorder-after", "-1"])
     assert negative.exit_code == 2 and "--reorder-after" in negative.stderr
+    for reveal in ("-0.5", "nan"):
+        refused = runner.invoke(app, ["run", str(scenario), "--until", "60", "--reveal", reveal])
+        assert refused.exit_code == 2 and "--reveal" in refused.stderr
     unknown = runner.invoke(app, ["run", str(scenario), "--until", "60", "--fail", "R9@6"])
     assert unknown.exit_code == 2 and "R9 is not a robot" in unknown.stderr
     plan = runner.invoke(app, ["plan", str(scenario), "-o", str(tmp_path / "p.json")])
@@ -218,14 +221,49 @@ def test_a_robot_with_work_waiting_takes_it_at_the_dock_not_after_going_home():
     ]
     scenario = parse_scenario(_data(orders))
     result = run_fleet(scenario, fleet=FleetSettings(until=150.0))
-    first, second = result.orders
-    assert first.delivered is not None and second.delivered is not None
-    given = [e for e in result.dispatch_log if e["order"] == 1 and e["accepted"]]
+    assert all(o.delivered is not None for o in result.orders)
+    first, second = sorted(result.orders, key=lambda o: o.delivered)
+    given = [e for e in result.dispatch_log if e["order"] == second.index and e["accepted"]]
     # handed over in the cycle that recorded the drop, from the dock
     assert given and given[0]["t"] == pytest.approx(first.delivered, abs=0.11)
     assert all(e["wall_s"] >= 0 for e in result.dispatch_log)
     assert result.summary()["handover_wall_s"]["p50"] is not None
     assert result.contacts_while_moving == 0
+
+
+def test_the_dispatcher_gives_a_robot_the_order_of_least_work_in_its_window():
+    scene = parse_scenario(_data()).scene
+    far = Offer(Order(0.0, "O1", ("W1",), ("R1", "R2")), (2000.0, -1000.0))
+    near = Offer(Order(1.0, "O2", ("W1",), ("R1", "R2")), (-1800.0, -1000.0))
+    idle = [("R2", (-2000.0, -2000.0))]
+    assert choose_assignment(scene, [far, near], idle) == (1, "R2")  # least work, not the oldest
+    assert choose_assignment(scene, [far], idle) == (0, "R2")  # a window of one: oldest first
+    # an order passed over too often is served first, the oldest of those
+    assert choose_assignment(scene, [replace(far, overdue=True), near], idle) == (0, "R2")
+    # of two idle robots, the nearer one; an order no idle robot may serve is not given
+    idle = [("R1", (1800.0, -900.0)), ("R2", (-2000.0, -2000.0))]
+    assert choose_assignment(scene, [far], idle) == (0, "R1")
+    only_r3 = Offer(Order(0.0, "O1", ("W1",), ("R3",)), (2000.0, -1000.0))
+    assert choose_assignment(scene, [only_r3], idle) is None
+    assert choose_assignment(scene, [only_r3, near], idle) == (1, "R2")
+
+
+def test_a_robot_freed_takes_the_order_nearest_to_it_and_none_waits_for_ever():
+    # one robot may serve four orders released at once: O1 lies far, the others near its home.
+    # With a window (two orders for two robots) it serves the near ones first, but O1, passed
+    # over twice (as often as the window holds orders), is served before the last one
+    data = _data([{"at": 0, "object": o, "to": "W1", "by": "R1"} for o in ("O1", "O2", "O3", "O4")])
+    objects = data["scene"]["objects"]
+    objects["O1"]["position"] = [2000, -1000]
+    for k, o in enumerate(("O2", "O3", "O4")):
+        objects[o] = {"size": 100, "position": [-1500, -1500 + 350 * k]}
+    scenario = parse_scenario(data)
+    fifo = run_fleet(scenario, fleet=FleetSettings(until=240.0, reveal=0.0))
+    window = run_fleet(scenario, fleet=FleetSettings(until=240.0, reveal=1.0))
+    given = [[e["order"] for e in r.dispatch_log if e["accepted"]] for r in (fifo, window)]
+    assert given[0] == [0, 1, 2, 3]
+    assert given[1][:3] == [1, 2, 0]
+    assert window.contacts_while_moving == 0 and not window.not_as_ordered
 
 
 def test_refused_hand_overs_keep_the_order_and_wait_longer_each_time(monkeypatch):

@@ -66,6 +66,15 @@ def run(
             callback=finite,
         ),
     ] = 15.0,
+    reveal: Annotated[
+        float,
+        typer.Option(
+            help="Orders per robot the dispatcher chooses among, oldest first: each idle robot "
+            "takes the one of least work (0: each order in turn, oldest first).",
+            min=0.0,
+            callback=finite,
+        ),
+    ] = 1.0,
     summary: Annotated[
         Path | None, typer.Option(help="Write the summary (cosmop.run/1 JSON) here.", show_default=False)
     ] = None,
@@ -106,6 +115,8 @@ def run(
     reorder_after : float
         ``--reorder-after``: seconds a robot waits for a message before its conflicts are
         ordered again (``FleetSettings.reorder_after``; 0: never).
+    reveal : float
+        ``--reveal``: orders per robot the dispatcher chooses among (``FleetSettings.reveal``).
     summary : pathlib.Path or None
         ``--summary``: write the summary (``cosmop.run/1`` JSON) here.
     trace : pathlib.Path or None
@@ -132,7 +143,7 @@ def run(
             raise typer.Exit(EXIT_INPUT_ERROR)
     settings = SimSettings(delays=delays)
     try:
-        fleet = FleetSettings(until=until, reorder_after=reorder_after or None)
+        fleet = FleetSettings(until=until, reorder_after=reorder_after or None, reveal=reveal)
         result = _run_with_progress(loaded, stream, fleet, seed, settings, tuple(fail or ()))
     except FleetInterrupted as stop:  # Ctrl-C: what was delivered so far, written whole
         _save(stop.result, summary, trace)

@@ -1,14 +1,20 @@
 """Which robot serves which order, and its next mission: the dispatcher of a lifelong run.
 
-Released orders wait in a pool, oldest first.  An order goes to an idle robot that may serve
-it (``Order.by``): the one with the least estimated work, the L1 distance from where it stands
-to the goods and from the goods to the nearest of the order's docks (mm).  A robot that is busy
-competes again as soon as it has dropped its goods (from the dock, its way home still ahead)
-or is idle, so among busy robots the one whose order is done soonest is served first.  The
-mission handed over is the order's delivery and the way home: ``pick``, ``drop`` at that dock,
-``return``; the way home is replaced by the next order when one is given at the dock.  A robot
-that found no plan for an order from where it stood is passed over for it while another idle
-robot may serve it (:attr:`OrderState.no_plan_by`).
+Released orders wait in a pool, oldest first.  The dispatcher chooses among the oldest few of
+them (a window of about one order per robot, as the League of Robot Runners reveals a task pool
+of ``numTasksReveal`` tasks per robot): of every pair of an order of the window and an idle
+robot that may serve it (``Order.by``), the pair of least estimated work, the L1 distance from
+where the robot stands to the goods and from the goods to the nearest of the order's docks
+(mm).  Choosing among several orders lets a robot take work near where it stands, instead of
+crossing the warehouse for the oldest order while others cross it the other way; so that no
+order waits for ever, an order passed over for younger ones as many times as the window holds
+orders is served next (:func:`choose_assignment`).  A window of one order is the strict
+oldest-first rule.  A robot that is busy competes again as soon as it has dropped its goods
+(from the dock, its way home still ahead) or is idle, so among busy robots the one whose order
+is done soonest is served first.  The mission handed over is the order's delivery and the way
+home: ``pick``, ``drop`` at that dock, ``return``; the way home is replaced by the next order
+when one is given at the dock.  A robot that found no plan for an order from where it stood is
+passed over for it while another idle robot may serve it (:attr:`OrderState.no_plan_by`).
 """
 
 from __future__ import annotations
@@ -19,7 +25,7 @@ from dataclasses import dataclass, field
 from cosmop.events import Event
 from cosmop.scene import Order, Scene
 
-__all__ = ["OrderState", "choose_robot", "delivery_events"]
+__all__ = ["Offer", "OrderState", "choose_assignment", "choose_robot", "delivery_events"]
 
 
 @dataclass
@@ -50,6 +56,9 @@ class OrderState:
         did, s: the order goes to another idle robot first.
     retry_at : float
         Not tried again before this time, s.
+    passed : int
+        Times a younger order of the dispatcher's window was given to a robot that could have
+        served this one (:func:`choose_assignment`).
     """
 
     order: Order
@@ -63,6 +72,7 @@ class OrderState:
     refused: str | None = None
     no_plan_by: dict[str, float] = field(default_factory=dict)
     retry_at: float = 0.0
+    passed: int = 0
 
 
 def _l1(a: Sequence[float], b: Sequence[float]) -> float:
@@ -129,7 +139,71 @@ def choose_robot(
     -------
     str or None
     """
-    dock = scene.workspaces[_dock(scene, order, goods)].center
-    work = [(_l1(at, goods) + _l1(goods, dock), rid) for rid, at in idle if rid in order.by]
+    work = [(_work(scene, order, at, goods), rid) for rid, at in idle if rid in order.by]
     fresh = [w for w in work if w[1] not in passed_over]
     return min(fresh or work)[1] if work else None
+
+
+@dataclass(frozen=True)
+class Offer:
+    """An order the dispatcher may give now.
+
+    Attributes
+    ----------
+    order : Order
+    goods : tuple of float
+        Where its goods lie ``(x, y)``, mm.
+    passed_over : frozenset of str
+        Robots tried last for it (:func:`choose_robot`).
+    overdue : bool
+        Served before every order that is not (passed over too often for younger ones).
+    """
+
+    order: Order
+    goods: tuple[float, ...]
+    passed_over: frozenset[str] = frozenset()
+    overdue: bool = False
+
+
+def choose_assignment(
+    scene: Scene, offers: Sequence[Offer], idle: Sequence[tuple[str, Sequence[float]]]
+) -> tuple[int, str] | None:
+    """The next order to give and its robot: ``(index in offers, robot)``, or None when no idle
+    robot may serve any of them.
+
+    Each offer's robot is :func:`choose_robot`'s; of those pairs the dispatcher takes an overdue
+    offer first (the oldest), else the one of least estimated work, the oldest on a tie.  Over a
+    window of offers this is the greedy task assignment of lifelong MAPF (each free robot the
+    task nearest to it); over one offer, the strict oldest-first rule.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene (its workspaces place the docks).
+    offers : sequence of Offer
+        The orders the dispatcher may give now, oldest first.
+    idle : sequence of (str, (float, float))
+        The idle robots and where they stand (mm).
+
+    Returns
+    -------
+    tuple of (int, str) or None
+    """
+    best: tuple[tuple[bool, float, int], str] | None = None
+    for k, offer in enumerate(offers):
+        robot = choose_robot(scene, offer.order, idle, offer.goods, offer.passed_over)
+        if robot is None:
+            continue
+        at = next(p for r, p in idle if r == robot)
+        work = 0.0 if offer.overdue else _work(scene, offer.order, at, offer.goods)
+        key = (not offer.overdue, work, k)
+        if best is None or key < best[0]:
+            best = (key, robot)
+    return None if best is None else (best[0][2], best[1])
+
+
+def _work(scene: Scene, order: Order, at: Sequence[float], goods: Sequence[float]) -> float:
+    """The estimated work of `order` for a robot standing at `at`: L1 to the goods, then to
+    the nearest of the order's docks, mm."""
+    dock = scene.workspaces[_dock(scene, order, goods)].center
+    return _l1(at, goods) + _l1(goods, dock)

@@ -6,7 +6,9 @@ cycle (:func:`cosmop.sim.simulation.advance`), and between cycles it
 1. releases the orders whose time has come into a pool (:mod:`.dispatch`);
 2. every ``dispatch_every`` seconds, and at once when a robot has just dropped its goods (it
    competes from the dock, so that it goes home only when no work waits), gives pooled orders
-   to idle robots; each robot is tried once per dispatch.  The robot's next
+   to idle robots, each the order of least work among the oldest few (``reveal`` orders per
+   robot, :func:`~cosmop.lifelong.dispatch.choose_assignment`); each robot is tried once per
+   dispatch.  The robot's next
    mission (pick, drop, home) is planned from where it stands, with the robots that stand
    (idle or failed) as obstacles (:func:`cosmop.sim.replan.replan`, every plan passing the
    exact checker), then ordered against the plans the others have committed to, by the same
@@ -38,17 +40,18 @@ Units: mm, degrees, seconds.
 
 from __future__ import annotations
 
+import itertools
 import math
 import re
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Collection, Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from cosmop.control.geometry import box_gaps
-from cosmop.lifelong.dispatch import OrderState, choose_robot, delivery_events
+from cosmop.lifelong.dispatch import Offer, OrderState, choose_assignment, delivery_events
 from cosmop.lifelong.fleet_result import FleetResult
 from cosmop.planning.plan_types import PlanSet
 from cosmop.scene import Order, Scenario
@@ -143,6 +146,11 @@ class FleetSettings:
     max_reorders : int
         Most robots ordered again at one dispatch, the longest waiting first (each costs an
         ordering of the team, like a hand-over).
+    reveal : float
+        Orders per robot the dispatcher chooses among: the oldest ``ceil(reveal * robots)``
+        pooled orders, at least one (the League of Robot Runners' ``numTasksReveal``);
+        0 gives each order, oldest first, to the idle robot nearest to it
+        (:func:`~cosmop.lifelong.dispatch.choose_assignment`).
     """
 
     until: float
@@ -153,6 +161,7 @@ class FleetSettings:
     rlimit: int = 50_000_000
     reorder_after: float | None = 15.0
     max_reorders: int = 2
+    reveal: float = 1.0
 
 
 @dataclass
@@ -287,7 +296,8 @@ def _result(run: _Run, recorder: Recorder, *, interrupted: bool = False) -> Flee
 
 
 def _dispatch(run: _Run, at_dock: Agent | None = None) -> None:
-    """Hand pooled orders, oldest first, to idle robots (module docstring, step 2).
+    """Hand pooled orders to idle robots, each the order of least work among the oldest few
+    (module docstring, step 2; :func:`~cosmop.lifelong.dispatch.choose_assignment`).
 
     `at_dock`, a robot that has just dropped its goods, competes with the idle robots for the
     orders: if it is given one, the way home left in its plan is replaced by that order (whose
@@ -297,32 +307,36 @@ def _dispatch(run: _Run, at_dock: Agent | None = None) -> None:
     idle = {a.id: a for a in world.agents if a.done and a.id not in run.busy and a.id not in run.failed}
     if at_dock is not None:
         idle[at_dock.id] = at_dock
-    for state in list(run.pool):
-        if not idle:
+    window = max(1, math.ceil(run.fleet.reveal * len(world.robot_ids)))
+    while idle:
+        offered = list(itertools.islice(_offers(run, idle), window))
+        offers = [Offer(s.order, goods, frozenset(s.no_plan_by), s.passed >= window) for s, goods in offered]
+        at = [(r, tuple(world.pose[a.index, :2])) for r, a in idle.items()]
+        chosen = choose_assignment(world.scenario.scene, offers, at)
+        if chosen is None:
             return
-        if state.retry_at > world.t:
+        k, robot = chosen
+        state, goods = offered[k]
+        _hand_over(run, idle[robot], state, goods)
+        if state.robot == robot:  # given: the older orders it could have had were passed over
+            for older, _ in offered[:k]:
+                older.passed += robot in older.order.by
+        del idle[robot]  # given the order, or refused: one plan tried per robot and dispatch
+
+
+def _offers(run: _Run, idle: Collection[str]) -> Iterator[tuple[OrderState, tuple[float, ...]]]:
+    """The pooled orders that may be given now to one of the `idle` robots, oldest first, with
+    where their goods lie."""
+    for state in run.pool:
+        if state.retry_at > run.world.t:
             continue
         if all(robot in run.failed for robot in state.order.by):
             # said once, in the order's record; it stays in the pool, never served
             state.refused = state.refused or _unservable(run, state.order.by)
             continue
-        goods = _goods_at_rest(world, state)
-        if goods is None:
-            continue
-        # a robot that found no plan for the order from where it stood is tried again only when
-        # no other idle robot may serve it (a refusal of its order with the others, a matter of
-        # timing, is tried again with the same robot: the nearest)
-        robot = choose_robot(
-            world.scenario.scene,
-            state.order,
-            ((r, tuple(world.pose[a.index, :2])) for r, a in idle.items()),
-            goods,
-            passed_over=state.no_plan_by,
-        )
-        if robot is None:
-            continue
-        _hand_over(run, idle[robot], state, goods)
-        del idle[robot]  # given the order, or refused: one plan tried per robot and dispatch
+        goods = _goods_at_rest(run.world, state)
+        if goods is not None and any(robot in idle for robot in state.order.by):
+            yield state, goods
 
 
 def _unservable(run: _Run, robots: Sequence[str]) -> str:
