@@ -263,6 +263,7 @@ def test_a_robot_freed_takes_the_order_nearest_to_it_and_none_waits_for_ever():
     given = [[e["order"] for e in r.dispatch_log if e["accepted"]] for r in (fifo, window)]
     assert given[0] == [0, 1, 2, 3]
     assert given[1][:3] == [1, 2, 0]
+    assert (fifo.summary()["dispatch_window"], window.summary()["dispatch_window"]) == (1, 2)
     assert window.contacts_while_moving == 0 and not window.not_as_ordered
 
 

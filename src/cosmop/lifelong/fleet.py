@@ -292,6 +292,7 @@ def _result(run: _Run, recorder: Recorder, *, interrupted: bool = False) -> Flee
         run.log,
         reorders=run.reorders,
         interrupted=interrupted,
+        window=_window(run),
     )
 
 
@@ -307,7 +308,7 @@ def _dispatch(run: _Run, at_dock: Agent | None = None) -> None:
     idle = {a.id: a for a in world.agents if a.done and a.id not in run.busy and a.id not in run.failed}
     if at_dock is not None:
         idle[at_dock.id] = at_dock
-    window = max(1, math.ceil(run.fleet.reveal * len(world.robot_ids)))
+    window = _window(run)
     while idle:
         offered = list(itertools.islice(_offers(run, idle), window))
         offers = [Offer(s.order, goods, frozenset(s.no_plan_by), s.passed >= window) for s, goods in offered]
@@ -322,6 +323,11 @@ def _dispatch(run: _Run, at_dock: Agent | None = None) -> None:
             for older, _ in offered[:k]:
                 older.passed += robot in older.order.by
         del idle[robot]  # given the order, or refused: one plan tried per robot and dispatch
+
+
+def _window(run: _Run) -> int:
+    """Orders the dispatcher chooses among at a time: ``reveal`` per robot, at least one."""
+    return max(1, math.ceil(run.fleet.reveal * len(run.world.robot_ids)))
 
 
 def _offers(run: _Run, idle: Collection[str]) -> Iterator[tuple[OrderState, tuple[float, ...]]]:

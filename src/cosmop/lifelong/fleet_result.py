@@ -164,6 +164,8 @@ class FleetResult:
         Every robot whose conflicts were ordered again while it stood for a message: ``t``,
         ``robot``, ``waited_s``, ``due_in_s`` (when its message was expected, the order kept),
         ``accepted``, ``why`` not, ``messages`` added, ``wall_s``.
+    window : int
+        Orders the dispatcher chose among at a time (``FleetSettings.reveal`` times the robots).
     """
 
     scenario: str
@@ -183,6 +185,7 @@ class FleetResult:
     scene: Scene | None = field(default=None, repr=False, compare=False)
     interrupted: bool = False
     reorders: tuple[Mapping[str, Any], ...] = ()
+    window: int = 1
 
     @classmethod
     def of(
@@ -197,6 +200,7 @@ class FleetResult:
         *,
         reorders: Sequence[Mapping[str, Any]] = (),
         interrupted: bool = False,
+        window: int = 1,
     ) -> FleetResult:
         """The result of a finished run (:func:`cosmop.lifelong.run_fleet` calls it).
 
@@ -220,6 +224,8 @@ class FleetResult:
             One record per robot whose conflicts were ordered again while it waited.
         interrupted : bool
             Whether Ctrl-C ended the run before its time.
+        window : int
+            Orders the dispatcher chose among at a time.
 
         Returns
         -------
@@ -250,6 +256,7 @@ class FleetResult:
             failures=dict(failed),
             dispatch_log=tuple(log),
             reorders=tuple(reorders),
+            window=window,
             contacts=tuple(world.contacts),
             messages=tuple(world.messages),
             replans=world.replans,
@@ -316,6 +323,7 @@ class FleetResult:
                 "pending": self.released - self.delivered - self.lost,
             },
             "deliveries_per_hour": round(self.deliveries_per_hour, 3),
+            "dispatch_window": self.window,
             "as_ordered": {"checked": self.delivered, "broken": len(self.not_as_ordered)},
             "wait_s": self.wait_s(),
             "handover_wall_s": self.handover_wall_s(),
