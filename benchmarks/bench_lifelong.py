@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import random
 import statistics
 import subprocess
@@ -110,7 +109,7 @@ def peer_row(data: dict, until: float, seed: int, reveal: float = 1.0) -> dict:
     import pymapf
     from pymapf.algorithms.pibt import distance_table, pibt_step
 
-    from cosmop.lifelong.dispatch import Offer, choose_assignment
+    from cosmop.lifelong.dispatch import Offer, choose_assignment, window_size
     from cosmop.scenario import parse_scenario
 
     sys.path.insert(0, str(HERE))
@@ -127,7 +126,7 @@ def peer_row(data: dict, until: float, seed: int, reveal: float = 1.0) -> dict:
     }
     scenario = parse_scenario(data)  # the same orders and docks as cosmop's dispatcher sees
     orders = sorted(scenario.orders, key=lambda o: o.at)
-    window = max(1, math.ceil(reveal * len(scene["robots"])))
+    window = window_size(reveal, len(scene["robots"]))
     tables: dict = {}
 
     def dist(goal, cell):

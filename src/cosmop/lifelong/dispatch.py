@@ -19,13 +19,14 @@ passed over for it while another idle robot may serve it (:attr:`OrderState.no_p
 
 from __future__ import annotations
 
-from collections.abc import Collection, Iterable, Sequence
+import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 from cosmop.events import Event
 from cosmop.scene import Order, Scene
 
-__all__ = ["Offer", "OrderState", "choose_assignment", "choose_robot", "delivery_events"]
+__all__ = ["Offer", "OrderState", "choose_assignment", "delivery_events", "window_size"]
 
 
 @dataclass
@@ -112,38 +113,6 @@ def delivery_events(scene: Scene, robot: str, order: Order, goods: Sequence[floa
     )
 
 
-def choose_robot(
-    scene: Scene,
-    order: Order,
-    idle: Iterable[tuple[str, Sequence[float]]],
-    goods: Sequence[float],
-    passed_over: Collection[str] = (),
-) -> str | None:
-    """The idle robot with the least estimated work for `order`, or None when none may serve it;
-    a robot of `passed_over` only when no other idle robot may.
-
-    Parameters
-    ----------
-    scene : Scene
-        The scene (its workspaces place the docks).
-    order : Order
-        The order to serve.
-    idle : iterable of (str, (float, float))
-        The idle robots and where they stand (mm).
-    goods : (float, float)
-        Where the order's goods lie (mm).
-    passed_over : collection of str
-        Robots tried last (those that found no plan for the order, :attr:`OrderState.no_plan_by`).
-
-    Returns
-    -------
-    str or None
-    """
-    work = [(_work(scene, order, at, goods), rid) for rid, at in idle if rid in order.by]
-    fresh = [w for w in work if w[1] not in passed_over]
-    return min(fresh or work)[1] if work else None
-
-
 @dataclass(frozen=True)
 class Offer:
     """An order the dispatcher may give now.
@@ -154,7 +123,8 @@ class Offer:
     goods : tuple of float
         Where its goods lie ``(x, y)``, mm.
     passed_over : frozenset of str
-        Robots tried last for it (:func:`choose_robot`).
+        Robots that found no plan for it from where they stood (:attr:`OrderState.no_plan_by`):
+        given it only when no other idle robot may serve it.
     overdue : bool
         Served before every order that is not (passed over too often for younger ones).
     """
@@ -171,8 +141,9 @@ def choose_assignment(
     """The next order to give and its robot: ``(index in offers, robot)``, or None when no idle
     robot may serve any of them.
 
-    Each offer's robot is :func:`choose_robot`'s; of those pairs the dispatcher takes an overdue
-    offer first (the oldest), else the one of least estimated work, the oldest on a tie.  Over a
+    Each offer's robot is the idle robot of least estimated work that may serve it (one of its
+    `passed_over` only when no other may); of those pairs the dispatcher takes an overdue offer
+    first (the oldest), else the one of least estimated work, the oldest on a tie.  Over a
     window of offers this is the greedy task assignment of lifelong MAPF (each free robot the
     task nearest to it); over one offer, the strict oldest-first rule.
 
@@ -191,15 +162,38 @@ def choose_assignment(
     """
     best: tuple[tuple[bool, float, int], str] | None = None
     for k, offer in enumerate(offers):
-        robot = choose_robot(scene, offer.order, idle, offer.goods, offer.passed_over)
-        if robot is None:
+        found = _least_work(scene, offer, idle)
+        if found is None:
             continue
-        at = next(p for r, p in idle if r == robot)
-        work = 0.0 if offer.overdue else _work(scene, offer.order, at, offer.goods)
-        key = (not offer.overdue, work, k)
+        work, robot = found
+        key = (not offer.overdue, 0.0 if offer.overdue else work, k)
         if best is None or key < best[0]:
             best = (key, robot)
     return None if best is None else (best[0][2], best[1])
+
+
+def window_size(reveal: float, robots: int) -> int:
+    """How many of the oldest orders the dispatcher chooses among: ``ceil(reveal * robots)``,
+    at least one (``reveal`` orders per robot, the League of Robot Runners' ``numTasksReveal``).
+
+    Parameters
+    ----------
+    reveal : float
+        Orders per robot (>= 0).
+    robots : int
+        Robots in the fleet.
+    """
+    return max(1, math.ceil(reveal * robots))
+
+
+def _least_work(
+    scene: Scene, offer: Offer, idle: Sequence[tuple[str, Sequence[float]]]
+) -> tuple[float, str] | None:
+    """The idle robot of least work for `offer`, with that work (mm); a robot it passed over
+    only when no other idle robot may serve it; None when none may."""
+    work = [(_work(scene, offer.order, at, offer.goods), rid) for rid, at in idle if rid in offer.order.by]
+    fresh = [w for w in work if w[1] not in offer.passed_over]
+    return min(fresh or work) if work else None
 
 
 def _work(scene: Scene, order: Order, at: Sequence[float], goods: Sequence[float]) -> float:

@@ -51,7 +51,7 @@ from typing import Any
 import numpy as np
 
 from cosmop.control.geometry import box_gaps
-from cosmop.lifelong.dispatch import Offer, OrderState, choose_assignment, delivery_events
+from cosmop.lifelong.dispatch import Offer, OrderState, choose_assignment, delivery_events, window_size
 from cosmop.lifelong.fleet_result import FleetResult
 from cosmop.planning.plan_types import PlanSet
 from cosmop.scene import Order, Scenario
@@ -326,8 +326,8 @@ def _dispatch(run: _Run, at_dock: Agent | None = None) -> None:
 
 
 def _window(run: _Run) -> int:
-    """Orders the dispatcher chooses among at a time: ``reveal`` per robot, at least one."""
-    return max(1, math.ceil(run.fleet.reveal * len(run.world.robot_ids)))
+    """Orders the dispatcher chooses among at a time (:func:`~cosmop.lifelong.dispatch.window_size`)."""
+    return window_size(run.fleet.reveal, len(run.world.robot_ids))
 
 
 def _offers(run: _Run, idle: Collection[str]) -> Iterator[tuple[OrderState, tuple[float, ...]]]:
