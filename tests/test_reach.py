@@ -10,7 +10,7 @@ import cosmop.planning.synthesis as synthesis_module
 from cosmop.errors import ScenarioError
 from cosmop.events import Event
 from cosmop.planning.checker import check_robot_plan
-from cosmop.planning.reach import unreachable
+from cosmop.planning.reach import event_place, least_drives, unreachable
 from cosmop.planning.specification import MOTION_MARGIN
 from cosmop.planning.synthesis import synthesize
 from cosmop.scenario import load_scenario, parse_scenario
@@ -115,3 +115,46 @@ def test_whatever_it_refuses_the_solver_cannot_plan(seed, monkeypatch):
         if found == 2:
             break
     assert found >= 1
+
+
+def _places(scene, events):
+    return [event_place(scene, "R1", e) for e in events]
+
+
+def test_least_drives_counts_the_turns_the_walls_force():
+    open_room = _scene([])
+    assert least_drives(open_room, "R1", _places(open_room, PICK)) == 3  # each place seen from the last
+    # a shelf between the robot and the goods, open at the top: to the goods and back home, two each
+    shelf = _scene([[[0, -2000], [0, 1000]]])
+    assert least_drives(shelf, "R1", _places(shelf, PICK)) == 2 + 2 + 1
+    assert least_drives(shelf, "R1", []) == 0  # nowhere to go
+    assert least_drives(shelf, "R1", _places(shelf, PICK[2:])) == 0  # already home
+    result = synthesize(shelf, "R1", PICK, max_horizon=12)
+    assert result.feasible and result.horizon >= 2 + 5  # the pick and the drop, and five drives
+    # a horizon shorter than that is refused by counting, without the solver
+    short = synthesize(shelf, "R1", PICK, max_horizon=6)
+    assert not short.feasible and short.checks == 0
+    assert "needs at least 7 steps" in short.reason and "--max-horizon" in short.reason
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_counted_drives_never_exceed_a_plan(seed):
+    # random shelves: every plan the solver finds drives at least as often as counted
+    rng = random.Random(100 + seed)
+    compared = 0
+    while compared < 3:
+        walls = []
+        for _ in range(rng.randint(1, 3)):
+            x = rng.randrange(-2000, 2001, 250)
+            y0 = rng.choice([-2000, rng.randrange(-1500, 0, 250)])
+            walls.append([[x, y0], [x, rng.choice([2000, rng.randrange(0, 1500, 250)])]])
+        try:
+            scene = _scene(walls, obj=(rng.randrange(-1000, 2500, 250), rng.randrange(-1500, 1500, 250)))
+        except ScenarioError:  # a shelf through the object or the robot: not a scene at all
+            continue
+        result = synthesize(scene, "R1", PICK, max_horizon=9, explain=False)
+        if not result.feasible:
+            continue
+        drives = sum(1 for step in result.plan.steps if step.primitive == "GoTo")
+        assert least_drives(scene, "R1", _places(scene, PICK)) <= drives
+        compared += 1

@@ -7,6 +7,7 @@ of a scene and the global paths all grow walls and motions by the same square.
 from __future__ import annotations
 
 from collections.abc import Iterable
+from functools import lru_cache
 
 import numpy as np
 import shapely
@@ -111,6 +112,11 @@ def swept_square(start: Iterable[float], end: Iterable[float], side: float) -> P
     """
     x0, y0, *_ = start
     x1, y1, *_ = end
+    return _swept(float(x0), float(y0), float(x1), float(y1), float(side))
+
+
+@lru_cache(maxsize=1 << 16)  # a running fleet asks again for every robot's drives at every hand-over
+def _swept(x0: float, y0: float, x1: float, y1: float, side: float) -> Polygon:
     first = square(x0, y0, side)
     if abs(x1 - x0) == 0 and abs(y1 - y0) == 0:
         return first

@@ -16,6 +16,10 @@ If not, the event is unreachable at any horizon.  Ignoring objects only enlarges
 space, and the walls are grown by the exact Minkowski sum with the square, less half a
 millimetre (a passage exactly one robot wide stays open), so the test never refuses a
 feasible mission; it proves only what no plan can do.
+
+The same free space bounds how many drives a plan needs (:func:`least_drives`): a mission that
+needs more steps than the search allows is refused without the solver.  Most missions are
+reached by the free space near the robot and its places (the walls far away are not grown).
 """
 
 from __future__ import annotations
@@ -27,11 +31,11 @@ import shapely
 
 from cosmop.docking import docking_pose
 from cosmop.events import Event
-from cosmop.scene import Scene
+from cosmop.scene import Scene, Workspace
 from cosmop.squares import docking_places
 from cosmop.units import show_point
 
-__all__ = ["free_component", "unreachable"]
+__all__ = ["event_place", "free_component", "least_drives", "unreachable"]
 
 _SLACK = 0.5  # mm the grown walls are shrunk by: touching and one-robot-wide passages stay free
 
@@ -62,36 +66,88 @@ def unreachable(
     body = scene.robots[robot]
     half = body.size / 2.0
     x0, y0 = start if start is not None else body.pose[:2]
+    places = [
+        (i, e, event_place(scene, robot, e)) for i, e in enumerate(events, 1) if e.kind in ("pick", "drop")
+    ]
+    if not places or _reached_nearby(scene, half, (x0, y0), [where for _, _, where in places]):
+        return None
     component = free_component(scene, half, (x0, y0))
     if component is None:
         return None
-    for i, event in enumerate(events, 1):
-        if event.kind not in ("pick", "drop"):
-            continue
-        assert event.obj is not None  # picks and drops name their object
-        d = (body.size + scene.objects[event.obj].size) / 2.0
-        if event.kind == "pick":
-            obj = scene.objects[event.obj]
-            poses = [docking_pose(obj.position, d, h) for h in obj.headings]
-            where = shapely.MultiPoint(poses)
-            sides = ", ".join(
-                f"{side} {show_point(pose, scene.units)}" for side, pose in zip(obj.sides, poses, strict=True)
-            )
-            what = f"its pick poses on the sides tried: {sides}"
-        else:
-            assert event.workspace is not None  # a drop names its workspace
-            obj = scene.objects[event.obj]
-            centres = scene.workspaces[event.workspace].centres(obj.size)
-            where = shapely.union_all(docking_places(*centres.ranges, d, obj.headings))
-            what = f"any pose that drops {event.obj} in {event.workspace}"
-            what += f" (sides tried: {', '.join(obj.sides)})"
+    for i, event, where in places:
         if not component.intersects(where):
             return (
                 f"{robot} cannot reach {event.name} (event {i} of its mission) at any horizon: "
                 f"{_separating(scene, half, (x0, y0), where)} its start "
-                f"{show_point((x0, y0), scene.units)} from {what}"
+                f"{show_point((x0, y0), scene.units)} from {_place_words(scene, robot, event)}"
             )
     return None
+
+
+def event_place(
+    scene: Scene,
+    robot: str,
+    event: Event,
+    at: tuple[float, float] | None = None,
+    centres: Workspace | None = None,
+) -> shapely.Geometry | None:
+    """Where `event` needs the robot's centre (mm), or ``None`` for an event without a place:
+    a pick's poses facing its goods, a drop's every pose that puts its goods in the workspace
+    (PickUp's and DropOff's poses, :func:`~cosmop.squares.docking_places`), a return's home.
+
+    Parameters
+    ----------
+    scene : Scene
+    robot : str
+        The robot's id.
+    event : Event
+    at : tuple of float, optional
+        Where a pick's goods lie (mm), if not where the scene puts them.
+    centres : Workspace, optional
+        Where a drop may put its goods' centre, if not anywhere inside its workspace.
+    """
+    body = scene.robots[robot]
+    if event.kind == "return":
+        return shapely.Point(body.pose[:2])
+    if event.kind not in ("pick", "drop"):
+        return None
+    assert event.obj is not None  # picks and drops name their object
+    obj = scene.objects[event.obj]
+    d = (body.size + obj.size) / 2.0
+    if event.kind == "pick":
+        return shapely.MultiPoint([docking_pose(at or obj.position, d, h) for h in obj.headings])
+    assert event.workspace is not None  # a drop names its workspace
+    centres = centres or scene.workspaces[event.workspace].centres(obj.size)
+    return shapely.union_all(docking_places(*centres.ranges, d, obj.headings))
+
+
+def _place_words(scene: Scene, robot: str, event: Event) -> str:
+    """The places of :func:`event_place` in words, for a pick or a drop."""
+    assert event.obj is not None  # picks and drops name their object
+    obj = scene.objects[event.obj]
+    if event.kind == "pick":
+        d = (scene.robots[robot].size + obj.size) / 2.0
+        poses = [docking_pose(obj.position, d, h) for h in obj.headings]
+        sides = ", ".join(
+            f"{side} {show_point(pose, scene.units)}" for side, pose in zip(obj.sides, poses, strict=True)
+        )
+        return f"its pick poses on the sides tried: {sides}"
+    return f"any pose that drops {event.obj} in {event.workspace} (sides tried: {', '.join(obj.sides)})"
+
+
+def _reached_nearby(
+    scene: Scene, half: float, start: tuple[float, float], places: Sequence[shapely.Geometry]
+) -> bool:
+    """Whether the free space inside a box around `start` and `places` already joins the start
+    to every place: then the whole free space does (it holds that part), and the walls far
+    away need not be grown and joined (most of a warehouse's, for most missions)."""
+    lo_x, lo_y, hi_x, hi_y = shapely.union_all([shapely.Point(start), *places]).bounds
+    room = 4 * half + 1000.0
+    box = (lo_x - room, lo_y - room, hi_x + room, hi_y + room)
+    free = shapely.box(*box).difference(scene.blocked(half, _SLACK, within=box))
+    point = shapely.Point(start).buffer(_SLACK)
+    part = next((g for g in getattr(free, "geoms", [free]) if g.intersects(point)), None)
+    return part is not None and all(part.intersects(where) for where in places)
 
 
 def _separating(scene: Scene, half: float, start: tuple[float, float], where: shapely.Geometry) -> str:
@@ -153,3 +209,60 @@ def free_component(scene: Scene, half: float, start: tuple[float, float]) -> sha
         if part.intersects(point.buffer(_SLACK)):
             return part
     return None  # the start itself is inside a wall: leave the verdict to the solver
+
+
+def least_drives(
+    scene: Scene, robot: str, places: Sequence[shapely.Geometry], start: tuple[float, float] | None = None
+) -> int:
+    """Fewest GoTo steps of any plan that takes `robot` from `start` to each of `places` in turn.
+
+    A lower bound, sound for the same reason as :func:`unreachable`: each GoTo is one straight
+    drive whose centre path stays in the free space (walls grown by the robot's square, less
+    :data:`_SLACK`; objects ignored, which only enlarges it).  Between two consecutive places
+    :math:`P` and :math:`Q` a plan drives at least
+
+    * 0 times if they meet;
+    * once if one straight drive may join them: some part of the free space inside the convex
+      hull of :math:`P \\cup Q` touches both (a drive from :math:`p \\in P` to :math:`q \\in Q`
+      lies in that hull, and is connected);
+    * twice otherwise.
+
+    The bound is the sum over the legs: a plan's drives split at the instants it is at each place.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene whose walls block the robot.
+    robot : str
+        The robot's id.
+    places : sequence of shapely geometries
+        Where the robot must be, in order (mm): its pick poses, drop poses, home.
+    start : tuple of float, optional
+        Where the robot starts (mm), if not its pose in the scene.
+
+    Returns
+    -------
+    int
+    """
+    body = scene.robots[robot]
+    here = shapely.Point(start if start is not None else body.pose[:2])
+    total = 0
+    for there in places:
+        if here.distance(there) > _TOUCH:
+            total += 1 if _one_drive_may_join(scene, body.size / 2.0, here, there) else 2
+        here = there
+    return total
+
+
+_TOUCH = 1e-3  # mm within which two places count as meeting: floating point is not exact
+
+
+def _one_drive_may_join(scene: Scene, half: float, a: shapely.Geometry, b: shapely.Geometry) -> bool:
+    """Whether a straight drive of a square of half-side `half` might join `a` to `b`: whether
+    one piece of the free space inside their convex hull comes within :data:`_TOUCH` of both."""
+    hull = shapely.union(a, b).convex_hull
+    blocked = scene.blocked(half, _SLACK, within=hull.bounds) if scene.obstacles else None
+    if blocked is None or blocked.is_empty:
+        return True
+    free = hull.difference(blocked)
+    return any(part.dwithin(a, _TOUCH) and part.dwithin(b, _TOUCH) for part in getattr(free, "geoms", [free]))

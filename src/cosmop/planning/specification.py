@@ -112,7 +112,15 @@ def position_sort(scene: Scene, start: State | None = None, spots: Iterable[tupl
     if start is not None:  # a plan from a given state (mid-run) starts exactly there
         numbers += [*start.robot[:2], *(v for o in start.objects.values() for v in o.position)]
     numbers += [v for spot in spots for v in spot]
-    return "int" if all(_num(v).denominator == 1 for v in numbers) else "real"
+    return "int" if all(_whole(v) for v in numbers) else "real"
+
+
+def _whole(value: float) -> bool:
+    """Whether `value` is a whole number (mm), as :func:`_num` reads it; a float is tested
+    directly (a warehouse's thousands of goods would otherwise each make three fractions)."""
+    if isinstance(value, float):
+        return value.is_integer()
+    return _num(value).denominator == 1
 
 
 def heading_sort(scene: Scene, robot: str, start: State | None = None) -> str:
@@ -210,6 +218,11 @@ class ObjectVars:
 def _negated(flag: Var | Formula) -> Formula:
     """:math:`\\neg` `flag`, folded when it is a constant."""
     return FALSE if flag == TRUE else TRUE if flag == FALSE else ~flag
+
+
+def _flag(value: bool) -> Formula:
+    """A fixed flag as a formula."""
+    return TRUE if value else FALSE
 
 
 def _later(term: Any) -> Any:
@@ -496,14 +509,30 @@ class RobotProblem:
         out: dict[str, ObjectVars] = {}
         for o in self.scene.objects:
             position, carried, away = self.at_start(o)
+            if o not in handled and o not in asked:  # nothing varies: values only
+                out[o] = ObjectVars(_num(position[0]), _num(position[1]), _flag(carried), _flag(away))
+                continue
             v = ObjectVars.named(o, self.sort)
             out[o] = ObjectVars(
                 v.x if o in handled else _num(position[0]),
                 v.y if o in handled else _num(position[1]),
-                v.carried if o in handled else (TRUE if carried else FALSE),
-                v.away if o in asked else (TRUE if away else FALSE),
+                v.carried if o in handled else _flag(carried),
+                v.away if o in asked else _flag(away),
             )
         return out
+
+    @cached_property
+    def varying_objects(self) -> tuple[str, ...]:
+        """The objects with a field that varies (:attr:`objects`: a variable), in the scene's
+        order.  Every frame condition and flag over the objects needs only these, and
+        :attr:`carried_elsewhere`: the others' fields are values that keep themselves."""
+        return tuple(o for o, v in self.objects.items() if v.varies)
+
+    @cached_property
+    def carried_elsewhere(self) -> bool:
+        """Whether an object whose fields are fixed is carried (by another robot, as `start`
+        knows it): then this robot can never pick or drop, as it would hold two."""
+        return any(v.carried == TRUE for v in self.objects.values())
 
     # asked for every object of every part: worked out once (a warehouse holds thousands of goods)
     @cached_property
@@ -580,11 +609,37 @@ class RobotProblem:
         handling : bool
             The walls to picks and drops, not to drives.
         """
-        return [(i, w) for i, w in enumerate(self.scene.obstacles) if self.written(wall_key(i, handling))]
+        return [(i, self.scene.obstacles[i]) for i in self._written_walls(handling, past_ends=False)]
 
     def obstacle_objects(self) -> list[str]:
         """The objects whose parts as obstacles are written (:attr:`obstacles`)."""
-        return [o for o in self.scene.objects if self.written(object_key(o))]
+        return self._written_objects(past_ends=False)
+
+    def _written_walls(self, handling: bool, past_ends: bool | None) -> list[int]:
+        """Indices of the walls with a written key of that `handling` and `past_ends` (``None``:
+        either), ascending.  From the keys, not the scene: a warehouse has thousands of walls
+        and a lazy problem writes a few."""
+        if self.obstacles is None:
+            return list(range(len(self.scene.obstacles)))
+        return sorted(
+            {
+                k.wall
+                for k in self.obstacles
+                if k.wall is not None and k.handling == handling and past_ends in (None, k.past_ends)
+            }
+        )
+
+    def _written_objects(self, past_ends: bool | None) -> list[str]:
+        """The objects with a written key of that `past_ends` (``None``: either), in the scene's order."""
+        if self.obstacles is None:
+            return list(self.scene.objects)
+        written = {k.obj for k in self.obstacles if k.obj is not None and past_ends in (None, k.past_ends)}
+        return [o for o in self.scene.objects if o in written] if written else []
+
+    def drive_obstacles(self) -> tuple[list[int], list[str]]:
+        """The walls (indices) and objects with a GoTo part written (their own or the stronger,
+        :func:`corner_clearance_key`)."""
+        return self._written_walls(False, past_ends=None), self._written_objects(past_ends=None)
 
     def at_start(self, obj: str) -> tuple[tuple[float, float], bool, bool]:
         """``(position, carried, away)`` of `obj` at instant 0: in `start`, else the scenario's.
@@ -848,7 +903,7 @@ def _objects_static(p: RobotProblem, *, carried: bool = True, skip: str | None =
     """Every object but `skip` keeps its position (and carried flag).  ``away`` flags have one
     frame axiom each instead (:func:`away_frames`): only a request changes one."""
     out: list[Var | Fraction | Formula] = []
-    for o in p.scene.objects:
+    for o in p.varying_objects:  # the others' fields are values: they keep themselves
         if o == skip:
             continue
         v = p.obj(o)
@@ -1018,7 +1073,9 @@ class GoTo(Encoding):
     def parts(self, p: RobotProblem, obj: str | None) -> list[tuple[PartName, Formula]]:
         x, y = p.x, p.y
         out: list[tuple[PartName, Formula]] = [("GoTo keeps the objects", _objects_static(p))]
-        for i, wall in enumerate(p.scene.obstacles):
+        walls, objects = p.drive_obstacles()
+        for i in walls:
+            wall = p.scene.obstacles[i]
             if written := _goto_parts(p, wall_key(i)):
                 sides = _wall_sides(p, wall, wall_key(i).text)
                 coordinates = f" {[list(wall.start), list(wall.end)]}"
@@ -1026,7 +1083,7 @@ class GoTo(Encoding):
                     (ObstaclePart(key, key.text, after=coordinates), _apart(x, y, sides, ends=key.past_ends))
                     for key in written
                 ]
-        for o in p.scene.objects:
+        for o in objects:
             if written := _goto_parts(p, object_key(o)):
                 v = p.obj(o)
                 sides = _object_sides(v, p.clearance(o), p.margin)
@@ -1057,9 +1114,10 @@ class PickUp(Encoding):
         assert obj is not None  # PickUp acts on an object
         v, d = p.obj(obj), p.clearance(obj)
         assert isinstance(v.x, Var) and isinstance(v.y, Var)  # its own goods: their position varies
-        now = [_negated(p.obj(o).carried) for o in p.scene.objects]
-        later = [(_later if o == obj else _released)(p.obj(o).carried) for o in p.scene.objects]
-        carry = conj(now + later)
+        # the robot's hands are empty now, hold `obj` next; the fixed flags: none is carried
+        now = [_negated(p.obj(o).carried) for o in p.varying_objects]
+        later = [(_later if o == obj else _released)(p.obj(o).carried) for o in p.varying_objects]
+        carry = conj([_flag(not p.carried_elsewhere), *now, *later])
         pose = _docked(p, obj, v.x, v.y, d) & ~v.away
         out = [(f"PickUp {obj}", _robot_static(p) & carry & pose & _objects_static(p, carried=False))]
         return out + _gripper_clear(p, obj, v.x, v.y) + _handling_room(p, obj, _pick_places(p, obj))
@@ -1078,8 +1136,11 @@ class DropOff(Encoding):
         assert obj is not None  # DropOff acts on an object
         v, d = p.obj(obj), p.clearance(obj)
         assert isinstance(v.x, Var) and isinstance(v.y, Var)  # its own goods: their position varies
-        held = conj(p.obj(o).carried if o == obj else _negated(p.obj(o).carried) for o in p.scene.objects)
-        released = conj(_released(p.obj(o).carried) for o in p.scene.objects)
+        # only `obj` is held now, nothing next; the fixed flags: none is carried
+        fixed = _flag(not p.carried_elsewhere)
+        flags = {o: p.obj(o).carried for o in p.varying_objects}
+        held = conj([fixed, *(flag if o == obj else _negated(flag) for o, flag in flags.items())])
+        released = conj([fixed, *(_released(p.obj(o).carried) for o in p.varying_objects)])
         place = _docked(p, obj, v.x.next(), v.y.next(), d)
         rest = _objects_static(p, carried=False, skip=obj)
         out: list[tuple[PartName, Formula]] = [
@@ -1266,7 +1327,7 @@ def initial_state(p: RobotProblem) -> Formula:
     """
     x0, y0, h0 = p.start.robot if p.start is not None else p.scene.robots[p.robot].pose
     parts = [p.x.eq(_num(x0)), p.y.eq(_num(y0)), p.h.eq(_num(h0)), p.pi.eq(NONE)]
-    for o in p.scene.objects:
+    for o in p.varying_objects:  # the others' values already hold
         position, carried, away = p.at_start(o)
         v = p.obj(o)
         for term, value in ((v.x, position[0]), (v.y, position[1])):

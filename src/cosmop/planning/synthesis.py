@@ -45,6 +45,7 @@ from fractions import Fraction
 from typing import Any
 
 import numpy as np
+import shapely
 import z3
 
 from cosmop.automata import DFA
@@ -55,7 +56,7 @@ from cosmop.logic import Formula, IncrementalUnrolling, Signature, Unrolling, as
 from cosmop.planning.messages import answer_early, place_mission_messages, strip_messages, wait_early
 from cosmop.planning.obstacles import Geometry
 from cosmop.planning.plan_types import ObjectState, ObjectStates, RobotPlan, State, Step
-from cosmop.planning.reach import unreachable
+from cosmop.planning.reach import event_place, least_drives, unreachable
 from cosmop.planning.specification import (
     MOTION_MARGIN,
     NONE,
@@ -148,7 +149,7 @@ def _plan(
     steps: list[Step] = []
     requested: list[str] = []
     # most objects have no variable (the plan never moves them): read once, kept in every step
-    varying = [o for o in p.scene.objects if p.obj(o).varies]
+    varying = p.varying_objects
     every = ObjectStates({o: _object_state(p, o, trace[0]) for o in p.scene.objects})
     for state in trace[1:]:
         action = decode(p, int(state["pi"]))
@@ -276,6 +277,16 @@ def synthesize(
         margin=margin,
         spots=spots,
     )
+    least = _least_horizon(p, m)
+    if least > max_horizon:  # counting alone rules every plan out: say so without the solver
+        why = (
+            f"{robot}'s mission needs at least {least} steps (one per pick and drop, and the drives "
+            f"between the places they need, around the walls), more than the horizon {max_horizon} "
+            "(raise --max-horizon)"
+        )
+        return Synthesis(robot, False, None, None, reason=why, solve_s=time.perf_counter() - t0)
+    # the search still starts at the events' count: starting at `least` finds plans as short,
+    # but the solver's first model there differs (other routes, timings) for no measured gain
     found = _shortest_plan(p, max(m.lower, min_horizon), max_horizon, rlimit, incremental, lazy, route_rounds)
     if found.plan is not None:
         return found.synthesis(robot, t0, plan=_place_messages(p, found.plan, m.full))
@@ -368,6 +379,31 @@ def _out_of_hand(robot: str, events: Iterable[Event], start: State | None) -> st
 def _least_steps(events: Iterable[Event]) -> int:
     """Fewest steps of a plan that performs `events`: one per event but ``return``."""
     return sum(1 for e in events if e.kind != "return")
+
+
+def _least_horizon(p: RobotProblem, m: _Mission) -> int:
+    """Fewest steps of a plan of the sequence mission `m`: a step per event but ``return``
+    (:func:`_least_steps`), and the drives between the places the events need the robot at
+    (:func:`~cosmop.planning.reach.least_drives`); 0 for a branching mission (not bounded here).
+    A horizon below it has no plan: a mission that needs more steps than the search allows is
+    refused without the solver.
+    """
+    if m.automaton is not None:
+        return 0
+    places = [where for e in m.events if (where := _place(p, e)) is not None]
+    origin = p.start.robot[:2] if p.start is not None else None
+    return m.lower + least_drives(p.scene, p.robot, places, origin)
+
+
+def _place(p: RobotProblem, event: Event) -> shapely.Geometry | None:
+    """Where `event` needs the robot's centre (:func:`~cosmop.planning.reach.event_place`), with
+    the goods where `p` starts them and a drop's spot where it is pinned."""
+    if event.kind == "pick":
+        assert event.obj is not None  # a pick names its goods
+        return event_place(p.scene, p.robot, event, at=p.at_start(event.obj)[0])
+    if event.kind == "drop":
+        return event_place(p.scene, p.robot, event, centres=p.drop_centres(event))
+    return event_place(p.scene, p.robot, event)
 
 
 def _problem(

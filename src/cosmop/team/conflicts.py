@@ -34,6 +34,7 @@ import itertools
 import math
 from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import lru_cache
 
 import numpy as np
 import shapely
@@ -238,19 +239,37 @@ def _robot_occupancies(
     A standing robot's body, which goods keep clear of, is its square grown by `rest`; the
     words show lengths in `units`.
     """
-    K = plan.horizon
-    poses = [start.robot, *(s.robot for s in plan.steps)]
+    motion = (tuple(start.robot), tuple((step.primitive, tuple(step.robot)) for step in plan.steps))
+    return list(_motion_occupancies(robot, motion, side, tuple(home), grow, rest, units))
+
+
+@lru_cache(maxsize=4096)  # a running fleet asks again for every robot's rest at every hand-over
+def _motion_occupancies(
+    robot: str,
+    motion: tuple[tuple[float, ...], tuple[tuple[Primitive, tuple[float, ...]], ...]],
+    side: float,
+    home: tuple[float, ...],
+    grow: float,
+    rest: float,
+    units: UnitSystem,
+) -> tuple[Occupancy, ...]:
+    """:func:`_robot_occupancies` of the `motion` ``(start pose, ((primitive, pose), ...))``:
+    all they depend on of a plan."""
+    start, moves = motion
+    primitives = [primitive for primitive, _ in moves]
+    K = len(moves)
+    poses = [start, *(pose for _, pose in moves)]
     party = frozenset((robot,))
     bare = square(poses[0][0], poses[0][1], side - grow)  # its body at its start
-    first_drive = next((k for k, s in enumerate(plan.steps, 1) if s.primitive == Primitive.GOTO), 0)
+    first_drive = next((k for k, primitive in enumerate(primitives, 1) if primitive == Primitive.GOTO), 0)
     # home again at the end: the gap the scene gave it there holds again (see `conflicts`)
-    homing = _homing_drive(plan, poses, home)
+    homing = _homing_drive(primitives, poses, home)
     at_home = square(home[0], home[1], side - grow)
     out: list[Occupancy] = []
     k = 0
     while k <= K:
         end = k
-        while end < K and plan.steps[end].primitive != Primitive.GOTO:
+        while end < K and primitives[end] != Primitive.GOTO:
             end += 1  # steps end+1 keep the pose
         x, y, _ = poses[k]
         first = None if k == 0 else (robot, k)
@@ -258,7 +277,7 @@ def _robot_occupancies(
         where = "at its start" if k == 0 else f"from instant {k}"
         fixed = (
             k == 0
-            or any(plan.steps[i].primitive == Primitive.PICKUP for i in range(k, end))
+            or any(primitives[i] == Primitive.PICKUP for i in range(k, end))
             or (end == K and at_pose(poses[k], home))
         )
         out.append(
@@ -277,8 +296,8 @@ def _robot_occupancies(
             )
         )
         k = end + 1
-    for k, step in enumerate(plan.steps, 1):
-        if step.primitive == Primitive.GOTO:
+    for k, primitive in enumerate(primitives, 1):
+        if primitive == Primitive.GOTO:
             p, q = poses[k - 1], poses[k]
             out.append(
                 Occupancy(
@@ -296,17 +315,20 @@ def _robot_occupancies(
                     start=bare if k == first_drive else at_home if k == homing else None,
                 )
             )
-    return out
+    return tuple(out)
 
 
-def _homing_drive(plan: RobotPlan, poses: Sequence[Sequence[float]], home: Sequence[float]) -> int | None:
-    """The instant `k` of the GoTo that brings the robot home for good (its plan keeps that pose
-    from instant `k` to the end), or ``None`` when the plan does not end at `home` after a drive."""
-    K = plan.horizon
+def _homing_drive(
+    primitives: Sequence[Primitive], poses: Sequence[Sequence[float]], home: Sequence[float]
+) -> int | None:
+    """The instant `k` of the GoTo that brings the robot home for good (its plan, the
+    `primitives` of its steps, keeps that pose from instant `k` to the end), or ``None`` when
+    the plan does not end at `home` after a drive."""
+    K = len(primitives)
     if K == 0 or not at_pose(poses[K], home):
         return None
     k = K
-    while k > 0 and plan.steps[k - 1].primitive != Primitive.GOTO:
+    while k > 0 and primitives[k - 1] != Primitive.GOTO:
         k -= 1
     return k or None
 
