@@ -41,6 +41,20 @@ def _scene(walls, robot=(-2000, 0), obj=(2000, 0)):
 PICK = (Event("pick", "R1", obj="O1"), Event("drop", "R1", obj="O1", workspace="W1"), Event("return", "R1"))
 
 
+def _random_shelves(rng):
+    """The room with one to three random shelves and the goods somewhere, or None when a shelf
+    runs through the goods or the robot."""
+    walls = []
+    for _ in range(rng.randint(1, 3)):
+        x = rng.randrange(-2000, 2001, 250)
+        y0 = rng.choice([-2000, rng.randrange(-1500, 0, 250)])
+        walls.append([[x, y0], [x, rng.choice([2000, rng.randrange(0, 1500, 250)])]])
+    try:
+        return _scene(walls, obj=(rng.randrange(-1000, 2500, 250), rng.randrange(-1500, 1500, 250)))
+    except ScenarioError:
+        return None
+
+
 def test_a_wall_without_a_door_is_proved_at_once():
     scene = _scene([[[0, -2000], [0, 2000]]])
     why = unreachable(scene, "R1", PICK)
@@ -97,14 +111,8 @@ def test_whatever_it_refuses_the_solver_cannot_plan(seed, monkeypatch):
     rng = random.Random(seed)
     found = 0
     for _ in range(40):
-        walls = []
-        for _ in range(rng.randint(1, 3)):
-            x = rng.randrange(-2000, 2001, 250)
-            y0 = rng.choice([-2000, rng.randrange(-1500, 0, 250)])
-            walls.append([[x, y0], [x, rng.choice([2000, rng.randrange(0, 1500, 250)])]])
-        try:
-            scene = _scene(walls, obj=(rng.randrange(-1000, 2500, 250), rng.randrange(-1500, 1500, 250)))
-        except ScenarioError:  # a shelf through the object or the robot: not a scene at all
+        scene = _random_shelves(rng)
+        if scene is None:  # a shelf through the object or the robot: not a scene at all
             continue
         if unreachable(scene, "R1", PICK[:1]) is None:
             continue
@@ -143,14 +151,8 @@ def test_the_counted_drives_never_exceed_a_plan(seed):
     rng = random.Random(100 + seed)
     compared = 0
     while compared < 3:
-        walls = []
-        for _ in range(rng.randint(1, 3)):
-            x = rng.randrange(-2000, 2001, 250)
-            y0 = rng.choice([-2000, rng.randrange(-1500, 0, 250)])
-            walls.append([[x, y0], [x, rng.choice([2000, rng.randrange(0, 1500, 250)])]])
-        try:
-            scene = _scene(walls, obj=(rng.randrange(-1000, 2500, 250), rng.randrange(-1500, 1500, 250)))
-        except ScenarioError:  # a shelf through the object or the robot: not a scene at all
+        scene = _random_shelves(rng)
+        if scene is None:  # a shelf through the object or the robot: not a scene at all
             continue
         result = synthesize(scene, "R1", PICK, max_horizon=9, explain=False)
         if not result.feasible:
