@@ -139,6 +139,9 @@ def test_least_drives_counts_the_turns_the_walls_force():
     assert least_drives(shelf, "R1", _places(shelf, PICK[2:])) == 0  # already home
     result = synthesize(shelf, "R1", PICK, max_horizon=12)
     assert result.feasible and result.horizon >= 2 + 5  # the pick and the drop, and five drives
+    # goods picked again where the mission put them are not counted (their place is not known)
+    again = (*PICK[:2], Event("pick", "R1", obj="O1"))
+    assert synthesize(shelf, "R1", again, max_horizon=3, explain=False).checks > 0
     # a horizon shorter than that is refused by counting, without the solver
     short = synthesize(shelf, "R1", PICK, max_horizon=6)
     assert not short.feasible and short.checks == 0

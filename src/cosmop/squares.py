@@ -115,7 +115,7 @@ def swept_square(start: Iterable[float], end: Iterable[float], side: float) -> P
     return _swept(float(x0), float(y0), float(x1), float(y1), float(side))
 
 
-@lru_cache(maxsize=1 << 16)  # a running fleet asks again for every robot's drives at every hand-over
+@lru_cache(maxsize=1 << 14)  # a running fleet asks again for every robot's drives at every hand-over
 def _swept(x0: float, y0: float, x1: float, y1: float, side: float) -> Polygon:
     first = square(x0, y0, side)
     if abs(x1 - x0) == 0 and abs(y1 - y0) == 0:

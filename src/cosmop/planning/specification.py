@@ -530,8 +530,8 @@ class RobotProblem:
 
     @cached_property
     def carried_elsewhere(self) -> bool:
-        """Whether an object whose fields are fixed is carried (by another robot, as `start`
-        knows it): then this robot can never pick or drop, as it would hold two."""
+        """Whether an object's carried flag is a fixed true (another robot carries it, as
+        `start` knows it): then this robot can never pick or drop, as it would hold two."""
         return any(v.carried == TRUE for v in self.objects.values())
 
     # asked for every object of every part: worked out once (a warehouse holds thousands of goods)

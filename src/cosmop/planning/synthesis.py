@@ -390,6 +390,12 @@ def _least_horizon(p: RobotProblem, m: _Mission) -> int:
     """
     if m.automaton is not None:
         return 0
+    dropped: set[str | None] = set()
+    for e in m.events:  # goods picked again where the mission put them: their place is not known here
+        if e.kind == "pick" and e.obj in dropped:
+            return m.lower
+        if e.kind == "drop":
+            dropped.add(e.obj)
     places = [where for e in m.events if (where := _place(p, e)) is not None]
     origin = p.start.robot[:2] if p.start is not None else None
     return m.lower + least_drives(p.scene, p.robot, places, origin)
