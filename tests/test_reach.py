@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import random
+from dataclasses import replace
 
 import pytest
 
@@ -14,6 +15,7 @@ from cosmop.planning.reach import event_place, least_drives, unreachable
 from cosmop.planning.specification import MOTION_MARGIN
 from cosmop.planning.synthesis import synthesize
 from cosmop.scenario import load_scenario, parse_scenario
+from cosmop.scene import Wall
 
 ROOM = [
     [[-3000, -2000], [3000, -2000]],
@@ -163,3 +165,24 @@ def test_the_counted_drives_never_exceed_a_plan(seed):
         drives = sum(1 for step in result.plan.steps if step.primitive == "GoTo")
         assert least_drives(scene, "R1", _places(scene, PICK)) <= drives
         compared += 1
+
+
+def test_a_way_round_far_outside_the_places_is_still_found():
+    # a long shelf between the robot and the goods, open only far below both: the free space
+    # near them does not join them, the whole map does
+    room = [[[-3000, -9000], [3000, -9000]], [[3000, -9000], [3000, 2000]], [[-3000, -9000], [-3000, 2000]]]
+    scene = parse_scenario(
+        {
+            "name": "reach",
+            "scene": {
+                "obstacles": [*ROOM[2:3], *room, [[0, -7500], [0, 2000]]],
+                "robots": {"R1": {"size": 400, "pose": [-2000, 0, 0]}},
+                "objects": {"O1": {"size": 200, "position": [2000, 0]}},
+                "workspaces": {"W1": {"x": [-2800, -2200], "y": [1000, 1800]}},
+            },
+            "mission": {"tasks": {"R1": ["return"]}},
+        }
+    ).scene
+    assert unreachable(scene, "R1", PICK) is None
+    closed = replace(scene, obstacles=(*scene.obstacles, Wall((0.0, -9000.0), (0.0, -7500.0))))
+    assert unreachable(closed, "R1", PICK) is not None
