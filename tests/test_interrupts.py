@@ -12,6 +12,7 @@ import json
 import multiprocessing
 import os
 import random
+import subprocess
 import sys
 import threading
 import time
@@ -120,3 +121,23 @@ def test_ctrl_c_during_a_lifelong_run_writes_what_was_delivered_so_far(tmp_path,
     assert data["interrupted"] is True and 0 < data["until_s"] < 1_000_000
     assert data["orders"]["released"] == sum(o["at"] <= data["until_s"] for o in data["order_log"])
     assert json.loads(trace.read_text())["frames"]  # the trace of the same run so far
+
+
+def test_a_ctrl_c_python_had_to_swallow_still_ends_the_program():
+    # a KeyboardInterrupt raised in a finaliser cannot propagate (Python prints "Exception
+    # ignored" and goes on); the program ends as a second Ctrl-C would, without a traceback
+    code = (
+        "import time, cosmop.cli, cosmop._entry as entry\n"
+        "class Finaliser:\n"
+        "    def __del__(self):\n"
+        "        raise KeyboardInterrupt\n"
+        "def main():\n"
+        "    Finaliser()\n"
+        "    time.sleep(20)\n"
+        "cosmop.cli.main = main\n"
+        "entry.run()\n"
+    )
+    start = time.perf_counter()
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert (done.returncode, done.stderr) == (130, "interrupted\n")
+    assert time.perf_counter() - start < 15

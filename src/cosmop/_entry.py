@@ -14,6 +14,10 @@ expect), no traceback, no process left and nothing half-written, in one of two w
 - A Ctrl-C that comes when the program is already ending (a second one, while the first
   unwinds; or one when the command is done) ends it on the spot: its child processes killed,
   the staging folders removed, ``interrupted``, 130.
+- A first Ctrl-C that lands where Python cannot raise (in a finaliser such as a Z3 term's
+  ``__del__``, or in the import system's lock callback, while a module loads) would be
+  swallowed, with an "Exception ignored" traceback, and the program would go on: it ends the
+  program on the spot instead, as a second one does (:data:`sys.unraisablehook`).
 
 A command that is done ends the program the same way, at once (:func:`os._exit` with the
 command's status, its output flushed): the interpreter's teardown would wait for any thread
@@ -35,6 +39,7 @@ import sys
 TYPE_CHECKING = False  # (typing itself is not imported at run time)
 if TYPE_CHECKING:
     from collections.abc import Callable
+    from typing import Any
 
 EXIT_INTERRUPTED = 130
 """Exit status after Ctrl-C (128 + SIGINT)."""
@@ -76,6 +81,19 @@ def _end() -> None:
     os._exit(EXIT_INTERRUPTED)
 
 
+def _ending_when_swallowed(default: Callable[[Any], object]) -> Callable[[Any], None]:
+    """A :data:`sys.unraisablehook` that ends the program (:func:`_end`) when the exception
+    Python could not raise is the Ctrl-C's KeyboardInterrupt, and leaves the others to
+    `default`."""
+
+    def hook(unraisable: Any) -> None:
+        if isinstance(unraisable.exc_value, KeyboardInterrupt):
+            _end()
+        default(unraisable)
+
+    return hook
+
+
 def _finish(code: object) -> None:
     """End the program whose command is done (no return), with the command's exit status
     (`code` as :class:`SystemExit` holds it), at once: the interpreter's teardown is skipped."""
@@ -105,6 +123,7 @@ def run() -> None:
     ctrl_c = _CtrlC()
     if signal.getsignal(signal.SIGINT) is signal.default_int_handler:  # not ignored by the caller
         signal.signal(signal.SIGINT, ctrl_c)
+        sys.unraisablehook = _ending_when_swallowed(sys.unraisablehook)
     try:
         from cosmop.cli import main
 
