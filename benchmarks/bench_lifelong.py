@@ -90,14 +90,6 @@ def _median(values: list[float]) -> float | None:
     return round(statistics.median(values), 3) if values else None
 
 
-def _centre(cell: tuple[int, int]) -> tuple[float, float]:
-    """The centre of a grid cell in the scene's mm (the inverse of :func:`_cell`)."""
-    from movingai_gen import CELL, ROWS
-
-    row, col = cell
-    return ((col + 0.5) * CELL, (ROWS - 1 - row + 0.5) * CELL)
-
-
 def _cell(point) -> tuple[int, int]:
     from movingai_gen import CELL, ROWS
 
@@ -113,7 +105,7 @@ def peer_row(data: dict, until: float, seed: int, reveal: float = 1.0) -> dict:
     from cosmop.scenario import parse_scenario
 
     sys.path.insert(0, str(HERE))
-    from movingai_gen import CELL, COLS, ROWS, blocked_cells
+    from movingai_gen import CELL, COLS, ROWS, _centre, blocked_cells
 
     blocked = blocked_cells()
     grid = pymapf.GridMap([[1 if (r, c) in blocked else 0 for c in range(COLS)] for r in range(ROWS)])
@@ -150,7 +142,7 @@ def peer_row(data: dict, until: float, seed: int, reveal: float = 1.0) -> dict:
             pool.append((orders[released], 0))
             released += 1
         while True:
-            idle = [(r, _centre(at[r])) for r in names if task[r] is None and at[r] == home[r]]
+            idle = [(r, tuple(_centre(*at[r]))) for r in names if task[r] is None and at[r] == home[r]]
             offers = [
                 Offer(o, tuple(scene["objects"][o.object]["position"]), overdue=n >= window)
                 for o, n in pool[:window]

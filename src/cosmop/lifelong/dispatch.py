@@ -191,13 +191,9 @@ def _least_work(
 ) -> tuple[float, str] | None:
     """The idle robot of least work for `offer`, with that work (mm); a robot it passed over
     only when no other idle robot may serve it; None when none may."""
-    work = [(_work(scene, offer.order, at, offer.goods), rid) for rid, at in idle if rid in offer.order.by]
+    # the work: L1 from the robot to the goods, then on to the nearest of the order's docks
+    goods = offer.goods
+    onward = _l1(goods, scene.workspaces[_dock(scene, offer.order, goods)].center)  # the same for every robot
+    work = [(_l1(at, goods) + onward, rid) for rid, at in idle if rid in offer.order.by]
     fresh = [w for w in work if w[1] not in offer.passed_over]
     return min(fresh or work) if work else None
-
-
-def _work(scene: Scene, order: Order, at: Sequence[float], goods: Sequence[float]) -> float:
-    """The estimated work of `order` for a robot standing at `at`: L1 to the goods, then to
-    the nearest of the order's docks, mm."""
-    dock = scene.workspaces[_dock(scene, order, goods)].center
-    return _l1(at, goods) + _l1(goods, dock)

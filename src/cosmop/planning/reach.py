@@ -115,10 +115,20 @@ def event_place(
     obj = scene.objects[event.obj]
     d = (body.size + obj.size) / 2.0
     if event.kind == "pick":
-        return shapely.MultiPoint([docking_pose(at or obj.position, d, h) for h in obj.headings])
+        return shapely.MultiPoint(_pick_poses(scene, robot, event.obj, at))
     assert event.workspace is not None  # a drop names its workspace
     centres = centres or scene.workspaces[event.workspace].centres(obj.size)
     return shapely.union_all(docking_places(*centres.ranges, d, obj.headings))
+
+
+def _pick_poses(
+    scene: Scene, robot: str, obj: str, at: tuple[float, float] | None = None
+) -> list[tuple[float, float]]:
+    """Where `robot` stands to pick `obj` (lying at `at`, by default where the scene puts it),
+    one pose per side it is handled from, in the order of its sides (PickUp's poses)."""
+    goods = scene.objects[obj]
+    d = (scene.robots[robot].size + goods.size) / 2.0
+    return [docking_pose(at or goods.position, d, h) for h in goods.headings]
 
 
 def _place_words(scene: Scene, robot: str, event: Event) -> str:
@@ -126,8 +136,7 @@ def _place_words(scene: Scene, robot: str, event: Event) -> str:
     assert event.obj is not None  # picks and drops name their object
     obj = scene.objects[event.obj]
     if event.kind == "pick":
-        d = (scene.robots[robot].size + obj.size) / 2.0
-        poses = [docking_pose(obj.position, d, h) for h in obj.headings]
+        poses = _pick_poses(scene, robot, event.obj)
         sides = ", ".join(
             f"{side} {show_point(pose, scene.units)}" for side, pose in zip(obj.sides, poses, strict=True)
         )
@@ -143,10 +152,7 @@ def _reached_nearby(
     away need not be grown and joined (most of a warehouse's, for most missions)."""
     lo_x, lo_y, hi_x, hi_y = shapely.union_all([shapely.Point(start), *places]).bounds
     room = 4 * half + 1000.0
-    box = (lo_x - room, lo_y - room, hi_x + room, hi_y + room)
-    free = shapely.box(*box).difference(scene.blocked(half, _SLACK, within=box))
-    point = shapely.Point(start).buffer(_SLACK)
-    part = next((g for g in getattr(free, "geoms", [free]) if g.intersects(point)), None)
+    part = free_component(scene, half, start, within=(lo_x - room, lo_y - room, hi_x + room, hi_y + room))
     return part is not None and all(part.intersects(where) for where in places)
 
 
@@ -176,7 +182,12 @@ def _separating(scene: Scene, half: float, start: tuple[float, float], where: sh
 _MOST_LABELS_TRIED = 8  # each label tried costs a free-space component of the scene
 
 
-def free_component(scene: Scene, half: float, start: tuple[float, float]) -> shapely.Polygon | None:
+def free_component(
+    scene: Scene,
+    half: float,
+    start: tuple[float, float],
+    within: tuple[float, float, float, float] | None = None,
+) -> shapely.Polygon | None:
     """The centres of a square of half-side `half` (mm) that overlaps no wall, connected to `start`.
 
     A shapely polygon (objects ignored; touching allowed), or ``None`` when `start` itself is
@@ -190,19 +201,26 @@ def free_component(scene: Scene, half: float, start: tuple[float, float]) -> sha
         The square's half-side (mm).
     start : (float, float)
         A centre in the component wanted (mm).
+    within : (float, float, float, float), optional
+        A box ``(xmin, ymin, xmax, ymax)`` (mm): the component of the free space inside it
+        only, which is part of the whole one (by default a frame around the whole scene).
     """
-    blocked = scene.blocked(half, _SLACK)
-    # a frame around everything: walls, objects, workspaces and the start
-    points = [start, *(o.position for o in scene.objects.values())]
-    for ws in scene.workspaces.values():
-        if ws.point is not None:
-            points += [ws.point]
-        else:
-            assert ws.x is not None and ws.y is not None  # a rectangle
-            points += [(ws.x[0], ws.y[0]), (ws.x[1], ws.y[1])]
-    lo_x, lo_y, hi_x, hi_y = shapely.MultiPoint(points).union(blocked).bounds
-    margin = 4 * half + 1000.0
-    frame = shapely.box(lo_x - margin, lo_y - margin, hi_x + margin, hi_y + margin)
+    if within is not None:
+        blocked = scene.blocked(half, _SLACK, within=within)
+        frame = shapely.box(*within)
+    else:
+        blocked = scene.blocked(half, _SLACK)
+        # a frame around everything: walls, objects, workspaces and the start
+        points = [start, *(o.position for o in scene.objects.values())]
+        for ws in scene.workspaces.values():
+            if ws.point is not None:
+                points += [ws.point]
+            else:
+                assert ws.x is not None and ws.y is not None  # a rectangle
+                points += [(ws.x[0], ws.y[0]), (ws.x[1], ws.y[1])]
+        lo_x, lo_y, hi_x, hi_y = shapely.MultiPoint(points).union(blocked).bounds
+        margin = 4 * half + 1000.0
+        frame = shapely.box(lo_x - margin, lo_y - margin, hi_x + margin, hi_y + margin)
     free = frame.difference(blocked)
     point = shapely.Point(start)
     for part in getattr(free, "geoms", [free]):

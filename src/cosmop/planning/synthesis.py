@@ -277,7 +277,7 @@ def synthesize(
         margin=margin,
         spots=spots,
     )
-    least = _least_horizon(p, m)
+    least = _least_horizon(p, m, max_horizon)
     if least > max_horizon:  # counting alone rules every plan out: say so without the solver
         why = (
             f"{robot}'s mission needs at least {least} steps (one per pick and drop, and the drives "
@@ -381,15 +381,20 @@ def _least_steps(events: Iterable[Event]) -> int:
     return sum(1 for e in events if e.kind != "return")
 
 
-def _least_horizon(p: RobotProblem, m: _Mission) -> int:
+def _least_horizon(p: RobotProblem, m: _Mission, max_horizon: int) -> int:
     """Fewest steps of a plan of the sequence mission `m`: a step per event but ``return``
     (:func:`_least_steps`), and the drives between the places the events need the robot at
     (:func:`~cosmop.planning.reach.least_drives`); 0 for a branching mission (not bounded here).
     A horizon below it has no plan: a mission that needs more steps than the search allows is
-    refused without the solver.
+    refused without the solver.  When at most two drives a place cannot exceed `max_horizon`,
+    the events' count is returned without the geometry (a hand-over's usual case: it is only
+    asked whether the search may be skipped).
     """
     if m.automaton is not None:
         return 0
+    located = sum(1 for e in m.events if e.kind in ("pick", "drop", "return"))
+    if m.lower + 2 * located <= max_horizon:  # least_drives counts at most two per place
+        return m.lower
     dropped: set[str | None] = set()
     for e in m.events:  # goods picked again where the mission put them: their place is not known here
         if e.kind == "pick" and e.obj in dropped:
