@@ -573,16 +573,18 @@ BINARY = [Implies, Iff, Until, Since]
 
 
 @st.composite
-def formulas(draw, depth: int = 4):
-    """Random formulas with at most ``depth`` nested operators above the atoms."""
+def formulas(draw, depth: int = 4, unary=tuple(UNARY), binary=tuple(BINARY)):
+    """Random formulas with at most ``depth`` nested operators (of `unary`, `binary`, and and
+    or) above the atoms."""
     if depth == 0 or draw(st.integers(0, 3)) == 0:
         return draw(atoms)
     shape = draw(st.sampled_from(["unary", "binary", "n-ary"]))
+    below = formulas(depth - 1, unary, binary)
     if shape == "unary":
-        return draw(st.sampled_from(UNARY))(draw(formulas(depth - 1)))
+        return draw(st.sampled_from(unary))(draw(below))
     if shape == "binary":
-        return draw(st.sampled_from(BINARY))(draw(formulas(depth - 1)), draw(formulas(depth - 1)))
-    args = draw(st.lists(formulas(depth - 1), max_size=3))
+        return draw(st.sampled_from(binary))(draw(below), draw(below))
+    args = draw(st.lists(below, max_size=3))
     return draw(st.sampled_from([And, Or]))(*args)
 
 
@@ -771,3 +773,78 @@ def test_incremental_with_longer_shifts():
             for _ in range(5):
                 assert_valid(s, literal == symbolic_reference(u, formula, k), u.end, note=(u.K, str(formula)))
                 s.add(u.extend())
+
+
+def steady_formulas(depth: int = 3):
+    """Random formulas without future, since or Last operators: the time-invariant ones."""
+    return formulas(depth, (Not, Next, Prev), (Implies, Iff))
+
+
+@st.composite
+def transition_formulas(draw):
+    """A specification's shape: transition constraints, and whatever else, conjoined."""
+    steps = [
+        Always(Implies(Next(draw(steady_formulas(1))), draw(steady_formulas())))
+        for _ in range(draw(st.integers(1, 3)))
+    ]
+    return conj([*steps, draw(st.sampled_from([TRUE, draw(formulas(2)), draw(steady_formulas())]))])
+
+
+class _CopyingEverything:
+    """Copy every formula between instants, however small (the encoder copies only large ones)."""
+
+    def __enter__(self) -> None:
+        import cosmop.logic.encode as encode
+
+        self._module, self._saved = encode, encode._COPY_MIN
+        encode._COPY_MIN = 1
+
+    def __exit__(self, *exc: object) -> None:
+        self._module._COPY_MIN = self._saved
+
+
+@settings(max_examples=300, deadline=None)
+@given(formula=st.one_of(transition_formulas(), formulas()), K=st.integers(0, 4))
+def test_copies_between_instants_are_the_definition(formula, K):
+    with _CopyingEverything():
+        u = Unrolling(SIG, K, ctx=CTX, copies=True)
+        s = solver()
+        for k in range(K + 1):
+            assert_valid(s, u.encode(formula, k) == symbolic_reference(u, formula, k), note=(k, str(formula)))
+
+
+@settings(max_examples=300, deadline=None)
+@given(formula=st.one_of(transition_formulas(), formulas()), K0=st.integers(0, 3), k=st.integers(0, 3))
+def test_copies_at_a_growing_frontier_are_the_definition(formula, K0, k):
+    k = min(k, K0)
+    with _CopyingEverything():
+        u = IncrementalUnrolling(SIG, K0, ctx=CTX, copies=True)
+        s = solver()
+        literal, definitions = u.encode(formula, k)
+        s.add(definitions)
+        for horizon in range(K0, K0 + 4):
+            if horizon > K0:
+                s.add(u.extend())
+                # formulas met only now are copied from instants of an older horizon
+                more, definitions = u.encode(formula, horizon - 1)
+                s.add(definitions)
+                assert_valid(s, more == symbolic_reference(u, formula, horizon - 1), u.end, note=str(formula))
+            assert s.check(u.end) == z3.sat  # the definitions are consistent
+            assert_valid(s, literal == symbolic_reference(u, formula, k), u.end, note=(horizon, str(formula)))
+
+
+@pytest.mark.parametrize("copies", [True, False])
+def test_a_transition_grows_the_horizon_without_a_literal_per_atom(copies):
+    # Growing the horizon by one instant adds the transition at the old frontier and at the new
+    # one; with copies the effect B is copied (no walk, no frontier literal for each of its ten
+    # atoms), without them each atom gets its literal: the same meaning either way
+    effect = conj((i.next() - i <= c) | (j.next() >= c) for c in range(5))
+    spec = Always(Implies(Next(p), effect))
+    u = IncrementalUnrolling(SIG, 2, ctx=CTX, copies=copies)
+    s = solver()
+    s.add(u.require(spec))
+    for _ in range(3):
+        added = u.extend()
+        assert (len(added) <= 6) == copies, [str(c) for c in added]
+        s.add(added)
+        assert_valid(s, u.encode(spec)[0] == symbolic_reference(u, spec, 0), u.end)

@@ -110,6 +110,27 @@ def test_incremental_and_fresh_search_agree(small):
         assert check_robot_plan(small.scene, robot, b.plan) == []
 
 
+QUICK = [{"copies": True}, {"from_bound": True}, {"copies": True, "from_bound": True}]
+
+
+@pytest.mark.parametrize("quick", QUICK)
+def test_the_quick_searches_find_the_same_shortest_plans(big, quick):
+    # the same constraints made by copies, the search from the counted bound: the same horizons
+    # and requests (the plans may differ among the equally short ones), every plan checked,
+    # and the same plan again when rerun
+    for robot in ("R1", "R4", "R7"):
+        walked = synthesize(big.scene, robot, big.mission.tasks[robot], max_horizon=12)
+        found = synthesize(big.scene, robot, big.mission.tasks[robot], max_horizon=12, **quick)
+        assert (found.horizon, sorted(found.requests)) == (walked.horizon, sorted(walked.requests))
+        if quick.get("from_bound"):  # lengths below the bound (drives round shelves) not searched
+            assert set(found.unsat_horizons) < set(walked.unsat_horizons)
+        else:
+            assert found.unsat_horizons == walked.unsat_horizons
+        assert check_robot_plan(big.scene, robot, found.plan) == []
+        again = synthesize(big.scene, robot, big.mission.tasks[robot], max_horizon=12, **quick)
+        assert again.plan.to_dict() == found.plan.to_dict()
+
+
 def test_minimality_evidence(small):
     res = synthesize(small.scene, "R1", small.mission.tasks["R1"])
     assert res.unsat_horizons == tuple(range(2, res.horizon))  # 2 non-return events: K >= 2

@@ -112,6 +112,15 @@ class Terms:
     def ite(self, c: z3.BoolRef, a: z3.ArithRef, b: z3.ArithRef) -> z3.ArithRef:
         return self._arith(z3core.Z3_mk_ite(self._ref, c.ast, a.ast, b.ast))
 
+    def renaming(self, sources: Sequence[z3.ExprRef], targets: Sequence[z3.ExprRef]) -> tuple[int, Any, Any]:
+        """A renaming of constants, each of `sources` to the `targets` at its place, for :meth:`renamed`."""
+        return len(sources), _array(sources), _array(targets)
+
+    def renamed(self, term: z3.BoolRef, renaming: tuple[int, Any, Any]) -> z3.BoolRef:
+        """`term` with the constants of `renaming` replaced at once (Z3's ``substitute``)."""
+        n, sources, targets = renaming
+        return self._bool(z3core.Z3_substitute(self._ref, term.ast, n, sources, targets))
+
 
 def assert_all(solver: z3.Solver, terms: Sequence[z3.BoolRef]) -> None:
     """Assert Boolean `terms` in `solver`, as ``solver.add(terms)`` without its per-term cast."""

@@ -55,6 +55,24 @@ an "end" literal :math:`e_K` (":math:`K` is the last instant"), e.g.
 unguarded step definition :math:`d \\leftrightarrow g[K] \\vee (f[K] \\wedge u[K+1])`. The
 constraints only accumulate, so one solver (with its learnt lemmas) serves every horizon: check
 with the assumption :attr:`IncrementalUnrolling.end`.
+
+Copies between instants
+-----------------------
+A specification is mostly transition constraints :math:`\\Box(\\bigcirc g \\rightarrow B)`
+encoded at every instant, and walking a large :math:`B` in Python once per instant was most
+of the encoder's time. A formula without future, since or ``Last`` operators that reads
+instants :math:`k + lo .. k + hi` at :math:`k` is *time-invariant* away from the ends: when
+:math:`0 \\le k + lo` and :math:`k + hi \\le K`, its encoding at :math:`k + d` is the one at
+:math:`k` with every :math:`x[i]` renamed :math:`x[i + d]` (Z3's ``substitute``, one C call).
+So each such formula is walked at one instant whose reads lie within the first horizon (an
+encoding made then holds no literal of a frontier) and copied to the others.
+
+At the frontier of a growing unrolling, :math:`\\bigcirc g` is false, so
+:math:`\\bigcirc g \\rightarrow B` holds whatever :math:`B` is; and once the horizon grows,
+:math:`B` at :math:`K` is its plain encoding if it reads no further than :math:`K + 1`. Such a
+:math:`B` is therefore copied over the constants of instant :math:`K + 1` (made before they are
+in the horizon, free until then) instead of walked with a frontier literal per atom: half the
+constraints of a growing search, the same models projected on the instants :math:`0..K`.
 """
 
 from __future__ import annotations
@@ -107,6 +125,23 @@ _COMPARE: dict[str, Callable[[Any, Any], Any]] = {
 }
 
 
+_COPYABLE = frozenset((Not, And, Or, Implies, Iff, Next, Prev))
+"""Nodes whose encoding may be copied from another instant (see :meth:`_Encoding._shape`)."""
+
+_COPY_MIN = 6
+"""Nodes below which walking a formula costs less than copying it."""
+
+_SIZE_CAP = 1 << 20
+
+
+def _children(f: Formula) -> tuple[Formula, ...]:
+    if isinstance(f, (And, Or)):
+        return tuple(f.args)
+    if isinstance(f, (Implies, Iff)):
+        return (f.left, f.right)
+    return (f.arg,)  # type: ignore[attr-defined]
+
+
 def _check_horizon(K: object) -> int:
     if isinstance(K, bool) or not isinstance(K, int) or K < 0:
         raise ValueError(f"the horizon K is an integer >= 0, got {K!r}")
@@ -117,7 +152,13 @@ class _Encoding:
     """The Z3 variables of a signature over instants 0..K, and the shared encoding machinery."""
 
     def __init__(
-        self, signature: Signature | Mapping[str, str], K: int, *, ctx: z3.Context | None, prefix: str
+        self,
+        signature: Signature | Mapping[str, str],
+        K: int,
+        *,
+        ctx: z3.Context | None,
+        prefix: str,
+        copies: bool = False,
     ) -> None:
         self._signature = signature if isinstance(signature, Signature) else Signature(signature)
         K = _check_horizon(K)
@@ -131,6 +172,7 @@ class _Encoding:
         self._grid: dict[str, list[Any]] = {name: [] for name in self._signature}
         self._K = -1
         self._grow(K)
+        self._first = K  # the smallest horizon: encodings reading no further hold no frontier
         self._memo: dict[tuple[Formula, int], z3.BoolRef] = {}
         # one representative of each formula met, by identity: the specification builds the
         # same sub-formula many times, and a memo lookup of an equal copy compares whole trees
@@ -139,6 +181,11 @@ class _Encoding:
         self._seen: dict[int, tuple[Formula, Formula]] = {}
         self._integral: dict[LinExpr, bool] = {}
         self._scales: dict[Compare, int] = {}
+        # time-invariant formulas: an encoding at one instant copied to another (module docs)
+        self._shapes: dict[int, tuple[int, int, int] | None] = {}
+        self._copies: dict[int, tuple[int, Any]] = {}
+        self._moves: dict[tuple[int, int, int], tuple[int, Any, Any]] = {}
+        self._copying = copies
 
     # -- the variables ------------------------------------------------------------------------
     @property
@@ -162,12 +209,16 @@ class _Encoding:
         return self._prefix
 
     def _grow(self, K: int) -> None:
+        self._columns(K)
+        self._K = K
+
+    def _columns(self, last: int) -> None:
+        """Make the Z3 constants of instants up to `last` (beyond K too: see :meth:`_copy`)."""
         makers = {"int": z3.Int, "real": z3.Real, "bool": z3.Bool}
         for name, sort in self._signature.items():
             column = self._grid[name]
-            for k in range(len(column), K + 1):
+            for k in range(len(column), last + 1):
                 column.append(makers[sort](f"{self._prefix}{name}@{k}", self._ctx))
-        self._K = K
 
     def __getitem__(self, key: tuple[str | Var, int]) -> Any:
         """The Z3 constant of a variable at an instant: ``unrolling["x", 3]`` is :math:`x[3]`.
@@ -380,6 +431,13 @@ class _Encoding:
         return self._terms.eq(a, b)
 
     # -- formulas -----------------------------------------------------------------------------
+    def _canon(self, f: Formula) -> Formula:
+        """The one representative of the formulas equal to `f`."""
+        seen = self._seen.get(id(f))
+        if seen is None:
+            seen = self._seen[id(f)] = (f, self._canonical.setdefault(f, f))
+        return seen[1]
+
     def _lit(self, f: Formula, k: int) -> Any:
         """:math:`[\\![f]\\!]_k`, memoised."""
         seen = self._seen.get(id(f))
@@ -391,6 +449,12 @@ class _Encoding:
         if known is not None:
             return known
         kind = type(f)
+        copyable = self._copying and kind in _COPYABLE
+        if copyable:
+            result = self._copy(f, k, self._K)
+            if result is not None:
+                self._memo[key] = result
+                return result
         if kind is BoolConst:
             result = self._true if f.value else self._false  # type: ignore[attr-defined]
         elif kind is Shifted or kind is Compare:
@@ -402,7 +466,7 @@ class _Encoding:
         elif kind is Or:
             result = self._or([self._lit(a, k) for a in f.args])  # type: ignore[attr-defined]
         elif kind is Implies:
-            result = self._or([self._not(self._lit(f.left, k)), self._lit(f.right, k)])  # type: ignore[attr-defined]
+            result = self._implies(f, k)  # type: ignore[arg-type]
         elif kind is Iff:
             result = self._iff(self._lit(f.left, k), self._lit(f.right, k))  # type: ignore[attr-defined]
         elif kind is Prev:
@@ -418,7 +482,82 @@ class _Encoding:
         else:
             raise TypeError(f"not a formula node: {f!r}")
         self._memo[key] = result
+        if copyable and id(f) not in self._copies:
+            self._keep(f, k, result)
         return result
+
+    def _implies(self, f: Implies, k: int) -> Any:
+        return self._or([self._not(self._lit(f.left, k)), self._lit(f.right, k)])
+
+    # -- copies between instants ------------------------------------------------------------
+    def _shape(self, f: Formula) -> tuple[int, int, int] | None:
+        """``(lo, hi, size)`` of a formula whose encoding is the same at every instant up to a
+        shift of the instants, or None (it holds a future or since operator, or ``Last``).
+
+        At instant ``k`` the encoding reads instants ``k + lo .. k + hi`` only (0 included), and
+        when ``0 <= k + lo`` and ``k + hi <= K`` nothing is folded at the ends of the trace, so the
+        encoding at ``k + d`` is the one at ``k`` with every ``x[i]`` replaced by ``x[i + d]``.
+        `size` is the number of nodes, counted as a tree up to a cap.
+        """
+        known = self._shapes.get(id(f), False)
+        if known is not False:
+            return known  # type: ignore[return-value]
+        kind = type(f)
+        shape: tuple[int, int, int] | None
+        if kind is BoolConst:
+            shape = (0, 0, 1)
+        elif kind is Shifted or kind is Compare:
+            offsets = f.offsets or frozenset((0,))  # type: ignore[attr-defined]
+            shape = (min(0, min(offsets)), max(0, max(offsets)), 1)
+        elif kind in _COPYABLE:
+            shapes = [self._shape(c) for c in _children(f)]
+            children = [c for c in shapes if c is not None]
+            if len(children) < len(shapes):
+                shape = None
+            else:
+                lo = min([0, *(c[0] for c in children)])
+                hi = max([0, *(c[1] for c in children)])
+                size = min(_SIZE_CAP, 1 + sum(c[2] for c in children))
+                if kind is Next:
+                    lo, hi = min(lo + 1, 0), hi + 1
+                elif kind is Prev:
+                    lo, hi = lo - 1, max(hi - 1, 0)
+                shape = (lo, hi, size)
+        else:
+            shape = None
+        self._shapes[id(f)] = shape  # f is kept alive by the memo's representatives
+        return shape
+
+    def _keep(self, f: Formula, k: int, result: Any) -> None:
+        """Keep `f`'s encoding at `k` to copy to other instants, when it is a plain shift of them.
+
+        Only an instant whose reads lie within the first horizon is kept: an encoding made
+        then holds no literal of a frontier (nothing it reads was ever past a frontier)."""
+        shape = self._shape(f)
+        if shape is not None and shape[2] >= _COPY_MIN and k + shape[0] >= 0 and k + shape[1] <= self._first:
+            self._copies[id(f)] = (k, result)
+
+    def _copy(self, f: Formula, k: int, last: int) -> Any:
+        """`f` at `k` copied from its kept encoding (reads up to instant `last`), or None."""
+        kept = self._copies.get(id(f))
+        if kept is None:
+            return None
+        lo, hi, _ = self._shapes[id(f)]  # type: ignore[misc]
+        if k + lo < 0 or k + hi > last:
+            return None
+        j, term = kept
+        if term is self._true or term is self._false:
+            return term
+        key = (j + lo, j + hi, k - j)
+        move = self._moves.get(key)
+        if move is None:
+            self._columns(k + hi)
+            columns = self._grid.values()
+            move = self._moves[key] = self._terms.renaming(
+                [c[i] for c in columns for i in range(j + lo, j + hi + 1)],
+                [c[i + k - j] for c in columns for i in range(j + lo, j + hi + 1)],
+            )
+        return self._terms.renamed(term, move)
 
     def _since(self, f: Since, k: int) -> Any:
         memo = self._memo
@@ -471,6 +610,10 @@ class Unrolling(_Encoding):
         The Z3 context (Z3's main context when omitted).
     prefix : str, default ""
         Prepended to every Z3 constant name, to unroll several systems side by side.
+    copies : bool, default False
+        Copy time-invariant formulas between instants instead of walking them at each one
+        (module documentation): the same constraints, made faster, in another order, so the
+        solver may return another of the models.
 
     Notes
     -----
@@ -501,8 +644,9 @@ class Unrolling(_Encoding):
         *,
         ctx: z3.Context | None = None,
         prefix: str = "",
+        copies: bool = False,
     ) -> None:
-        super().__init__(signature, K, ctx=ctx, prefix=prefix)
+        super().__init__(signature, K, ctx=ctx, prefix=prefix, copies=copies)
 
     def encode(self, formula: object, k: int = 0) -> z3.BoolRef:
         """:math:`[\\![\\phi]\\!]_k`: a Z3 formula true exactly on the traces where ``formula``
@@ -559,6 +703,11 @@ class IncrementalUnrolling(_Encoding):
         The Z3 context (Z3's main context when omitted).
     prefix : str, default ""
         Prepended to every Z3 constant name.
+    copies : bool, default False
+        Copy time-invariant formulas between instants, and at the frontier copy the effect
+        of a transition over the next instant's constants instead of writing a literal for
+        each of its atoms (module documentation): faster, with other constraints of the same
+        meaning, so the solver may return another of the models.
 
     Notes
     -----
@@ -594,8 +743,9 @@ class IncrementalUnrolling(_Encoding):
         *,
         ctx: z3.Context | None = None,
         prefix: str = "",
+        copies: bool = False,
     ) -> None:
-        super().__init__(signature, K, ctx=ctx, prefix=prefix)
+        super().__init__(signature, K, ctx=ctx, prefix=prefix, copies=copies)
         self._end = self._new_end()
         self._pending: list[tuple[Any, ...]] = []
         self._last_values: dict[Formula, Any] = {}
@@ -711,6 +861,20 @@ class IncrementalUnrolling(_Encoding):
         self._out.append(self._guarded(self._terms.not_(d)))
         self._pending.append((_ATOM, f, k, d))
         return d
+
+    def _implies(self, f: Implies, k: int) -> Any:
+        if self._copying and k == self._K and type(f.left) is Next:
+            # At the last instant X(g) is false, so X(g) -> B holds whatever B is; once the
+            # horizon grows, B here is its plain encoding if it reads no further than K + 1.  So
+            # B is copied over the constants of K + 1 (no literal of the frontier, no walk).
+            left = self._lit(f.left, k)
+            right = self._copy(self._canon(f.right), k, k + 1)
+            if right is None and k > 0:  # walked at k - 1, where a formula met now is needed next
+                self._lit(f.right, k - 1)
+                right = self._copy(self._canon(f.right), k, k + 1)
+            if right is not None:
+                return self._or([self._not(left), right])
+        return super()._implies(f, k)
 
     def _next(self, f: Next, k: int) -> Any:
         if k < self._K:

@@ -102,7 +102,7 @@ class Synthesis:
     unsat_horizons : tuple of int
         The horizons proved unsatisfiable before the plan was found (evidence that ``horizon``
         is minimal: every shorter length is among them or below the lower bound, one step per
-        non-return event).
+        non-return event, or with ``from_bound`` the counted drives too).
     admitted : int
         Obstacles the lazy geometry added to the solver after a plan broke them.
     route_mm : float
@@ -206,6 +206,8 @@ def synthesize(
     spots: tuple[tuple[Event, tuple[float, float]], ...] = (),
     min_horizon: int = 0,
     route_rounds: int = 0,
+    copies: bool = False,
+    from_bound: bool = False,
 ) -> Synthesis:
     """The shortest safe plan of motion primitives for one robot's local mission.
 
@@ -253,6 +255,20 @@ def synthesize(
         How many times a shorter route is asked for among the shortest plans with the fewest
         requests (:func:`_shortest_route`; 0, the default: the solver's first such plan;
         :data:`ROUTE_ROUNDS` for a robot re-planned among others moving).
+    copies : bool
+        Unroll by copying the transition constraints between instants
+        (:class:`cosmop.logic.IncrementalUnrolling`'s ``copies``): the same shortest horizon and
+        fewest requests, found faster, but the solver may return another of the equally short
+        plans.  Off by default: a team planned at once takes the solver's first plan of each
+        robot, and how well the team's plans interleave depends on which plan that is
+        (``benchmarks/BENCHMARKS.md``); a robot re-planned among others moving asks for
+        shorter routes anyway (`route_rounds`).
+    from_bound : bool
+        Start the search at the counted lower bound (a step per event but ``return``, and the
+        drives between the places the events need, :func:`~cosmop.planning.reach.least_drives`)
+        instead of the events' count: the same shortest horizon without proving the lengths
+        below the bound one by one, but the solver's first plan there may be another (off by
+        default, as `copies`).
 
     Returns
     -------
@@ -277,7 +293,7 @@ def synthesize(
         margin=margin,
         spots=spots,
     )
-    least = _least_horizon(p, m, max_horizon)
+    least = _least_horizon(p, m, max_horizon, counted=from_bound)
     if least > max_horizon:  # counting alone rules every plan out: say so without the solver
         why = (
             f"{robot}'s mission needs at least {least} steps (one per pick and drop, and the drives "
@@ -285,9 +301,10 @@ def synthesize(
             "(raise --max-horizon)"
         )
         return Synthesis(robot, False, None, None, reason=why, solve_s=time.perf_counter() - t0)
-    # the search still starts at the events' count: starting at `least` finds plans as short,
-    # but the solver's first model there differs (other routes, timings) for no measured gain
-    found = _shortest_plan(p, max(m.lower, min_horizon), max_horizon, rlimit, incremental, lazy, route_rounds)
+    # by default the search starts at the events' count: starting at `least` finds plans as
+    # short, but the solver's first plan there may differ (`from_bound`)
+    first = max(m.lower, min_horizon, least if from_bound else 0)
+    found = _shortest_plan(p, first, max_horizon, rlimit, incremental, lazy, route_rounds, copies)
     if found.plan is not None:
         return found.synthesis(robot, t0, plan=_place_messages(p, found.plan, m.full))
     if found.gave_up is not None:  # the solver could not decide a horizon: claim nothing beyond
@@ -381,19 +398,19 @@ def _least_steps(events: Iterable[Event]) -> int:
     return sum(1 for e in events if e.kind != "return")
 
 
-def _least_horizon(p: RobotProblem, m: _Mission, max_horizon: int) -> int:
+def _least_horizon(p: RobotProblem, m: _Mission, max_horizon: int, *, counted: bool = False) -> int:
     """Fewest steps of a plan of the sequence mission `m`: a step per event but ``return``
     (:func:`_least_steps`), and the drives between the places the events need the robot at
     (:func:`~cosmop.planning.reach.least_drives`); 0 for a branching mission (not bounded here).
     A horizon below it has no plan: a mission that needs more steps than the search allows is
     refused without the solver.  When at most two drives a place cannot exceed `max_horizon`,
-    the events' count is returned without the geometry (a hand-over's usual case: it is only
-    asked whether the search may be skipped).
+    the events' count is returned without the geometry (when it is only asked whether the
+    search may be skipped), unless `counted` (the search starts there).
     """
     if m.automaton is not None:
         return 0
     located = sum(1 for e in m.events if e.kind in ("pick", "drop", "return"))
-    if m.lower + 2 * located <= max_horizon:  # least_drives counts at most two per place
+    if not counted and m.lower + 2 * located <= max_horizon:  # least_drives counts at most two per place
         return m.lower
     dropped: set[str | None] = set()
     for e in m.events:  # goods picked again where the mission put them: their place is not known here
@@ -496,7 +513,7 @@ class _Horizon:
 
 
 def _horizons(
-    geometry: Geometry, first: int, last: int, rlimit: int, *, incremental: bool
+    geometry: Geometry, first: int, last: int, rlimit: int, *, incremental: bool, copies: bool = False
 ) -> Iterator[_Horizon]:
     """The specification unrolled for ``K = first .. last`` in turn, each in a solver ready to check.
 
@@ -511,6 +528,8 @@ def _horizons(
     incremental : bool
         One solver whose unrolling grows (the horizon chosen by an assumption), else a fresh
         context and solver per horizon.
+    copies : bool
+        Unroll by copies between instants (:class:`~cosmop.logic.IncrementalUnrolling`).
     """
     signature = Signature.of(geometry.held)  # every variable is in the initial state
     grow: IncrementalUnrolling | None = None
@@ -518,7 +537,7 @@ def _horizons(
         if incremental:  # one solver; the horizon grows under the assumption ``end``
             if grow is None:
                 ctx = z3.Context()
-                grow = IncrementalUnrolling(signature, K, ctx=ctx)
+                grow = IncrementalUnrolling(signature, K, ctx=ctx, copies=copies)
                 s = _solver(rlimit, ctx)
                 assert_all(s, grow.require(geometry.held))
             else:
@@ -526,7 +545,7 @@ def _horizons(
             yield _Horizon(K, s, grow, (grow.end,))
         else:  # a fresh context and solver per horizon: answers never depend on earlier calls
             ctx = z3.Context()
-            u = Unrolling(signature, K, ctx=ctx)
+            u = Unrolling(signature, K, ctx=ctx, copies=copies)
             s = _solver(rlimit, ctx)
             s.add(u.encode(geometry.held))
             yield _Horizon(K, s, u, ())
@@ -599,6 +618,7 @@ def _shortest_plan(
     incremental: bool,
     lazy: bool,
     route_rounds: int = 0,
+    copies: bool = False,
 ) -> _Search:
     """The first satisfiable horizon from `lower` to `max_horizon`, and its plan.
 
@@ -611,7 +631,7 @@ def _shortest_plan(
     geometry = Geometry(p, None, lazy)
     checks = 0
     unsat: list[int] = []
-    for h in _horizons(geometry, lower, max_horizon, rlimit, incremental=incremental):
+    for h in _horizons(geometry, lower, max_horizon, rlimit, incremental=incremental, copies=copies):
         verdict, model, made = h.check(geometry)
         checks += made
         if verdict == z3.unknown:  # no answer within the resource limit: say so, claim nothing more
