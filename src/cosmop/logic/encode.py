@@ -440,7 +440,7 @@ class _Encoding:
 
     def _lit(self, f: Formula, k: int) -> Any:
         """:math:`[\\![f]\\!]_k`, memoised."""
-        seen = self._seen.get(id(f))
+        seen = self._seen.get(id(f))  # :meth:`_canon` written out: the encoder's hottest line
         if seen is None:
             seen = self._seen[id(f)] = (f, self._canonical.setdefault(f, f))
         f = seen[1]
@@ -867,11 +867,11 @@ class IncrementalUnrolling(_Encoding):
             # At the last instant X(g) is false, so X(g) -> B holds whatever B is; once the
             # horizon grows, B here is its plain encoding if it reads no further than K + 1.  So
             # B is copied over the constants of K + 1 (no literal of the frontier, no walk).
-            left = self._lit(f.left, k)
-            right = self._copy(self._canon(f.right), k, k + 1)
+            left, effect = self._lit(f.left, k), self._canon(f.right)
+            right = self._copy(effect, k, k + 1)
             if right is None and k > 0:  # walked at k - 1, where a formula met now is needed next
-                self._lit(f.right, k - 1)
-                right = self._copy(self._canon(f.right), k, k + 1)
+                self._lit(effect, k - 1)
+                right = self._copy(effect, k, k + 1)
             if right is not None:
                 return self._or([self._not(left), right])
         return super()._implies(f, k)
