@@ -8,7 +8,10 @@ applies the exact conflict rule to every robot's committed rest
 (:func:`cosmop.sim.recoordinate.unordered_now`) before and after it.  A pair of robots with an
 unordered conflict after and none before was broken by that re-coordination: it must never
 happen.  Conflicts that were there before (a robot tracking its plan a few millimetres off its
-line makes slivers of new overlap) are counted apart.
+line makes slivers of new overlap) are counted apart.  After each, every robot's rest as
+installed is also checked by the exact single-robot checker (walls and resting goods), from the
+start of its current step on its plan, with the goods where they are then: a rest cut on a line
+nobody checked fails it.
 
 The audit wraps the function the run calls to re-coordinate (instrumentation, not a feature),
 and costs two looks at every conflict per hand-over: it is a check, not a timing.
@@ -30,9 +33,27 @@ import cosmop.lifelong.fleet as fleet_module
 import cosmop.sim.replan as replan_module
 from _harness import save_results
 from cosmop.lifelong import FleetSettings, run_fleet
+from cosmop.planning.checker import check_robot_plan
+from cosmop.planning.plan_types import RobotPlan, State
 from cosmop.scenario import parse_scenario
 from cosmop.sim.recoordinate import recoordinate_world, reorder_world, unordered_now
+from cosmop.sim.replan import start_state
 from orders_gen import orders_warehouse
+
+
+def rests_failing(world) -> list[str]:
+    """Why each robot's rest as installed fails the single-robot checker (walls, resting goods)."""
+    out = []
+    for agent in world.agents:
+        k = agent.step_index
+        if agent.before is None or agent.done:
+            continue
+        picks = {e.obj for e in agent.split_mission(world.scenario)[1] if e.kind == "pick"}
+        start = State(agent.origin, start_state(world, agent, picks).objects)
+        plan = RobotPlan.from_steps([], agent.steps[k:])
+        found = check_robot_plan(world.scenario.scene, agent.id, plan, start=start)
+        out += [v.message for v in found if v.rule in ("wall", "object-collision")][:1]
+    return out
 
 
 def audited(call, depth: float, report: dict) -> object:
@@ -54,6 +75,9 @@ def audited(call, depth: float, report: dict) -> object:
             after = pairs(world)
             broken = sorted(after.keys() - before.keys())
             report["audited"] += 1
+            for why in rests_failing(world):
+                report["rests_failing"].append({"t": round(world.t, 1), "replanned": agent.id, "why": why})
+                print(f"  {world.t:7.1f} s: after {agent.id}'s new order, {why}")
             report["standing"] += len(after.keys() & before.keys())
             report["deepest_standing_mm"] = max(
                 [report["deepest_standing_mm"], *(after[k] for k in after.keys() & before.keys())]
@@ -84,7 +108,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", default=None)
     args = parser.parse_args(argv)
     scenario = parse_scenario(orders_warehouse(args.robots, args.seed, args.rate, args.until / 3600.0 + 0.1))
-    report: dict = {"audited": 0, "standing": 0, "deepest_standing_mm": 0.0, "broken": []}
+    report: dict = {
+        "audited": 0,
+        "standing": 0,
+        "deepest_standing_mm": 0.0,
+        "broken": [],
+        "rests_failing": [],
+    }
     wrapper = audited(recoordinate_world, args.depth, report)
     fleet_module.recoordinate_world = wrapper
     replan_module.recoordinate_world = wrapper
@@ -107,6 +137,8 @@ def main(argv: list[str] | None = None) -> int:
         "re_coordinations_audited": report["audited"],
         "pairs_broken": len(report["broken"]),
         "broken": report["broken"],
+        "rests_failing_checker": len(report["rests_failing"]),
+        "rests_failing": report["rests_failing"],
         "unordered_pairs_standing": report["standing"],
         "deepest_standing_mm": round(report["deepest_standing_mm"], 1),
         "wall_s": round(time.perf_counter() - began, 1),
@@ -116,12 +148,13 @@ def main(argv: list[str] | None = None) -> int:
         f"N={args.robots}, {args.until:g} s: {report['audited']} re-coordinations audited, "
         f"{len(report['broken'])} left a pair unordered ({dict(by_robot)}), "
         f"{report['standing']} unordered pairs already there "
-        f"(deepest {report['deepest_standing_mm']:.1f} mm); "
+        f"(deepest {report['deepest_standing_mm']:.1f} mm), "
+        f"{len(report['rests_failing'])} rests failing the checker; "
         f"{result.delivered} delivered"
     )
     if args.out:
         print(save_results(args.out, [row]))
-    return 1 if report["broken"] else 0
+    return 1 if report["broken"] or report["rests_failing"] else 0
 
 
 if __name__ == "__main__":

@@ -173,7 +173,8 @@ def _scattered(seed: int, side: float = 60_000.0):
 def test_a_route_found_near_first_costs_what_the_whole_map_search_finds(seed):
     start, goal, walls, boxes = _scattered(seed)
     near = plan_path(start, goal, 200.0, walls, boxes)
-    whole, cost = paths._route(np.array([start, goal]), 200.0, walls, boxes, None, 150.0, 3.0, 10.0)
+    ends, weights = np.array([start, goal]), (150.0, 3.0, 10.0)
+    whole, cost, _ = paths._route(ends, 200.0, walls, boxes, None, weights, 10**9)
     assert (near is None) == (whole is None)
     if near is not None:
         assert near.points[0] == start and near.points[-1] == goal
@@ -223,6 +224,17 @@ def test_a_goal_walled_in_is_refused_without_a_search(monkeypatch):
 def test_a_goal_inside_an_obstacle_has_no_route():
     boxes = np.array([[5000.0, 0.0, 300.0]])
     assert plan_path((0, 0), (5100, 0), 200.0, np.zeros((0, 4)), boxes) is None
+
+
+def test_a_route_search_stops_at_its_budget():
+    # a route squeezing along an aisle lined with goods grew its search to most of a large map
+    # (74 s); the edges tested are bounded, and past the bound there is no route (unless a
+    # smaller box found one)
+    start, goal, walls, boxes = _scattered(0)
+    found = plan_path(start, goal, 200.0, walls, boxes)
+    assert found is not None and len(found.points) > 2  # a way around, not the straight line
+    assert plan_path(start, goal, 200.0, walls, boxes, budget=10) is None
+    assert plan_path(start, goal, 200.0, walls, boxes, budget=10**9) == found
 
 
 def test_a_point_beyond_on_a_path_and_the_vertices_after_it():

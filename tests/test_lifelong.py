@@ -21,7 +21,7 @@ from cosmop.lifelong.dispatch import Offer, choose_assignment, delivery_events
 from cosmop.planning.primitive_effects import initial_state
 from cosmop.scenario import load_orders, load_scenario, parse_scenario
 from cosmop.scene import Order
-from cosmop.sim.replan import grown, replan, why_no_plan
+from cosmop.sim.replan import grown, replan, start_state, why_no_plan
 from cosmop.traces import Trace
 from run_2x2 import EXAMPLE
 
@@ -446,12 +446,33 @@ def test_robots_whose_routes_run_through_a_failed_robot_are_replanned_round_it()
     result = run_fleet(scenario, orders, fleet=FleetSettings(until=120.0), failures=[Failure("R3", 88.0)])
     failure = result.failures["R3"]
     assert failure["recoordinated"] is True and failure["carrying"] == ["O22"]
-    assert failure["replanned"] == ["R2"]  # the nearest first, until the fleet could be ordered
+    assert failure["replanned"] == ["R1", "R2"]  # the nearest first, until the fleet could be ordered
     final = result.frames["pose"][-1, result.robot_ids.index("R3"), :2]
     assert failure["at"] == pytest.approx(final, abs=1e-3)  # where it came to rest, after braking
     o10 = next(o for o in result.orders if o.object == "O10")
     assert o10.robot == "R1" and o10.delivered is not None and o10.as_ordered
     assert result.lost == 1 and result.contacts_while_moving == 0
+
+
+def test_a_robot_whose_home_a_failed_robot_takes_delivers_and_stays_at_the_dock():
+    # R3 fails at 90 s on R1's home while R1 carries O10 to its dock: no plan of R1 ends at
+    # home any more, so the fleet was never ordered around R3 and O10 was never delivered.
+    # Now R1 is re-planned first, without the way home, and stays where its plan ends.
+    scenario = load_scenario(EXAMPLES / "13_lifelong" / "scenario.yaml")
+    everyone = ("R1", "R2", "R3", "R4")
+    orders = [
+        Order(0.0, "O23", ("W2",), everyone),
+        Order(39.9, "O14", ("W3",), everyone),
+        Order(43.3, "O10", ("W1",), everyone),
+        Order(49.3, "O22", ("W1",), everyone),
+    ]
+    result = run_fleet(scenario, orders, fleet=FleetSettings(until=130.0), failures=[Failure("R3", 90.0)])
+    failure = result.failures["R3"]
+    assert failure["homes_taken"] == ["R1"] and failure["recoordinated"] is True
+    assert failure["replanned"] == ["R1"]
+    o10 = next(o for o in result.orders if o.object == "O10")
+    assert o10.robot == "R1" and o10.delivered is not None and o10.as_ordered
+    assert result.lost == 1 and result.contacts_while_moving == 0  # O22, which R3 carries
 
 
 def test_a_robot_standing_in_the_only_way_is_named_as_what_separates():
@@ -466,3 +487,36 @@ def test_a_robot_standing_in_the_only_way_is_named_as_what_separates():
     assert why.startswith("R1 cannot reach pick(R1,O1) (event 1 of its mission) at any horizon: ")
     assert "R9, failed at 3.0 s, separates its start (-500, -1500)" in why
     assert why_no_plan(scene, "R1", events, start, max_horizon=7).startswith("R1 cannot reach")  # no label
+
+
+def test_every_rest_a_recoordination_installs_passes_the_exact_checker(monkeypatch):
+    # found on a 50-robot stream: a fleet re-ordered while a robot drove cut the rest of its
+    # drive on the line from where it really was (30 mm beside its plan's), a line nobody
+    # checked, which ran into goods along the aisle (the case: test_team's
+    # test_a_robot_beside_its_line_is_reordered_on_its_plan).  The audit of a running fleet:
+    # each rest installed is checked from its step's origin, with the goods where they are now.
+    import cosmop.sim.recoordinate as recoordinate
+    from cosmop.planning.checker import check_robot_plan
+    from cosmop.planning.plan_types import RobotPlan, State
+
+    take, installs, violations = recoordinate._take, [], []
+
+    def audited(world, result, splits, new):
+        out = take(world, result, splits, new)
+        if out[0]:
+            installs.append(world.t)
+            for agent in world.agents:
+                k, scene = agent.step_index, world.scenario.scene
+                if agent.before is not None and not agent.done:
+                    picks = {e.obj for e in agent.split_mission(world.scenario)[1] if e.kind == "pick"}
+                    start = State(agent.origin, start_state(world, agent, picks).objects)
+                    plan = RobotPlan.from_steps([], agent.steps[k:])
+                    found = check_robot_plan(scene, agent.id, plan, start=start)
+                    violations.extend(v.message for v in found if v.rule in ("wall", "object-collision"))
+        return out
+
+    monkeypatch.setattr(recoordinate, "_take", audited)
+    scenario = load_scenario(EXAMPLES / "13_lifelong" / "scenario.yaml")
+    result = run_fleet(scenario, fleet=FleetSettings(until=240.0))
+    assert len(installs) >= 10 and result.contacts_while_moving == 0
+    assert violations == []

@@ -8,6 +8,7 @@ executed word of mission events is a complete word of the global mission.
 from __future__ import annotations
 
 import functools
+import math
 from pathlib import Path
 
 import numpy as np
@@ -290,6 +291,42 @@ def test_a_robot_held_back_by_a_stale_order_goes_first_when_reordered():
     assert due == pytest.approx(kept.agents[1].step_log[0][3], abs=3.0)  # as long as it waited
     assert max(ends[world].values()) <= max(ends[kept].values()) + 1.0
     assert not world.contacts
+
+
+def test_a_robot_beside_its_line_is_reordered_on_its_plan():
+    # A robot tracks its plan within centimetres.  Re-ordered mid-drive, the rest of its drive
+    # was cut on the line from where it really was, a line no check had seen (30 mm beside an
+    # aisle lined with goods, it ran into them); the rest now starts on the plan's own segment.
+    world = stale_order_world()
+    r1, r2 = world.agents
+    r1.step_index = 2  # R1 drives across, from (-3000, 0) to (3000, 0), 30 mm off its line
+    world.pose[r1.index] = [-1000.0, 30.0, 0.0]
+    accepted, why, _ = reorder_world(world, r2)
+    assert accepted, why
+    drives = [s.robot for s in r1.steps[2:] if s.primitive == Primitive.GOTO]
+    assert len(drives) >= 2  # cut where it crosses R2's way
+    assert all(abs(y) < 1e-9 for _, y, _ in drives)
+    assert unordered_now(world) == []
+
+
+def test_a_robot_told_to_wait_part_way_along_a_drive_waits_there_in_its_rest():
+    # R1 stopped 2.4 m along its drive across is re-ordered behind R2: its wait stands where it
+    # is, and a later re-ordering starts its rest there, not back at the drive's start (from
+    # where R2, backed off, would be expected at the crossing first)
+    world = stale_order_world()
+    r1, r2 = world.agents
+    r1.step_index, r2.step_index = 2, 1
+    world.pose[r1.index] = [-560.0, 30.0, 0.0]
+    world.pose[r2.index] = [0.0, -450.0, math.pi / 2]
+    accepted, why, _ = reorder_world(world, r2)
+    assert accepted, why
+    assert r1.step.primitive == Primitive.REQ and r1.step.robot[:2] == (-560.0, 0.0)
+    world.pose[r2.index] = [0.0, -1600.0, math.pi / 2]  # R2 now farther from the crossing
+    accepted, why, _ = reorder_world(world, r1)
+    assert accepted, why
+    assert r1.step.primitive == Primitive.GOTO  # R1, nearer, goes first
+    assert any(s.primitive == Primitive.REQ for s in r2.steps[r2.step_index :])
+    assert unordered_now(world) == []
 
 
 def _initial(scenario, robot):

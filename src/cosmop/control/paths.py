@@ -161,6 +161,7 @@ def plan_path(
     margin: float = 150.0,
     penalty: float = 3.0,
     squeeze: float = 10.0,
+    budget: int = 1_000_000,
 ) -> GlobalPath | None:
     r"""The shortest route of a square robot's centre from `start` to `goal`, with clearance.
 
@@ -183,6 +184,14 @@ def plan_path(
     everything else.  A start or goal inside an obstacle has no route (every edge from or to
     it enters the obstacle), which is seen at once.
 
+    **Bounded.**  A route that squeezes along an aisle lined with goods costs several times its
+    length, so its box grows to most of a large map (16,835 corners on the MovingAI warehouse:
+    74 s for one search).  At most `budget` edges are tested over all boxes; past it, the route
+    a smaller box found is taken (free of every obstacle, perhaps not the cheapest), else there
+    is none (``None``) and the caller drives on as it can (the dynamic window stops short of
+    anything in the way, and a robot that stalls re-plans).  A detour around a person or a
+    robot tests about ten thousand.
+
     Parameters
     ----------
     start, goal : (float, float)
@@ -199,11 +208,14 @@ def plan_path(
         :math:`p`, the extra cost factor of an edge with no clearance at all.
     squeeze : float
         :math:`q`, the fixed extra cost of such an edge, in units of the margin.
+    budget : int
+        The most edges tested (each a segment against the grown obstacles).
 
     Returns
     -------
     GlobalPath or None
-        ``None`` when the goal cannot be reached even touching the obstacles.
+        ``None`` when the goal cannot be reached even touching the obstacles, or no route is
+        found within `budget`.
     """
     walls, boxes = (
         np.asarray(walls, dtype=float).reshape(-1, 4),
@@ -219,19 +231,20 @@ def plan_path(
         if near and shapely.intersects_xy(_interior(shapely.unary_union(near)), *point):
             return None
     reach = max(NEAR, 2.0 * float(np.abs(ends[1] - ends[0]).max()))
-    while True:
+    weights = (margin, penalty, squeeze)
+    found: GlobalPath | None = None  # the last box's route, free but perhaps not the cheapest
+    while budget > 0:
         lo, hi = ends.min(axis=0) - reach, ends.max(axis=0) + reach
         # an obstacle farther than the margin from the box changes no edge's cost inside it
         meets = np.all((lows <= hi + margin) & (highs >= lo - margin), axis=1)
         if meets.all():  # the whole map
-            return _route(ends, half, walls, boxes, None, margin, penalty, squeeze)[0]
+            return _route(ends, half, walls, boxes, None, weights, budget)[0] or found
         inside = meets[: len(walls)], meets[len(walls) :]
-        path, cost = _route(
-            ends, half, walls[inside[0]], boxes[inside[1]], (lo, hi), margin, penalty, squeeze
-        )
+        path, cost, tested = _route(ends, half, walls[inside[0]], boxes[inside[1]], (lo, hi), weights, budget)
         if path is not None and cost <= 2.0 * reach:
             return path
-        reach *= 2.0
+        found, reach, budget = path or found, reach * 2.0, budget - tested
+    return found
 
 
 NEAR = 5000.0
@@ -244,15 +257,16 @@ def _route(
     walls: NDArray[np.float64],
     boxes: NDArray[np.float64],
     region: tuple[NDArray[np.float64], NDArray[np.float64]] | None,
-    margin: float,
-    penalty: float,
-    squeeze: float,
-) -> tuple[GlobalPath | None, float]:
+    weights: tuple[float, float, float],
+    budget: int,
+) -> tuple[GlobalPath | None, float, int]:
     """The cheapest route among `walls` and `boxes` with corners inside `region` (``(lo, hi)``
-    corners of a box, or ``None``: anywhere), and its cost (:func:`plan_path`)."""
+    corners of a box, or ``None``: anywhere), its cost and the edges tested (:func:`plan_path`;
+    `weights`: its margin, penalty and squeeze; no route past `budget` edges tested)."""
+    margin = weights[0]
     grown = shapely.unary_union(_grown(walls, boxes, half))
     if not _one_piece(ends, grown, region, margin):
-        return None, math.inf  # walled apart: the search would try every corner in vain
+        return None, math.inf, 0  # walled apart: the search would try every corner in vain
     # Touching is allowed: only the open interior blocks (shrink by a hair against round-off).
     inner = _interior(grown)
     corners = [_corners(grown, inner, offset) for offset in (1.0, margin)]
@@ -261,12 +275,13 @@ def _route(
         nodes = nodes[
             np.all((nodes >= region[0]) & (nodes <= region[1]), axis=1) | (np.arange(len(nodes)) < 2)
         ]
-    costs = _EdgeCosts(nodes, inner, None if grown.is_empty else grown.boundary, margin, penalty, squeeze)
-    found = _a_star(nodes, costs)
+    costs = _EdgeCosts(nodes, inner, None if grown.is_empty else grown.boundary, *weights)
+    found = _a_star(nodes, costs, budget)
     if found is None:
-        return None, math.inf
+        return None, math.inf, costs.tested
     route, least, cost = found
-    return GlobalPath(tuple((float(x), float(y)) for x, y in nodes[route]), min(least, margin)), cost
+    path = GlobalPath(tuple((float(x), float(y)) for x, y in nodes[route]), min(least, margin))
+    return path, cost, costs.tested
 
 
 def straight_path(
@@ -402,11 +417,13 @@ class _EdgeCosts:
     ) -> None:
         self.nodes, self.inner, self.boundary = nodes, inner, boundary
         self.margin, self.penalty, self.squeeze = margin, penalty, squeeze
+        self.tested = 0  # edges tested so far
 
     def __call__(
         self, u: int, others: NDArray[np.intp]
     ) -> tuple[NDArray[np.intp], NDArray[np.float64], NDArray[np.float64]]:
         """The free edges from `u` to `others`: their far ends, costs and clearances."""
+        self.tested += len(others)
         ends = self.nodes[others]
         lines = shapely.linestrings(np.stack([np.broadcast_to(self.nodes[u], ends.shape), ends], axis=1))
         free = ~shapely.intersects(self.inner, lines)
@@ -421,8 +438,11 @@ class _EdgeCosts:
         return others, cost, clearance
 
 
-def _a_star(nodes: NDArray[np.float64], costs: _EdgeCosts) -> tuple[list[int], float, float] | None:
-    """Cheapest route from node 0 to node 1, the least clearance along it, and its cost.
+def _a_star(
+    nodes: NDArray[np.float64], costs: _EdgeCosts, budget: int
+) -> tuple[list[int], float, float] | None:
+    """Cheapest route from node 0 to node 1, the least clearance along it, and its cost;
+    ``None`` when there is none, or none found before `budget` edges are tested.
 
     A* with the straight-line distance to the goal, which never overestimates (an edge costs
     at least its length) and is consistent, so a node taken off the queue is final and the
@@ -441,7 +461,7 @@ def _a_star(nodes: NDArray[np.float64], costs: _EdgeCosts) -> tuple[list[int], f
         if final[u]:
             continue
         final[u] = True
-        if u == 1:
+        if u == 1 or costs.tested >= budget:
             break
         ends, cost, clearance = costs(u, np.flatnonzero(~final))
         via = d + cost

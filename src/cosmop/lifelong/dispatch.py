@@ -13,8 +13,9 @@ oldest-first rule.  A robot that is busy competes again as soon as it has droppe
 (from the dock, its way home still ahead) or is idle, so among busy robots the one whose order
 is done soonest is served first.  The mission handed over is the order's delivery and the way
 home: ``pick``, ``drop`` at that dock, ``return``; the way home is replaced by the next order
-when one is given at the dock.  A robot that found no plan for an order from where it stood is
-passed over for it while another idle robot may serve it (:attr:`OrderState.no_plan_by`).
+when one is given at the dock, and left out for a robot whose home a failed robot stands on.
+A robot that found no plan for an order from where it stood is passed over for it while another
+idle robot may serve it (:attr:`OrderState.no_plan_by`).
 """
 
 from __future__ import annotations
@@ -85,9 +86,12 @@ def _dock(scene: Scene, order: Order, goods: Sequence[float]) -> str:
     return min(order.to, key=lambda w: (_l1(scene.workspaces[w].center, goods), w))
 
 
-def delivery_events(scene: Scene, robot: str, order: Order, goods: Sequence[float]) -> tuple[Event, ...]:
+def delivery_events(
+    scene: Scene, robot: str, order: Order, goods: Sequence[float], *, home: bool = True
+) -> tuple[Event, ...]:
     """The mission that serves `order` by `robot`: pick the goods (lying at `goods`, mm), drop
-    them at the nearest of the order's docks, and go home.
+    them at the nearest of the order's docks, and go home (unless `home` is false: a robot
+    whose home is taken for good stays at the dock, until it is given the next order).
 
     Parameters
     ----------
@@ -99,18 +103,17 @@ def delivery_events(scene: Scene, robot: str, order: Order, goods: Sequence[floa
         The order to serve.
     goods : sequence of float
         Where the order's goods lie ``(x, y)``, mm.
+    home : bool
+        Whether the robot goes home after the drop.
 
     Returns
     -------
     tuple of Event
-        ``pick``, ``drop`` at the nearest dock, ``return``.
+        ``pick``, ``drop`` at the nearest dock, ``return`` (with `home`).
     """
     dock = _dock(scene, order, goods)
-    return (
-        Event("pick", robot, obj=order.object),
-        Event("drop", robot, obj=order.object, workspace=dock),
-        Event("return", robot),
-    )
+    events = (Event("pick", robot, obj=order.object), Event("drop", robot, obj=order.object, workspace=dock))
+    return (*events, Event("return", robot)) if home else events
 
 
 @dataclass(frozen=True)

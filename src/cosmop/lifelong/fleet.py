@@ -8,13 +8,13 @@ cycle (:func:`cosmop.sim.simulation.advance`), and between cycles it
    competes from the dock, so that it goes home only when no work waits), gives pooled orders
    to idle robots, each the order of least work among the oldest few (``reveal`` orders per
    robot, :func:`~cosmop.lifelong.dispatch.choose_assignment`); each robot is tried once per
-   dispatch.  The robot's next
-   mission (pick, drop, home) is planned from where it stands, with the robots that stand
-   (idle or failed) as obstacles (:func:`cosmop.sim.replan.replan`, every plan passing the
-   exact checker), then ordered against the plans the others have committed to, by the same
-   messages and exact checks as a planned team (:func:`cosmop.sim.recoordinate.recoordinate_world`:
-   the conflicts of every robot's rest are ordered again and the team proved deadlock-free);
-   only then is it handed over.  The robots not involved keep their plans and keep moving.
+   dispatch.  The robot's next mission (pick, drop, home unless a failed robot took it) is
+   planned from where it stands, with the robots that stand (idle or failed) as obstacles
+   (:func:`cosmop.sim.replan.replan`, every plan passing the exact checker), then ordered
+   against the plans the others have committed to, by the same messages and exact checks as a
+   planned team (:func:`cosmop.sim.recoordinate.recoordinate_world`: the conflicts of every
+   robot's rest are ordered again and the team proved deadlock-free); only then is it handed
+   over.  The robots not involved keep their plans and keep moving.
    An order whose plan is refused stays in the pool and waits ``retry_after`` seconds, twice
    as long after each refusal up to ``max_retry_after``: in a world that moves, a refusal
    says "not now", never "never", so refusals alone do not lose an order.  A robot that
@@ -33,7 +33,9 @@ cycle (:func:`cosmop.sim.simulation.advance`), and between cycles it
    returns to the pool unless it carries the goods (then the order is lost, and the goods are
    reported where they stand), and once it stands the others are ordered again around it;
    where a committed route runs through it, the robots still to move are re-planned around
-   it, nearest first, until they can be (:func:`_settle_failures`).
+   it, nearest first, until they can be (:func:`_settle_failures`).  A robot whose home it
+   stands on has no way home any more: it is re-planned first, and from then on its plans end
+   where they drop the goods, the next order taking it on from there.
 
 Units: mm, degrees, seconds.
 """
@@ -177,6 +179,7 @@ class _Run:
     busy_time: dict[str, float] = field(default_factory=dict)
     failed: dict[str, dict[str, Any]] = field(default_factory=dict)  # JSON records of the summary
     failure_retry: dict[str, float] = field(default_factory=dict)  # robot: next try to order around it, s
+    homeless: set[str] = field(default_factory=set)  # robots whose home a failed robot stands on
     log: list[dict[str, Any]] = field(default_factory=list)
     reorders: list[dict[str, Any]] = field(default_factory=list)  # JSON records of the summary
     waits: dict[str, tuple[int, float]] = field(default_factory=dict)  # robot: (step, since), s
@@ -302,7 +305,8 @@ def _dispatch(run: _Run, at_dock: Agent | None = None) -> None:
 
     `at_dock`, a robot that has just dropped its goods, competes with the idle robots for the
     orders: if it is given one, the way home left in its plan is replaced by that order (whose
-    mission ends at home again, for when no more work waits); if not, it goes home.
+    mission ends at home again, for when no more work waits); if not, it goes home (it stays
+    where it is when a failed robot has taken its home).
     """
     world = run.world
     idle = {a.id: a for a in world.agents if a.done and a.id not in run.busy and a.id not in run.failed}
@@ -365,7 +369,7 @@ def _hand_over(run: _Run, agent: Agent, state: OrderState, goods: tuple[float, .
     world, fleet = run.world, run.fleet
     scene = world.scenario.scene
     began = time.perf_counter()  # the hand-over's wall time: dispatch, plan, coordinate, check
-    events = delivery_events(scene, agent.id, state.order, goods)
+    events = delivery_events(scene, agent.id, state.order, goods, home=agent.id not in run.homeless)
     start = start_state(world, agent, {state.order.object})
     sensed, labels = _standing(run, agent)
     bounds = {"max_horizon": fleet.max_horizon, "rlimit": fleet.rlimit}
@@ -475,7 +479,7 @@ def _standing(run: _Run, agent: Agent, homes: bool = False) -> tuple[list[Rectan
         for a in standing
     ]
     if homes:
-        going = [a for a in world.agents if a is not agent and a not in standing]
+        going = [a for a in world.agents if a is not agent and a not in standing and a.id not in run.homeless]
         at_home = [(*world.scenario.scene.robots[a.id].pose[:2], world.robot_half[a.index]) for a in going]
         boxes = np.vstack([boxes, np.asarray(at_home, dtype=float).reshape(-1, 3)])
         labels += [f"the home of {a.id}" for a in going]
@@ -540,6 +544,7 @@ def _fail(run: _Run, robot: str) -> None:
         "t": round(world.t, 6),
         "at": [round(float(v), 3) for v in world.pose[agent.index, :2]],
         "carrying": carrying,
+        "homes_taken": [],  # known once it stands
         "recoordinated": False,
         "why": "not yet ordered around: it brakes",
     }
@@ -571,6 +576,8 @@ def _settle_failures(run: _Run) -> None:
         ):
             continue
         record["at"] = [round(float(v), 3) for v in world.pose[agent.index, :2]]  # where it came to rest
+        record["homes_taken"] = _homes_taken(run, agent)
+        run.homeless.update(record["homes_taken"])
         accepted, why, _ = order_around_failure(world, agent, {})
         replanned: dict[str, Remaining] = {}
         for other in [] if accepted else _in_the_way(run, agent)[:FAILURE_REPLANS]:
@@ -588,11 +595,30 @@ def _settle_failures(run: _Run) -> None:
 
 
 def _in_the_way(run: _Run, failed: Agent) -> list[Agent]:
-    """The robots still to move (not done, not failed), nearest to `failed` first."""
+    """The robots still to move (not done, not failed): those whose home it took first (their
+    way home is gone), then the nearest to `failed` first."""
     world = run.world
     moving = [a for a in world.agents if not a.done and a.id not in run.failed]
     at = world.pose[failed.index, :2]
-    return sorted(moving, key=lambda a: (float(np.hypot(*(world.pose[a.index, :2] - at))), a.id))
+    return sorted(
+        moving,
+        key=lambda a: (a.id not in run.homeless, float(np.hypot(*(world.pose[a.index, :2] - at))), a.id),
+    )
+
+
+def _homes_taken(run: _Run, failed: Agent) -> list[str]:
+    """The robots whose home `failed` stands on for good, the clearance between robots
+    included: they cannot end a plan there any more, so they stay where their plans end."""
+    world = run.world
+    room = (world.conflict_settings or ConflictSettings()).clearance
+    x, y, half = world.robot_boxes()[failed.index]
+    taken = []
+    for other in world.agents:
+        hx, hy = world.scenario.scene.robots[other.id].pose[:2]
+        reach = half + world.robot_half[other.index] + room
+        if other is not failed and abs(hx - x) < reach and abs(hy - y) < reach:
+            taken.append(other.id)
+    return taken
 
 
 def _replanned(run: _Run, agent: Agent) -> Remaining | None:
@@ -600,6 +626,8 @@ def _replanned(run: _Run, agent: Agent) -> Remaining | None:
     (failed ones included), or None when it has no plan."""
     world, fleet = run.world, run.fleet
     remaining, start = mission_left(world, agent)
+    if agent.id in run.homeless:
+        remaining = [e for e in remaining if e.kind != "return"]
     sensed, labels = _standing(run, agent, homes=True)
     plan = replan(
         world.scenario.scene,

@@ -143,8 +143,9 @@ class FleetResult:
         Per robot, the share of the run it served an order (0 to 1).
     failures : Mapping[str, Mapping]
         Per failed robot: when (``t``), where it came to rest (``at``), what it carries,
-        whether the others could be ordered around it (``recoordinated``, ``why`` not) and the
-        robots re-planned around it for that (``replanned``).
+        whether the others could be ordered around it (``recoordinated``, ``why`` not), the
+        robots re-planned around it for that (``replanned``) and those whose home it stands on
+        (``homes_taken``: they stay where their plans end from then on).
     dispatch_log : tuple of Mapping
         Every hand-over tried: ``t``, ``order``, ``robot``, ``accepted``, ``why`` not,
         ``wall_s``, the wall time it took (plan, coordinate, check), s, and ``plan_wall_s``, the
@@ -217,7 +218,8 @@ class FleetResult:
         busy : Mapping of str to float
             Per robot, the time it served orders, s.
         failed : Mapping of str to Mapping
-            Per failed robot, its record (``t``, ``at``, ``carrying``, ``recoordinated``, ``why``).
+            Per failed robot, its record (``t``, ``at``, ``carrying``, ``homes_taken``,
+            ``recoordinated``, ``why``, ``replanned``).
         log : sequence of Mapping
             The dispatcher's log, one record per plan handed over or refused.
         reorders : sequence of Mapping

@@ -128,11 +128,7 @@ def go_to(world: World, agent: Agent, step: Step) -> Action | None:
         world.static_gaps(agent.steps[after].robot[:2], world.robot_half[agent.index])[0]
         < world.settings.leave_gap
     )
-    origin: Pose | None
-    if agent.replan_start is not None and agent.replan_start[0] == k:  # a replan's first step
-        origin = agent.replan_start[1]
-    else:
-        origin = agent.steps[k - 1].robot if k > 0 else None
+    origin = agent.origin
     if agent.way_out is not False:  # at the start, and after creeping back onto the plan's segment
         action = creep_out(world, agent, goal)
         if action is not None:

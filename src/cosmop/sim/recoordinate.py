@@ -2,7 +2,9 @@
 
 When a stalled robot replans (:mod:`cosmop.sim.replan`), its new route may meet the other
 robots' routes where its old one did not.  Its new plan is therefore not executed on its own:
-the rest of every robot's plan, from where each robot is now, is ordered again by
+the rest of every robot's plan, from where each robot is on its plan now (the point of its plan
+nearest it: a robot tracks its plan within centimetres, and the rest keeps to lines the checker
+passed), is ordered again by
 :func:`cosmop.team.safe_plans.make_team_safe`, exactly as before the run --
 
 * messages already sent stay sent: the steps that wait for them are done;
@@ -26,7 +28,7 @@ its robots' executors.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from collections.abc import Set as AbstractSet
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -448,7 +450,7 @@ def _take(
     for other in world.agents:
         _install(other, result.plans[other.id], splits[other.id][0], new=other.id in new)
         if other.id in new:  # its new plan starts where it stood, to the millimetre
-            other.replan_start = (other.step_index, new[other.id].start.robot)
+            other.replan_start = (other.step_index, new[other.id].start)
     added = [m.event for m in result.messages]
     world.conflict_messages |= set(added)
     return True, "", added
@@ -461,13 +463,13 @@ def _unresolved(safety: TeamSafety) -> str:
 
 def unordered_now(world: World, depth: float = 1.0) -> list[Conflict]:
     """The conflicts between the robots' committed rests that no message orders, now: the
-    exact checker's conflict rule on every robot's steps from its current one, from where it
-    stands, with the messages already sent done (an audit of a running fleet).
+    exact checker's conflict rule on every robot's steps from its current one, from where its
+    plan has it now (:func:`_state_now`), with the messages already sent done (an audit of a
+    running fleet).
 
-    A robot a little off its plan's line (it tracks it within centimetres) may make slivers of
-    new overlap that no plan made; only conflicts whose shared space is at least `depth` mm
-    across both ways are returned (1 mm by default: a re-planned robot plans from its pose
-    rounded to the millimetre).
+    Only conflicts whose shared space is at least `depth` mm across both ways are returned
+    (1 mm by default: a re-planned robot plans from its pose rounded to the millimetre, which
+    may make slivers of overlap no plan made).
 
     Parameters
     ----------
@@ -593,18 +595,41 @@ def _positions(world: World) -> dict[str, tuple[float, float] | None]:
 
 
 def _rest_now(world: World, agent: Agent, todo: Iterable[Event]) -> Remaining:
-    """What is left of `agent`'s committed plan, from where its robot is now; `todo`: the
-    mission events it has still to do (:meth:`~cosmop.sim.world.Agent.split_mission`)."""
+    """What is left of `agent`'s committed plan, from where its plan has the robot now
+    (:func:`_state_now`); `todo`: the mission events it has still to do
+    (:meth:`~cosmop.sim.world.Agent.split_mission`)."""
     return Remaining(tuple(agent.steps[agent.step_index :]), tuple(todo), _state_now(world, agent))
 
 
 def _state_now(world: World, agent: Agent) -> State:
-    """Where `agent`'s robot is (mm, degrees) and the objects as its plan sees them now."""
+    """Where `agent`'s robot is on its plan now (mm, degrees) and the objects as its plan sees them.
+
+    A robot tracks its plan within centimetres (the clearance between robots allows for it), so
+    the rest of its plan starts on the plan itself: at the point of the current drive's segment
+    nearest the robot (heading as the robot does: a heading never changes a footprint, but it
+    times the turns), or where its current step has it stand (a wait a re-ordering put part
+    way along a drive stands there, not at the drive's start).  Measured from where the robot
+    really is, the rest's first drive would be a line nobody checked: 30 mm beside an aisle
+    lined with goods, it cut into them.  Where the robot really is when it has failed (it
+    stands there for good) or finished (within its goal tolerance of its plan's end, until it
+    is given work).
+    """
     k = agent.step_index
     scene = world.scenario.scene
-    if k > 0:
-        objects = agent.steps[k - 1].objects
-    else:
-        objects = initial_state(scene, agent.id, agent.steps, scene.objects).objects
-    x, y, h = world.pose[agent.index]
-    return State((float(x), float(y), math.degrees(float(h))), objects)
+    before = agent.before or initial_state(scene, agent.id, agent.steps, scene.objects)
+    x, y, h = (float(v) for v in world.pose[agent.index])
+    if agent.done or agent.stopped_until == math.inf:
+        return State((x, y, math.degrees(h)), before.objects)
+    step = agent.steps[k]
+    if step.primitive == Primitive.GOTO:
+        x, y = _nearest_on(before.robot[:2], step.robot[:2], (x, y))
+        return State((x, y, math.degrees(h)), before.objects)
+    return State(step.robot, before.objects)  # a step other than a drive does not move it
+
+
+def _nearest_on(a: Sequence[float], b: Sequence[float], p: tuple[float, float]) -> tuple[float, float]:
+    """The point of segment `a` `b` nearest `p` (mm)."""
+    dx, dy = b[0] - a[0], b[1] - a[1]
+    length2 = dx * dx + dy * dy
+    t = 0.0 if length2 == 0.0 else min(1.0, max(0.0, ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / length2))
+    return (a[0] + t * dx, a[1] + t * dy)

@@ -391,9 +391,10 @@ def start_state(world: World, agent: Agent, picks: AbstractSet[str | None] = fro
     i = agent.index
     k = agent.step_index
     done_steps = agent.steps[:k]
+    before = agent.before  # a replan's first step: the objects as the replan saw them
     expected = (
-        agent.steps[k - 1].objects
-        if k > 0
+        before.objects
+        if before is not None
         else initial_state(world.scenario.scene, agent.id, agent.steps, world.object_ids).objects
     )
     requested = {st.object for st in done_steps if st.primitive == Primitive.REQ}

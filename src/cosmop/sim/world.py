@@ -22,7 +22,7 @@ from cosmop.control.geometry import box_gaps, point_segment_linf, rect_gaps, seg
 from cosmop.control.paths import GlobalPath
 from cosmop.control.safety import Limits
 from cosmop.events import MESSAGE_KINDS, Event, Primitive, realising_step
-from cosmop.planning.plan_types import PlanSet, Pose, RobotPlan, Step
+from cosmop.planning.plan_types import PlanSet, Pose, RobotPlan, State, Step
 from cosmop.planning.realisation import event_instants
 from cosmop.scenario.overlaps import TOUCH  # the one tolerance under which two squares touch
 from cosmop.scene import Scenario
@@ -76,7 +76,7 @@ class Agent:
         self.dock_stage: str | None = None
         self.path: GlobalPath | None = None  # the global path being followed
         self.reseat_point: tuple[float, float] | None = None  # the plan's segment start to creep back to
-        self.replan_start: tuple[int, Pose] | None = None  # (step, pose): where a replan starts that step
+        self.replan_start: tuple[int, State] | None = None  # (step, state): where a replan starts that step
         self.handling_left = 0.0  # seconds of gripper work left
         self.gripped: int | None = None  # the object (index) the gripper touches, not carried
         self.best_path_left = math.inf  # path left (mm) at the last progress
@@ -119,6 +119,22 @@ class Agent:
                 e for e in self._mission if realising_step(e, self.id) == (primitive, obj, None)
             ]
         return self._realising[key]
+
+    @property
+    def before(self) -> State | None:
+        """Its plan's state before its current step: a replan's start at the replan's first
+        step, else the previous step's pose and objects; ``None`` before the first step of the
+        run (the robot stands at its start)."""
+        k = self.step_index
+        if self.replan_start is not None and self.replan_start[0] == k:
+            return self.replan_start[1]
+        return State(self.steps[k - 1].robot, self.steps[k - 1].objects) if k > 0 else None
+
+    @property
+    def origin(self) -> Pose | None:
+        """Where its plan has the robot before its current step (mm, mm, degrees; :attr:`before`)."""
+        before = self.before
+        return None if before is None else before.robot
 
     @property
     def done(self) -> bool:
