@@ -33,27 +33,19 @@ import cosmop.lifelong.fleet as fleet_module
 import cosmop.sim.replan as replan_module
 from _harness import save_results
 from cosmop.lifelong import FleetSettings, run_fleet
-from cosmop.planning.checker import check_robot_plan
-from cosmop.planning.plan_types import RobotPlan, State
 from cosmop.scenario import parse_scenario
 from cosmop.sim.recoordinate import recoordinate_world, reorder_world, unordered_now
-from cosmop.sim.replan import start_state
+from cosmop.sim.replan import rest_collisions
 from orders_gen import orders_warehouse
 
 
 def rests_failing(world) -> list[str]:
-    """Why each robot's rest as installed fails the single-robot checker (walls, resting goods)."""
-    out = []
-    for agent in world.agents:
-        k = agent.step_index
-        if agent.before is None or agent.done:
-            continue
-        picks = {e.obj for e in agent.split_mission(world.scenario)[1] if e.kind == "pick"}
-        start = State(agent.origin, start_state(world, agent, picks).objects)
-        plan = RobotPlan.from_steps([], agent.steps[k:])
-        found = check_robot_plan(world.scenario.scene, agent.id, plan, start=start)
-        out += [v.message for v in found if v.rule in ("wall", "object-collision")][:1]
-    return out
+    """Why each robot's rest as installed fails the single-robot checker (walls, resting goods;
+    :func:`cosmop.sim.replan.rest_collisions`), the first violation per robot."""
+    first = {}
+    for violation in rest_collisions(world):
+        first.setdefault(violation.robot, violation.message)
+    return list(first.values())
 
 
 def audited(call, depth: float, report: dict) -> object:

@@ -21,7 +21,7 @@ from cosmop.lifelong.dispatch import Offer, choose_assignment, delivery_events
 from cosmop.planning.primitive_effects import initial_state
 from cosmop.scenario import load_orders, load_scenario, parse_scenario
 from cosmop.scene import Order
-from cosmop.sim.replan import grown, replan, start_state, why_no_plan
+from cosmop.sim.replan import grown, replan, rest_collisions, why_no_plan
 from cosmop.traces import Trace
 from run_2x2 import EXAMPLE
 
@@ -496,8 +496,6 @@ def test_every_rest_a_recoordination_installs_passes_the_exact_checker(monkeypat
     # test_a_robot_beside_its_line_is_reordered_on_its_plan).  The audit of a running fleet:
     # each rest installed is checked from its step's origin, with the goods where they are now.
     import cosmop.sim.recoordinate as recoordinate
-    from cosmop.planning.checker import check_robot_plan
-    from cosmop.planning.plan_types import RobotPlan, State
 
     take, installs, violations = recoordinate._take, [], []
 
@@ -505,14 +503,7 @@ def test_every_rest_a_recoordination_installs_passes_the_exact_checker(monkeypat
         out = take(world, result, splits, new)
         if out[0]:
             installs.append(world.t)
-            for agent in world.agents:
-                k, scene = agent.step_index, world.scenario.scene
-                if agent.before is not None and not agent.done:
-                    picks = {e.obj for e in agent.split_mission(world.scenario)[1] if e.kind == "pick"}
-                    start = State(agent.origin, start_state(world, agent, picks).objects)
-                    plan = RobotPlan.from_steps([], agent.steps[k:])
-                    found = check_robot_plan(scene, agent.id, plan, start=start)
-                    violations.extend(v.message for v in found if v.rule in ("wall", "object-collision"))
+            violations.extend(v.message for v in rest_collisions(world))
         return out
 
     monkeypatch.setattr(recoordinate, "_take", audited)

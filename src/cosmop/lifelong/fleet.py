@@ -611,14 +611,12 @@ def _homes_taken(run: _Run, failed: Agent) -> list[str]:
     included: they cannot end a plan there any more, so they stay where their plans end."""
     world = run.world
     room = (world.conflict_settings or ConflictSettings()).clearance
-    x, y, half = world.robot_boxes()[failed.index]
-    taken = []
-    for other in world.agents:
-        hx, hy = world.scenario.scene.robots[other.id].pose[:2]
-        reach = half + world.robot_half[other.index] + room
-        if other is not failed and abs(hx - x) < reach and abs(hy - y) < reach:
-            taken.append(other.id)
-    return taken
+    others = [a for a in world.agents if a is not failed]
+    homes = [(*world.scenario.scene.robots[a.id].pose[:2], world.robot_half[a.index]) for a in others]
+    gaps = box_gaps(
+        world.pose[failed.index, :2], world.robot_half[failed.index], np.asarray(homes).reshape(-1, 3)
+    )
+    return [a.id for a, gap in zip(others, gaps, strict=True) if gap < room]
 
 
 def _replanned(run: _Run, agent: Agent) -> Remaining | None:

@@ -27,6 +27,7 @@ from cosmop.events import Event, Primitive
 from cosmop.planning.checker import check_robot_plan
 from cosmop.planning.plan_types import ObjectState, RobotPlan, State
 from cosmop.planning.primitive_effects import initial_state
+from cosmop.planning.report import Violation
 from cosmop.scene import Scene, Wall
 from cosmop.sim.recoordinate import recoordinate_world
 from cosmop.team.conflicts import ConflictSettings
@@ -41,6 +42,7 @@ __all__ = [
     "mission_left",
     "replan",
     "replan_stalled",
+    "rest_collisions",
     "robot_room",
     "route",
     "sensed_scene",
@@ -412,3 +414,32 @@ def start_state(world: World, agent: Agent, picks: AbstractSet[str | None] = fro
         )
     x, y, h = world.pose[i]
     return State((round(float(x)), round(float(y)), round(math.degrees(float(h)))), objects)
+
+
+def rest_collisions(world: World) -> list[Violation]:
+    """Where the robots' committed rests run into walls or resting goods, now: every robot's
+    steps from its current one, checked by the exact single-robot checker from the start of
+    that step on its plan (:attr:`~cosmop.sim.world.Agent.before`), with the goods where they
+    are now as its plan sees them (:func:`start_state`).  An audit of a running fleet, beside
+    :func:`~cosmop.sim.recoordinate.unordered_now`: a rest cut on a line nobody checked fails it.
+
+    Parameters
+    ----------
+    world : World
+        The running simulation.
+
+    Returns
+    -------
+    list of Violation
+        The ``wall`` and ``object-collision`` violations, robot by robot; empty when none.
+    """
+    out = []
+    for agent in world.agents:
+        if agent.before is None or agent.done:  # not yet started, or nothing left
+            continue
+        picks = {e.obj for e in agent.split_mission(world.scenario)[1] if e.kind == "pick"}
+        start = State(agent.before.robot, start_state(world, agent, picks).objects)
+        plan = RobotPlan.from_steps([], agent.steps[agent.step_index :])
+        found = check_robot_plan(world.scenario.scene, agent.id, plan, start=start)
+        out += [v for v in found if v.rule in ("wall", "object-collision")]
+    return out
