@@ -2,16 +2,19 @@
 
 from __future__ import annotations
 
+import itertools
+import math
 import random
 from dataclasses import replace
 
 import pytest
+import shapely
 
 import cosmop.planning.synthesis as synthesis_module
 from cosmop.errors import ScenarioError
 from cosmop.events import Event
 from cosmop.planning.checker import check_robot_plan
-from cosmop.planning.reach import event_place, least_drives, unreachable
+from cosmop.planning.reach import event_place, least_drives, least_route, unreachable
 from cosmop.planning.specification import MOTION_MARGIN
 from cosmop.planning.synthesis import synthesize
 from cosmop.scenario import load_scenario, parse_scenario
@@ -186,3 +189,32 @@ def test_a_way_round_far_outside_the_places_is_still_found():
     assert unreachable(scene, "R1", PICK) is None
     closed = replace(scene, obstacles=(*scene.obstacles, Wall((0.0, -9000.0), (0.0, -7500.0))))
     assert unreachable(closed, "R1", PICK) is not None
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_least_route_is_the_least_manhattan_length_through_boxes(seed):
+    # brute force: on each axis an optimal route turns only at the boxes' edges or the start,
+    # so trying every such coordinate for every place finds the least length
+    rng = random.Random(seed)
+    boxes = []
+    for _ in range(rng.randint(1, 3)):
+        place = []
+        for _ in range(rng.randint(1, 3)):
+            x, y = rng.uniform(-5000, 5000), rng.uniform(-5000, 5000)
+            width, height = rng.choice([0, rng.uniform(0, 2000)]), rng.uniform(0, 2000)
+            place.append(shapely.box(x, y, x + width, y + height))
+        boxes.append(place)
+    start = (rng.uniform(-5000, 5000), rng.uniform(-5000, 5000))
+    places = [shapely.GeometryCollection(place) if len(place) > 1 else place[0] for place in boxes]
+    best = math.inf
+    for choice in itertools.product(*boxes):
+        total = 0.0
+        for axis in (0, 1):
+            cuts = sorted({start[axis], *(c for b in choice for c in b.bounds[axis::2])})
+            options = [[c for c in cuts if b.bounds[axis] <= c <= b.bounds[axis + 2]] for b in choice]
+            total += min(
+                sum(abs(q - p) for p, q in itertools.pairwise([start[axis], *zs]))
+                for zs in itertools.product(*options)
+            )
+        best = min(best, total)
+    assert least_route(places, start) == pytest.approx(best)

@@ -16,6 +16,7 @@ from pathlib import Path
 
 import pytest
 
+import cosmop.planning.synthesis as synthesis
 from cosmop.planning.checker import check_robot_plan
 from cosmop.planning.specification import RobotProblem, events_of, specification
 from cosmop.planning.synthesis import ROUTE_ROUNDS, synthesize
@@ -249,3 +250,21 @@ def test_among_the_shortest_plans_the_route_is_made_shorter(big):
         assert check_robot_plan(big.scene, robot, best.plan) == []
         shorter += best.route_mm < first.route_mm
     assert shorter >= 3
+
+
+def test_a_route_is_never_asked_below_its_floor_and_the_plan_stays_the_same(big, monkeypatch):
+    # the floor (the Manhattan length through the mission's places, walls ignored) is below
+    # every route; a round that would ask below it is skipped, which changes no plan
+    floors: list[float] = []
+    real = synthesis._route_floor
+    monkeypatch.setattr(synthesis, "_route_floor", lambda *a: floors.append(real(*a)) or floors[-1])
+    skipped = 0
+    for robot, word in big.mission.tasks.items():
+        best = synthesize(big.scene, robot, word, route_rounds=ROUTE_ROUNDS)
+        assert 0 < floors[-1] <= best.route_mm
+        with monkeypatch.context() as without:
+            without.setattr(synthesis, "_route_floor", lambda *a: 0.0)
+            proved = synthesize(big.scene, robot, word, route_rounds=ROUTE_ROUNDS)
+        assert proved.plan == best.plan and proved.route_mm == best.route_mm
+        skipped += proved.checks - best.checks
+    assert skipped >= 3  # most of the 10x10's routes are straight once made shorter

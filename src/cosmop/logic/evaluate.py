@@ -21,6 +21,7 @@ formula depth is limited by Python's recursion limit.
 
 from __future__ import annotations
 
+import math
 import operator
 from collections.abc import Callable, Mapping, Sequence
 from fractions import Fraction
@@ -48,14 +49,13 @@ from cosmop.logic.formulas import (
     Var,
     as_formula,
     normalize_value,
-    subformulas,
 )
 
 __all__ = ["evaluate", "evaluate_all", "failing"]
 
 Trace = Sequence[Mapping[str, object]]
 
-_COMPARE: dict[str, Callable[[Fraction, Fraction], bool]] = {
+_COMPARE: dict[str, Callable[[Fraction | int, Fraction | int], bool]] = {
     "<=": operator.le,
     "<": operator.lt,
     ">=": operator.ge,
@@ -158,6 +158,7 @@ class _Evaluator:
         self.K = len(trace) - 1
         self.columns: dict[Formula, list[bool]] = {}
         self.values: dict[tuple[Var, int], bool | int | Fraction] = {}
+        self.scaled: dict[Compare, tuple[tuple[tuple[Shifted | Max | Min, int], ...], int]] = {}
 
     # -- values -------------------------------------------------------------------------------
     def value(self, var: Var, i: int) -> bool | int | Fraction:
@@ -188,12 +189,35 @@ class _Evaluator:
         left, right = self.linear(term.left, k), self.linear(term.right, k)
         return max(left, right) if isinstance(term, Max) else min(left, right)
 
+    def _integral(self, node: Compare) -> tuple[tuple[tuple[Shifted | Max | Min, int], ...], int]:
+        """`node`'s coefficients and constant times the least common multiple of their
+        denominators: the same comparison (the factor is positive) in integers, which Python
+        adds far faster than fractions."""
+        known = self.scaled.get(node)
+        if known is None:
+            terms = node.expr.terms
+            scale = math.lcm(node.const.denominator, *(c.denominator for _, c in terms))
+            known = tuple((t, int(c * scale)) for t, c in terms), int(node.const * scale)
+            self.scaled[node] = known
+        return known
+
     # -- formulas -----------------------------------------------------------------------------
     def column(self, root: Formula) -> list[bool]:
-        for node in subformulas(root):
-            if node not in self.columns:
-                self.columns[node] = self._compute(node)
-        return self.columns[root]
+        """The truth column of `root`, computing only the sub-formulas not computed yet: a
+        specification's parts share most of their nodes, and each is tested in turn."""
+        columns = self.columns
+        known = columns.get(root)
+        if known is not None:
+            return known
+        stack: list[tuple[Formula, bool]] = [(root, False)]
+        while stack:  # post-order, iterative: deep formulas do not hit the recursion limit
+            node, expanded = stack.pop()
+            if expanded:
+                columns[node] = self._compute(node)
+            elif node not in columns:
+                stack.append((node, True))
+                stack.extend((child, False) for child in reversed(node.children) if child not in columns)
+        return columns[root]
 
     def _in_range(self, offsets: frozenset[int]) -> range:
         """The instants k at which every k + o, o in offsets, lies in [0, K]."""
@@ -216,9 +240,16 @@ class _Evaluator:
         if kind is Compare:
             assert isinstance(node, Compare)
             test = _COMPARE[node.op]
+            terms, const = self._integral(node)
             out = [False] * n
             for k in self._in_range(node.offsets):
-                out[k] = test(self.linear(node.expr, k), node.const)
+                total: int | Fraction = 0
+                for term, c in terms:
+                    if type(term) is Shifted:
+                        total += c * self.value(term.var, k + term.offset)
+                    else:
+                        total += c * self.term(term, k)
+                out[k] = test(total, const)
             return out
         children = [col[c] for c in node.children]
         if kind is Not:

@@ -1311,6 +1311,17 @@ def subformulas(formula: object) -> list[Formula]:
     return order
 
 
+_FIELD_NAMES: dict[type, tuple[str, ...]] = {}
+"""Each node class's field names: :func:`dataclasses.fields` is slow to call once per node."""
+
+
+def _field_names(kind: type) -> tuple[str, ...]:
+    names = _FIELD_NAMES.get(kind)
+    if names is None:
+        names = _FIELD_NAMES[kind] = tuple(f.name for f in fields(kind))
+    return names
+
+
 def _iter_vars(obj: object) -> Iterator[Var]:
     """Variables of a node tree in left-to-right pre-order (with repetitions)."""
     stack: list[object] = [obj]
@@ -1323,8 +1334,7 @@ def _iter_vars(obj: object) -> Iterator[Var]:
             if id(item) in seen:
                 continue
             seen.add(id(item))
-            values = [getattr(item, f.name) for f in fields(item)]  # type: ignore[arg-type]
-            stack.extend(reversed(values))
+            stack.extend(reversed([getattr(item, name) for name in _field_names(type(item))]))
         elif isinstance(item, tuple):
             stack.extend(reversed(item))
 

@@ -24,6 +24,8 @@ reached by the free space near the robot and its places (the walls far away are 
 
 from __future__ import annotations
 
+import itertools
+import math
 from collections.abc import Sequence
 from dataclasses import replace
 
@@ -35,7 +37,7 @@ from cosmop.scene import Scene, Workspace
 from cosmop.squares import docking_places
 from cosmop.units import show_point
 
-__all__ = ["event_place", "free_component", "least_drives", "unreachable"]
+__all__ = ["event_place", "free_component", "least_drives", "least_route", "unreachable"]
 
 _SLACK = 0.5  # mm the grown walls are shrunk by: touching and one-robot-wide passages stay free
 
@@ -273,6 +275,68 @@ def least_drives(
 
 
 _TOUCH = 1e-3  # mm within which two places count as meeting: floating point is not exact
+
+
+def least_route(places: Sequence[shapely.Geometry], start: tuple[float, float]) -> float:
+    """A lower bound on the Manhattan length (mm) of any route from `start` through each of
+    `places` in turn: :math:`\\min \\sum_i |z_i - z_{i+1}|_1` over :math:`z_0 =` `start` and
+    :math:`z_i` in place :math:`i`, walls ignored (which only shortens it).
+
+    Each place is taken as the union of the bounding boxes of its parts (which contain it, so
+    the bound stays sound). For one choice of box per place the Manhattan metric splits by axis,
+    and on one axis the least total of moves between intervals in turn is found greedily: keep
+    the interval of positions reached at the least cost so far; the next interval either meets
+    it (no cost, keep the overlap) or lies beside it (pay the gap, keep its near end).  Every
+    choice of boxes is tried (a pick has up to four poses, a drop one place per heading); past
+    :data:`_CHOICES` of them, each leg is bounded alone (a weaker bound, still sound).
+
+    Parameters
+    ----------
+    places : sequence of shapely geometries
+        Where the route must pass, in order (mm): pick poses, drop places, home.
+    start : tuple of float
+        Where the route starts (mm).
+
+    Returns
+    -------
+    float
+        mm.
+
+    Examples
+    --------
+    >>> least_route([shapely.Point(300, 400), shapely.box(1000, 0, 2000, 100)], (0.0, 0.0))
+    1700.0
+    """
+    layers = [[(start[0], start[1], start[0], start[1])]]
+    for place in places:
+        parts = [part.bounds for part in getattr(place, "geoms", [place]) if not part.is_empty]
+        if not parts:
+            return 0.0
+        layers.append(parts)
+    if math.prod(len(layer) for layer in layers) > _CHOICES:
+        legs = itertools.pairwise(layers)
+        return sum(min(_chase([a, b]) for a in here for b in there) for here, there in legs)
+    return min(_chase(list(boxes)) for boxes in itertools.product(*layers))
+
+
+_CHOICES = 4096
+"""Choices of one box per place beyond which :func:`least_route` bounds each leg alone."""
+
+
+def _chase(boxes: Sequence[tuple[float, float, float, float]]) -> float:
+    """The least Manhattan length through `boxes` (``x0, y0, x1, y1``, mm) in turn."""
+    total = 0.0
+    for axis in (0, 1):
+        lo, hi = boxes[0][axis], boxes[0][axis + 2]
+        for box in boxes[1:]:
+            a, b = box[axis], box[axis + 2]
+            if b < lo:  # the next interval lies below: move to its top
+                total, lo, hi = total + lo - b, b, b
+            elif a > hi:  # above: move to its bottom
+                total, lo, hi = total + a - hi, a, a
+            else:  # they meet: no move, and only the overlap is reached at this cost
+                lo, hi = max(lo, a), min(hi, b)
+    return total
 
 
 def _one_drive_may_join(scene: Scene, half: float, a: shapely.Geometry, b: shapely.Geometry) -> bool:

@@ -56,7 +56,7 @@ from cosmop.logic import Formula, IncrementalUnrolling, Signature, Unrolling, as
 from cosmop.planning.messages import answer_early, place_mission_messages, strip_messages, wait_early
 from cosmop.planning.obstacles import Geometry
 from cosmop.planning.plan_types import ObjectState, ObjectStates, RobotPlan, State, Step
-from cosmop.planning.reach import event_place, least_drives, unreachable
+from cosmop.planning.reach import event_place, least_drives, least_route, unreachable
 from cosmop.planning.specification import (
     MOTION_MARGIN,
     NONE,
@@ -304,7 +304,8 @@ def synthesize(
     # by default the search starts at the events' count: starting at `least` finds plans as
     # short, but the solver's first plan there may differ (`from_bound`)
     first = max(m.lower, min_horizon, least if from_bound else 0)
-    found = _shortest_plan(p, first, max_horizon, rlimit, incremental, lazy, route_rounds, copies)
+    floor = _route_floor(p, m) if route_rounds else 0.0
+    found = _shortest_plan(p, first, max_horizon, rlimit, incremental, lazy, route_rounds, copies, floor)
     if found.plan is not None:
         return found.synthesis(robot, t0, plan=_place_messages(p, found.plan, m.full))
     if found.gave_up is not None:  # the solver could not decide a horizon: claim nothing beyond
@@ -412,15 +413,36 @@ def _least_horizon(p: RobotProblem, m: _Mission, max_horizon: int, *, counted: b
     located = sum(1 for e in m.events if e.kind in ("pick", "drop", "return"))
     if not counted and m.lower + 2 * located <= max_horizon:  # least_drives counts at most two per place
         return m.lower
-    dropped: set[str | None] = set()
-    for e in m.events:  # goods picked again where the mission put them: their place is not known here
-        if e.kind == "pick" and e.obj in dropped:
-            return m.lower
-        if e.kind == "drop":
-            dropped.add(e.obj)
-    places = [where for e in m.events if (where := _place(p, e)) is not None]
+    places = _places(p, m)
+    if places is None:
+        return m.lower
     origin = p.start.robot[:2] if p.start is not None else None
     return m.lower + least_drives(p.scene, p.robot, places, origin)
+
+
+def _places(p: RobotProblem, m: _Mission) -> list[shapely.Geometry] | None:
+    """Where the events of the sequence mission `m` need the robot's centre, in order
+    (:func:`_place`), or None when a place is not known before solving (goods picked again
+    where the mission put them, or a branching mission)."""
+    if m.automaton is not None:
+        return None
+    dropped: set[str | None] = set()
+    for e in m.events:
+        if e.kind == "pick" and e.obj in dropped:
+            return None
+        if e.kind == "drop":
+            dropped.add(e.obj)
+    return [where for e in m.events if (where := _place(p, e)) is not None]
+
+
+def _route_floor(p: RobotProblem, m: _Mission) -> float:
+    """A length (mm) below which no route of `m` lies (:func:`~cosmop.planning.reach.least_route`,
+    less a millimetre for floating point), 0 when the places are not known before solving."""
+    places = _places(p, m)
+    if places is None:
+        return 0.0
+    origin = p.start.robot[:2] if p.start is not None else p.scene.robots[p.robot].pose[:2]
+    return max(least_route(places, (float(origin[0]), float(origin[1]))) - 1.0, 0.0)
 
 
 def _place(p: RobotProblem, event: Event) -> shapely.Geometry | None:
@@ -619,13 +641,14 @@ def _shortest_plan(
     lazy: bool,
     route_rounds: int = 0,
     copies: bool = False,
+    floor: float = 0.0,
 ) -> _Search:
     """The first satisfiable horizon from `lower` to `max_horizon`, and its plan.
 
     Each horizon is checked in turn; at the first satisfiable one the number of requests is
     minimised (:func:`_fewest_requests`), then the route (:func:`_shortest_route`, `route_rounds`
-    rounds).  A horizon the solver cannot decide within `rlimit` ends the search with
-    ``gave_up`` set.  With `lazy`, obstacles join the solver as plans
+    rounds, none asking below `floor` mm).  A horizon the solver cannot decide within `rlimit`
+    ends the search with ``gave_up`` set.  With `lazy`, obstacles join the solver as plans
     break them (:class:`~cosmop.planning.obstacles.Geometry`).
     """
     geometry = Geometry(p, None, lazy)
@@ -644,7 +667,7 @@ def _shortest_plan(
             unsat.append(h.K)
             continue
         model, more = _fewest_requests(p, h, geometry, model)
-        model, route, shorter = _shortest_route(p, h, geometry, model, route_rounds)
+        model, route, shorter = _shortest_route(p, h, geometry, model, route_rounds, floor)
         plan, asked = _plan(p, h.unrolling, model)
         checks += more + shorter
         return _Search(
@@ -698,7 +721,7 @@ def _number(value: Any) -> Fraction:
 
 
 def _shortest_route(
-    p: RobotProblem, h: _Horizon, geometry: Geometry, model: z3.ModelRef, rounds: int
+    p: RobotProblem, h: _Horizon, geometry: Geometry, model: z3.ModelRef, rounds: int, floor: float = 0.0
 ) -> tuple[z3.ModelRef, float, int]:
     """A model of `h` with as few requests as `model` and a shorter route, if one is found.
 
@@ -707,6 +730,8 @@ def _shortest_route(
     first unsat (or undecided, within the resource limit) check ends the search.  So the
     route is within a step of the shortest of its K steps only when the rounds did not run out:
     a few rounds take most of what there is (the first model's detours) at a bounded cost.
+    A bound below `floor` (no route is shorter, :func:`_route_floor`) is not asked: the solver
+    would only prove it unsatisfiable, most of a round's time on a route already straight.
 
     Returns
     -------
@@ -723,7 +748,7 @@ def _shortest_route(
     checks = 0
     for _ in range(rounds):
         bound = math.floor(best - max(Fraction(250), best * Fraction(3, 100)))
-        if bound < 0:
+        if bound < floor:  # unsatisfiable: no route is that short
             break
         _, better, made = h.check(geometry, length <= bound, *keep)
         checks += made
