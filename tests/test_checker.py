@@ -774,3 +774,18 @@ def test_sweep_covers_every_intermediate_square(start, end, t: float) -> None:
     area = swept_square(start, end, 400)
     middle = (start[0] + t * (end[0] - start[0]), start[1] + t * (end[1] - start[1]))
     assert area.buffer(1e-6).contains(square(*middle, 400))
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(-2400, 2400), st.integers(-2400, 2400))
+def test_a_drive_is_tested_against_every_wall_and_good_it_could_meet(x, y):
+    # the checker tests exactly only what a drive's box meets; every wall and resting good the
+    # swept square overlaps, tested one by one, is still reported, and nothing else
+    plan = plan_from_actions(SCENE, "R1", [parse_event("return(R1)")], [("GoTo", (x, y, 0))])
+    found = check_robot_plan(SCENE, "R1", plan)
+    home = SCENE.robots["R1"].pose
+    area = swept_square(home, (x, y, 0), SCENE.robots["R1"].size)
+    walls = [w for w in SCENE.obstacles if overlaps(LineString([w.start, w.end]), area)]
+    goods = [o for o, ob in SCENE.objects.items() if overlaps(square(*ob.position, ob.size), area)]
+    assert sum(v.rule == "wall" and v.instant == 1 for v in found) == len(walls)
+    assert sum(v.rule == "object-collision" and v.instant == 1 for v in found) == len(goods)

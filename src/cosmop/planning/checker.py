@@ -56,6 +56,7 @@ from __future__ import annotations
 from collections.abc import Collection, Iterable
 from typing import Any
 
+import numpy as np
 from shapely.geometry import LineString
 from shapely.geometry.base import BaseGeometry
 
@@ -165,7 +166,12 @@ class _RobotChecker:
         self.initial = initial_state(scene, robot_id, plan, moved) if start is None else start
         self.home = scene.robots[robot_id].pose
         self.states: list[State] = [self.initial, *(step.state for step in plan.steps)]
-        self.walls = [(wall, _wall_line(wall)) for wall in scene.obstacles]
+        # each wall's bounding box, to test exactly only the walls a shape's box meets: a
+        # warehouse has hundreds of walls and thousands of goods, and a step meets a few
+        ends = np.array([(*w.start, *w.end) for w in scene.obstacles], dtype=float).reshape(-1, 4)
+        starts, stops = ends[:, :2], ends[:, 2:]
+        self._wall_boxes = np.hstack([np.minimum(starts, stops), np.maximum(starts, stops)])
+        self._lines: dict[int, LineString] = {}
         self.violations: list[Violation] = []
 
     # -- reporting ---------------------------------------------------------------------------
@@ -307,12 +313,30 @@ class _RobotChecker:
             return None
         return heading
 
-    def resting(self, state: State, exclude: str | None = None) -> Iterable[tuple[str, Any]]:
-        """Objects neither carried nor away in `state`, with their squares."""
+    def walls_meeting(self, shape: BaseGeometry) -> Iterable[tuple[Wall, LineString]]:
+        """The walls, in the scene's order, whose bounding box meets `shape`'s (closed boxes:
+        a wall whose box does not meet it cannot meet the shape), each with its segment."""
+        x0, y0, x1, y1 = shape.bounds
+        box = self._wall_boxes
+        near = (box[:, 0] <= x1) & (box[:, 2] >= x0) & (box[:, 1] <= y1) & (box[:, 3] >= y0)
+        for i in np.flatnonzero(near).tolist():
+            line = self._lines.get(i)
+            if line is None:
+                line = self._lines[i] = _wall_line(self.scene.obstacles[i])
+            yield self.scene.obstacles[i], line
+
+    def resting(
+        self, state: State, exclude: str | None = None, near: BaseGeometry | None = None
+    ) -> Iterable[tuple[str, Any]]:
+        """Objects neither carried nor away in `state`, with their squares; with `near`, only
+        those whose square's box (grown by a millimetre, for rounding) meets its box."""
+        x0, y0, x1, y1 = near.bounds if near is not None else (-np.inf, -np.inf, np.inf, np.inf)
         for oid, obj in state.objects.items():
             if oid != exclude and not obj.carried and not obj.away:
                 x, y = obj.position
-                yield oid, square(x, y, self.scene.objects[oid].size)
+                half = self.scene.objects[oid].size / 2.0 + 1.0
+                if x - half <= x1 and x + half >= x0 and y - half <= y1 and y + half >= y0:
+                    yield oid, square(x, y, self.scene.objects[oid].size)
 
     # -- primitives --------------------------------------------------------------------------
 
@@ -330,7 +354,7 @@ class _RobotChecker:
                 "crosses",
                 "sweeps over",
             )
-        for wall, line in self.walls:
+        for wall, line in self.walls_meeting(area):
             if overlaps(line, area):
                 self.add(
                     k,
@@ -339,7 +363,7 @@ class _RobotChecker:
                     "add a waypoint (another GoTo) to go around it",
                     labelled=True,
                 )
-        for oid, shape in self.resting(prev):
+        for oid, shape in self.resting(prev, near=area):
             if overlaps(shape, area):
                 position = prev.objects[oid].position
                 self.add(
@@ -358,7 +382,7 @@ class _RobotChecker:
         x, y, _ = robot.robot
         reach = square(x, y, self.side).union(square(*where, self.scene.objects[oid].size))
         skipped = set(skip)
-        for wall, line in self.walls:
+        for wall, line in self.walls_meeting(reach):
             if wall not in skipped and overlaps(line, reach):
                 self.add(
                     k,
@@ -447,7 +471,7 @@ class _RobotChecker:
         self.flags_static(k, prev, cur, "away")
         shape = square(where[0], where[1], self.scene.objects[oid].size)
         crossed = []
-        for wall, line in self.walls:
+        for wall, line in self.walls_meeting(shape):
             if overlaps(line, shape):
                 crossed.append(wall)
                 self.add(
@@ -458,7 +482,7 @@ class _RobotChecker:
                 )
         if placed:
             self.reach(k, oid, cur, where, skip=crossed)
-        for other, other_shape in self.resting(cur, exclude=oid):
+        for other, other_shape in self.resting(cur, exclude=oid, near=shape):
             if overlaps(other_shape, shape):
                 self.add(
                     k,

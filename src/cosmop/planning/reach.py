@@ -20,6 +20,8 @@ feasible mission; it proves only what no plan can do.
 The same free space bounds how many drives a plan needs (:func:`least_drives`): a mission that
 needs more steps than the search allows is refused without the solver.  Most missions are
 reached by the free space near the robot and its places (the walls far away are not grown).
+The places alone bound how long its route is (:func:`least_route`, in the Manhattan metric the
+synthesis measures routes in): a shorter route need not be asked for below it.
 """
 
 from __future__ import annotations
