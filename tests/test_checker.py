@@ -789,3 +789,37 @@ def test_a_drive_is_tested_against_every_wall_and_good_it_could_meet(x, y):
     goods = [o for o, ob in SCENE.objects.items() if overlaps(square(*ob.position, ob.size), area)]
     assert sum(v.rule == "wall" and v.instant == 1 for v in found) == len(walls)
     assert sum(v.rule == "object-collision" and v.instant == 1 for v in found) == len(goods)
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.lists(st.tuples(st.integers(-600, 600), st.integers(-600, 600)), min_size=4, max_size=4))
+def test_the_box_filter_reports_what_testing_every_wall_and_good_reports(shifts):
+    # R1's plan with its drives moved: drives, picks, drops and the gripper's reach then meet
+    # walls and goods; the checker that tests only what a step's box meets reports the same
+    # violations, in the same order, as one that tests every wall and every resting good
+    from cosmop.planning import checker
+
+    moves = iter(shifts)
+    actions = []
+    for kind, arg in R1_ACTIONS:
+        if kind == "GoTo":
+            dx, dy = next(moves)
+            arg = (arg[0] + dx, arg[1] + dy, arg[2])
+        actions.append((kind, arg))
+    plan = r1_plan(actions)
+    filtered = [v.message for v in check_robot_plan(SCENE, "R1", plan)]
+    every_wall = checker._RobotChecker.walls_meeting
+    every_good = checker._RobotChecker.resting
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(
+            checker._RobotChecker,
+            "walls_meeting",
+            lambda self, shape: every_wall(self, shape.envelope.buffer(1e9)),
+        )
+        patch.setattr(
+            checker._RobotChecker,
+            "resting",
+            lambda self, state, exclude=None, near=None: every_good(self, state, exclude),
+        )
+        unfiltered = [v.message for v in check_robot_plan(SCENE, "R1", plan)]
+    assert filtered == unfiltered
