@@ -51,6 +51,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from cosmop.control.geometry import box_gaps
 from cosmop.lifelong.dispatch import Offer, OrderState, choose_assignment, delivery_events, window_size
@@ -480,8 +481,7 @@ def _standing(run: _Run, agent: Agent, homes: bool = False) -> tuple[list[Rectan
     ]
     if homes:
         going = [a for a in world.agents if a is not agent and a not in standing and a.id not in run.homeless]
-        at_home = [(*world.scenario.scene.robots[a.id].pose[:2], world.robot_half[a.index]) for a in going]
-        boxes = np.vstack([boxes, np.asarray(at_home, dtype=float).reshape(-1, 3)])
+        boxes = np.vstack([boxes, _homes(world, going)])
         labels += [f"the home of {a.id}" for a in going]
     gaps = box_gaps(world.pose[i, :2], world.robot_half[i], boxes)
     goods = world.resting_boxes()
@@ -612,11 +612,14 @@ def _homes_taken(run: _Run, failed: Agent) -> list[str]:
     world = run.world
     room = (world.conflict_settings or ConflictSettings()).clearance
     others = [a for a in world.agents if a is not failed]
-    homes = [(*world.scenario.scene.robots[a.id].pose[:2], world.robot_half[a.index]) for a in others]
-    gaps = box_gaps(
-        world.pose[failed.index, :2], world.robot_half[failed.index], np.asarray(homes).reshape(-1, 3)
-    )
+    gaps = box_gaps(world.pose[failed.index, :2], world.robot_half[failed.index], _homes(world, others))
     return [a.id for a, gap in zip(others, gaps, strict=True) if gap < room]
+
+
+def _homes(world: World, agents: Sequence[Agent]) -> NDArray[np.float64]:
+    """The `agents`' homes as squares ``x, y, half side`` (mm), shape ``(n, 3)``."""
+    homes = [(*world.scenario.scene.robots[a.id].pose[:2], world.robot_half[a.index]) for a in agents]
+    return np.asarray(homes, dtype=float).reshape(-1, 3)
 
 
 def _replanned(run: _Run, agent: Agent) -> Remaining | None:

@@ -60,6 +60,7 @@ import numpy as np
 from shapely.geometry import LineString
 from shapely.geometry.base import BaseGeometry
 
+from cosmop.control.geometry import segment_array, segment_bounds
 from cosmop.docking import DOCKING_HEADINGS, docking_pose, in_front
 from cosmop.events import Event, Primitive, realising_step
 from cosmop.planning.plan_types import RobotPlan, State, Step
@@ -168,9 +169,8 @@ class _RobotChecker:
         self.states: list[State] = [self.initial, *(step.state for step in plan.steps)]
         # each wall's bounding box, to test exactly only the walls a shape's box meets: a
         # warehouse has hundreds of walls and thousands of goods, and a step meets a few
-        ends = np.array([(*w.start, *w.end) for w in scene.obstacles], dtype=float).reshape(-1, 4)
-        starts, stops = ends[:, :2], ends[:, 2:]
-        self._wall_boxes = np.hstack([np.minimum(starts, stops), np.maximum(starts, stops)])
+        walls = segment_array((w.start, w.end) for w in scene.obstacles)
+        self._wall_lo, self._wall_hi = segment_bounds(walls)
         self._lines: dict[int, LineString] = {}
         self.violations: list[Violation] = []
 
@@ -317,8 +317,7 @@ class _RobotChecker:
         """The walls, in the scene's order, whose bounding box meets `shape`'s (closed boxes:
         a wall whose box does not meet it cannot meet the shape), each with its segment."""
         x0, y0, x1, y1 = shape.bounds
-        box = self._wall_boxes
-        near = (box[:, 0] <= x1) & (box[:, 2] >= x0) & (box[:, 1] <= y1) & (box[:, 3] >= y0)
+        near = np.all((self._wall_lo <= (x1, y1)) & (self._wall_hi >= (x0, y0)), axis=1)
         for i in np.flatnonzero(near).tolist():
             line = self._lines.get(i)
             if line is None:
