@@ -172,7 +172,7 @@ def test_the_numeric_test_of_the_ends_never_passes_what_the_formula_breaks(monke
     # numeric pre-test calls an obstacle's stronger part surely kept, the exact formula agrees.
     scene = _past_the_end()
     seen = []
-    monkeypatch.setattr(obstacles, "_near_route", lambda p: set())
+    monkeypatch.setattr(obstacles, "_near_route", lambda p, lines=False: set())
     broken = obstacles.Geometry.broken
     monkeypatch.setattr(obstacles.Geometry, "broken", lambda g, t: seen.append((g, t)) or broken(g, t))
     synthesize(scene, "R1", MISSION, max_horizon=12)

@@ -268,3 +268,18 @@ def test_a_route_is_never_asked_below_its_floor_and_the_plan_stays_the_same(big,
         assert proved.plan == best.plan and proved.route_mm == best.route_mm
         skipped += proved.checks - best.checks
     assert skipped >= 3  # most of the 10x10's routes are straight once made shorter
+
+
+def test_an_ask_for_a_shorter_route_spends_at_most_its_budget(big, monkeypatch):
+    # with no budget at all every ask ends undecided: the first plan is kept, as without rounds;
+    # with the shipped budget the 10x10's routes are made shorter as before
+    for robot, word in big.mission.tasks.items():  # the first robot whose route is made shorter
+        first = synthesize(big.scene, robot, word)
+        if synthesize(big.scene, robot, word, route_rounds=ROUTE_ROUNDS).route_mm < first.route_mm:
+            break
+    else:
+        pytest.fail("no route of the 10x10 is made shorter")
+    monkeypatch.setattr(synthesis, "ROUTE_RLIMIT", 1)
+    spent = synthesize(big.scene, robot, word, route_rounds=ROUTE_ROUNDS)
+    assert spent.plan == first.plan and spent.route_mm == first.route_mm
+    assert spent.checks > first.checks  # it asked, and got no answer within the budget

@@ -95,6 +95,11 @@ class Geometry:
     lazy : bool
         Hold back the obstacles out of reach of the robot's route until a plan breaks them
         (see the module docstring); else hold every part from the start.
+    lines : bool
+        With `lazy`, hold from the start only the obstacles near the straight lines between the
+        mission's places, within their box (:func:`_corridor`), instead of the whole box: the
+        same shortest horizon, found sooner on a large map, but the solver's first plan may be
+        another (off by default, as :func:`~cosmop.planning.synthesis.synthesize`'s ``copies``).
 
     Attributes
     ----------
@@ -113,12 +118,14 @@ class Geometry:
     (:data:`_GAP`): it may send an obstacle to the exact test needlessly, never skip one.
     """
 
-    def __init__(self, p: RobotProblem, events: Sequence[Event] | None, lazy: bool) -> None:
+    def __init__(
+        self, p: RobotProblem, events: Sequence[Event] | None, lazy: bool, *, lines: bool = False
+    ) -> None:
         walls = range(len(p.scene.obstacles))
         keys = [wall_key(i, handling) for handling in (False, True) for i in walls]
         keys += [object_key(o) for o in p.scene.objects]
         keys += [corner_clearance_key(k) for k in [*map(wall_key, walls), *map(object_key, p.scene.objects)]]
-        held = set(keys) if not lazy else _near_route(p) | {object_key(o) for o in p.own_objects}
+        held = set(keys) if not lazy else _near_route(p, lines) | {object_key(o) for o in p.own_objects}
         self._p, self._events = p, events
         self.held = conj(f for _, f in specification(p.with_obstacles(frozenset(held)), events))
         self._waiting = [k for k in keys if k not in held]
@@ -334,13 +341,16 @@ def _clear(planes: NDArray[np.float64], points: Sequence[tuple[float, ...]]) -> 
     return on_it
 
 
-def _near_route(p: RobotProblem) -> set[ObstacleKey]:
+def _near_route(p: RobotProblem, lines: bool = False) -> set[ObstacleKey]:
     """The obstacles within reach of where the robot must be.
 
     To drives: the walls and objects in the box around the robot's start and home, its goods
-    where they start and the places it may drop them.  To picks and drops: the walls near
-    those goods and places.  Boxes are grown by the robot's side, the motion margin and the
-    largest good, so that every obstacle a straight drive inside them could touch is in.
+    where they start and the places it may drop them; with `lines` (and a sequence of events),
+    only those of the box near the straight lines between those places in the mission's order
+    or near the places themselves (:func:`_corridor`).  To picks
+    and drops: the walls near those goods and places.  Boxes are grown by the robot's side,
+    the motion margin and the largest good, so that every obstacle a straight drive inside
+    them could touch is in.
     """
     scene = p.scene
     grow = float(p.side + p.margin) + max((ob.size for ob in scene.objects.values()), default=0.0)
@@ -350,13 +360,13 @@ def _near_route(p: RobotProblem) -> set[ObstacleKey]:
         places.append((p.at_start(o)[0],) * 2)
         for e in p.mission:
             if e.kind == "drop" and e.obj == o:
-                assert e.workspace is not None  # a drop names its workspace
-                (x0, x1), (y0, y1) = scene.workspaces[e.workspace].centres(scene.objects[o].size).ranges
-                places.append(((x0, y0), (x1, y1)))
+                places.append(_drop_box(p, e))
     corners = robot + [q for place in places for q in place]
     xs, ys = [q[0] for q in corners], [q[1] for q in corners]
-    route = shapely.box(min(xs) - grow, min(ys) - grow, max(xs) + grow, max(ys) + grow)
     boxes = [shapely.box(a[0] - grow, a[1] - grow, b[0] + grow, b[1] + grow) for a, b in places]
+    route = shapely.box(min(xs) - grow, min(ys) - grow, max(xs) + grow, max(ys) + grow)
+    if lines and p.automaton is None:  # a sequence: its places in order
+        route = route.intersection(shapely.union_all([_corridor(p, grow), *boxes]))
     handling = shapely.union_all(boxes)
     walls = shapely.linestrings([[w.start, w.end] for w in scene.obstacles]) if scene.obstacles else []
     near = (
@@ -364,14 +374,48 @@ def _near_route(p: RobotProblem) -> set[ObstacleKey]:
     )
     if len(walls) and not handling.is_empty:
         near |= {wall_key(int(i), handling=True) for i in np.flatnonzero(shapely.intersects(handling, walls))}
-    if scene.objects:  # each object's square grown by its side meets the route's box (or touches it)
+    if scene.objects:  # each object's square grown by its side meets the route (or touches it)
         ids = list(scene.objects)
         at = np.array([p.at_start(o)[0] for o in ids], dtype=float)
-        size = np.array([scene.objects[o].size for o in ids], dtype=float)[:, None]
-        x0, y0, x1, y1 = route.bounds
-        meets = ((at - size <= (x1, y1)) & (at + size >= (x0, y0))).all(axis=1)
-        near |= {object_key(o) for o, yes in zip(ids, meets, strict=True) if yes}
+        size = np.array([scene.objects[o].size for o in ids], dtype=float)
+        squares = shapely.box(at[:, 0] - size, at[:, 1] - size, at[:, 0] + size, at[:, 1] + size)
+        near |= {object_key(o) for o, yes in zip(ids, shapely.intersects(route, squares), strict=True) if yes}
     return near
+
+
+_CORRIDOR_SIDES = 2
+"""How many robot sides, beyond the reach of a drive, the first obstacles lie within of the
+straight lines between a mission's places (:func:`_corridor`)."""
+
+
+def _drop_box(p: RobotProblem, e: Event) -> tuple[tuple[float, float], tuple[float, float]]:
+    """The box ``(x0, y0), (x1, y1)`` of the centres where the drop `e` may put its good (mm)."""
+    assert e.workspace is not None and e.obj is not None  # a drop names its goods and workspace
+    (x0, x1), (y0, y1) = p.scene.workspaces[e.workspace].centres(p.scene.objects[e.obj].size).ranges
+    return (x0, y0), (x1, y1)
+
+
+def _corridor(p: RobotProblem, grow: float) -> shapely.Geometry:
+    """Where the robot's centre is within `grow` and :data:`_CORRIDOR_SIDES` sides (mm) of the
+    broken line from its start through the places of its events in order (a good where it
+    starts, the middle of a drop's box) to its home.
+
+    Only which obstacles the solver holds from the start depends on it (the module docstring's
+    claim holds for any set): on a large map the box around far-apart places holds thousands
+    of walls and goods the robot never comes near, while a route keeps mostly near these lines
+    (measured on MovingAI hand-overs, ``benchmarks/BENCHMARKS.md``, 2026-12-07, sixth).
+    """
+    start = p.start.robot[:2] if p.start is not None else p.scene.robots[p.robot].pose[:2]
+    line = [tuple(start)]
+    for e in p.mission:
+        if e.kind == "pick" and e.obj is not None:
+            line.append(p.at_start(e.obj)[0])
+        elif e.kind == "drop":
+            (x0, y0), (x1, y1) = _drop_box(p, e)
+            line.append(((x0 + x1) / 2, (y0 + y1) / 2))
+    line.append(tuple(p.scene.robots[p.robot].pose[:2]))
+    width = grow + _CORRIDOR_SIDES * float(p.side)
+    return shapely.LineString(line).buffer(width, cap_style="square", join_style="mitre")
 
 
 __all__ = ["Geometry", "obstacle_of"]

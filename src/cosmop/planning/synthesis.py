@@ -73,6 +73,11 @@ from cosmop.scene import MAX_TASK_EVENTS, Scene
 DEFAULT_RLIMIT = 50_000_000
 ROUTE_ROUNDS = 4
 """How many times a re-planned robot asks for a shorter route (:func:`_shortest_route`)."""
+ROUTE_RLIMIT = 2_000_000
+"""Z3 resource limit of each ask for a shorter route (:func:`_shortest_route`), below the search's:
+a shorter route is worth a bounded effort.  Asks that found one took at most 1.7 million on the
+MovingAI hand-overs measured (``benchmarks/BENCHMARKS.md``, 2026-12-07, sixth); the proofs that
+none is shorter took up to 7 million (3 s), for nothing."""
 
 
 @dataclass(frozen=True)
@@ -208,6 +213,7 @@ def synthesize(
     route_rounds: int = 0,
     copies: bool = False,
     from_bound: bool = False,
+    near_lines: bool = False,
 ) -> Synthesis:
     """The shortest safe plan of motion primitives for one robot's local mission.
 
@@ -269,6 +275,11 @@ def synthesize(
         instead of the events' count: the same shortest horizon without proving the lengths
         below the bound one by one, but the solver's first plan there may be another (off by
         default, as `copies`).
+    near_lines : bool
+        With `lazy`, the solver starts with the obstacles near the straight lines between the
+        mission's places instead of the whole box around them (:class:`Geometry`'s ``lines``):
+        the same shortest horizon and fewest requests, found sooner where the places lie far
+        apart, but the solver's first plan may be another (off by default, as `copies`).
 
     Returns
     -------
@@ -305,7 +316,9 @@ def synthesize(
     # short, but the solver's first plan there may differ (`from_bound`)
     first = max(m.lower, min_horizon, least if from_bound else 0)
     floor = _route_floor(p, m) if route_rounds else 0.0
-    found = _shortest_plan(p, first, max_horizon, rlimit, incremental, lazy, route_rounds, copies, floor)
+    found = _shortest_plan(
+        p, first, max_horizon, rlimit, incremental, lazy, route_rounds, copies, floor, near_lines
+    )
     if found.plan is not None:
         return found.synthesis(robot, t0, plan=_place_messages(p, found.plan, m.full))
     if found.gave_up is not None:  # the solver could not decide a horizon: claim nothing beyond
@@ -642,6 +655,7 @@ def _shortest_plan(
     route_rounds: int = 0,
     copies: bool = False,
     floor: float = 0.0,
+    near_lines: bool = False,
 ) -> _Search:
     """The first satisfiable horizon from `lower` to `max_horizon`, and its plan.
 
@@ -649,9 +663,9 @@ def _shortest_plan(
     minimised (:func:`_fewest_requests`), then the route (:func:`_shortest_route`, `route_rounds`
     rounds, none asking below `floor` mm).  A horizon the solver cannot decide within `rlimit`
     ends the search with ``gave_up`` set.  With `lazy`, obstacles join the solver as plans
-    break them (:class:`~cosmop.planning.obstacles.Geometry`).
+    break them (:class:`~cosmop.planning.obstacles.Geometry`; `near_lines`, its ``lines``).
     """
-    geometry = Geometry(p, None, lazy)
+    geometry = Geometry(p, None, lazy, lines=near_lines)
     checks = 0
     unsat: list[int] = []
     for h in _horizons(geometry, lower, max_horizon, rlimit, incremental=incremental, copies=copies):
@@ -667,7 +681,7 @@ def _shortest_plan(
             unsat.append(h.K)
             continue
         model, more = _fewest_requests(p, h, geometry, model)
-        model, route, shorter = _shortest_route(p, h, geometry, model, route_rounds, floor)
+        model, route, shorter = _shortest_route(p, h, geometry, model, route_rounds, floor, rlimit)
         plan, asked = _plan(p, h.unrolling, model)
         checks += more + shorter
         return _Search(
@@ -721,7 +735,13 @@ def _number(value: Any) -> Fraction:
 
 
 def _shortest_route(
-    p: RobotProblem, h: _Horizon, geometry: Geometry, model: z3.ModelRef, rounds: int, floor: float = 0.0
+    p: RobotProblem,
+    h: _Horizon,
+    geometry: Geometry,
+    model: z3.ModelRef,
+    rounds: int,
+    floor: float = 0.0,
+    rlimit: int = DEFAULT_RLIMIT,
 ) -> tuple[z3.ModelRef, float, int]:
     """A model of `h` with as few requests as `model` and a shorter route, if one is found.
 
@@ -732,6 +752,8 @@ def _shortest_route(
     a few rounds take most of what there is (the first model's detours) at a bounded cost.
     A bound below `floor` (no route is shorter, :func:`_route_floor`) is not asked: the solver
     would only prove it unsatisfiable, most of a round's time on a route already straight.
+    Each ask has at most :data:`ROUTE_RLIMIT` of the solver's resources (`rlimit` if smaller),
+    counted in Z3's deterministic units: the same input gives the same route.
 
     Returns
     -------
@@ -746,15 +768,19 @@ def _shortest_route(
         count = _count_requests(p, h.unrolling)
         keep.append(count <= model.eval(count, model_completion=True))
     checks = 0
-    for _ in range(rounds):
-        bound = math.floor(best - max(Fraction(250), best * Fraction(3, 100)))
-        if bound < floor:  # unsatisfiable: no route is that short
-            break
-        _, better, made = h.check(geometry, length <= bound, *keep)
-        checks += made
-        if better is None:
-            break
-        model, best = better, _number(better.eval(length, model_completion=True))
+    h.solver.set("rlimit", min(rlimit, ROUTE_RLIMIT))
+    try:
+        for _ in range(rounds):
+            bound = math.floor(best - max(Fraction(250), best * Fraction(3, 100)))
+            if bound < floor:  # unsatisfiable: no route is that short
+                break
+            _, better, made = h.check(geometry, length <= bound, *keep)
+            checks += made
+            if better is None:  # none shorter, or not found within the budget
+                break
+            model, best = better, _number(better.eval(length, model_completion=True))
+    finally:
+        h.solver.set("rlimit", rlimit)
     return model, float(best), checks
 
 

@@ -142,8 +142,9 @@ def replan(
     """The shortest plan of `events` from `start` among the walls and the sensed obstacles,
     its route made shorter among those (:data:`~cosmop.planning.synthesis.ROUTE_ROUNDS`: a
     robot among others that move drives the shortest way it finds, measured in lifelong runs).
-    Found by the quick search (:func:`~cosmop.planning.synthesis.synthesize`'s ``copies`` and
-    ``from_bound``): as short as the batch planner's, not necessarily the same plan.
+    Found by the quick search (:func:`~cosmop.planning.synthesis.synthesize`'s ``copies``,
+    ``from_bound`` and ``near_lines``): as short as the batch planner's, not necessarily the
+    same plan.
 
     Parameters
     ----------
@@ -239,6 +240,7 @@ def _synthesize(
         # found faster: any of the shortest plans will do, its route is made shorter anyway
         copies=True,
         from_bound=True,
+        near_lines=True,
     )
 
 
