@@ -178,3 +178,20 @@ def test_near_the_lines_the_solver_starts_with_fewer_obstacles_and_those_on_the_
         assert crossed <= lines
         assert {k for k in box if k.handling} <= lines  # picks and drops keep their walls
     assert fewer >= 4
+
+
+def test_a_replan_starts_near_the_lines_and_the_batch_planner_from_the_box(monkeypatch):
+    from cosmop.sim.replan import replan
+
+    asked: list[bool] = []
+    near_route = obstacles._near_route
+    monkeypatch.setattr(
+        obstacles, "_near_route", lambda p, lines=False: asked.append(lines) or near_route(p, lines)
+    )
+    scene = parse_scenario(shelves(1)).scene  # no request needed: a replan makes none
+    first = synthesize(scene, "R1", FETCH)
+    assert asked == [False]
+    step = first.plan.steps[0]  # a drive: the robot on its way, nothing picked yet
+    assert step.primitive == "GoTo"
+    again = replan(scene, "R1", tuple(parse_event(e) for e in FETCH), State(step.robot, step.objects))
+    assert asked == [False, True] and again is not None

@@ -397,23 +397,27 @@ def _drop_box(p: RobotProblem, e: Event) -> tuple[tuple[float, float], tuple[flo
 
 def _corridor(p: RobotProblem, grow: float) -> shapely.Geometry:
     """Where the robot's centre is within `grow` and :data:`_CORRIDOR_SIDES` sides (mm) of the
-    broken line from its start through the places of its events in order (a good where it
-    starts, the middle of a drop's box) to its home.
+    broken line from its start through the places of its events in order (a good where it lies
+    then, the middle of a drop's box, home for a ``return``) to its home.
 
     Only which obstacles the solver holds from the start depends on it (the module docstring's
     claim holds for any set): on a large map the box around far-apart places holds thousands
     of walls and goods the robot never comes near, while a route keeps mostly near these lines
     (measured on MovingAI hand-overs, ``benchmarks/BENCHMARKS.md``, 2026-12-07, sixth).
     """
-    start = p.start.robot[:2] if p.start is not None else p.scene.robots[p.robot].pose[:2]
-    line = [tuple(start)]
+    home = tuple(p.scene.robots[p.robot].pose[:2])
+    line = [tuple(p.start.robot[:2]) if p.start is not None else home]
+    put: dict[str, tuple[float, float]] = {}  # where the mission last put each good
     for e in p.mission:
         if e.kind == "pick" and e.obj is not None:
-            line.append(p.at_start(e.obj)[0])
-        elif e.kind == "drop":
+            line.append(put.get(e.obj, p.at_start(e.obj)[0]))
+        elif e.kind == "drop" and e.obj is not None:
             (x0, y0), (x1, y1) = _drop_box(p, e)
-            line.append(((x0 + x1) / 2, (y0 + y1) / 2))
-    line.append(tuple(p.scene.robots[p.robot].pose[:2]))
+            put[e.obj] = ((x0 + x1) / 2, (y0 + y1) / 2)
+            line.append(put[e.obj])
+        elif e.kind == "return":
+            line.append(home)
+    line.append(home)
     width = grow + _CORRIDOR_SIDES * float(p.side)
     return shapely.LineString(line).buffer(width, cap_style="square", join_style="mitre")
 

@@ -74,10 +74,10 @@ DEFAULT_RLIMIT = 50_000_000
 ROUTE_ROUNDS = 4
 """How many times a re-planned robot asks for a shorter route (:func:`_shortest_route`)."""
 ROUTE_RLIMIT = 2_000_000
-"""Z3 resource limit of each ask for a shorter route (:func:`_shortest_route`), below the search's:
-a shorter route is worth a bounded effort.  Asks that found one took at most 1.7 million on the
-MovingAI hand-overs measured (``benchmarks/BENCHMARKS.md``, 2026-12-07, sixth); the proofs that
-none is shorter took up to 7 million (3 s), for nothing."""
+"""Z3 resource limit of each solver check of an ask for a shorter route (:func:`_shortest_route`),
+below the search's: a shorter route is worth a bounded effort.  Asks that found one took at most
+1.7 million on the MovingAI hand-overs measured (``benchmarks/BENCHMARKS.md``, 2026-12-07,
+sixth); the proofs that none is shorter took up to 7 million (3 s), for nothing."""
 
 
 @dataclass(frozen=True)
@@ -748,11 +748,13 @@ def _shortest_route(
     Up to `rounds` times the route length ``L`` (:func:`_route_length`) is bounded below the
     best found, ``L <= best - max(250 mm, 3 % of best)``, each bound for one check only; the
     first unsat (or undecided, within the resource limit) check ends the search.  So the
-    route is within a step of the shortest of its K steps only when the rounds did not run out:
+    route is within a step of the shortest of its K steps only when the rounds did not run out
+    and the last ask was proved unsatisfiable (not undecided):
     a few rounds take most of what there is (the first model's detours) at a bounded cost.
     A bound below `floor` (no route is shorter, :func:`_route_floor`) is not asked: the solver
     would only prove it unsatisfiable, most of a round's time on a route already straight.
-    Each ask has at most :data:`ROUTE_RLIMIT` of the solver's resources (`rlimit` if smaller),
+    Each solver check of an ask (more than one when the plan found breaks obstacles not yet
+    held) has at most :data:`ROUTE_RLIMIT` of the solver's resources (`rlimit` if smaller),
     counted in Z3's deterministic units: the same input gives the same route.
 
     Returns
@@ -768,7 +770,7 @@ def _shortest_route(
         count = _count_requests(p, h.unrolling)
         keep.append(count <= model.eval(count, model_completion=True))
     checks = 0
-    h.solver.set("rlimit", min(rlimit, ROUTE_RLIMIT))
+    h.solver.set("rlimit", min(rlimit, ROUTE_RLIMIT) if rlimit > 0 else ROUTE_RLIMIT)  # 0: no limit
     try:
         for _ in range(rounds):
             bound = math.floor(best - max(Fraction(250), best * Fraction(3, 100)))
