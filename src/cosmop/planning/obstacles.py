@@ -347,10 +347,9 @@ def _near_route(p: RobotProblem, lines: bool = False) -> set[ObstacleKey]:
     To drives: the walls and objects in the box around the robot's start and home, its goods
     where they start and the places it may drop them; with `lines` (and a sequence of events),
     only those of the box near the straight lines between those places in the mission's order
-    or near the places themselves (:func:`_corridor`).  To picks
-    and drops: the walls near those goods and places.  Boxes are grown by the robot's side,
-    the motion margin and the largest good, so that every obstacle a straight drive inside
-    them could touch is in.
+    or near the places themselves (:func:`_corridor`).  To picks and drops: the walls near
+    those goods and places.  Boxes are grown by the robot's side, the motion margin and the
+    largest good, so that every obstacle a straight drive inside them could touch is in.
     """
     scene = p.scene
     grow = float(p.side + p.margin) + max((ob.size for ob in scene.objects.values()), default=0.0)
