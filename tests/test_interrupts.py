@@ -124,6 +124,33 @@ def test_ctrl_c_during_a_lifelong_run_writes_what_was_delivered_so_far(tmp_path,
     assert json.loads(trace.read_text())["frames"]  # the trace of the same run so far
 
 
+def test_a_finaliser_that_fails_after_a_ctrl_c_is_not_shown():
+    # a Ctrl-C that lands while an object is built (a Z3 context, seen in a run) leaves it half
+    # built; its finaliser fails as the program unwinds, and only "interrupted" is said
+    code = (
+        "import os, signal, time, cosmop.cli, cosmop._entry as entry\n"
+        "class HalfBuilt:\n"
+        "    def __init__(self):\n"
+        "        os.kill(os.getpid(), signal.SIGINT)\n"
+        "        time.sleep(20)\n"
+        "        self.owner = True\n"
+        "    def __del__(self):\n"
+        "        self.owner\n"
+        "def main():\n"
+        "    HalfBuilt()\n"
+        "cosmop.cli.main = main\n"
+        "entry.run()\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", code],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),  # as from a terminal
+    )
+    assert (done.returncode, done.stderr) == (130, "interrupted\n")
+
+
 def test_a_ctrl_c_python_had_to_swallow_still_ends_the_program():
     # a KeyboardInterrupt raised in a finaliser cannot propagate (Python prints "Exception
     # ignored" and goes on); the program ends as a second Ctrl-C would, without a traceback

@@ -18,6 +18,9 @@ expect), no traceback, no process left and nothing half-written, in one of two w
   ``__del__``, or in the import system's lock callback, while a module loads) would be
   swallowed, with an "Exception ignored" traceback, and the program would go on: it ends the
   program on the spot instead, as a second one does (:data:`sys.unraisablehook`).
+- A Ctrl-C that lands while an object is being built (a Z3 context, say) leaves it half built,
+  and its finaliser may then fail as the program unwinds ("Exception ignored" and a traceback):
+  after a Ctrl-C such failures are the interrupt's doing and are not shown.
 
 A command that is done ends the program the same way, at once (:func:`os._exit` with the
 command's status, its output flushed): the interpreter's teardown would wait for any thread
@@ -81,15 +84,17 @@ def _end() -> None:
     os._exit(EXIT_INTERRUPTED)
 
 
-def _ending_when_swallowed(default: Callable[[Any], object]) -> Callable[[Any], None]:
+def _ending_when_swallowed(default: Callable[[Any], object], ctrl_c: _CtrlC) -> Callable[[Any], None]:
     """A :data:`sys.unraisablehook` that ends the program (:func:`_end`) when the exception
-    Python could not raise is the Ctrl-C's KeyboardInterrupt, and leaves the others to
-    `default`."""
+    Python could not raise is the Ctrl-C's KeyboardInterrupt, keeps quiet about the others once
+    `ctrl_c` has taken a Ctrl-C (a finaliser of an object it left half built), and leaves the
+    others to `default`."""
 
     def hook(unraisable: Any) -> None:
         if isinstance(unraisable.exc_value, KeyboardInterrupt):
             _end()
-        default(unraisable)
+        if not ctrl_c.taken:
+            default(unraisable)
 
     return hook
 
@@ -123,7 +128,7 @@ def run() -> None:
     ctrl_c = _CtrlC()
     if signal.getsignal(signal.SIGINT) is signal.default_int_handler:  # not ignored by the caller
         signal.signal(signal.SIGINT, ctrl_c)
-        sys.unraisablehook = _ending_when_swallowed(sys.unraisablehook)
+        sys.unraisablehook = _ending_when_swallowed(sys.unraisablehook, ctrl_c)
     try:
         from cosmop.cli import main
 
