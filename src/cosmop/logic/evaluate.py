@@ -178,9 +178,16 @@ class _Evaluator:
         return cached
 
     def linear(self, expr: LinExpr, k: int) -> Fraction:
-        total = expr.const
-        for term, coefficient in expr.terms:
-            total += coefficient * self.term(term, k)
+        return expr.const + self.weighted(expr.terms, k)
+
+    def weighted(self, terms: Sequence[tuple[Shifted | Max | Min, Fraction | int]], k: int) -> Fraction | int:
+        """:math:`\\sum_t c_t \\cdot t` at instant `k` (integers stay integers: :meth:`_integral`)."""
+        total: Fraction | int = 0
+        for term, coefficient in terms:
+            if type(term) is Shifted:  # most terms: the value itself, without a call or a Fraction
+                total += coefficient * self.value(term.var, k + term.offset)
+            else:
+                total += coefficient * self.term(term, k)
         return total
 
     def term(self, term: Shifted | Max | Min, k: int) -> Fraction:
@@ -243,13 +250,7 @@ class _Evaluator:
             terms, const = self._integral(node)
             out = [False] * n
             for k in self._in_range(node.offsets):
-                total: int | Fraction = 0
-                for term, c in terms:
-                    if type(term) is Shifted:
-                        total += c * self.value(term.var, k + term.offset)
-                    else:
-                        total += c * self.term(term, k)
-                out[k] = test(total, const)
+                out[k] = test(self.weighted(terms, k), const)
             return out
         children = [col[c] for c in node.children]
         if kind is Not:
