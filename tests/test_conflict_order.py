@@ -221,34 +221,40 @@ def test_an_implied_conflict_is_ordered_by_every_way_of_the_one_that_implies_it(
 @given(st.data())
 @settings(max_examples=150, deadline=None)
 def test_conflicts_imply_each_other_exactly_as_their_ways_do(data):
-    """`_implications` against its definition: d implies c when each way of d that exists
-    implies some way of c that exists (the same robots in the same roles, i_d >= i_c, j_d <= j_c)."""
-    m = data.draw(st.integers(1, 7))
-    robots = data.draw(st.lists(st.integers(0, 4), min_size=2, max_size=2, unique=True))
-    present = np.zeros((1, m, 2), dtype=bool)
-    ends = np.zeros((1, m, 2, 4), dtype=np.int64)
+    """`_implied` against its definition: d implies c when both are between the same robots
+    and each way of d that exists implies some way of c that exists (the same robots in the
+    same roles, i_d >= i_c, j_d <= j_c); of two that imply each other, the earlier stands for
+    both.  Two pairs of robots, so that conflicts of different pairs never imply each other."""
+    m = data.draw(st.integers(0, 12))
+    pairs = [(0, 1), (1, 2)]
+    pair = np.array([data.draw(st.integers(0, 1)) for _ in range(m)], dtype=np.int64)
+    present = np.zeros((m, 2), dtype=bool)
+    ends = np.zeros((m, 2, 4), dtype=np.int64)
     for n in range(m):
-        x, y = robots if data.draw(st.booleans()) else robots[::-1]
+        x, y = pairs[pair[n]] if data.draw(st.booleans()) else pairs[pair[n]][::-1]
         for w, (first, then) in enumerate(((x, y), (y, x))):
             if data.draw(st.integers(0, 4)):  # one way in five is missing
-                present[0, n, w] = True
-                ends[0, n, w] = (first, data.draw(st.integers(1, 5)), then, data.draw(st.integers(1, 5)))
+                present[n, w] = True
+                ends[n, w] = (first, data.draw(st.integers(1, 5)), then, data.draw(st.integers(1, 5)))
 
-    def implies(way, other):
+    def implies_way(way, other):
         return way[0] == other[0] and way[2] == other[2] and way[1] >= other[1] and way[3] <= other[3]
 
-    expected = [
-        [
-            all(
-                any(present[0, c, v] and implies(ends[0, d, w], ends[0, c, v]) for v in (0, 1))
-                for w in (0, 1)
-                if present[0, d, w]
-            )
-            for c in range(m)
-        ]
+    def implies(d, c):
+        return pair[d] == pair[c] and all(
+            any(present[c, v] and implies_way(ends[d, w], ends[c, v]) for v in (0, 1))
+            for w in (0, 1)
+            if present[d, w]
+        )
+
+    expected = sorted(
+        (int(pair[c]), d, c)
         for d in range(m)
-    ]
-    assert conflict_order._implications(present, ends)[0].tolist() == expected
+        for c in range(m)
+        if d != c and implies(d, c) and (d < c or not implies(c, d))
+    )
+    stronger, weaker = conflict_order._implied(pair, present, ends)
+    assert [(int(pair[c]), int(d), int(c)) for d, c in zip(stronger, weaker, strict=True)] == expected
 
 
 @pytest.mark.parametrize("seed", range(20))

@@ -1,4 +1,5 @@
-"""Every field of every public dataclass of the library is documented.
+"""Every field of every public dataclass of the library is documented, and every option the
+README's table of commands shows exists.
 
 A field counts as documented when its class's docstring (or a base class's, for inherited
 fields) lists it numpydoc-style (``name : type``, possibly with others, ``left, right : LinExpr``)
@@ -11,8 +12,14 @@ import dataclasses
 import importlib
 import pkgutil
 import re
+from pathlib import Path
+
+from typer.testing import CliRunner
 
 import cosmop
+from cosmop.cli import app
+
+README = Path(__file__).resolve().parents[1] / "README.md"
 
 
 def _public_dataclasses():
@@ -61,3 +68,17 @@ def test_the_check_can_fail():
         y: float
 
     assert _documented(Point, "x") and not _documented(Point, "y")
+
+
+def test_every_option_of_the_readme_command_table_exists():
+    # a row of the README's table of commands: | `cosmop CMD ARGS [--option ...]` | ... |
+    rows = re.findall(r"^\| `cosmop ([a-z-]+) ([^`]*)`", README.read_text(), re.MULTILINE)
+    assert len(rows) >= 8  # the table was found
+    runner = CliRunner()
+    missing = []
+    for command, usage in rows:
+        shown = runner.invoke(app, [command, "--help"], terminal_width=400)
+        assert shown.exit_code == 0, (command, shown.output)
+        words = set(re.findall(r"--[a-z0-9-]+", shown.output))
+        missing += [f"{command} {o}" for o in re.findall(r"--[a-z0-9-]+", usage) if o not in words]
+    assert not missing, "options the README shows but the command lacks: " + ", ".join(missing)

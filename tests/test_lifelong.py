@@ -197,6 +197,7 @@ def test_cosmop_run_writes_the_summary_and_refuses_bad_options(tmp_path):
     data = json.loads(summary.read_text())
     assert data["format"] == "cosmop.run/1" and data["orders"]["delivered"] == 2
     assert data["reorders"]["tried"] == len(data["reorder_log"])  # waits re-ordered, if any
+    assert data["reorders"]["shortened"] == sum(r["shortened"] for r in data["reorder_log"])
     assert {"p50", "p95", "max"} <= set(data["wait_s"]) and "deliveries_per_hour" in data
     assert "2 of 2 orders delivered" in " ".join(ran.stdout.split())
     view = runner.invoke(app, ["view", str(scenario), "--trace", str(trace), "-o", str(tmp_path / "v.html")])
@@ -346,6 +347,36 @@ def test_a_robot_that_stands_long_for_a_message_has_its_conflicts_ordered_again(
         _reorder_long_waits(run)
         assert [(r["robot"], r["accepted"]) for r in run.reorders] == ([("R2", True)] if reordered else [])
         assert world.agents[1].waiting is not reordered  # the new order lets it go at once
+        if reordered:  # it went: the wait was shortened, to nothing
+            assert run.reorders[0]["shortened"] and run.reorders[0]["due_after_s"] is None
+
+
+def test_a_reordering_that_does_not_shorten_a_wait_is_tried_again_less_and_less_often(monkeypatch):
+    # a re-ordering that leaves the robot's message as far away (here: one that changes
+    # nothing) doubles the time before the same wait is tried again: 4 s, then 8 s, then 16 s
+    from cosmop.lifelong import fleet as fleet_module
+    from cosmop.lifelong.fleet import _note_waits, _reorder_long_waits, _Run
+    from cosmop.sim.simulation import advance
+    from stale_order import stale_order_world
+
+    for changes_nothing in (True, False):
+        world = stale_order_world()
+        run = _Run(world, [], FleetSettings(until=60.0, reorder_after=4.0))
+        if changes_nothing:
+            monkeypatch.setattr(fleet_module, "reorder_world", lambda world, agent: (True, "", []))
+        else:
+            monkeypatch.undo()
+        for _ in range(400):
+            advance(world)
+            _note_waits(run)
+            _reorder_long_waits(run)
+        times = [r["t"] for r in run.reorders]
+        if changes_nothing:  # R1's message still ~30 s away at the first try, ~5 s at the third
+            assert [r["shortened"] for r in run.reorders] == [False] * 3
+            assert [round(b - a, 1) for a, b in itertools.pairwise(times)] == [8.1, 16.0]
+            assert all(r["due_after_s"] == r["due_in_s"] for r in run.reorders)
+        else:  # the real re-ordering lets R2 go at once: one try
+            assert len(times) == 1 and run.reorders[0]["shortened"]
 
 
 def test_a_delivery_that_breaks_its_order_is_not_as_ordered():

@@ -80,3 +80,28 @@ def test_the_conflicts_are_those_of_the_area_of_the_intersection():
             if a.what != b.what and a.region.intersection(b.region).area > 1e-9:
                 expected.add((id(a), id(b)))
     assert found == expected and len(found) > 50
+
+
+def test_the_conflicts_of_one_robot_are_those_of_the_team_in_the_same_order():
+    # a robot ordered again among plans already ordered (`about`, with the pairs of `also`)
+    # asks the R-tree about its own regions only; the conflicts kept, and their order (which
+    # decides the ordering's ties), must be those of all the team's conflicts filtered
+    rng = random.Random(5)
+    robots = [f"R{i}" for i in range(12)]
+    items = []
+    for n in range(400):
+        robot = rng.choice(robots)
+        if n % 8 == 0:  # goods two robots move, or goods nobody moves
+            movers = frozenset(rng.sample(robots, 2)) if n % 16 else frozenset()
+            items.append(Occupancy(f"O{n}", movers, _region(rng), None, None, f"o{n}"))
+        else:
+            items.append(Occupancy(robot, frozenset({robot}), _region(rng), (robot, 1), (robot, 2), f"o{n}"))
+    every = conflicts(items)
+    for about, also in (("R3", ()), ("R7", (("R1", "R2"), ("R0", "R11"))), ("R11", (("R4", "R5"),))):
+        mine = [
+            (id(c.a), id(c.b))
+            for c in every
+            if about in c.a.parties | c.b.parties or tuple(sorted(c.a.parties | c.b.parties)) in also
+        ]
+        found = [(id(c.a), id(c.b)) for c in conflicts(items, about=about, also=also)]
+        assert found == mine and len(mine) > 20

@@ -26,7 +26,9 @@ cycle (:func:`cosmop.sim.simulation.advance`), and between cycles it
    may hold a robot back for one still far from the shared place, and ordered again from the
    times expected now, the robot that gets there first goes first
    (:func:`cosmop.sim.recoordinate.reorder_world`, the same checks as a hand-over; a refusal
-   keeps the order);
+   keeps the order).  A try that brings the robot's message neither ``reorder_after``
+   seconds nearer nor within ``reorder_after`` seconds (its sender stands in the way, or is
+   held up itself) doubles the time before the same wait is tried again;
 4. ships delivered goods: once the drop is recorded the goods leave the world, so docks do not
    fill up (:meth:`cosmop.sim.world.World.ship`);
 5. fails robots (:class:`Failure`): a failed robot brakes and stands for good, its order
@@ -145,7 +147,8 @@ class FleetSettings:
     reorder_after : float or None
         Seconds a robot stands waiting for another's conflict message before its conflicts are
         ordered again from the times expected then (:func:`~cosmop.sim.recoordinate.reorder_world`),
-        and again at most this often; ``None``: orders are kept as handed over.
+        and again at most this often (twice as long after each try that brought its
+        message neither this much nearer nor this near); ``None``: orders are kept as handed over.
     max_reorders : int
         Most robots ordered again at one dispatch, the longest waiting first (each costs an
         ordering of the team, like a hand-over).
@@ -185,6 +188,8 @@ class _Run:
     reorders: list[dict[str, Any]] = field(default_factory=list)  # JSON records of the summary
     waits: dict[str, tuple[int, float]] = field(default_factory=dict)  # robot: (step, since), s
     reordered_at: dict[str, float] = field(default_factory=dict)
+    # robot: (the wait it applies to, seconds from one re-ordering of it to the next)
+    reorder_gap: dict[str, tuple[tuple[int, float], float]] = field(default_factory=dict)
     seen_events: int = 0
     delivered: int = 0
 
@@ -423,7 +428,11 @@ def _reorder_long_waits(run: _Run) -> None:
     from the times expected then, may hold a robot back for one still far from the place
     (module docstring, step 3).  Only a robot whose message is expected no sooner than
     ``reorder_after`` seconds from now (:func:`~cosmop.sim.recoordinate.message_due_in`) is
-    tried: a message that comes soon leaves little to gain."""
+    tried: a message that comes soon leaves little to gain.  A re-ordering that neither brings
+    the message ``reorder_after`` seconds nearer nor within ``reorder_after`` seconds (the
+    sender stands in the way, or is held up itself) doubles the time before the same wait is
+    tried again (:func:`_gap`), with no bound: each try costs an ordering of the team, and one
+    that changed nothing is likely to change nothing again until the wait ends."""
     world, after = run.world, run.fleet.reorder_after
     if after is None:
         return
@@ -431,7 +440,7 @@ def _reorder_long_waits(run: _Run) -> None:
     due = sorted(
         (since, rid)
         for rid, (_, since) in run.waits.items()
-        if world.t - since >= after and world.t - run.reordered_at.get(rid, -math.inf) >= after
+        if world.t - since >= after and world.t - run.reordered_at.get(rid, -math.inf) >= _gap(run, rid)
     )
     tried = 0
     for since, rid in due:
@@ -444,6 +453,11 @@ def _reorder_long_waits(run: _Run) -> None:
         tried += 1
         began = time.perf_counter()
         accepted, why, added = reorder_world(world, agent)
+        wall = time.perf_counter() - began
+        due_after = message_due_in(world, agent) if accepted else due_in
+        # shortened: now due soon (not tried again anyway), or at least `after` seconds sooner
+        shortened = due_after is None or due_after < after or due_after <= due_in - after
+        run.reorder_gap[rid] = (run.waits[rid], after if shortened else 2 * _gap(run, rid))
         run.reordered_at[rid] = world.t
         run.reorders.append(
             {
@@ -454,9 +468,20 @@ def _reorder_long_waits(run: _Run) -> None:
                 "accepted": accepted,
                 "why": why or None,
                 "messages": len(added),
-                "wall_s": round(time.perf_counter() - began, 3),
+                "due_after_s": None if due_after is None else round(due_after, 3),  # None: no wait left
+                "shortened": shortened,
+                "wall_s": round(wall, 3),
             }
         )
+
+
+def _gap(run: _Run, robot: str) -> float:
+    """Seconds between two re-orderings of `robot`'s current wait: ``reorder_after``, doubled
+    after each try that did not shorten it (:func:`_reorder_long_waits`)."""
+    after = run.fleet.reorder_after
+    assert after is not None  # (re-orderings are on)
+    wait, gap = run.reorder_gap.get(robot, (None, after))
+    return gap if wait == run.waits.get(robot) else after
 
 
 def _standing(run: _Run, agent: Agent, homes: bool = False) -> tuple[list[Rectangle], list[str]]:

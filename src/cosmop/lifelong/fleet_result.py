@@ -164,7 +164,9 @@ class FleetResult:
     reorders : tuple of Mapping
         Every robot whose conflicts were ordered again while it stood for a message: ``t``,
         ``robot``, ``waited_s``, ``due_in_s`` (when its message was expected, the order kept),
-        ``accepted``, ``why`` not, ``messages`` added, ``wall_s``.
+        ``accepted``, ``why`` not, ``messages`` added, ``due_after_s`` (when it is expected after;
+        ``None``: it waits no more), ``shortened`` (by ``reorder_after`` seconds, or to within
+        them), ``wall_s``.
     window : int
         Orders the dispatcher chose among at a time (``FleetSettings.reveal`` times the robots).
     """
@@ -338,6 +340,7 @@ class FleetResult:
             "reorders": {
                 "tried": len(self.reorders),
                 "accepted": sum(1 for r in self.reorders if r["accepted"]),
+                "shortened": sum(1 for r in self.reorders if r.get("shortened")),
                 "wall_s": _spread([r["wall_s"] for r in self.reorders]),
             },
             "order_log": [o.to_dict() for o in self.orders],

@@ -309,26 +309,7 @@ class _Dominance:
         pairs: dict[frozenset[str], int] = {}
         pair = np.array([pairs.setdefault(frozenset(c.robots), len(pairs)) for c in found], dtype=np.int64)
         table = table if table is not None else OrientationTable.of(found, ())
-        present, ends = table.possible, table.ends
-        order = np.argsort(pair, kind="stable")
-        groups = np.split(order, np.flatnonzero(np.diff(pair[order])) + 1) if len(order) else []
-        by_size: dict[int, list[int]] = {}
-        for n, group in enumerate(groups):
-            if len(group) > 1:
-                by_size.setdefault(len(group), []).append(n)
-        found_pairs = [np.zeros((0, 3), dtype=np.int64)]  # (group, stronger, weaker)
-        for size, numbers in by_size.items():  # the groups of one size at once
-            rows = np.stack([groups[n] for n in numbers])
-            implies = _implications(present[rows], ends[rows])
-            # strictly: of two that imply each other, the earlier stands for both
-            ahead = np.arange(size)[:, None] < np.arange(size)
-            strict = implies & (ahead | ~implies.transpose(0, 2, 1))
-            strict[:, np.arange(size), np.arange(size)] = False
-            g, d, c = np.nonzero(strict)
-            found_pairs.append(np.stack([np.asarray(numbers)[g], rows[g, d], rows[g, c]], axis=1))
-        implied = np.concatenate(found_pairs)
-        implied = implied[np.lexsort((implied[:, 2], implied[:, 1], implied[:, 0]))]  # group by group
-        self.stronger, self.weaker = implied[:, 1].copy(), implied[:, 2].copy()
+        self.stronger, self.weaker = _implied(pair, table.possible, table.ends)
 
     def by(self, conflict: Conflict) -> list[Conflict]:
         """The conflicts that imply `conflict`."""
@@ -356,35 +337,88 @@ class _Dominance:
         return self.needed([c for c in self.found if id(c) not in gone])
 
 
-def _implications(present: np.ndarray, ends: np.ndarray) -> np.ndarray:
-    """``[..., d, c]``: whether each way of conflict *d* implies a way of *c*
-    (:class:`_Dominance`), for conflicts between the same two robots: `present` ``(..., m, 2)``
-    says which ways they have, `ends` ``(..., m, 2, 4)`` each way as ``(A, i, B, j)`` with the
-    robots numbered (leading axes: groups of conflicts, each on its own).
+def _implied(pair: np.ndarray, present: np.ndarray, ends: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The pairs ``(stronger, weaker)`` of conflicts of which the first implies the second
+    (:class:`_Dominance`), sorted by `pair`, then stronger, then weaker; of two that imply each
+    other, only the earlier is the stronger.
 
-    A way implies only the way of the other conflict that lets the same robot go first, so the
-    ways are first put side by side by direction (the lower-numbered robot first, then the
-    other): *d* implies *c* when, in each direction, *d* has no way or *c* has one that it
-    implies (:math:`i_d \\ge i_c`, :math:`j_d \\le j_c`).
+    `pair` numbers each conflict's two robots, `present` ``(m, 2)`` says which of its ways it
+    has and `ends` ``(m, 2, 4)`` gives each as ``(A, i, B, j)``, the robots numbered.  A way
+    implies only the way of the other conflict that lets the same robot go first, so the ways
+    are first put side by side by direction (the lower-numbered robot first, then the other); a
+    missing way is given the latest end and the earliest start, so that it implies every way
+    and no way implies it.  Then *d* implies *c* when :math:`i_d \\ge i_c` and
+    :math:`j_d \\le j_c` in both directions: a dominance in four numbers, here split by robot
+    into two halves, the steps of the lower-numbered robot :math:`(i_0, j_1)` and the other's
+    :math:`(i_1, j_0)`.  Each half takes few distinct values (about one per occupancy of that
+    robot), so the halves above each half are found by comparing the distinct values
+    (:func:`_dominating`), and the conflicts that imply *c* are those with a half above each of
+    *c*'s: no two conflicts of a pair are compared (two robots whose plans cross many times can
+    have thousands of conflicts, and a few implications each).  The work is, per conflict, the
+    halves above its first half times those above its second: small because one robot's
+    occupancies rarely hold one another.  Steps are numbered from 0 (the stand-ins for a
+    missing way lie beyond every step).
     """
-    # each conflict's two robots, read from a way it has (way 1 lets the other robot first)
-    a = np.where(present[..., 0], ends[..., 0, 0], ends[..., 1, 2])
-    b = np.where(present[..., 0], ends[..., 0, 2], ends[..., 1, 0])
+    a = np.where(present[:, 0], ends[:, 0, 0], ends[:, 1, 2])  # each conflict's robots, from a way
+    b = np.where(present[:, 0], ends[:, 0, 2], ends[:, 1, 0])
     first = (a > b).astype(np.int64)  # the way that lets the lower-numbered robot go first
-    by_direction = np.stack([first, 1 - first], axis=-1)  # (..., m, 2)
+    by_direction = np.stack([first, 1 - first], axis=-1)
     has = np.take_along_axis(present, by_direction, axis=-1)
-    i = np.take_along_axis(ends[..., 1], by_direction, axis=-1)
-    j = np.take_along_axis(ends[..., 3], by_direction, axis=-1)
-    implies = np.ones(present.shape[:-1] + present.shape[-2:-1], dtype=bool)
-    for k in (0, 1):
-        i_k, j_k, has_k = i[..., k], j[..., k], has[..., k]
-        implied = (
-            has_k[..., None, :]
-            & (i_k[..., :, None] >= i_k[..., None, :])
-            & (j_k[..., :, None] <= j_k[..., None, :])
-        )
-        implies &= ~has_k[..., :, None] | implied
-    return implies
+    late = int(ends[:, :, [1, 3]].max(initial=0)) + 1
+    i = np.where(has, np.take_along_axis(ends[:, :, 1], by_direction, axis=-1), late)
+    j = np.where(has, np.take_along_axis(ends[:, :, 3], by_direction, axis=-1), -late)
+    x_values, x = np.unique(np.stack([pair, i[:, 0], j[:, 1]], axis=1), axis=0, return_inverse=True)
+    y_values, y = np.unique(np.stack([pair, i[:, 1], j[:, 0]], axis=1), axis=0, return_inverse=True)
+    x, y = x.reshape(-1), y.reshape(-1)
+    # every conflict c with every half above its first half, then with every half above its second
+    c, upper_x = _above(x, *_dominating(x_values))
+    at, upper_y = _above(y[c], *_dominating(y_values))
+    c, upper_x = c[at], upper_x[at]
+    # the conflicts whose halves are those: the stronger ones
+    key = x * len(y_values) + y
+    by_key = np.argsort(key, kind="stable")
+    wanted = upper_x * len(y_values) + upper_y
+    low = np.searchsorted(key[by_key], wanted, "left")
+    at, d = _spread(low, np.searchsorted(key[by_key], wanted, "right") - low)
+    c, d = c[at], by_key[d]
+    keep = (d != c) & ((key[d] != key[c]) | (d < c))  # of two alike, the earlier stands for both
+    c, d = c[keep], d[keep]
+    order = np.lexsort((c, d, pair[c]))
+    return d[order], c[order]
+
+
+def _dominating(values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The pairs ``(above, below)`` of the rows ``(pair, i, j)`` of `values` (sorted by pair)
+    with the same pair, :math:`i_{above} \\ge i_{below}` and :math:`j_{above} \\le j_{below}`
+    (each row with itself too).  The rows of one pair are compared all at once, the pairs with
+    as many rows together."""
+    starts = np.flatnonzero(np.diff(values[:, 0], prepend=values[:1, 0] - 1))
+    sizes = np.diff(np.append(starts, len(values)))
+    above, below = [np.zeros(0, dtype=np.int64)], [np.zeros(0, dtype=np.int64)]
+    for size in np.unique(sizes).tolist():
+        rows = starts[sizes == size][:, None] + np.arange(size)  # (pairs, size)
+        i, j = values[rows, 1], values[rows, 2]
+        block, high, low = np.nonzero((i[:, :, None] >= i[:, None, :]) & (j[:, :, None] <= j[:, None, :]))
+        above.append(rows[block, high])
+        below.append(rows[block, low])
+    return np.concatenate(above), np.concatenate(below)
+
+
+def _above(values: np.ndarray, above: np.ndarray, below: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For each conflict (its half's row in `values`), every row that dominates that row (the
+    pairs ``(above, below)`` of :func:`_dominating`): the conflict's position repeated once per
+    such row, and those rows beside it."""
+    by_below = np.argsort(below, kind="stable")
+    count = np.bincount(below, minlength=int(values.max(initial=-1)) + 1)
+    start = np.cumsum(count) - count
+    index, at = _spread(start[values], count[values])
+    return index, above[by_below[at]]
+
+
+def _spread(start: np.ndarray, count: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each position ``n`` repeated ``count[n]`` times, beside ``start[n], start[n] + 1, ...``."""
+    index = np.repeat(np.arange(len(start)), count)
+    return index, start[index] + np.arange(len(index)) - (np.cumsum(count) - count)[index]
 
 
 def _check(solver: Any, labels: Sequence[Any]) -> Any:

@@ -552,8 +552,7 @@ def conflicts(
     if not items:
         return []
     regions = [item.region for item in items]
-    tree = STRtree(regions)
-    left, right = tree.query(regions, predicate="intersects")
+    left, right = _touching(regions, None if about is None else _named(items, about, also))
     keep = left < right
     # shape n is item n's region, shape N + n its body (a robot keeps its clearance from
     # robots, not from goods)
@@ -578,6 +577,40 @@ def conflicts(
         for (a, b), real in zip(pairs, overlap, strict=True)
         if real and not _given_gap(a, b, clearance) and not _placed_so(a, b)
     ]
+
+
+def _named(items: Sequence[Occupancy], about: str, also: Collection[tuple[str, ...]]) -> np.ndarray:
+    """Which `items` have `about` or a robot of `also` (pairs of robots' names) among their
+    parties: every pair :func:`conflicts` keeps with `about` has one of them."""
+    named = {about, *(robot for parties in also for robot in parties)}
+    return np.array([bool(item.parties & named) for item in items], dtype=bool)
+
+
+def _touching(regions: list[BaseGeometry], wanted: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """The pairs of intersecting `regions` as an R-tree query of all of them finds them
+    (``left`` by index, each one's partners in the tree's order), or only the pairs with a
+    region `wanted` in them, in the same order.
+
+    Asking the tree about every region costs as many pairs as the team has; with `wanted`
+    (a re-planned robot's few regions) only those regions are asked about, and then the
+    regions that meet them at a lower index (a pair is kept where its lower index asks), so
+    the conflicts come in the same order and the ordering makes the same choices.
+    """
+    tree = STRtree(regions)
+    if wanted is None:
+        left, right = tree.query(regions, predicate="intersects")
+        return left, right
+    shapes = _geometries(regions)
+    mine = np.flatnonzero(wanted)
+    left, right = tree.query(shapes[mine], predicate="intersects")
+    left = mine[left]
+    lower = np.unique(right[(right < left) & ~wanted[right]])  # they meet a wanted region above them
+    more_left, more_right = tree.query(shapes[lower], predicate="intersects")
+    more_left, with_wanted = lower[more_left], wanted[more_right]
+    left = np.concatenate([left, more_left[with_wanted]])
+    right = np.concatenate([right, more_right[with_wanted]])
+    by_left = np.argsort(left, kind="stable")  # each region's partners were found in one query
+    return left[by_left], right[by_left]
 
 
 def _placed_so(a: Occupancy, b: Occupancy) -> bool:

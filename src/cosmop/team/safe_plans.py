@@ -196,24 +196,24 @@ def _reduce(horizons: Mapping[str, int], links: Sequence[Link], chosen: Sequence
         if link.send is not None and link.wait is not None:
             links_out.setdefault((link.sender, link.send), []).append((link.receiver, link.wait))
     starts: dict[Node, list[Node]] = {}
-    by_pair: dict[tuple[str, str], list[tuple[int, int, int]]] = {}  # kept edges, robot to robot
+    by_pair: dict[tuple[str, str], list[int]] = {}  # the edges robot to robot
     for n, ((source, target), _) in enumerate(chosen):
         starts.setdefault(source, []).append(target)
-        by_pair.setdefault((source[0], target[0]), []).append((source[1], target[1], n))
-    dropped: set[int] = set()
+        by_pair.setdefault((source[0], target[0]), []).append(n)
+    pairs = {key: np.array(members) for key, members in by_pair.items()}
+    ends = np.array([(source[1], target[1]) for (source, target), _ in chosen], dtype=np.int64).reshape(-1, 2)
+    kept = np.ones(len(chosen), dtype=bool)
     for n in reversed(range(len(chosen))):
         source, target = chosen[n][0]
         starts[source].remove(target)
         # another kept edge from later in A's plan to earlier in B's implies it at once
-        pair = by_pair[(source[0], target[0])]
-        if any(m != n and i >= source[1] and j <= target[1] for i, j, m in pair) or _implied(
-            order, horizons, links_out, starts, source, target
-        ):
-            dropped.add(n)
-            pair.remove((source[1], target[1], n))
+        pair = pairs[(source[0], target[0])]
+        later = kept[pair] & (ends[pair, 0] >= source[1]) & (ends[pair, 1] <= target[1]) & (pair != n)
+        if later.any() or _implied(order, horizons, links_out, starts, source, target):
+            kept[n] = False
         else:
             starts[source].append(target)
-    return [item for n, item in enumerate(chosen) if n not in dropped]
+    return [item for n, item in enumerate(chosen) if kept[n]]
 
 
 def _implied(
@@ -518,9 +518,14 @@ def _cut_where_shared(
     """
     precedence = Precedence({r: p.horizon for r, p in plans.items()}, message_links(plans))
     items, _ = occupancies(scene, plans, precedence, settings, starts, positions)
+    every = list(range(len(items)))
     tree = shapely.STRtree([item.region for item in items])
+    # with `about`, the others' drives are cut only where they meet its places: a tree of those
+    theirs = every if about is None else [n for n in every if about in items[n].parties]
+    their_tree = tree if about is None else shapely.STRtree([items[n].region for n in theirs])
     out: dict[str, RobotPlan] = {}
     for robot, plan in plans.items():
+        index, near = (every, tree) if about in (None, robot) else (theirs, their_tree)
         grown = scene.robots[robot].size + settings.clearance
         poses = [start_pose(scene, robot, starts), *(step.robot for step in plan.steps)]
         cuts: dict[int, list[float]] = {}
@@ -528,9 +533,9 @@ def _cut_where_shared(
             p, q = poses[k - 1], poses[k]
             if step.primitive != Primitive.GOTO or math.dist(p[:2], q[:2]) < 2 * settings.piece:
                 continue
-            for j in tree.query(swept_square(p, q, grown), predicate="intersects"):
-                if robot not in items[j].parties and (about in (None, robot) or about in items[j].parties):
-                    region = items[j].region
+            for n in near.query(swept_square(p, q, grown), predicate="intersects"):
+                if robot not in items[index[n]].parties:
+                    region = items[index[n]].region
                     cuts.setdefault(k, []).extend(_entry_exit(p, q, grown / 2.0, region, settings.passing))
             cuts[k] = _spaced(cuts.get(k, []), settings.piece / math.dist(p[:2], q[:2]))
         roomy = _roomy(walls, scene, robot, settings.clearance)
