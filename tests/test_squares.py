@@ -64,6 +64,11 @@ def test_other_shapes_are_left_to_the_area():
     assert np.isnan(depth).all()
 
 
+def _robot_occupancy(robot, region, n):
+    """An occupancy of `robot` alone, from its step 1 to its step 2."""
+    return Occupancy(robot, frozenset({robot}), region, (robot, 1), (robot, 2), f"o{n}")
+
+
 def test_the_conflicts_are_those_of_the_area_of_the_intersection():
     # the depth decides what it can; the rest (touching regions, other shapes) by the area
     rng = random.Random(11)
@@ -72,7 +77,7 @@ def test_the_conflicts_are_those_of_the_area_of_the_intersection():
     for n in range(160):
         robot = rng.choice(robots)
         region = _region(rng) if n % 10 else square(rng.randint(0, 20) * 250, 0, 400).buffer(30)
-        items.append(Occupancy(robot, frozenset({robot}), region, (robot, 1), (robot, 2), f"o{n}"))
+        items.append(_robot_occupancy(robot, region, n))
     found = {(id(c.a), id(c.b)) for c in conflicts(items)}
     expected = set()
     for i, a in enumerate(items):
@@ -95,7 +100,7 @@ def test_the_conflicts_of_one_robot_are_those_of_the_team_in_the_same_order():
             movers = frozenset(rng.sample(robots, 2)) if n % 16 else frozenset()
             items.append(Occupancy(f"O{n}", movers, _region(rng), None, None, f"o{n}"))
         else:
-            items.append(Occupancy(robot, frozenset({robot}), _region(rng), (robot, 1), (robot, 2), f"o{n}"))
+            items.append(_robot_occupancy(robot, _region(rng), n))
     every = conflicts(items)
     for about, also in (("R3", ()), ("R7", (("R1", "R2"), ("R0", "R11"))), ("R11", (("R4", "R5"),))):
         mine = [
