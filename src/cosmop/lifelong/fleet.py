@@ -187,9 +187,8 @@ class _Run:
     log: list[dict[str, Any]] = field(default_factory=list)
     reorders: list[dict[str, Any]] = field(default_factory=list)  # JSON records of the summary
     waits: dict[str, tuple[int, float]] = field(default_factory=dict)  # robot: (step, since), s
-    reordered_at: dict[str, float] = field(default_factory=dict)
-    # robot: (the wait it applies to, seconds from one re-ordering of it to the next)
-    reorder_gap: dict[str, tuple[tuple[int, float], float]] = field(default_factory=dict)
+    # robot: (the wait last re-ordered, when, seconds from that re-ordering of it to the next)
+    reordered: dict[str, tuple[tuple[int, float], float, float]] = field(default_factory=dict)
     seen_events: int = 0
     delivered: int = 0
 
@@ -437,10 +436,11 @@ def _reorder_long_waits(run: _Run) -> None:
     if after is None:
         return
     agents = {a.id: a for a in world.agents}
+    last = {rid: at for rid, (_, at, _) in run.reordered.items()}  # each robot's last try
     due = sorted(
         (since, rid)
         for rid, (_, since) in run.waits.items()
-        if world.t - since >= after and world.t - run.reordered_at.get(rid, -math.inf) >= _gap(run, rid)
+        if world.t - since >= after and world.t - last.get(rid, -math.inf) >= _gap(run, rid)
     )
     tried = 0
     for since, rid in due:
@@ -457,8 +457,7 @@ def _reorder_long_waits(run: _Run) -> None:
         due_after = message_due_in(world, agent) if accepted else due_in
         # shortened: now due soon (not tried again anyway), or at least `after` seconds sooner
         shortened = due_after is None or due_after < after or due_after <= due_in - after
-        run.reorder_gap[rid] = (run.waits[rid], after if shortened else 2 * _gap(run, rid))
-        run.reordered_at[rid] = world.t
+        run.reordered[rid] = (run.waits[rid], world.t, after if shortened else 2 * _gap(run, rid))
         run.reorders.append(
             {
                 "t": round(world.t, 6),
@@ -480,7 +479,7 @@ def _gap(run: _Run, robot: str) -> float:
     after each try that did not shorten it (:func:`_reorder_long_waits`)."""
     after = run.fleet.reorder_after
     assert after is not None  # (re-orderings are on)
-    wait, gap = run.reorder_gap.get(robot, (None, after))
+    wait, _, gap = run.reordered.get(robot, (None, -math.inf, after))
     return gap if wait == run.waits.get(robot) else after
 
 

@@ -552,11 +552,11 @@ def conflicts(
     if not items:
         return []
     regions = [item.region for item in items]
-    left, right = _touching(regions, None if about is None else _named(items, about, also))
-    keep = left < right
     # shape n is item n's region, shape N + n its body (a robot keeps its clearance from
     # robots, not from goods)
     shapes = _geometries(regions + [item.body or item.region for item in items])
+    left, right = _touching(shapes[: len(items)], None if about is None else _named(items, about, also))
+    keep = left < right
     pairs, first, second = [], [], []
     for i, j in zip(left[keep].tolist(), right[keep].tolist(), strict=True):
         a, b = items[i], items[j]
@@ -586,10 +586,10 @@ def _named(items: Sequence[Occupancy], about: str, also: Collection[tuple[str, .
     return np.array([bool(item.parties & named) for item in items], dtype=bool)
 
 
-def _touching(regions: list[BaseGeometry], wanted: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
-    """The pairs of intersecting `regions` as an R-tree query of all of them finds them
-    (``left`` by index, each one's partners in the tree's order), or only the pairs with a
-    region `wanted` in them, in the same order.
+def _touching(regions: np.ndarray, wanted: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """The pairs of intersecting `regions` (an array of shapes, :func:`_geometries`) as an
+    R-tree query of all of them finds them (``left`` by index, each one's partners in the
+    tree's order), or only the pairs with a region `wanted` in them, in the same order.
 
     Asking the tree about every region costs as many pairs as the team has; with `wanted`
     (a re-planned robot's few regions) only those regions are asked about, and then the
@@ -600,12 +600,11 @@ def _touching(regions: list[BaseGeometry], wanted: np.ndarray | None) -> tuple[n
     if wanted is None:
         left, right = tree.query(regions, predicate="intersects")
         return left, right
-    shapes = _geometries(regions)
     mine = np.flatnonzero(wanted)
-    left, right = tree.query(shapes[mine], predicate="intersects")
+    left, right = tree.query(regions[mine], predicate="intersects")
     left = mine[left]
     lower = np.unique(right[(right < left) & ~wanted[right]])  # they meet a wanted region above them
-    more_left, more_right = tree.query(shapes[lower], predicate="intersects")
+    more_left, more_right = tree.query(regions[lower], predicate="intersects")
     more_left, with_wanted = lower[more_left], wanted[more_right]
     left = np.concatenate([left, more_left[with_wanted]])
     right = np.concatenate([right, more_right[with_wanted]])
