@@ -111,11 +111,16 @@ class Geometry:
     Notes
     -----
     The parts of an obstacle not held are written only when a plan comes near enough to it to
-    need testing: a plan that keeps, at every instant, the robot and its goods on one side of
-    an obstacle (the side's half-plane grown by the motion margin for the robot, as in
-    :func:`~cosmop.planning.specification.specification`) satisfies all its parts, so only the
-    others are written and evaluated exactly.  The one-side test is numeric with a safety gap
-    (:data:`_GAP`): it may send an obstacle to the exact test needlessly, never skip one.
+    need testing.  Every part is about one motion or one instant, and is a disjunction over the
+    obstacle's sides: a plan whose every motion keeps the robot on one side of the obstacle
+    (both ends in the side's half-plane grown by the motion margin, as in
+    :func:`~cosmop.planning.specification.specification`; the motion's swept hull is then in it
+    too, since a half-plane is convex), and whose robot and goods, at every instant of a pick or
+    drop, lie on one side together, satisfies all its parts, so only the others are written and
+    evaluated exactly.  The sides may differ from motion to motion: a robot that drives round a
+    shelf never comes near most of the goods inside the corner it turns.  The one-side test is
+    numeric with a safety gap (:data:`_GAP`): it may send an obstacle to the exact test
+    needlessly, never skip one.
     """
 
     def __init__(
@@ -228,9 +233,10 @@ class _SeparatingHalfPlanes:
     def unsure(self, keys: Sequence[ObstacleKey], trace: Sequence[Mapping[str, Any]]) -> list[ObstacleKey]:
         """The obstacles among `keys` that the plan does not keep to one side of, in order.
 
-        A wall's drive parts look at the robot at every instant; its parts for picks and drops
-        at the robot and the goods at the instants of a PickUp or DropOff and the next; an
-        object's parts at both.
+        A wall's drive parts look at each motion of the robot (from one instant to the next);
+        its parts for picks and drops at the robot and the goods together at the instants of a
+        PickUp or DropOff and the next; an object's parts at the robot's motions and at the
+        goods at those instants.
         """
         if not keys:
             return []
@@ -264,13 +270,27 @@ class _SeparatingHalfPlanes:
         at = sorted({j for k in handled for j in (k, k + 1)})
         robot = [(float(s["x"]), float(s["y"])) for s in trace]
         rows = self._table[[self._row[k] for k in keys]]
-        role = np.array([self._roles[k] for k in keys])[:, None]
-        robot_all, robot_handling = _clear(rows[:, 0], robot), _clear(rows[:, 0], [robot[j] for j in at])
-        goods = np.ones_like(robot_all)
+        role = np.array([self._roles[k] for k in keys])
+        on = _on_sides(rows[:, 0], robot)  # (obstacles, 4 sides, instants)
+        # each motion on one side (its sides may differ from the next one's), each instant too
+        # (a plan of no step has no motion)
+        motions: NDArray[np.bool_] = on[..., :-1] & on[..., 1:]
+        drives = np.all(np.any(motions, axis=1), axis=1) & np.all(np.any(on, axis=1), axis=1)
+        # the gripper pairs the robot at one instant with the goods at the next: robot and goods
+        # on one side at every instant of a pick or drop and the next
+        together = np.all(on[..., at], axis=-1)
+        goods = np.ones((len(keys), len(at)), dtype=bool)  # each good on some side, each instant
         for b, o in enumerate(self._goods, start=1):
-            goods &= _clear(rows[:, b], [tuple(float(v) for v in p.obj(o).read(trace[j])[:2]) for j in at])
-        clear = np.where(role == 0, robot_all, np.where(role == 1, robot_handling & goods, robot_all & goods))
-        ok = np.asarray(clear.any(axis=1))
+            sides = _on_sides(rows[:, b], [tuple(float(v) for v in p.obj(o).read(trace[j])[:2]) for j in at])
+            together &= np.all(sides, axis=-1)
+            goods &= np.any(sides, axis=1)
+        # a wall's drive parts look at the robot's motions, its parts for picks and drops at the
+        # robot and goods together; an object's at the robot's motions (drives, and the room kept
+        # while handling at their ends) and, apart, at the goods dropped clear of it
+        handling = np.any(together, axis=1)
+        ok: NDArray[np.bool_] = np.where(
+            role == 0, drives, np.where(role == 1, handling, drives & np.all(goods, axis=1))
+        )
         ends = np.array([k.past_ends for k in keys])
         if ends.any():  # the stronger part differs only for starts past an end, near a side
             stronger_rows = [self._row[k] for k, stronger in zip(keys, ends, strict=True) if stronger]
@@ -331,13 +351,12 @@ def _passes_ends(
     return passes
 
 
-def _clear(planes: NDArray[np.float64], points: Sequence[tuple[float, ...]]) -> NDArray[np.bool_]:
-    """Per obstacle and side (`planes`: obstacles x 4 x abc), whether every point lies on it."""
-    if not points:
-        return np.ones(planes.shape[:2], dtype=bool)
-    xy = np.asarray(points)
+def _on_sides(planes: NDArray[np.float64], points: Sequence[tuple[float, ...]]) -> NDArray[np.bool_]:
+    """Per obstacle, side (`planes`: obstacles x 4 x abc) and point, whether the point lies on
+    the side (by :data:`_GAP` at least): ``(obstacles, 4, points)``."""
+    xy = np.asarray(points, dtype=float).reshape(-1, 2)
     value = planes[..., 0, None] * xy[:, 0] + planes[..., 1, None] * xy[:, 1]
-    on_it: NDArray[np.bool_] = (value >= planes[..., 2, None] + _GAP).all(axis=-1)
+    on_it: NDArray[np.bool_] = value >= planes[..., 2, None] + _GAP
     return on_it
 
 
