@@ -8,6 +8,7 @@ every variable fixed to the trace. Every solver is seeded and resource-limited.
 
 from __future__ import annotations
 
+import copy
 import operator
 import pickle
 import time
@@ -51,6 +52,7 @@ from cosmop.logic import (
     evaluate,
     evaluate_all,
     exactly_one,
+    failing,
     ints,
     maximum,
     minimum,
@@ -625,6 +627,17 @@ def test_encoding_agrees_with_evaluation(formula, trace):
             s.pop()
             assert result != z3.unknown, s.reason_unknown()
             assert (result == z3.sat) == want, (k, str(formula))
+
+
+@settings(max_examples=300, deadline=None)
+@given(many=st.lists(formulas(depth=3), min_size=1, max_size=4), trace=traces())
+def test_failing_agrees_with_evaluation_with_equal_formulas_that_are_other_objects(many, trace):
+    # one evaluation shares the columns of sub-formulas by structure and by object: copies
+    # (equal, not the same objects) and the originals, in any order, get the same answers
+    mixed = [f for original in many for f in (original, copy.deepcopy(original))]
+    expected = [i for i, f in enumerate(mixed) if not reference(f, trace, 0)]
+    assert failing(mixed, trace) == expected
+    assert failing(mixed[::-1], trace) == [len(mixed) - 1 - i for i in reversed(expected)]
 
 
 @settings(max_examples=400, deadline=None)

@@ -157,6 +157,10 @@ class _Evaluator:
         self.trace = trace
         self.K = len(trace) - 1
         self.columns: dict[Formula, list[bool]] = {}
+        # the same by object (id -> (node, column)): a structural look-up of a node equal to one
+        # computed but not the same object compares them deeply, so each object is looked up
+        # structurally once (as the encoder's canonical formulas are)
+        self.by_id: dict[int, tuple[Formula, list[bool]]] = {}
         self.values: dict[tuple[Var, int], bool | int | Fraction] = {}
         self.scaled: dict[Compare, tuple[tuple[tuple[Shifted | Max | Min, int], ...], int]] = {}
 
@@ -212,19 +216,22 @@ class _Evaluator:
     def column(self, root: Formula) -> list[bool]:
         """The truth column of `root`, computing only the sub-formulas not computed yet: a
         specification's parts share most of their nodes, and each is tested in turn."""
-        columns = self.columns
-        known = columns.get(root)
-        if known is not None:
-            return known
+        columns, by_id = self.columns, self.by_id
         stack: list[tuple[Formula, bool]] = [(root, False)]
         while stack:  # post-order, iterative: deep formulas do not hit the recursion limit
             node, expanded = stack.pop()
             if expanded:
-                columns[node] = self._compute(node)
-            elif node not in columns:
+                if id(node) not in by_id:  # (an object met twice before it was computed)
+                    column = columns[node] = self._compute(node)
+                    by_id[id(node)] = (node, column)
+            elif id(node) not in by_id:
+                known = columns.get(node)
+                if known is not None:
+                    by_id[id(node)] = (node, known)
+                    continue
                 stack.append((node, True))
-                stack.extend((child, False) for child in reversed(node.children) if child not in columns)
-        return columns[root]
+                stack.extend((child, False) for child in reversed(node.children) if id(child) not in by_id)
+        return by_id[id(root)][1]
 
     def _in_range(self, offsets: frozenset[int]) -> range:
         """The instants k at which every k + o, o in offsets, lies in [0, K]."""
@@ -233,7 +240,7 @@ class _Evaluator:
         return range(max(0, -min(offsets)), min(self.K, self.K - max(offsets)) + 1)
 
     def _compute(self, node: Formula) -> list[bool]:
-        K, col = self.K, self.columns
+        K, by_id = self.K, self.by_id
         n = K + 1
         kind = type(node)
         if kind is BoolConst:
@@ -252,7 +259,7 @@ class _Evaluator:
             for k in self._in_range(node.offsets):
                 out[k] = test(self.weighted(terms, k), const)
             return out
-        children = [col[c] for c in node.children]
+        children = [by_id[id(c)][1] for c in node.children]
         if kind is Not:
             return [not v for v in children[0]]
         if kind is And:

@@ -1359,8 +1359,11 @@ def specification(p: RobotProblem, events: Sequence[Event] | None = None) -> lis
         ("one primitive per step", Always(Implies(Next(TRUE), Next(disj(p.pi.eq(c) for c in codes))))),
     ]
     for action in p.actions:
+        # one guard object for all the action's parts: the evaluator and the encoder look
+        # formulas up by structure, and an equal but distinct guard costs a deep comparison
+        guard = Next(p.pi.eq(action.code))
         for name, effect in primitives[action.primitive].parts(p, action.obj):
-            parts.append((name, Always(Implies(Next(p.pi.eq(action.code)), effect))))
+            parts.append((name, Always(Implies(guard, effect))))
     parts += away_frames(p)
     if p.automaton is not None and events is None:
         return parts + automaton_parts(p)
