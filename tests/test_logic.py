@@ -638,6 +638,10 @@ def test_failing_agrees_with_evaluation_with_equal_formulas_that_are_other_objec
     expected = [i for i, f in enumerate(mixed) if not reference(f, trace, 0)]
     assert failing(mixed, trace) == expected
     assert failing(mixed[::-1], trace) == [len(mixed) - 1 - i for i in reversed(expected)]
+    # bare variables are made formulas for the call (short-lived objects): each its own answer,
+    # as one evaluation each gives
+    bare = [p, p.next(), q, p, ~q]
+    assert failing(bare, trace) == [i for i, f in enumerate(bare) if not evaluate(f, trace)]
 
 
 @settings(max_examples=400, deadline=None)

@@ -147,7 +147,7 @@ def failing(formulas: Sequence[object], trace: Trace) -> list[int]:
 
 
 class _Evaluator:
-    """Truth columns of sub-formulas on one trace, memoised by (structural) node."""
+    """Truth columns of sub-formulas on one trace, memoised by node: by object, then by structure."""
 
     def __init__(self, trace: Trace) -> None:
         if isinstance(trace, Mapping) or not isinstance(trace, Sequence):

@@ -115,12 +115,12 @@ class Geometry:
     obstacle's sides: a plan whose every motion keeps the robot on one side of the obstacle
     (both ends in the side's half-plane grown by the motion margin, as in
     :func:`~cosmop.planning.specification.specification`; the motion's swept hull is then in it
-    too, since a half-plane is convex), and whose robot and goods, at every instant of a pick or
-    drop, lie on one side together, satisfies all its parts, so only the others are written and
-    evaluated exactly.  The sides may differ from motion to motion: a robot that drives round a
-    shelf never comes near most of the goods inside the corner it turns.  The one-side test is
-    numeric with a safety gap (:data:`_GAP`): it may send an obstacle to the exact test
-    needlessly, never skip one.
+    too, since a half-plane is convex), and whose robot and goods lie together on one and the
+    same side at all the instants of its picks and drops and the next, satisfies all its parts,
+    so only the others are written and evaluated exactly.  The sides may differ from motion to
+    motion: a robot that drives round a shelf never comes near most of the goods inside the
+    corner it turns.  The one-side test is numeric with a safety gap (:data:`_GAP`): it may send
+    an obstacle to the exact test needlessly, never skip one.
     """
 
     def __init__(
@@ -272,12 +272,12 @@ class _SeparatingHalfPlanes:
         rows = self._table[[self._row[k] for k in keys]]
         role = np.array([self._roles[k] for k in keys])
         on = _on_sides(rows[:, 0], robot)  # (obstacles, 4 sides, instants)
-        # each motion on one side (its sides may differ from the next one's), each instant too
-        # (a plan of no step has no motion)
+        # each motion on one side (its sides may differ from the next one's); a plan of no step
+        # has no motion, and no part to break (each looks at the next instant)
         motions: NDArray[np.bool_] = on[..., :-1] & on[..., 1:]
-        drives = np.all(np.any(motions, axis=1), axis=1) & np.all(np.any(on, axis=1), axis=1)
+        drives = np.all(np.any(motions, axis=1), axis=1)
         # the gripper pairs the robot at one instant with the goods at the next: robot and goods
-        # on one side at every instant of a pick or drop and the next
+        # together on one and the same side at all the instants of the picks and drops and the next
         together = np.all(on[..., at], axis=-1)
         goods = np.ones((len(keys), len(at)), dtype=bool)  # each good on some side, each instant
         for b, o in enumerate(self._goods, start=1):
