@@ -190,6 +190,27 @@ def _assert_sound_and_irredundant(found, horizons, durations, answer, starts=())
         assert schedule.solve([*ordered, conflict]) is not None, conflict
 
 
+def test_a_search_stopped_at_its_limit_of_conflicts_set_aside_answers_soundly():
+    # a hand-over's ordering stops once it has set aside more conflicts than its limit (one
+    # already means the attempt fails): it answers with what it has, the edges taken so far
+    # acyclic, and a limit the search stays within changes nothing
+    stopped = 0
+    for seed in range(30):
+        found, horizons, durations = _team(seed, robots=5, conflicts=40)
+        full = order_conflicts(found, horizons, [], [], durations)
+        assert order_conflicts(found, horizons, [], [], durations, max_set_aside=len(found)) == full
+        answer = order_conflicts(found, horizons, [], [], durations, max_set_aside=1)
+        search = Search(found, _Dominance(found), (horizons, [], [], durations), CorrectionSetPicker(None))
+        if search.run(200, limit=1) is not None or not search.stopped:
+            assert answer == full  # within the limit: the whole answer
+            continue
+        stopped += 1
+        assert answer == (search.edges, search.set_aside)
+        assert len(answer[1]) >= 2 and full[1]  # past the limit; and no order resolves them all
+        assert Precedence(horizons, (), [edge for edge, _ in answer[0]], durations).complete
+    assert stopped >= 3  # the limit was reached in the sample
+
+
 def test_the_sample_has_unresolvable_teams():
     # the property above is only worth something if some teams cannot be ordered in full
     assert sum(bool(order_conflicts(*_args(seed))[1]) for seed in range(12)) >= 4
@@ -496,6 +517,53 @@ def test_start_edges_taken_back_from_the_middle_leave_the_order_of_the_rest(seed
     order.undo(again)
     _assert_same_order(order, saved)
     assert gone and left  # edges went and stayed
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_watched_rows_are_read_exactly_and_the_rest_when_the_tables_are_read(seed):
+    # the search keeps up to date only the copies of the rows it reads (Precedence.watch): at
+    # every step those reads must be the order's built from scratch, and reading the tables as
+    # attributes brings every other row up to date
+    rng = random.Random(seed)
+    horizons = {f"R{i}": rng.randint(2, 7) for i in range(1, 6)}
+    durations = {r: [rng.uniform(0.5, 4.0) for _ in range(k)] for r, k in horizons.items()}
+    links = [Link(message("R1", "R2", "m"), "R1", 1, "R2", 2)]
+    order = Precedence(horizons, links, (), durations)
+    done, begin = (rng.sample(range(order.size), order.size // 3) for _ in range(2))
+    order.watch(done, begin)
+    steps = np.arange(order.size)
+    added: list[list] = []
+    logs: list = []
+    for _ in range(40):
+        move = rng.random()
+        if logs and move < 0.2:
+            order.undo(logs.pop())
+            added.pop()
+        elif len(logs) > 1 and move < 0.35:  # the last two batches merged, one edge of them gone
+            gone = rng.choice(added[-1] + added[-2] or [None])
+            if gone is None:
+                continue
+            logs[-2:] = [order.retract(logs[-2:], [gone])]
+            both = added[-2] + added[-1]
+            del both[len(both) - 1 - both[::-1].index(gone)]
+            added[-2:] = [both]
+        else:
+            edges = []
+            for _ in range(rng.randint(1, 5)):
+                a, b = rng.sample(sorted(horizons), 2)
+                edges.append(((a, rng.randint(1, horizons[a])), (b, rng.randint(1, horizons[b]))))
+            log, refused = order.add_starts(edges)
+            logs.append(log)
+            added.append([e for n, e in enumerate(edges) if n not in refused])
+        fresh = Precedence(horizons, links, [e for batch in added for e in batch], durations)
+        for rows, start in ((done, False), (begin, True)):
+            at = order.places(np.repeat(steps, len(rows)), np.tile(rows, order.size))
+            read = order.completes_before(at, start=start)
+            assert np.array_equal(read, fresh.completes_before(at, start=start))
+        assert np.array_equal(order.start_times(np.array(begin)), fresh.started_flat[begin])
+        if rng.random() < 0.3:
+            _assert_same_order(order, fresh)
+    _assert_same_order(order, Precedence(horizons, links, [e for batch in added for e in batch], durations))
 
 
 @pytest.mark.parametrize("seed", range(6))

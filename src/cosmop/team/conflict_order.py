@@ -53,6 +53,7 @@ def order_conflicts(
     max_backtracks: int = 200,
     fixed: Mapping[str, Sequence[BaseGeometry]] | None = None,
     rlimit: int = 200_000_000,
+    max_set_aside: int | None = None,
 ) -> tuple[list[tuple[tuple[Node, Node], Conflict]], list[Conflict]]:
     """Start edges that order every conflict in `found`, and the conflicts no order resolves.
 
@@ -78,6 +79,14 @@ def order_conflicts(
     The unresolved conflicts returned are therefore irredundant: none of them could be ordered
     together with all the ordered ones.
 
+    With `max_set_aside`, the search stops once it has set aside more conflicts than that, and
+    the conflicts set aside so far are returned as unresolved, with the edges taken so far.
+    A single core already proves that no order resolves every conflict; what the search would
+    do after that only makes the list of unresolved conflicts complete and irredundant, and a
+    crowded fleet can set aside hundreds of conflicts before it is (a minute of search).  The
+    list returned is then neither: each conflict in it is in a core, and the rest may not all
+    be ordered.
+
     Returns the edges added (on top of `starts`), each with the conflict it orders, and the
     unresolved conflicts.
 
@@ -100,12 +109,17 @@ def order_conflicts(
         (:func:`~cosmop.team.conflicts.fixed_places`), to choose which conflict to set aside.
     rlimit : int
         Z3 resource limit of each scheduling call.
+    max_set_aside : int, optional
+        Conflicts set aside after which the search stops (default: it never does).
     """
     table = OrientationTable.of(found, list(horizons))
     implied, picker = _Dominance(found, table), CorrectionSetPicker(fixed)
     team = (horizons, links, starts, durations)
     search = Search(found, implied, team, picker, table)
-    if search.run(max_backtracks) and (settled := _give_back(search, picker, max_backtracks)):
+    done = search.run(max_backtracks, limit=max_set_aside)
+    if search.stopped:
+        return search.edges, search.set_aside
+    if done and (settled := _give_back(search, picker, max_backtracks)):
         return settled
     unresolved, cores = search.set_aside, search.cores
     gone = {id(c) for c in unresolved}

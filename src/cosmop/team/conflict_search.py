@@ -117,6 +117,7 @@ class Search:
         self.every = self.live = np.arange(len(found))  # the conflicts not known to be ordered yet
         self._hide()
         self.cores: dict[int, list[Conflict]] = {}  # id of each conflict set aside -> its core
+        self.stopped = False  # whether :meth:`run` stopped at its limit of conflicts set aside
 
     @property
     def edges(self) -> list[tuple[Edge, Conflict]]:
@@ -138,11 +139,13 @@ class Search:
         """
         return bool(self.aside[self.number[id(conflict)]])
 
-    def run(self, budget: int, back: int | None = None) -> bool | None:
+    def run(self, budget: int, back: int | None = None, limit: int | None = None) -> bool | None:
         """Order every conflict left: ``True`` when done, ``None`` past `budget` dead ends.
 
         With `back` (a conflict given back), a core sets aside `back` itself (every core found
         contains it, the others being ordered): then ``False`` once the rest is ordered again.
+        With `limit`, the search stops (``None``, and :attr:`stopped` set) once more than
+        `limit` conflicts are set aside.
 
         Parameters
         ----------
@@ -150,6 +153,8 @@ class Search:
             Dead ends after which the search gives up.
         back : int, optional
             The index of a conflict given back.
+        limit : int, optional
+            Conflicts set aside after which the search stops.
         """
         dead_ends, kept = 0, True
         while True:
@@ -162,6 +167,9 @@ class Search:
             stuck = live[counts == 0]
             if len(stuck):
                 verdict = self._dead_ends(stuck.tolist(), back)
+                if limit is not None and verdict == "core" and np.count_nonzero(self.aside) > limit:
+                    self.stopped = True
+                    return None
                 if verdict == "choice":
                     dead_ends += 1
                     if dead_ends > budget:
@@ -665,6 +673,9 @@ class _OrientationTests:
         # each side's edge as rows (Precedence.rows: -1 for a step past the plan), as lists
         x_source = np.where(x_k > end[ends[..., 0]] - 1, -1, x_row)
         self.rows = np.stack([x_source, y_row], axis=-1).tolist()
+        # the order keeps up to date only the copies read here (about a third of its steps)
+        starts = np.unique(np.concatenate([y_row[by_order], self.first_row[~self.from_start]]))
+        precedence.watch(np.unique(x_row[by_order]).tolist(), starts.tolist())
 
     def way(self, i: int, n: int) -> Edge:
         """Side `n` of conflict `i`, one that exists."""
@@ -688,7 +699,7 @@ class _OrientationTests:
 
     def expected_start(self, precedence: Precedence, rows: np.ndarray) -> np.ndarray:
         """The expected start of the earlier occupancy of each conflict in `rows`, s."""
-        started = np.where(self.from_start[rows], 0.0, precedence.started_flat[self.first_row[rows]])
+        started = np.where(self.from_start[rows], 0.0, precedence.start_times(self.first_row[rows]))
         earliest: np.ndarray = started.min(axis=1)
         return earliest
 

@@ -40,7 +40,7 @@ robot starting at 0, :attr:`Precedence.finish` is the earliest completion of eac
 from __future__ import annotations
 
 import heapq
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from typing import Any, TypeAlias, TypeVar
 
 import numpy as np
@@ -151,15 +151,18 @@ class Precedence:
         self._flat = {start: np.zeros(self.size * n + 2, dtype=np.uint8) for start in (False, True)}
         for flat in self._flat.values():
             flat[-1] = 255
-        self.done_bits = self._flat[False][:-2].reshape(self.size, n)
-        self.begin_bits = self._flat[True][:-2].reshape(self.size, n)
+        self._done_bits = self._flat[False][:-2].reshape(self.size, n)
+        self._begin_bits = self._flat[True][:-2].reshape(self.size, n)
         self.never, self.always = self.size * n * 8, (self.size * n + 1) * 8
-        self.finish_flat = np.zeros(self.size)
-        self.started_flat = np.zeros(self.size)
-        everything = list(range(self.size))
-        self._mirror(everything, everything)
-        self.finish = {r: self.finish_flat[o : o + self.horizons[r] + 1] for r, o in self.offsets.items()}
-        self.started = {r: self.started_flat[o : o + self.horizons[r] + 2] for r, o in self.offsets.items()}
+        self._finish_flat = np.zeros(self.size)
+        self._started_flat = np.zeros(self.size)
+        # the rows whose copies are kept up to date at every change (:meth:`watch`), and the
+        # rows (completion, start) whose copies are out of date: all of them to begin with,
+        # since many orders are built only to be asked whether they deadlock
+        self._watched: tuple[set[int], set[int]] | None = None
+        self._stale: tuple[set[int], set[int]] = (set(range(self.size)), set(range(self.size)))
+        self._finish = {r: self._finish_flat[o : o + self.horizons[r] + 1] for r, o in self.offsets.items()}
+        self._started = {r: self._started_flat[o : o + self.horizons[r] + 2] for r, o in self.offsets.items()}
 
     def _row(self, node: Node) -> int:
         row = self._rows.get(node)  # (asked for millions of times by the ordering search)
@@ -237,13 +240,55 @@ class Precedence:
             done, t_done = done | more, max(t_done, later)
         return clock, t, done, t_done
 
+    def watch(self, done: Iterable[int], begin: Iterable[int]) -> None:
+        """Keep these rows' copies in the NumPy tables up to date at every change: the
+        completion of the rows `done`, the start of the rows `begin` (and rows named by earlier
+        calls).
+
+        The clocks live in Python integers; the NumPy tables are copies, and copying a changed
+        row costs about as much as computing it.  Unwatched copies are brought up to date when
+        they are read: the tables as attributes (:attr:`done_bits`, :attr:`finish`, ...), or
+        any query before the first call of :meth:`watch`.  After it, :meth:`completes_before`
+        and :meth:`start_times` read the tables as they are, so they may be asked only about
+        watched rows: the ordering search asks about a third of the rows, again and again.
+
+        Parameters
+        ----------
+        done, begin : iterable of int
+            Rows (:meth:`rows`) whose completion (start) the caller asks about.
+        """
+        if self._watched is None:
+            self._watched = (set(), set())
+        copy: list[list[int]] = []
+        for watched, stale, rows in zip(self._watched, self._stale, (done, begin), strict=True):
+            watched.update(rows)
+            copy.append(sorted(stale & watched))
+            stale -= watched
+        self._copy(*copy)
+
+    def _flush(self) -> None:
+        """Copy every row whose copy is out of date (:meth:`watch`)."""
+        done, begin = self._stale
+        if done or begin:
+            self._stale = (set(), set())
+            self._copy(sorted(done), sorted(begin))
+
     def _mirror(self, done: list[int], begin: list[int]) -> None:
+        """The rows `done` (completion) and `begin` (start) changed: copy the watched ones to
+        the NumPy tables, mark them all out of date (a watched row copied again is harmless)."""
+        self._stale[0].update(done)
+        self._stale[1].update(begin)
+        if self._watched is not None:
+            watched_done, watched_begin = self._watched
+            self._copy([r for r in done if r in watched_done], [r for r in begin if r in watched_begin])
+
+    def _copy(self, done: list[int], begin: list[int]) -> None:
         """Copy the clocks and times of the rows `done` (completion) and `begin` (start) to
         the NumPy tables."""
-        n = self.done_bits.shape[1]
+        n = self._done_bits.shape[1]
         for rows, masks, times, bits, flat in (
-            (done, self._done_clocks, self._finish_times, self.done_bits, self.finish_flat),
-            (begin, self._begin_clocks, self._start_times, self.begin_bits, self.started_flat),
+            (done, self._done_clocks, self._finish_times, self._done_bits, self._finish_flat),
+            (begin, self._begin_clocks, self._start_times, self._begin_bits, self._started_flat),
         ):
             if rows:
                 packed = b"".join([masks[r].to_bytes(n, "little") for r in rows])
@@ -252,9 +297,44 @@ class Precedence:
 
     def _mirror_log(self, log: list[_Entry]) -> None:
         """:meth:`_mirror` the rows an undo log changed."""
-        D = self._done_clocks
-        changed = [(entry[0], entry[1] is D) for entry in log if entry[0] is not None]
-        self._mirror([r for r, done in changed if done], [r for r, done in changed if not done])
+        D, B = self._done_clocks, self._begin_clocks  # (a link's entry holds neither)
+        self._mirror([e[0] for e in log if e[1] is D], [e[0] for e in log if e[1] is B])
+
+    @property
+    def done_bits(self) -> NDArray[np.uint8]:
+        """``(rows, bytes)``: row by row, the steps that complete by the step's completion."""
+        self._flush()
+        return self._done_bits
+
+    @property
+    def begin_bits(self) -> NDArray[np.uint8]:
+        """``(rows, bytes)``: row by row, the steps that complete before the step starts."""
+        self._flush()
+        return self._begin_bits
+
+    @property
+    def finish_flat(self) -> NDArray[np.float64]:
+        """The earliest completion time of every row, s."""
+        self._flush()
+        return self._finish_flat
+
+    @property
+    def started_flat(self) -> NDArray[np.float64]:
+        """The earliest start time of every row, s."""
+        self._flush()
+        return self._started_flat
+
+    @property
+    def finish(self) -> dict[str, NDArray[np.float64]]:
+        """Robot -> earliest completion times, index = instant (0 for the start)."""
+        self._flush()
+        return self._finish
+
+    @property
+    def started(self) -> dict[str, NDArray[np.float64]]:
+        """Robot -> earliest start times, index = instant (also K+1, the end of the plan)."""
+        self._flush()
+        return self._started
 
     # -- adding start edges one at a time (the ordering search) ---------------------------------
 
@@ -341,7 +421,8 @@ class Precedence:
             done, t_done = D[row], F[row]
             grew = False
             if starts:
-                clock, t = latest(starts)
+                # (mostly the one step before: read directly, a call saved per step)
+                clock, t = (D[starts[0]], F[starts[0]]) if len(starts) == 1 else latest(starts)
                 old, old_t = B[row], S[row]
                 if t > old_t + 1e-12 or clock | old != old:
                     log.append((row, B, old, S, old_t))
@@ -353,7 +434,7 @@ class Precedence:
                         done, t_done = clock | done, t if t > t_done else t_done
                         D[row], F[row] = done, t_done
             if dones:
-                clock, t = latest(dones)
+                clock, t = (D[dones[0]], F[dones[0]]) if len(dones) == 1 else latest(dones)
                 if t > t_done + 1e-12 or clock | done != done:
                     log.append((row, D, done, F, t_done))
                     D[row], F[row] = clock | done, t if t > t_done else t_done
@@ -362,15 +443,20 @@ class Precedence:
                 continue
             if row in last:  # "start of K+1": after the whole plan
                 _raise(log, B, S, row + 1, D[row], F[row])
-            after: Sequence[tuple[int, bool]] = succ.get(row, ())
-            following = nxt[row]
+            following = nxt[row]  # the robot's next step starts after this one
             if following is not None:
-                after = [(following, False), *after]
-            for then, is_done in after:
-                if then not in pending:
-                    pending[then] = ([], [])
+                waiting = pending.get(following)
+                if waiting is None:
+                    pending[following] = ([row], [])
+                    push(queue, (place[following], following))
+                else:
+                    waiting[0].append(row)
+            for then, is_done in succ.get(row, ()):
+                waiting = pending.get(then)
+                if waiting is None:
+                    pending[then] = waiting = ([], [])
                     push(queue, (place[then], then))
-                pending[then][is_done].append(row)
+                waiting[is_done].append(row)
 
     def _place(self, source: int, target: int) -> bool:
         """Keep :attr:`_ord` a topological order with the edge ``source -> target``; ``False``
@@ -624,12 +710,13 @@ class Precedence:
         steps, rows : ndarray of int
             Rows of the steps asked about and of the steps they are compared with.
         """
-        at: NDArray[np.int64] = rows * (self.done_bits.shape[1] * 8) + steps
+        at: NDArray[np.int64] = rows * (self._done_bits.shape[1] * 8) + steps
         return at
 
     def completes_before(self, at: NDArray[np.int64], *, start: bool = False) -> NDArray[np.bool_]:
         """Vectorised :meth:`precedes` (:meth:`before_start` with `start`) at the :meth:`places`
-        `at`: whether each step completes before the other completes (starts).
+        `at`: whether each step completes before the other completes (starts).  Once rows are
+        watched (:meth:`watch`), only places in watched rows may be asked about.
 
         Parameters
         ----------
@@ -638,8 +725,24 @@ class Precedence:
         start : bool, default False
             Whether to ask about the other step's start instead of its completion.
         """
+        if self._watched is None:
+            self._flush()
         found: NDArray[np.bool_] = (self._flat[start][at >> 3] >> (at & 7)) & 1 == 1
         return found
+
+    def start_times(self, rows: NDArray[np.int64]) -> NDArray[np.float64]:
+        """The earliest start times of `rows`, s (:attr:`started_flat` without bringing the
+        unwatched rows up to date: once rows are watched, :meth:`watch`, only watched rows).
+
+        Parameters
+        ----------
+        rows : ndarray of int
+            Rows (:meth:`rows`).
+        """
+        if self._watched is None:
+            self._flush()
+        times: NDArray[np.float64] = self._started_flat[rows]
+        return times
 
     @property
     def makespan(self) -> float:

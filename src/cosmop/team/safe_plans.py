@@ -72,8 +72,10 @@ _Context = tuple[
     str | None,
     set[Event] | None,
     frozenset[tuple[str, ...]],
+    int | None,
 ]
-"""What every ordering attempt shares: ``(scene, settings, starts, positions, about, used, also)``."""
+"""What every ordering attempt shares: ``(scene, settings, starts, positions, about, used, also,
+max_set_aside)``."""
 
 
 @dataclass(frozen=True)
@@ -247,6 +249,7 @@ def make_team_safe(
     positions: Mapping[str, tuple[float, float] | None] | None = None,
     about: str | None = None,
     also: Collection[tuple[str, ...]] = (),
+    max_set_aside: int | None = None,
 ) -> TeamSafety:
     """Order every conflict between `plans` by messages (see the module docstring).
 
@@ -271,6 +274,11 @@ def make_team_safe(
         With `about`: the parties (as :attr:`Conflict.robots` names them) whose conflicts are
         ordered too where the plans no longer order them (the robot's old messages ordered
         them, passing through it: :func:`cosmop.sim.recoordinate.recoordinate`).
+    max_set_aside : int, optional
+        An ordering attempt stops once its search has set aside more conflicts than this (it
+        cannot be safe then; :func:`~cosmop.team.conflict_order.order_conflicts`); its
+        unresolved conflicts are those set aside so far, and the next attempt starts from them.
+        Default: every attempt orders all it can.
 
     Returns
     -------
@@ -286,7 +294,7 @@ def make_team_safe(
         )
         for r, p in plans.items()
     }
-    context: _Context = (scene, settings, starts, positions, about, used, frozenset(also))
+    context: _Context = (scene, settings, starts, positions, about, used, frozenset(also), max_set_aside)
     uncut = frozenset() if settings.cut else frozenset(plans)
     # each robot's cuts depend on the others' whole drives only: made once, undone robot by robot
     cut = (
@@ -377,7 +385,7 @@ def _order(
 ) -> TeamSafety:
     """One ordering of every conflict between `plans` (already cut; `waypoints` are the
     robots' own, where pieces are joined again after), its time not yet set."""
-    scene, settings, starts, positions, about, used, also = context
+    scene, settings, starts, positions, about, used, also, max_set_aside = context
     horizons = {r: p.horizon for r, p in plans.items()}
     links = message_links(plans)
     times = durations(scene, plans, starts=starts)
@@ -394,7 +402,9 @@ def _order(
     ]
     ordered = sum(1 for c in found if is_ordered(c, precedence))
     fixed = fixed_places(items)
-    chosen, unresolved = order_conflicts(found, horizons, links, [], times, fixed=fixed)
+    chosen, unresolved = order_conflicts(
+        found, horizons, links, [], times, fixed=fixed, max_set_aside=max_set_aside
+    )
     kept = _reduce(horizons, links, chosen)
     taken = set(used or ())
     new_plans, placed = place_edges(scene, plans, [edge for edge, _ in kept], "clear", taken, starts)
