@@ -42,7 +42,7 @@ from cosmop.planning.primitive_effects import initial_state
 from cosmop.planning.realisation import message_links
 from cosmop.scene import Scene
 from cosmop.sim.realised_times import carry_instants
-from cosmop.team.conflicts import Conflict, ConflictSettings, conflicts, is_ordered, occupancies
+from cosmop.team.conflicts import Conflict, ConflictSettings, Occupancy, conflicts, is_ordered, occupancies
 from cosmop.team.precedence import Precedence
 from cosmop.team.safe_plans import TeamSafety, make_team_safe
 from cosmop.team.timing import step_durations
@@ -51,6 +51,7 @@ if TYPE_CHECKING:
     from cosmop.sim.world import Agent, World
 
 __all__ = [
+    "SET_ASIDE_LIMIT",
     "Recoordination",
     "Remaining",
     "message_due_in",
@@ -64,11 +65,13 @@ __all__ = [
 ]
 
 SET_ASIDE_LIMIT = 64
-"""Conflicts an ordering attempt of a hand-over may set aside before it stops
+"""The most conflicts an ordering attempt of :func:`recoordinate` (a new plan handed over, or
+an order turned round) sets aside before it stops
 (:func:`~cosmop.team.safe_plans.make_team_safe`'s `max_set_aside`).  One set aside already
 means the attempt fails; the rest of its search only names every conflict it fails on, which
-took up to a minute in a crowded fleet (about 600 set aside).  The hand-overs of the first six
-minutes of three 50-robot streams set aside at most 19."""
+took up to a minute in a crowded fleet (572 set aside).  The re-coordinations captured over the
+first six minutes of two 50-robot streams, and the 43 slower than 1.5 s over 1,250 s of a
+third, set aside at most 19.  The ordering around a failed robot has no limit."""
 
 
 @dataclass(frozen=True)
@@ -242,24 +245,36 @@ def orders_lost(
         return frozenset()
     order, without = Precedence(horizons, links), Precedence(horizons, kept)
     if not order.complete:  # `robot`'s old rest is not known: order all that is unordered
-        order, losing = without, set(plans)
-    else:
-        losing = _others_losing(order, without, robot)
-    if not losing:
+        items, _ = occupancies(scene, plans, without, settings, starts, positions)
+        found = conflicts(items, settings.clearance)
+        return frozenset(c.robots for c in found if robot not in c.robots and not is_ordered(c, without))
+    later, earlier = _lost_steps(order, without, robot)
+    if not later:
         return frozenset()
     items, _ = occupancies(scene, plans, order, settings, starts, positions)
+    # a conflict lost has one side that starts at a step in `later`, and the other side ends
+    # at a step in `earlier` that it no longer always starts after: only those sides are paired
+    near = [i for i in items if _may_lose(i, order, later, earlier)]
     return frozenset(
         c.robots
-        for c in conflicts([i for i in items if i.parties & losing], settings.clearance)
-        if robot not in c.robots and (order is without or is_ordered(c, order)) and not is_ordered(c, without)
+        for c in conflicts(near, settings.clearance)
+        if robot not in c.robots and is_ordered(c, order) and not is_ordered(c, without)
     )
 
 
-def _others_losing(order: Precedence, without: Precedence, robot: str) -> set[str]:
-    """The robots other than `robot` on either side of an order lost between their steps:
-    a step that no longer always starts after another robot's step (not `robot`'s) once the
-    dropped links are gone (`order` -> `without`, the same steps), and that other step's robot.
-    Most re-plans lose only orders with `robot` itself, and then no conflict needs looking at."""
+def _may_lose(item: Occupancy, order: Precedence, later: AbstractSet[int], earlier: AbstractSet[int]) -> bool:
+    """Whether `item` starts at a step of `later` or ends at a step of `earlier` (rows of
+    `order`)."""
+    return (item.first is not None and order.row(item.first) in later) or (
+        item.last is not None and order.row(item.last) in earlier
+    )
+
+
+def _lost_steps(order: Precedence, without: Precedence, robot: str) -> tuple[set[int], set[int]]:
+    """The orders lost between the steps of robots other than `robot` once the dropped links
+    are gone (`order` -> `without`, the same steps): the rows of the steps that no longer always
+    start after some other robot's step (not `robot`'s), and the rows of those other steps.
+    Most re-plans lose only orders with `robot` itself, and then both are empty."""
     mine = np.zeros(order.size, dtype=bool)
     mine[order.offsets[robot] : order.offsets[robot] + order.horizons[robot] + 2] = True
     others = np.packbits(~mine, bitorder="little")  # the bit set of the others' steps
@@ -267,9 +282,7 @@ def _others_losing(order: Precedence, without: Precedence, robot: str) -> set[st
     lost[mine] = 0
     later = np.flatnonzero(lost.any(axis=1))  # steps that lost some order
     earlier = np.flatnonzero(np.unpackbits(np.bitwise_or.reduce(lost, axis=0), bitorder="little"))
-    rows = np.concatenate([later, earlier[earlier < order.size]])
-    offsets = np.array([order.offsets[r] for r in order.robots])  # increasing
-    return {order.robots[i] for i in np.unique(np.searchsorted(offsets, rows, side="right") - 1)}
+    return set(later.tolist()), set(earlier[earlier < order.size].tolist())
 
 
 # ----------------------------------------------------------------------------------------------

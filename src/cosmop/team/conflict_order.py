@@ -110,7 +110,8 @@ def order_conflicts(
     rlimit : int
         Z3 resource limit of each scheduling call.
     max_set_aside : int, optional
-        Conflicts set aside after which the search stops (default: it never does).
+        The most conflicts the search sets aside before it stops (it stops at more than
+        this; default: it never stops).
     """
     table = OrientationTable.of(found, list(horizons))
     implied, picker = _Dominance(found, table), CorrectionSetPicker(fixed)

@@ -145,7 +145,7 @@ class Search:
         With `back` (a conflict given back), a core sets aside `back` itself (every core found
         contains it, the others being ordered): then ``False`` once the rest is ordered again.
         With `limit`, the search stops (``None``, and :attr:`stopped` set) once more than
-        `limit` conflicts are set aside.
+        `limit` conflicts are set aside in all.
 
         Parameters
         ----------
@@ -154,9 +154,10 @@ class Search:
         back : int, optional
             The index of a conflict given back.
         limit : int, optional
-            Conflicts set aside after which the search stops.
+            The most conflicts set aside before the search stops (it stops at more than this).
         """
         dead_ends, kept = 0, True
+        self.stopped = False
         while True:
             # a side that holds keeps holding until something is taken back (_pop)
             held = self.orientations.holds(self.precedence, self.live)

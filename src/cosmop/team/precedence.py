@@ -164,6 +164,16 @@ class Precedence:
         self._finish = {r: self._finish_flat[o : o + self.horizons[r] + 1] for r, o in self.offsets.items()}
         self._started = {r: self._started_flat[o : o + self.horizons[r] + 2] for r, o in self.offsets.items()}
 
+    def row(self, node: Node) -> int:
+        """The row of step `node` ``(robot, k)``: ``offsets[robot] + k``, `k` clamped to 0..K+1.
+
+        Parameters
+        ----------
+        node : Node
+            The step ``(robot, k)``.
+        """
+        return self._row(node)
+
     def _row(self, node: Node) -> int:
         row = self._rows.get(node)  # (asked for millions of times by the ordering search)
         if row is None:
@@ -326,13 +336,15 @@ class Precedence:
 
     @property
     def finish(self) -> dict[str, NDArray[np.float64]]:
-        """Robot -> earliest completion times, index = instant (0 for the start)."""
+        """Robot -> earliest completion times, index = instant (0 for the start): views of
+        the table as read now (read again after the order changes)."""
         self._flush()
         return self._finish
 
     @property
     def started(self) -> dict[str, NDArray[np.float64]]:
-        """Robot -> earliest start times, index = instant (also K+1, the end of the plan)."""
+        """Robot -> earliest start times, index = instant (also K+1, the end of the plan):
+        views of the table as read now (read again after the order changes)."""
         self._flush()
         return self._started
 
@@ -424,20 +436,24 @@ class Precedence:
                 # (mostly the one step before: read directly, a call saved per step)
                 clock, t = (D[starts[0]], F[starts[0]]) if len(starts) == 1 else latest(starts)
                 old, old_t = B[row], S[row]
-                if t > old_t + 1e-12 or clock | old != old:
+                begin = clock | old  # (each union of two clocks made once: they are long)
+                if t > old_t + 1e-12 or begin != old:
                     log.append((row, B, old, S, old_t))
-                    B[row], S[row] = clock | old, t if t > old_t else old_t
-                    clock, t = B[row], S[row] + dur[row]
-                    grew = t > t_done + 1e-12 or clock | done != done
-                    if grew:
+                    t = t if t > old_t else old_t
+                    B[row], S[row] = begin, t
+                    t += dur[row]
+                    clock = begin | done
+                    if t > t_done + 1e-12 or clock != done:
+                        grew = True
                         log.append((row, D, done, F, t_done))
-                        done, t_done = clock | done, t if t > t_done else t_done
+                        done, t_done = clock, t if t > t_done else t_done
                         D[row], F[row] = done, t_done
             if dones:
                 clock, t = (D[dones[0]], F[dones[0]]) if len(dones) == 1 else latest(dones)
-                if t > t_done + 1e-12 or clock | done != done:
+                clock |= done
+                if t > t_done + 1e-12 or clock != done:
                     log.append((row, D, done, F, t_done))
-                    D[row], F[row] = clock | done, t if t > t_done else t_done
+                    D[row], F[row] = clock, t if t > t_done else t_done
                     grew = True
             if not grew:
                 continue

@@ -129,7 +129,8 @@ class TeamSafety:
     ordered_before : int
         Of those, how many the plans' own messages already ordered.
     unresolved : tuple of Conflict
-        Conflicts no order can resolve (then ``plans`` are not team-safe).
+        Conflicts no order can resolve (then ``plans`` are not team-safe); of an attempt
+        stopped at its limit (`max_set_aside`), those set aside when it stopped.
     makespan_alone, makespan : float
         Expected seconds until the whole team is done: each robot on its own (no waiting), and
         with every message.
@@ -277,8 +278,10 @@ def make_team_safe(
     max_set_aside : int, optional
         An ordering attempt stops once its search has set aside more conflicts than this (it
         cannot be safe then; :func:`~cosmop.team.conflict_order.order_conflicts`); its
-        unresolved conflicts are those set aside so far, and the next attempt starts from them.
-        Default: every attempt orders all it can.
+        unresolved conflicts are those set aside so far (other conflicts may be left unordered
+        too), and the next attempt starts from them, so the attempts that follow, and which
+        one is kept, may differ from a search without a limit.  Default: every attempt orders
+        all it can.
 
     Returns
     -------
