@@ -421,3 +421,30 @@ def test_goods_shipped_on_drop_still_need_their_drop_spot_free_while_dropped():
     found = conflicts(occupancies(scene, safe, precedence, shipped)[0])
     assert any({c.a.what, c.b.what} == {"O2", "R1"} for c in found)
     assert precedence.complete and all(is_ordered(c, precedence) for c in found)
+
+
+def test_a_planner_rewound_to_a_checkpoint_forgets_what_was_tried_since_but_keeps_its_answers(corridor):
+    from cosmop.planning.plan_types import AddedTask
+    from cosmop.planning.synthesis import Synthesis
+    from cosmop.scene import Wall
+    from cosmop.team.planner import Planner
+
+    scenario, _ = corridor
+    planner = Planner(scenario)
+    planner.forbid("R1", frozenset({"O1"}))
+    planner.spots["R2"] = {parse_event("drop(R2,O2,W2)"): (1.0, 2.0)}
+    mark = planner.checkpoint()
+    planner.forbid("R1", frozenset({"O2"}))
+    planner.forbid("R2", frozenset({"O1"}))
+    planner.wall_off("R2", (Wall((0.0, 0.0), (1.0, 0.0), "a trial"),))
+    planner.added.append(AddedTask("R1", "O1", "aside_O1", (5.0, 5.0), "a trial"))
+    planner.scenario = PlanSet(scenario.name, True, added=tuple(planner.added)).extend(scenario)
+    planner.placed["R1"] = {"O2": (3.0, 4.0)}
+    planner.spots["R2"][parse_event("drop(R2,O1,W1)")] = (6.0, 7.0)
+    planner.cache[("an answer",)] = Synthesis("R1", False, None, None, reason="a trial")
+    planner.rewind(mark)
+    assert planner.forbidden == {"R1": frozenset({"O1"})}
+    assert planner.obstacles == {} and planner.added == [] and planner.placed == {}
+    assert planner.scenario is scenario
+    assert planner.spots == {"R2": {parse_event("drop(R2,O2,W2)"): (1.0, 2.0)}}
+    assert ("an answer",) in planner.cache  # what was solved since stays solved

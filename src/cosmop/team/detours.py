@@ -55,12 +55,15 @@ class MadeSafe:
         Why robots were re-planned, in plain words.
     reasons : tuple of str
         Why the team cannot be planned (empty: the plans are team-safe).
+    stuck : Conflict or None
+        When that is why: the conflict that no order resolves and no re-plan tried moves.
     """
 
     results: Mapping[str, Synthesis]
     safety: TeamSafety
     replans: tuple[str, ...] = ()
     reasons: tuple[str, ...] = ()
+    stuck: Conflict | None = None
 
     @property
     def ok(self) -> bool:
@@ -121,7 +124,7 @@ def make_safe(
         if stuck or last:
             conflict = (stuck or list(safety.unresolved))[0]
             why = f"no order or re-plan keeps {' and '.join(conflict.robots)} apart: {conflict.describe()}"
-            return MadeSafe(results, safety, tuple(replans), (why,))
+            return MadeSafe(results, safety, tuple(replans), (why,), conflict)
         moves = _give_way(safety, safety.unresolved)
         step = _detour(planner, current, moves, settings, safety.fixed)
         fresh, failed = dict(step.results), step.failed

@@ -13,7 +13,8 @@
 4. *Make the plans team-safe* (:mod:`cosmop.team.safe_plans`): every place two plans share is
    ordered by a message.  A conflict that no order resolves (a robot parked for good where
    another must pass) is resolved by re-planning one robot with the other's space as an
-   obstacle.
+   obstacle; one between a robot waiting for goods to be moved and the robot that moves them
+   (it must stand beside the waiting one) by forbidding the request, and steps 2-4 run again.
 5. *Verify*: the robots' words with all their messages cannot deadlock and do exactly what the
    global mission asks (:func:`cosmop.team.mission_proof.verify_team`); every plan set passes the
    exact checker (:func:`cosmop.team.plan_set_checker.check_plan`).
@@ -25,7 +26,7 @@ import os
 import time
 from collections.abc import Callable, Mapping
 from concurrent.futures import Executor
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from types import MappingProxyType
 
 from cosmop.errors import MissionTooLargeError
@@ -41,19 +42,23 @@ from cosmop.team.choices import Allocation, allocate
 from cosmop.team.conflicts import ConflictSettings
 from cosmop.team.coordination_events import Coordinated
 from cosmop.team.detours import MadeSafe, make_safe, shorten_waits
-from cosmop.team.handover import handovers
+from cosmop.team.handover import Handovers, handovers
 from cosmop.team.initial_plans import pack_docks, plan_in_turn
 from cosmop.team.mission_proof import TeamVerdict, check_words
 from cosmop.team.plan_set_checker import check_plan
-from cosmop.team.planner import Planner, Workers
+from cosmop.team.planner import Checkpoint, Planner, Workers
 from cosmop.team.requests import RequestsAnswered, coordinate_requests
 from cosmop.team.safe_plans import TeamSafety
 from cosmop.team.timing import itinerary
 
-__all__ = ["PHASES", "WAYS_AROUND", "TeamResult", "plan_team"]
+__all__ = ["PHASES", "REQUEST_RETRIES", "WAYS_AROUND", "TeamResult", "plan_team"]
 
 WAYS_AROUND = 4
 """Re-plans :func:`plan_team` tries, at most, to take a way around a long wait for a shared place."""
+
+REQUEST_RETRIES = 3
+"""Times :func:`plan_team` forbids requests, at most, whose wait and answer share a place (see
+:func:`_answer_and_order`)."""
 
 PHASES = ("decompose", "allocate", "synthesize", "coordinate", "conflicts", "verify", "check")
 """The phases whose seconds :attr:`TeamResult.phases` records."""
@@ -245,14 +250,8 @@ def _loop(
         reasons = pack_docks(base, planner)
     answered, made = None, None
     if not reasons:
-        first = plan_in_turn(base, givers, planner)
-        answered = coordinate_requests(base, first, planner, max_iterations)
-        reasons = answered.reasons
-    if answered is not None and not reasons:  # the scenario with the places of goods set aside, if any
-        made = make_safe(answered.current, answered.results, planner, settings)
-        if made.ok and ways_around > 0:
-            made = shorten_waits(answered.current, made, planner, settings, ways_around)
-        reasons = made.reasons
+        answered, made = _answer_and_order(base, givers, planner, max_iterations, settings, ways_around)
+        reasons = answered.reasons if made is None else made.reasons
     results = made.results if made is not None else answered.results if answered is not None else {}
     plans = dict(made.safety.plans) if made is not None else _plans_of(results)
     verdict = None
@@ -263,6 +262,70 @@ def _loop(
         if not verdict.holds:
             reasons = (verdict.reason() or "the coordinated missions violate the global mission",)
     return _result(scenario, mission, start, planner, answered, made, verdict, plans, reasons)
+
+
+def _answer_and_order(
+    base: Mapping[str, tuple[Event, ...]],
+    givers: Handovers,
+    planner: Planner,
+    max_iterations: int,
+    settings: ConflictSettings,
+    ways_around: int,
+) -> tuple[RequestsAnswered, MadeSafe | None]:
+    """Steps 2-4 from each robot's word: its first plan, the requests answered, the plans made
+    team-safe (``None`` when the requests could not be).
+
+    A robot that asks for goods to be moved waits for them where it stands; when the robot that
+    moves them must stand within the clearance of that place to pick them (the requester's start
+    beside the goods, say), neither can go first: the conflict is stuck, and no re-plan around
+    places moves either side.  The request is then forbidden (the requester drives around the
+    goods, or waits elsewhere), as a request that deadlocks the team's words is in step 3, and
+    the steps run again from the start, at most :data:`REQUEST_RETRIES` times.  When that does
+    not plan the team, the first outcome stands, and with it its reason.
+    """
+    start, forbidden, notes = planner.checkpoint(), dict[str, frozenset[str]](), list[str]()
+    first: tuple[RequestsAnswered, MadeSafe | None, Checkpoint] | None = None
+    for _ in range(REQUEST_RETRIES + 1):
+        planner.rewind(start)
+        for robot, goods in forbidden.items():
+            planner.forbid(robot, goods)
+        answered = coordinate_requests(base, plan_in_turn(base, givers, planner), planner, max_iterations)
+        made = None
+        if answered.ok:  # the scenario with the places of goods set aside, if any
+            made = make_safe(answered.current, answered.results, planner, settings)
+            if made.ok and ways_around > 0:
+                made = shorten_waits(answered.current, made, planner, settings, ways_around)
+            if made.ok:
+                return replace(answered, replans=(*notes, *answered.replans)), made
+        if first is None:
+            first = (answered, made, planner.checkpoint())
+        more = _requests_in_the_way(answered, made)
+        if all(goods <= forbidden.get(robot, frozenset()) for robot, goods in more.items()):
+            break  # nothing new to forbid
+        for robot, goods in more.items():
+            forbidden[robot] = forbidden.get(robot, frozenset()) | goods
+            assert made is not None and made.stuck is not None  # (what `more` comes from)
+            notes.append(
+                f"{robot} re-planned without requesting {', '.join(sorted(goods))}: waiting for them "
+                f"where it stands, it is in the way of the robot that moves them ({made.stuck.describe()})"
+            )
+    assert first is not None  # (the loop runs at least once)
+    answered, made, mark = first
+    planner.rewind(mark)
+    return answered, made
+
+
+def _requests_in_the_way(answered: RequestsAnswered, made: MadeSafe | None) -> dict[str, frozenset[str]]:
+    """The requests between the two sides of the conflict stuck in `made`: per requester, the
+    goods it asks the other side to move (``{}``: none, or nothing stuck)."""
+    if made is None or made.stuck is None or answered.coordinated is None:
+        return {}
+    sides = set(made.stuck.robots)
+    out: dict[str, frozenset[str]] = {}
+    for pair in answered.coordinated.pairs:
+        if pair.requester != pair.responder and {pair.requester, pair.responder} <= sides:
+            out[pair.requester] = out.get(pair.requester, frozenset()) | {pair.obj}
+    return out
 
 
 def _plans_of(results: Mapping[str, Synthesis]) -> dict[str, RobotPlan]:

@@ -26,7 +26,16 @@ from cosmop.planning.synthesis import DEFAULT_RLIMIT, Synthesis, synthesize
 from cosmop.scene import Scenario, Scene, Wall
 from cosmop.team.handover import Handover
 
-__all__ = ["Planner", "Replanned", "Restrictions", "SynthesisJob", "Workers", "default_horizon", "goods_at"]
+__all__ = [
+    "Checkpoint",
+    "Planner",
+    "Replanned",
+    "Restrictions",
+    "SynthesisJob",
+    "Workers",
+    "default_horizon",
+    "goods_at",
+]
 
 _P = ParamSpec("_P")
 _T = TypeVar("_T")
@@ -217,6 +226,29 @@ class Restrictions:
     obstacles: Mapping[str, tuple[Wall, ...]]
 
 
+@dataclass(frozen=True)
+class Checkpoint:
+    """All that the loop's steps change in a :class:`Planner` (its answers aside), to go back to.
+
+    Attributes
+    ----------
+    restrictions : Restrictions
+        The forbidden requests and added walls.
+    added : tuple of AddedTask
+        Goods moved aside.
+    scenario : Scenario
+        The scenario with their places.
+    placed, spots : mapping
+        The hand-overs' and shared docks' spots (:attr:`Planner.placed`, :attr:`Planner.spots`).
+    """
+
+    restrictions: Restrictions
+    added: tuple[AddedTask, ...]
+    scenario: Scenario
+    placed: Mapping[str, Mapping[str, tuple[float, float]]]
+    spots: Mapping[str, Mapping[Event, tuple[float, float]]]
+
+
 @dataclass
 class Planner:
     """Runs the robots' syntheses under the team's restrictions and keeps the phase times.
@@ -294,6 +326,29 @@ class Planner:
             What :meth:`restrictions` returned before the trial.
         """
         self.forbidden, self.obstacles = dict(saved.forbidden), dict(saved.obstacles)
+
+    def checkpoint(self) -> Checkpoint:
+        """Where the team's planning stands now, to :meth:`rewind` to after a try that failed."""
+        return Checkpoint(
+            self.restrictions(),
+            tuple(self.added),
+            self.scenario,
+            {r: dict(p) for r, p in self.placed.items()},
+            {r: dict(s) for r, s in self.spots.items()},
+        )
+
+    def rewind(self, mark: Checkpoint) -> None:
+        """Go back to `mark` (:meth:`checkpoint`); the answers found since are kept.
+
+        Parameters
+        ----------
+        mark : Checkpoint
+            What :meth:`checkpoint` returned.
+        """
+        self.restore(mark.restrictions)
+        self.added, self.scenario = list(mark.added), mark.scenario
+        self.placed = {r: dict(p) for r, p in mark.placed.items()}
+        self.spots = {r: dict(s) for r, s in mark.spots.items()}
 
     def forbid(self, robot: str, objects: frozenset[str]) -> None:
         """From now on `robot` may not request `objects` either.
