@@ -27,6 +27,7 @@ its robots' executors.
 
 from __future__ import annotations
 
+import bisect
 import math
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from collections.abc import Set as AbstractSet
@@ -252,9 +253,12 @@ def orders_lost(
     later, earlier = _lost_steps(order, without, robot)
     if not later:
         return frozenset()
-    items, _ = occupancies(scene, plans, order, settings, starts, positions)
     # a conflict lost has one side that starts at a step in `later`, and the other side ends
-    # at a step in `earlier` that it no longer always starts after: only those sides are paired
+    # at a step in `earlier` that it no longer always starts after: only those sides are paired,
+    # so only the robots with such steps are asked for their own occupancies
+    firsts = [order.offsets[r] for r in order.robots]  # the robots' rows, in order
+    owners = {order.robots[bisect.bisect_right(firsts, row) - 1] for row in later | earlier}
+    items, _ = occupancies(scene, plans, order, settings, starts, positions, robots=owners)
     near = [i for i in items if _may_lose(i, order, later, earlier)]
     return frozenset(
         c.robots

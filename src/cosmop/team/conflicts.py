@@ -35,6 +35,7 @@ import math
 from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import lru_cache
+from typing import overload
 
 import numpy as np
 import shapely
@@ -243,6 +244,12 @@ def _robot_occupancies(
     return list(_motion_occupancies(robot, motion, side, tuple(home), grow, rest, units))
 
 
+@lru_cache(maxsize=1 << 16)  # a fleet's plans visit the same poses again and again
+def _show_xy(x: float, y: float, units: UnitSystem) -> str:
+    """:func:`~cosmop.units.show_point` of ``(x, y)``."""
+    return show_point((x, y), units)
+
+
 @lru_cache(maxsize=4096)  # a running fleet asks again for every robot's rest at every hand-over
 def _motion_occupancies(
     robot: str,
@@ -287,7 +294,7 @@ def _motion_occupancies(
                 square(x, y, side),
                 first,
                 last,
-                f"{robot} standing at {show_point((x, y), units)} {where}",
+                f"{robot} standing at {_show_xy(x, y, units)} {where}",
                 not fixed,
                 square(x, y, side - grow + 2 * rest),
                 units,
@@ -306,8 +313,8 @@ def _motion_occupancies(
                     swept_square(p, q, side),
                     (robot, k),
                     (robot, k),
-                    f"{robot}'s GoTo at instant {k} from {show_point(p[:2], units)} to "
-                    f"{show_point(q[:2], units)}",
+                    f"{robot}'s GoTo at instant {k} from {_show_xy(p[0], p[1], units)} to "
+                    f"{_show_xy(q[0], q[1], units)}",
                     True,
                     swept_square(p, q, side - grow),
                     units,
@@ -331,6 +338,31 @@ def _homing_drive(
     while k > 0 and primitives[k - 1] != Primitive.GOTO:
         k -= 1
     return k or None
+
+
+class _States(Sequence[State]):
+    """A robot's states, instant 0 first, each made when it is read: the goods' occupancies read
+    a few instants of the robots that move them, and a running fleet's plans are long."""
+
+    def __init__(self, start: State, plan: RobotPlan) -> None:
+        self._start, self._steps = start, plan.steps
+
+    def __len__(self) -> int:
+        return len(self._steps) + 1
+
+    @overload
+    def __getitem__(self, k: int) -> State: ...
+
+    @overload
+    def __getitem__(self, k: slice) -> Sequence[State]: ...
+
+    def __getitem__(self, k: int | slice) -> State | Sequence[State]:
+        if isinstance(k, slice):
+            return [self[i] for i in range(*k.indices(len(self)))]
+        if not -len(self) <= k < len(self):
+            raise IndexError(k)
+        k %= len(self)
+        return self._start if k == 0 else self._steps[k - 1].state
 
 
 def _object_occupancies(
@@ -474,6 +506,7 @@ def occupancies(
     settings: ConflictSettings | None = None,
     starts: Mapping[str, State] | None = None,
     positions: Mapping[str, tuple[float, float] | None] | None = None,
+    robots: Collection[str] | None = None,
 ) -> tuple[list[Occupancy], list[str]]:
     """Every occupancy of the robots and the objects they move; problems with object handling.
 
@@ -494,6 +527,9 @@ def occupancies(
         The robots' states at the start, by id, when it is not the scenario.
     positions : Mapping[str, (float, float) or None], optional
         Where objects are at the start (mm; ``None``: carried), by default the scene's.
+    robots : collection of str, optional
+        Only these robots' own occupancies (the objects' are all made: where goods rest
+        depends on every plan that moves them); by default every robot's.
 
     Returns
     -------
@@ -503,7 +539,7 @@ def occupancies(
     settings = settings or ConflictSettings()
     grow = settings.clearance
     out: list[Occupancy] = []
-    models: dict[str, list[State]] = {}
+    models: dict[str, Sequence[State]] = {}
     moved = {
         s.object
         for plan in plans.values()
@@ -512,9 +548,10 @@ def occupancies(
     }
     for robot, plan in plans.items():
         start = (starts or {}).get(robot) or initial_state(scene, robot, plan, moved)
-        models[robot] = [start, *(step.state for step in plan.steps)]
-        size, home = scene.robots[robot].size + grow, scene.robots[robot].pose
-        out += _robot_occupancies(robot, plan, start, size, home, grow, settings.rest, scene.units)
+        models[robot] = _States(start, plan)
+        if robots is None or robot in robots:
+            size, home = scene.robots[robot].size + grow, scene.robots[robot].pose
+            out += _robot_occupancies(robot, plan, start, size, home, grow, settings.rest, scene.units)
     objects, problems = _object_occupancies(
         scene, plans, precedence, models, positions, settings.shipped_on_drop
     )
