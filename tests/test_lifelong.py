@@ -518,6 +518,11 @@ def test_a_robot_standing_in_the_only_way_is_named_as_what_separates():
     assert why.startswith("R1 cannot reach pick(R1,O1) (event 1 of its mission) at any horizon: ")
     assert "R9, failed at 3.0 s, separates its start (-500, -1500)" in why
     assert why_no_plan(scene, "R1", events, start, max_horizon=7).startswith("R1 cannot reach")  # no label
+    # among many labelled boxes (ten robots idle along the far wall), the nearest are tried
+    idle = [(-2950.0, -1900.0 + 350.0 * k, -2700.0, -1650.0 + 350.0 * k) for k in range(10)]
+    labels = [f"R{10 + k}, standing idle" for k in range(10)]
+    why = why_no_plan(scene, "R1", events, start, box + idle, labels=label + labels, max_horizon=16)
+    assert "R9, failed at 3.0 s, separates its start (-500, -1500)" in why
 
 
 def test_every_rest_a_recoordination_installs_passes_the_exact_checker(monkeypatch):

@@ -163,10 +163,18 @@ def _reached_nearby(
 def _separating(scene: Scene, half: float, start: tuple[float, float], where: shapely.Geometry) -> str:
     """What walls the robot off from `where`, with its verb: the walls the planner added and
     labelled (a robot standing, a space kept clear) without which it would reach ("R1, failed
-    at 90.1 s, separates"), else "walls separate"."""
+    at 90.1 s, separates"), else "walls separate".  Of many labels, those nearest `where` are
+    tried."""
     labels = sorted({w.label for w in scene.obstacles if w.label is not None})
-    if not labels or len(labels) > _MOST_LABELS_TRIED:
+    if not labels:
         return "walls separate"
+    if len(labels) > _MOST_LABELS_TRIED:  # the nearest to `where` are the likeliest to shut it out
+        labelled = [(w.label, (w.start, w.end)) for w in scene.obstacles if w.label is not None]
+        lines = shapely.linestrings([ends for _, ends in labelled])
+        far: dict[str, float] = {}
+        for (label, _), d in zip(labelled, shapely.distance(lines, where).tolist(), strict=True):
+            far[label] = min(far.get(label, math.inf), d)
+        labels = sorted(far, key=lambda label: (far[label], label))[:_MOST_LABELS_TRIED]
 
     def reaches_without(dropped: set[str]) -> bool:
         kept = tuple(w for w in scene.obstacles if w.label not in dropped)
