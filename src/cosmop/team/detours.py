@@ -2,7 +2,9 @@
 
 Every place two plans share is ordered by a message (:func:`cosmop.team.safe_plans.make_team_safe`).
 A conflict no order resolves (a robot parked for good where another must pass) is resolved by
-re-planning one robot with the other's space as walls (:func:`make_safe`).  Then, where waiting
+re-planning one robot with the other's space as walls (:func:`make_safe`); where both places
+are ones re-planning keeps (a robot's start against the pose another picks from), goods at rest
+are dropped elsewhere or goods to pick are picked from another side.  Then, where waiting
 for a shared place costs the team more than a way around, the way around is taken
 (:func:`shorten_waits`): two robots pass each other in lanes, or the waiting robot drives
 around what it waits for.
@@ -121,6 +123,11 @@ def make_safe(
             results.update({robot: result for robot, (result, _) in moved.items()})
             replans.extend(why for _, why in moved.values())
             continue
+        picked = _pick_elsewhere(stuck, safety, current, planner, settings) if stuck and not last else None
+        if picked is not None:  # goods picked from another side: order the new plan
+            results.update(picked.results)
+            replans.extend(picked.replans)
+            continue
         if stuck or last:
             conflict = (stuck or list(safety.unresolved))[0]
             why = f"no order or re-plan keeps {' and '.join(conflict.robots)} apart: {conflict.describe()}"
@@ -189,6 +196,38 @@ def _drop_elsewhere(
                 break
             planner.spots[robot] = saved
     return out
+
+
+def _pick_elsewhere(
+    stuck: Iterable[Conflict],
+    safety: TeamSafety,
+    current: Mapping[str, tuple[Event, ...]],
+    planner: Planner,
+    settings: ConflictSettings,
+) -> _Detoured | None:
+    """A robot that stands to pick goods where another robot must stand (at its start, say),
+    re-planned to pick them elsewhere: from another side, or after another way there.
+
+    Where a robot picks from counts as a place re-planning cannot move (:func:`fixed_places`),
+    and rightly so for every other conflict; but when two such places meet (each robot's first
+    pose is on the other's start) no order and no re-plan around places resolves them.  The
+    picking robot is then re-planned with the other side's space as walls (its own pose there
+    left out of its fixed places), once for each such space.  Returns the first re-plan that
+    has a plan (:func:`_detour`), or ``None``.
+    """
+    for conflict in stuck:
+        for side, other in ((conflict.a, conflict.b), (conflict.b, conflict.a)):
+            robot = side.what
+            if side.movable or robot not in side.parties or side.first is None or side.last is None:
+                continue  # not a robot standing to pick (its start, its home for good, or goods)
+            fixed = {**safety.fixed, robot: [g for g in safety.fixed.get(robot, ()) if g is not side.region]}
+            walls = _keep_out(robot, other, fixed, settings.clearance)
+            if set(walls) <= set(planner.obstacles.get(robot, ())):
+                continue  # kept out of that space already: nothing new to try
+            step = _detour(planner, current, {robot: [(conflict, other)]}, settings, fixed)
+            if step.results:
+                return step
+    return None
 
 
 def _team_safe(planner: Planner, plans: Mapping[str, RobotPlan], settings: ConflictSettings) -> TeamSafety:
