@@ -1,7 +1,7 @@
 """Plans that ``plan`` calls feasible execute: a sample of the generated-scenes sweep (issue 12, point 5).
 
-``benchmarks/sweep_generated.py`` draws 200 seeded scenes (2 to 5 robots, random walls) and
-runs each as a user does; this is a sample of 6 of its seeds, in this process, chosen among
+``benchmarks/sweep_generated.py`` draws seeded scenes (2 to 5 robots, random walls) and
+runs each as a user does; this is a sample of 6 seeds, in this process, chosen among
 those whose plans once failed in simulation (a pose flush against a wall, a drop next to a
 waiting robot, a wall corner touched while braking; the sweep runs the others, 41, 99 and 162
 among them) or were once
@@ -70,6 +70,9 @@ def test_a_request_whose_wait_blocks_its_answer_is_forbidden_and_the_team_planne
 
 
 def test_a_robot_whose_pick_pose_is_on_anothers_start_picks_from_another_side():
+    team = plan_team(parse_scenario(scene(726)), workers=1)  # R2 picks O2 beside R4's start
+    assert team.plans.feasible and len(team.plans.coordination) == 1  # R4 still asks for O2
+    assert [note.split(":")[0] for note in team.replans] == ["R2 re-planned around the space it shares"]
     team = plan_team(parse_scenario(scene(1000)), workers=1)
     assert team.plans.feasible
     assert [note.split(":")[0] for note in team.replans] == ["R3 re-planned around the space it shares"]
@@ -91,9 +94,16 @@ def test_when_the_request_forbidden_does_not_plan_the_team_the_first_outcome_sta
         calls.append(made)
         return made if len(calls) == 1 else dataclasses.replace(made, reasons=("later",), stuck=None)
 
-    real = loop.make_safe
+    class Planner(loop.Planner):  # the team's planner, kept to look at afterwards
+        def __init__(self, *args, **kwargs) -> None:
+            super().__init__(*args, **kwargs)
+            planners.append(self)
+
+    real, planners = loop.make_safe, []
     monkeypatch.setattr(loop, "make_safe", make_safe)
+    monkeypatch.setattr(loop, "Planner", Planner)
     team = plan_team(parse_scenario(_one_sided()), workers=1)
+    assert planners[0].forbidden.get("R4", frozenset()) == frozenset()  # rewound to the first try
     assert len(calls) == 2 and calls[0].stuck is not None
     assert not team.plans.feasible
     assert team.plans.reason == calls[0].reasons[0]

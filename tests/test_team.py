@@ -448,3 +448,31 @@ def test_a_planner_rewound_to_a_checkpoint_forgets_what_was_tried_since_but_keep
     assert planner.scenario is scenario
     assert planner.spots == {"R2": {parse_event("drop(R2,O2,W2)"): (1.0, 2.0)}}
     assert ("an answer",) in planner.cache  # what was solved since stays solved
+
+
+def test_a_robots_states_made_when_read_are_its_plans_states(corridor):
+    from cosmop.team.conflicts import _States
+
+    _, team = corridor
+    plan = team.plans.robots["R1"]
+    start = plan.steps[-1].state  # any state does for the start
+    states, listed = _States(start, plan), [start, *(step.state for step in plan.steps)]
+    assert len(states) == len(listed) == plan.horizon + 1
+    every = range(-len(listed), len(listed))
+    assert [states[k] for k in every] == [listed[k] for k in every]
+    assert states[1:3] == listed[1:3] and states[::-1] == listed[::-1] and list(states) == listed
+    for k in (len(listed), -len(listed) - 1):
+        with pytest.raises(IndexError):
+            states[k]
+
+
+def test_the_occupancies_of_some_robots_are_those_of_all_of_them_but_the_others(corridor):
+    scenario, team = corridor
+    plans = dict(team.plans.robots)
+    order = Precedence({r: p.horizon for r, p in plans.items()}, message_links(plans))
+    every, _ = occupancies(scenario.scene, plans, order)
+    robots = set(plans)
+    for some in ({"R1"}, {"R2"}, set(), robots):
+        items, _ = occupancies(scenario.scene, plans, order, robots=some)
+        assert items == [i for i in every if i.what in some or i.what not in robots]
+    assert any(i.what not in robots for i in every)  # goods among them, made for every choice

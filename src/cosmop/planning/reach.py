@@ -163,8 +163,9 @@ def _reached_nearby(
 def _separating(scene: Scene, half: float, start: tuple[float, float], where: shapely.Geometry) -> str:
     """What walls the robot off from `where`, with its verb: the walls the planner added and
     labelled (a robot standing, a space kept clear) without which it would reach ("R1, failed
-    at 90.1 s, separates"), else "walls separate".  Of many labels, those nearest `where` are
-    tried."""
+    at 90.1 s, separates"), else "walls separate".  Of more than :data:`_MOST_LABELS_TRIED`
+    labels, only those whose walls lie nearest `where` are tried (a label farther away that
+    separates is then not named)."""
     labels = sorted({w.label for w in scene.obstacles if w.label is not None})
     if not labels:
         return "walls separate"

@@ -342,7 +342,8 @@ def _homing_drive(
 
 class _States(Sequence[State]):
     """A robot's states, instant 0 first, each made when it is read: the goods' occupancies read
-    a few instants of the robots that move them, and a running fleet's plans are long."""
+    only the states of the robots that move them, and a running fleet has many robots with long
+    plans."""
 
     def __init__(self, start: State, plan: RobotPlan) -> None:
         self._start, self._steps = start, plan.steps

@@ -92,7 +92,9 @@ def make_safe(
     ordered, or `max_rounds` rounds pass without fewer unresolved conflicts than before (a
     large team may need more rounds, each resolving some), or `max_total` rounds are spent.
     A robot that cannot keep clear is given back its plan and the other side gives way instead,
-    where it can.
+    where it can.  Where neither side can give way (both are places re-planning keeps), goods
+    at rest are dropped elsewhere (:func:`_drop_elsewhere`) or goods to pick are picked from
+    another side (:func:`_pick_elsewhere`).
 
     Parameters
     ----------
@@ -131,7 +133,7 @@ def make_safe(
         if stuck or last:
             conflict = (stuck or list(safety.unresolved))[0]
             why = f"no order or re-plan keeps {' and '.join(conflict.robots)} apart: {conflict.describe()}"
-            return MadeSafe(results, safety, tuple(replans), (why,), conflict)
+            return MadeSafe(results, safety, tuple(replans), (why,), stuck[0] if stuck else None)
         moves = _give_way(safety, safety.unresolved)
         step = _detour(planner, current, moves, settings, safety.fixed)
         fresh, failed = dict(step.results), step.failed
@@ -208,9 +210,10 @@ def _pick_elsewhere(
     """A robot that stands to pick goods where another robot must stand (at its start, say),
     re-planned to pick them elsewhere: from another side, or after another way there.
 
-    Where a robot picks from counts as a place re-planning cannot move (:func:`fixed_places`),
-    and rightly so for every other conflict; but when two such places meet (each robot's first
-    pose is on the other's start) no order and no re-plan around places resolves them.  The
+    Where a robot picks from counts as a place re-planning cannot move
+    (:func:`~cosmop.team.conflicts.fixed_places`), and rightly so for every other conflict; but
+    when it meets another such place (the other robot's start, say, while the other's first pose
+    is on the picking robot's start), no order and no re-plan around places resolves them.  The
     picking robot is then re-planned with the other side's space as walls (its own pose there
     left out of its fixed places), once for each such space.  Returns the first re-plan that
     has a plan (:func:`_detour`), or ``None``.
@@ -219,7 +222,7 @@ def _pick_elsewhere(
         for side, other in ((conflict.a, conflict.b), (conflict.b, conflict.a)):
             robot = side.what
             if side.movable or robot not in side.parties or side.first is None or side.last is None:
-                continue  # not a robot standing to pick (its start, its home for good, or goods)
+                continue  # not a robot standing to pick and leaving again afterwards
             fixed = {**safety.fixed, robot: [g for g in safety.fixed.get(robot, ()) if g is not side.region]}
             walls = _keep_out(robot, other, fixed, settings.clearance)
             if set(walls) <= set(planner.obstacles.get(robot, ())):

@@ -13,8 +13,9 @@
 4. *Make the plans team-safe* (:mod:`cosmop.team.safe_plans`): every place two plans share is
    ordered by a message.  A conflict that no order resolves (a robot parked for good where
    another must pass) is resolved by re-planning one robot with the other's space as an
-   obstacle; one between a robot waiting for goods to be moved and the robot that moves them
-   (it must stand beside the waiting one) by forbidding the request, and steps 2-4 run again.
+   obstacle; where neither side can move, goods are dropped or picked elsewhere; and a conflict
+   between a robot waiting for goods to be moved and the robot that moves them (it must stand
+   beside the waiting one), by forbidding the request and running steps 2-4 again.
 5. *Verify*: the robots' words with all their messages cannot deadlock and do exactly what the
    global mission asks (:func:`cosmop.team.mission_proof.verify_team`); every plan set passes the
    exact checker (:func:`cosmop.team.plan_set_checker.check_plan`).
@@ -277,15 +278,15 @@ def _answer_and_order(
 
     A robot that asks for goods to be moved waits for them where it stands; when the robot that
     moves them must stand within the clearance of that place to pick them (the requester's start
-    beside the goods, say), neither can go first: the conflict is stuck, and no re-plan around
-    places moves either side.  The request is then forbidden (the requester drives around the
-    goods, or waits elsewhere), as a request that deadlocks the team's words is in step 3, and
-    the steps run again from the start, at most :data:`REQUEST_RETRIES` times.  When that does
-    not plan the team, the first outcome stands, and with it its reason.
+    beside the goods, say), neither can go first: the conflict is stuck.  When picking them from
+    another side does not help either (step 4 tries it), the request is forbidden (the requester
+    drives around the goods, or asks for less), as a request that deadlocks the team's words is
+    in step 3, and the steps run again from the start, at most :data:`REQUEST_RETRIES` times.
+    When that does not plan the team, the first outcome stands, and with it its reason.
     """
     start, forbidden, notes = planner.checkpoint(), dict[str, frozenset[str]](), list[str]()
     first: tuple[RequestsAnswered, MadeSafe | None, Checkpoint] | None = None
-    for _ in range(REQUEST_RETRIES + 1):
+    for attempt in range(REQUEST_RETRIES + 1):
         planner.rewind(start)
         for robot, goods in forbidden.items():
             planner.forbid(robot, goods)
@@ -299,9 +300,13 @@ def _answer_and_order(
                 return replace(answered, replans=(*notes, *answered.replans)), made
         if first is None:
             first = (answered, made, planner.checkpoint())
-        more = _requests_in_the_way(answered, made)
-        if all(goods <= forbidden.get(robot, frozenset()) for robot, goods in more.items()):
-            break  # nothing new to forbid
+        more = {
+            robot: new
+            for robot, goods in _requests_in_the_way(answered, made).items()
+            if (new := goods - forbidden.get(robot, frozenset()))
+        }
+        if not more or attempt == REQUEST_RETRIES:
+            break  # nothing new to forbid, or no try left
         for robot, goods in more.items():
             forbidden[robot] = forbidden.get(robot, frozenset()) | goods
             assert made is not None and made.stuck is not None  # (what `more` comes from)

@@ -375,12 +375,15 @@ class Planner:
         self.obstacles[robot] = self.obstacles.get(robot, ()) + walls
 
     def _restricting(self, robot: str, forbidden: Mapping[str, frozenset[str]]) -> tuple[Hashable, ...]:
-        """Everything besides the mission that decides `robot`'s synthesis."""
+        """Everything besides the mission that decides `robot`'s synthesis (the places of the
+        goods it sets aside too: after a :meth:`rewind`, goods set aside again take the same
+        workspace name, maybe at another place)."""
         return (
             forbidden.get(robot, self.forbidden.get(robot, frozenset())),
             self.obstacles.get(robot, ()),
             tuple(sorted(self.placed.get(robot, {}).items())),
             tuple(sorted(self.spots.get(robot, {}).items())),
+            tuple((t.workspace, t.object, t.point) for t in self.added if t.robot == robot),
         )
 
     def key(
