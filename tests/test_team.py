@@ -433,12 +433,14 @@ def test_a_planner_rewound_to_a_checkpoint_forgets_what_was_tried_since_but_keep
     planner = Planner(scenario)
     planner.forbid("R1", frozenset({"O1"}))
     planner.spots["R2"] = {parse_event("drop(R2,O2,W2)"): (1.0, 2.0)}
-    mark = planner.checkpoint()
+    mark, key = planner.checkpoint(), planner.key("R2", ())
     planner.forbid("R1", frozenset({"O2"}))
     planner.forbid("R2", frozenset({"O1"}))
     planner.wall_off("R2", (Wall((0.0, 0.0), (1.0, 0.0), "a trial"),))
-    planner.added.append(AddedTask("R1", "O1", "aside_O1", (5.0, 5.0), "a trial"))
+    before = planner.key("R2", ())
+    planner.added.append(AddedTask("R2", "O1", "aside_O1", (5.0, 5.0), "a trial"))
     planner.scenario = PlanSet(scenario.name, True, added=tuple(planner.added)).extend(scenario)
+    assert planner.key("R2", ()) != before  # asked again once the goods it sets aside lie elsewhere
     planner.placed["R1"] = {"O2": (3.0, 4.0)}
     planner.spots["R2"][parse_event("drop(R2,O1,W1)")] = (6.0, 7.0)
     planner.cache[("an answer",)] = Synthesis("R1", False, None, None, reason="a trial")
@@ -448,6 +450,7 @@ def test_a_planner_rewound_to_a_checkpoint_forgets_what_was_tried_since_but_keep
     assert planner.scenario is scenario
     assert planner.spots == {"R2": {parse_event("drop(R2,O2,W2)"): (1.0, 2.0)}}
     assert ("an answer",) in planner.cache  # what was solved since stays solved
+    assert planner.key("R2", ()) == key
 
 
 def test_a_robots_states_made_when_read_are_its_plans_states(corridor):
