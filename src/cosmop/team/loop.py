@@ -321,14 +321,16 @@ def _answer_and_order(
 
 
 def _requests_in_the_way(answered: RequestsAnswered, made: MadeSafe | None) -> dict[str, frozenset[str]]:
-    """The requests between the two sides of the conflict stuck in `made`: per requester, the
-    goods it asks the other side to move (``{}``: none, or nothing stuck)."""
+    """The requests between the two robots standing on the sides of the conflict stuck in
+    `made` (the requester waits where it stands, the responder stands to pick): per requester,
+    the goods it asks the other to move (``{}``: none, or nothing stuck)."""
     if made is None or made.stuck is None or answered.coordinated is None:
         return {}
-    sides = set(made.stuck.robots)
+    sides = (made.stuck.a, made.stuck.b)
+    standing = {o.what for o in sides if o.what in o.parties and not o.is_drive}
     out: dict[str, frozenset[str]] = {}
     for pair in answered.coordinated.pairs:
-        if pair.requester != pair.responder and {pair.requester, pair.responder} <= sides:
+        if pair.requester != pair.responder and {pair.requester, pair.responder} <= standing:
             out[pair.requester] = out.get(pair.requester, frozenset()) | {pair.obj}
     return out
 
