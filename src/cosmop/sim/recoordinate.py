@@ -247,8 +247,7 @@ def orders_lost(
     order, without = Precedence(horizons, links), Precedence(horizons, kept)
     if not order.complete:  # `robot`'s old rest is not known: order all that is unordered
         items, _ = occupancies(scene, plans, without, settings, starts, positions)
-        robots = set(plans)
-        found = conflicts([i for i in items if i.parties & robots], settings.clearance)
+        found = conflicts(items, settings.clearance)
         return frozenset(c.robots for c in found if robot not in c.robots and not is_ordered(c, without))
     later, earlier = _lost_steps(order, without, robot)
     if not later:
