@@ -10,7 +10,9 @@ by a robot that must pass there to pick them: the drop is now moved within its d
 unseen seed: a robot waits at its start for goods that another must stand beside it to pick,
 so neither could go first; 1000, another: two robots start side by side and each one's pick
 pose lies on the other's start: in both, one robot now picks its goods from another side; with
-one side only, the waiting robot's request is forbidden and it drives around the goods).
+one side only, the waiting robot's request is forbidden and it drives around the goods;
+1056 and 1093, two more: two robots whose homes touch, each one's last drive crossing the
+other's home, so one of them must come home another way -- the one whose way around works).
 """
 
 from __future__ import annotations
@@ -28,7 +30,7 @@ from cosmop.sim import SimSettings, simulate
 from cosmop.team.loop import plan_team
 from sweep_generated import scene
 
-SEEDS = (15, 53, 55, 187, 726, 1000)
+SEEDS = (15, 53, 55, 187, 726, 1000, 1056, 1093)
 
 
 def _run(seed: int) -> tuple[int, bool, bool, int]:
@@ -114,3 +116,28 @@ def test_when_the_request_forbidden_does_not_plan_the_team_the_first_outcome_sta
 
 def test_no_robot_moves_while_touching_anything(outcomes):
     assert sum(moving for *_, moving in outcomes) == 0
+
+
+def test_a_way_around_that_fails_gives_the_cycle_to_another_robot():
+    """Seed 1056: R4's last drive home crosses R2's home and R2's crosses R4's.  The search
+    first sets aside R4's, but walls around R2's home leave R4 no way out of its own (it starts
+    between them and a wall): that way is then known not to work, the search sets aside R2's
+    conflict with R4's home instead, and R2 comes home another way."""
+    team = plan_team(parse_scenario(scene(1056)), workers=1)
+    assert team.plans.feasible, team.plans.reason
+    assert not [note for note in team.replans if note.startswith("R4")]
+    assert any(
+        note.startswith("R2 re-planned") and "R4 standing at (-900, -800)" in note for note in team.replans
+    )
+
+
+def test_a_drive_past_a_home_at_the_scene_gap_is_not_the_conflict_set_aside():
+    """Seed 1093: R1 and R2 start touching.  R1's drive towards its home passes 20 mm above
+    R2's home, and R2's last drive crosses R1's home.  Walls at the scene's gap around R2's home
+    cannot make R1's drive keep the clearance the rule asks of it (the gap suffices only for a
+    drive off or into a robot's own start or home), so R2 is re-planned around R1's home."""
+    team = plan_team(parse_scenario(scene(1093)), workers=1)
+    assert team.plans.feasible, team.plans.reason
+    assert any(
+        note.startswith("R2 re-planned") and "R1 standing at (-1100, 600)" in note for note in team.replans
+    )

@@ -35,7 +35,7 @@ from cosmop.team.conflict_search import (
     depth_first,
     possible_orientations,
 )
-from cosmop.team.conflicts import Conflict
+from cosmop.team.conflicts import Conflict, Futile
 
 __all__ = ["order_conflicts"]
 
@@ -54,6 +54,7 @@ def order_conflicts(
     fixed: Mapping[str, Sequence[BaseGeometry]] | None = None,
     rlimit: int = 200_000_000,
     max_set_aside: int | None = None,
+    futile: Futile = frozenset(),
 ) -> tuple[list[tuple[tuple[Node, Node], Conflict]], list[Conflict]]:
     """Start edges that order every conflict in `found`, and the conflicts no order resolves.
 
@@ -112,9 +113,11 @@ def order_conflicts(
     max_set_aside : int, optional
         The most conflicts the search sets aside before it stops (it stops at more than
         this; default: it never stops).
+    futile : Futile
+        Ways around known not to work: a conflict whose only ways are these is set aside last.
     """
     table = OrientationTable.of(found, list(horizons))
-    implied, picker = _Dominance(found, table), CorrectionSetPicker(fixed)
+    implied, picker = _Dominance(found, table), CorrectionSetPicker(fixed, futile)
     team = (horizons, links, starts, durations)
     search = Search(found, implied, team, picker, table)
     done = search.run(max_backtracks, limit=max_set_aside)

@@ -25,7 +25,7 @@ import numpy as np
 from shapely.geometry.base import BaseGeometry
 
 from cosmop.events import Link, Node
-from cosmop.team.conflicts import Conflict, Occupancy, detours, replan_rank
+from cosmop.team.conflicts import Conflict, Futile, Occupancy, detours, replan_rank
 from cosmop.team.precedence import Precedence, RetractedEdges
 
 __all__ = [
@@ -496,8 +496,10 @@ class CorrectionSetPicker:
     the first in the core as given.
     """
 
-    def __init__(self, fixed: Mapping[str, Sequence[BaseGeometry]] | None) -> None:
-        self.fixed = fixed or {}
+    def __init__(
+        self, fixed: Mapping[str, Sequence[BaseGeometry]] | None, futile: Futile = frozenset()
+    ) -> None:
+        self.fixed, self.futile = fixed or {}, futile
         self.movers: set[str | None] = set()  # the robots of the conflicts set aside so far
         self._rank: dict[int, int] = {}
         self._mover: dict[int, str | None] = {}
@@ -511,7 +513,7 @@ class CorrectionSetPicker:
             A conflict between the plans.
         """
         if id(conflict) not in self._rank:
-            self._rank[id(conflict)] = replan_rank(conflict, self.fixed)
+            self._rank[id(conflict)] = replan_rank(conflict, self.fixed, self.futile)
         return self._rank[id(conflict)]
 
     def mover(self, conflict: Conflict) -> str | None:
@@ -523,7 +525,9 @@ class CorrectionSetPicker:
             A conflict between the plans.
         """
         if id(conflict) not in self._mover:
-            self._mover[id(conflict)] = next((robot for robot, _ in detours(conflict, self.fixed)), None)
+            self._mover[id(conflict)] = next(
+                (robot for robot, _ in detours(conflict, self.fixed, self.futile)), None
+            )
         return self._mover[id(conflict)]
 
     def pick(self, core: Sequence[Conflict], keep: bool = True) -> Conflict:

@@ -55,6 +55,7 @@ from cosmop.units import UnitSystem, show_number, show_point
 __all__ = [
     "Conflict",
     "ConflictSettings",
+    "Futile",
     "Occupancy",
     "conflicts",
     "detours",
@@ -739,7 +740,14 @@ def _before(x: Occupancy, y: Occupancy, precedence: Precedence) -> bool:
     return x.last is not None and y.first is not None and precedence.before_start(x.last, y.first)
 
 
-def detours(conflict: Conflict, fixed: Mapping[str, Sequence[BaseGeometry]]) -> list[tuple[str, Occupancy]]:
+Futile = frozenset[tuple[str, str]]
+"""Ways around known not to work: ``(robot, label of the occupancy it would keep out of)``
+(its re-plan around that space failed, or gave the same plan)."""
+
+
+def detours(
+    conflict: Conflict, fixed: Mapping[str, Sequence[BaseGeometry]], futile: Futile = frozenset()
+) -> list[tuple[str, Occupancy]]:
     """Who can be re-planned around an unresolved conflict, best first: ``(robot, what to avoid)``.
 
     The side that moves must be movable (:attr:`Occupancy.movable`): a drive (best: one that
@@ -754,15 +762,18 @@ def detours(conflict: Conflict, fixed: Mapping[str, Sequence[BaseGeometry]]) -> 
     fixed : Mapping[str, sequence of shapely geometry]
         Each robot's places re-planning cannot move (its start, pick poses, home), regions
         already grown (:func:`fixed_places`).
+    futile : Futile
+        Ways around known not to work, left out.
     """
-    return [(robot, keep) for _, robot, keep in ranked_detours(conflict, fixed)]
+    return [(robot, keep) for _, robot, keep in ranked_detours(conflict, fixed, futile)]
 
 
 def ranked_detours(
-    conflict: Conflict, fixed: Mapping[str, Sequence[BaseGeometry]]
+    conflict: Conflict, fixed: Mapping[str, Sequence[BaseGeometry]], futile: Futile = frozenset()
 ) -> list[tuple[int, str, Occupancy]]:
     """:func:`detours` with each way's rank: 0 a drive around something staying for good, 1 a
-    drive around something passing, 2 goods dropped elsewhere.
+    drive around something passing, 2 goods dropped elsewhere, 3 a drive kept out only by the
+    gap the scene gave (:func:`kept_out`) that the conflict rule holds to the clearance.
 
     Parameters
     ----------
@@ -771,6 +782,8 @@ def ranked_detours(
     fixed : Mapping[str, sequence of shapely geometry]
         Each robot's places re-planning cannot move (its start, pick poses, home), regions
         already grown (:func:`fixed_places`).
+    futile : Futile
+        Ways around known not to work, left out.
     """
     out: list[tuple[int, str, Occupancy]] = []
     clearance = ConflictSettings().clearance
@@ -778,6 +791,8 @@ def ranked_detours(
         if not mover.movable or mover.first is None:
             continue
         robot = mover.what if mover.what in mover.parties else mover.first[0]
+        if (robot, keep.label) in futile:
+            continue
         places = _geometries(list(fixed.get(robot, ())))
         avoid = kept_out(robot, keep, fixed, clearance)
         if avoid is not None:  # kept out by the gap the scene gave, bodies against bodies
@@ -785,6 +800,12 @@ def ranked_detours(
         if (shapely.area(shapely.intersection(keep.region if avoid is None else avoid, places)) > 1e-9).any():
             continue
         drive = mover.is_drive
+        if avoid is not None and drive and mover.start is None:
+            # walls at the scene's gap let this drive pass closer than the clearance, which the
+            # rule allows only drives off or into a place the scene gave (`conflicts`): the
+            # conflict is likely to come back, so other conflicts are re-planned first
+            out.append((3, robot, keep))
+            continue
         out.append((0 if drive and keep.last is None else 1 if drive else 2, robot, keep))
     return sorted(out, key=lambda o: o[0])
 
@@ -838,9 +859,15 @@ def fixed_places(items: Sequence[Occupancy]) -> dict[str, list[BaseGeometry]]:
     return out
 
 
-def replan_rank(conflict: Conflict, fixed: Mapping[str, Sequence[BaseGeometry]] | None = None) -> int:
+def replan_rank(
+    conflict: Conflict,
+    fixed: Mapping[str, Sequence[BaseGeometry]] | None = None,
+    futile: Futile = frozenset(),
+) -> int:
     """Rank of a conflict as a culprit to re-plan (lower first): a drive against something that
-    stays for good, then any detour, then none (two robots standing where their goods require).
+    stays for good, then any detour, then a detour likely to leave the conflict as it is
+    (:func:`ranked_detours`, rank 3), then none (two robots standing where their goods
+    require, or only ways known not to work).
 
     Parameters
     ----------
@@ -848,9 +875,11 @@ def replan_rank(conflict: Conflict, fixed: Mapping[str, Sequence[BaseGeometry]] 
         The conflict.
     fixed : Mapping[str, sequence of shapely geometry], optional
         Each robot's places re-planning cannot move (:func:`fixed_places`); none by default.
+    futile : Futile
+        Ways around known not to work.
     """
-    options = detours(conflict, fixed or {})
+    options = ranked_detours(conflict, fixed or {}, futile)
     if not options:
         return 3
-    _, keep = options[0]
-    return 0 if keep.last is None else 1
+    rank, _, keep = options[0]
+    return 2 if rank == 3 else 0 if keep.last is None else 1

@@ -24,7 +24,7 @@ from cosmop.planning.plan_types import RobotPlan
 from cosmop.planning.synthesis import Synthesis
 from cosmop.scene import Scene, Wall
 from cosmop.team.aside import handover_spot
-from cosmop.team.conflicts import Conflict, ConflictSettings, Occupancy, kept_out
+from cosmop.team.conflicts import Conflict, ConflictSettings, Futile, Occupancy, kept_out
 from cosmop.team.lanes import lanes
 from cosmop.team.planner import Planner, Window, goods_at
 from cosmop.team.safe_plans import TeamSafety, Wait, make_team_safe
@@ -111,9 +111,11 @@ def make_safe(
     """
     results = dict(results)
     replans: list[str] = []
+    futile: Futile = frozenset()  # ways around that failed, or left a plan as it was
+    refused: tuple[str, ...] = ()  # why the first of them failed
     best, since = None, 0
     for n in range(max_total + 1):
-        safety = _team_safe(planner, _plans(results), settings)
+        safety = _team_safe(planner, _plans(results), settings, futile)
         if safety.safe:
             return MadeSafe(results, safety, tuple(replans))
         left = len(safety.unresolved)
@@ -133,26 +135,48 @@ def make_safe(
         if stuck or last:
             conflict = (stuck or list(safety.unresolved))[0]
             why = f"no order or re-plan keeps {' and '.join(conflict.robots)} apart: {conflict.describe()}"
-            return MadeSafe(results, safety, tuple(replans), (why,), stuck[0] if stuck else None)
-        moves = _give_way(safety, safety.unresolved)
-        step = _detour(planner, current, moves, settings, safety.fixed)
-        fresh, failed = dict(step.results), step.failed
+            return MadeSafe(results, safety, tuple(replans), refused or (why,), stuck[0] if stuck else None)
+        step = _give_way_round(planner, current, results, safety, settings)
         replans.extend(step.replans)
-        instead = _give_way(safety, [c for r in failed for c, _ in moves[r]], set(failed))
-        if instead:  # the other side of their conflicts gives way instead, where it can
-            again = _detour(planner, current, instead, settings, safety.fixed)
-            fresh.update(again.results)
-            replans.extend(again.replans)
-            failed = again.failed
-        reasons = tuple(
-            f"{robot} cannot keep clear of the space it shares with another robot "
-            f"({conflict.describe()}): {why}"
-            for robot, (conflict, why) in failed.items()
-        )
-        if reasons:
-            return MadeSafe(results, safety, tuple(replans), reasons)
-        results.update(fresh)
+        if step.failed:
+            reasons = tuple(
+                f"{robot} cannot keep clear of the space it shares with another robot "
+                f"({conflict.describe()}): {why}"
+                for robot, (conflict, why) in step.failed.items()
+            )
+            if step.futile <= futile:  # nothing new known: the same round would come again
+                return MadeSafe(results, safety, tuple(replans), refused or reasons)
+            # the search sets aside another conflict of the same cycle next round, where one has
+            # a way around that may work (another robot's drive, say)
+            futile, refused = futile | step.futile, refused or reasons
+        results.update(step.results)
     return MadeSafe(results, safety, tuple(replans))
+
+
+def _give_way_round(
+    planner: Planner,
+    current: Mapping[str, tuple[Event, ...]],
+    results: Mapping[str, Synthesis],
+    safety: TeamSafety,
+    settings: ConflictSettings,
+) -> _Detoured:
+    """One round of :func:`make_safe`'s ways around: the robots that give way in the unresolved
+    conflicts (:func:`_give_way`) re-planned around the other side; where one fails, the other
+    side of its conflicts instead, where it can.  A re-plan that gives the robot the plan it had
+    counts as failed: the conflict would come back as it is.  The result's ``futile`` names the
+    ways that failed."""
+    moves = _give_way(safety, safety.unresolved)
+    step = _detour(planner, current, moves, settings, safety.fixed, results)
+    fresh, failed, replans = dict(step.results), dict(step.failed), list(step.replans)
+    futile = {(robot, keep.label) for robot in failed for _, keep in moves[robot]}
+    instead = _give_way(safety, [c for r in failed for c, _ in moves[r]], set(failed))
+    if instead:  # the other side of their conflicts gives way instead, where it can
+        again = _detour(planner, current, instead, settings, safety.fixed, results)
+        fresh.update(again.results)
+        replans.extend(again.replans)
+        failed = dict(again.failed)
+        futile |= {(robot, keep.label) for robot in failed for _, keep in instead[robot]}
+    return _Detoured(fresh, tuple(replans), failed, frozenset(futile))
 
 
 def _drop_elsewhere(
@@ -233,12 +257,14 @@ def _pick_elsewhere(
     return None
 
 
-def _team_safe(planner: Planner, plans: Mapping[str, RobotPlan], settings: ConflictSettings) -> TeamSafety:
+def _team_safe(
+    planner: Planner, plans: Mapping[str, RobotPlan], settings: ConflictSettings, futile: Futile = frozenset()
+) -> TeamSafety:
     """:func:`make_team_safe` of `plans`, its new messages named apart from those the plans
-    already send, timed as the conflict phase."""
+    already send, timed as the conflict phase (`futile`: ways around known not to work)."""
     used = {e for p in plans.values() for e in p.mission if e.kind == "msg"}
     t0 = time.perf_counter()
-    safety = make_team_safe(planner.scenario.scene, plans, settings=settings, used=used)
+    safety = make_team_safe(planner.scenario.scene, plans, settings=settings, used=used, futile=futile)
     planner.count_time("conflicts", time.perf_counter() - t0)
     return safety
 
@@ -270,11 +296,13 @@ def _give_way(safety: TeamSafety, conflicts: Iterable[Conflict], exclude: Iterab
 
 @dataclass(frozen=True)
 class _Detoured:
-    """The robots re-planned around their spaces, why, and for each that failed its conflict and why."""
+    """The robots re-planned around their spaces, why, for each that failed its conflict and
+    why, and the ways around that failed (``(robot, label of the space)``)."""
 
     results: Mapping[str, Synthesis]
     replans: tuple[str, ...]
     failed: Mapping[str, tuple[Conflict, str]]
+    futile: Futile = frozenset()
 
 
 def _detour(
@@ -283,27 +311,34 @@ def _detour(
     moves: _Moves,
     settings: ConflictSettings,
     fixed: Mapping[str, Sequence[BaseGeometry]],
+    results: Mapping[str, Synthesis] | None = None,
 ) -> _Detoured:
     """Re-plan every robot in `moves` around its spaces (`fixed`: each robot's fixed places,
-    :func:`~cosmop.team.conflicts.fixed_places`); a robot that fails gets its walls back."""
+    :func:`~cosmop.team.conflicts.fixed_places`); a robot that fails gets its walls back, and
+    so does one whose new plan is its plan in `results` (the walls changed nothing)."""
     saved = dict(planner.obstacles)
     walls = {
         robot: tuple(w for _, keep in items for w in _keep_out(robot, keep, fixed, settings.clearance))
         for robot, items in moves.items()
     }
-    replans = tuple(
-        f"{robot} re-planned around the space it shares: {items[0][0].describe()}"
-        for robot, items in moves.items()
-    )
     fresh = _replan_within(planner, current, walls)
     failed = {}
     for robot, res in list(fresh.items()):
-        if not res.feasible:
-            failed[robot] = (moves[robot][0][0], res.reason or "")
+        same = results is not None and res.feasible and res.plan == results[robot].plan
+        if not res.feasible or same:
+            failed[robot] = (
+                moves[robot][0][0],
+                "its plan keeps out of that space already" if same else res.reason or "",
+            )
             planner.obstacles[robot] = saved.get(robot, ())
             if not planner.obstacles[robot]:
                 del planner.obstacles[robot]
             del fresh[robot]
+    replans = tuple(
+        f"{robot} re-planned around the space it shares: {items[0][0].describe()}"
+        for robot, items in moves.items()
+        if robot in fresh
+    )
     return _Detoured(fresh, replans, failed)
 
 

@@ -43,6 +43,7 @@ from cosmop.team.conflict_order import order_conflicts
 from cosmop.team.conflicts import (
     Conflict,
     ConflictSettings,
+    Futile,
     Occupancy,
     conflicts,
     fixed_places,
@@ -73,6 +74,7 @@ _Context = tuple[
     set[Event] | None,
     frozenset[tuple[str, ...]],
     int | None,
+    Futile,
 ]
 """What every ordering attempt shares: ``(scene, settings, starts, positions, about, used, also,
 max_set_aside)``."""
@@ -146,6 +148,8 @@ class TeamSafety:
         where a cycle made the search depart from time (:mod:`cosmop.team.conflict_search`).
     waits : tuple of Wait
         Every conflict message's expected wait, the longest first.
+    futile : Futile
+        Ways around known not to work when it was made (:meth:`detours` leaves them out).
     """
 
     plans: Mapping[str, RobotPlan]
@@ -160,6 +164,7 @@ class TeamSafety:
     chosen: int = 0
     flipped: int = 0
     waits: tuple[Wait, ...] = ()
+    futile: Futile = frozenset()
 
     @property
     def safe(self) -> bool:
@@ -174,7 +179,7 @@ class TeamSafety:
         conflict : Conflict
             A conflict between the plans (one of :attr:`unresolved`).
         """
-        return ranked_detours(conflict, self.fixed)
+        return ranked_detours(conflict, self.fixed, self.futile)
 
 
 def _reduce(horizons: Mapping[str, int], links: Sequence[Link], chosen: Sequence[_Order]) -> list[_Order]:
@@ -251,6 +256,7 @@ def make_team_safe(
     about: str | None = None,
     also: Collection[tuple[str, ...]] = (),
     max_set_aside: int | None = None,
+    futile: Futile = frozenset(),
 ) -> TeamSafety:
     """Order every conflict between `plans` by messages (see the module docstring).
 
@@ -282,6 +288,9 @@ def make_team_safe(
         too), and the next attempt starts from them, so the attempts that follow, and which
         one is kept, may differ from a search without a limit.  Default: every attempt orders
         all it can.
+    futile : Futile
+        Ways around known not to work: the search sets aside a conflict whose only ways are
+        these last (:class:`~cosmop.team.conflict_search.CorrectionSetPicker`).
 
     Returns
     -------
@@ -297,7 +306,17 @@ def make_team_safe(
         )
         for r, p in plans.items()
     }
-    context: _Context = (scene, settings, starts, positions, about, used, frozenset(also), max_set_aside)
+    context: _Context = (
+        scene,
+        settings,
+        starts,
+        positions,
+        about,
+        used,
+        frozenset(also),
+        max_set_aside,
+        futile,
+    )
     uncut = frozenset() if settings.cut else frozenset(plans)
     # each robot's cuts depend on the others' whole drives only: made once, undone robot by robot
     cut = (
@@ -388,7 +407,7 @@ def _order(
 ) -> TeamSafety:
     """One ordering of every conflict between `plans` (already cut; `waypoints` are the
     robots' own, where pieces are joined again after), its time not yet set."""
-    scene, settings, starts, positions, about, used, also, max_set_aside = context
+    scene, settings, starts, positions, about, used, also, max_set_aside, futile = context
     horizons = {r: p.horizon for r, p in plans.items()}
     links = message_links(plans)
     times = durations(scene, plans, starts=starts)
@@ -406,7 +425,7 @@ def _order(
     ordered = sum(1 for c in found if is_ordered(c, precedence))
     fixed = fixed_places(items)
     chosen, unresolved = order_conflicts(
-        found, horizons, links, [], times, fixed=fixed, max_set_aside=max_set_aside
+        found, horizons, links, [], times, fixed=fixed, max_set_aside=max_set_aside, futile=futile
     )
     kept = _reduce(horizons, links, chosen)
     taken = set(used or ())
@@ -435,6 +454,7 @@ def _order(
         len(chosen),
         _flipped(chosen, precedence),
         _waits(new_plans, final, placed, kept, _drive_ends(scene, plans, starts)),
+        futile,
     )
 
 
