@@ -136,7 +136,7 @@ def make_safe(
             conflict = (stuck or list(safety.unresolved))[0]
             why = f"no order or re-plan keeps {' and '.join(conflict.robots)} apart: {conflict.describe()}"
             return MadeSafe(results, safety, tuple(replans), refused or (why,), stuck[0] if stuck else None)
-        step = _give_way_round(planner, current, results, safety, settings)
+        step = _give_way_round(planner, current, results, safety, settings, explain=not refused)
         replans.extend(step.replans)
         if step.failed:
             reasons = tuple(
@@ -159,19 +159,21 @@ def _give_way_round(
     results: Mapping[str, Synthesis],
     safety: TeamSafety,
     settings: ConflictSettings,
+    explain: bool = True,
 ) -> _Detoured:
     """One round of :func:`make_safe`'s ways around: the robots that give way in the unresolved
     conflicts (:func:`_give_way`) re-planned around the other side; where one fails, the other
     side of its conflicts instead, where it can.  A re-plan that gives the robot the plan it had
     counts as failed: the conflict would come back as it is.  The result's ``futile`` names the
-    ways that failed."""
+    ways that failed; without `explain` a re-plan that fails only says so (a trial: the reason
+    given is an earlier round's)."""
     moves = _give_way(safety, safety.unresolved)
-    step = _detour(planner, current, moves, settings, safety.fixed, results)
+    step = _detour(planner, current, moves, settings, safety.fixed, results, explain)
     fresh, failed, replans = dict(step.results), dict(step.failed), list(step.replans)
     futile = {(robot, keep.label) for robot in failed for _, keep in moves[robot]}
     instead = _give_way(safety, [c for r in failed for c, _ in moves[r]], set(failed))
     if instead:  # the other side of their conflicts gives way instead, where it can
-        again = _detour(planner, current, instead, settings, safety.fixed, results)
+        again = _detour(planner, current, instead, settings, safety.fixed, results, explain)
         fresh.update(again.results)
         replans.extend(again.replans)
         failed = dict(again.failed)
@@ -312,16 +314,18 @@ def _detour(
     settings: ConflictSettings,
     fixed: Mapping[str, Sequence[BaseGeometry]],
     results: Mapping[str, Synthesis] | None = None,
+    explain: bool = True,
 ) -> _Detoured:
     """Re-plan every robot in `moves` around its spaces (`fixed`: each robot's fixed places,
     :func:`~cosmop.team.conflicts.fixed_places`); a robot that fails gets its walls back, and
-    so does one whose new plan is its plan in `results` (the walls changed nothing)."""
+    so does one whose new plan is its plan in `results` (the walls changed nothing).  Without
+    `explain`, a robot that fails is not told why (:func:`_replan_within`)."""
     saved = dict(planner.obstacles)
     walls = {
         robot: tuple(w for _, keep in items for w in _keep_out(robot, keep, fixed, settings.clearance))
         for robot, items in moves.items()
     }
-    fresh = _replan_within(planner, current, walls)
+    fresh = _replan_within(planner, current, walls, explain)
     failed = {}
     for robot, res in list(fresh.items()):
         same = results is not None and res.feasible and res.plan == results[robot].plan
