@@ -11,20 +11,28 @@ Each scene is planned (``cosmop plan``) and, when feasible, simulated from that 
 plan's verdict, whether the run completed, the contacts while moving, the simulated and wall
 times.
 
+With ``--mixed`` the scenes are harder and closer to what users write: 2 to 7 robots of one
+side from 300 to 500 mm with headings in radians, 0 to 5 inner walls, as many goods as robots
+or up to two more (a robot may move several, one after another), fewer docks than goods (several
+goods into one dock), goods of 100 to 200 mm, docks of 600 to 800 mm, and a fifth of the robots
+ending where they drop their last goods (no ``return``).  Its draws are another stream of the
+same seeds.
+
 With ``--alone`` (issue 36, point 4: complete as a team), every scene the team is not planned
 for (infeasible or out of time) is planned again robot by robot, each alone in the same scene
 (the other robots removed, every object kept): ``alone`` is true when every robot alone has a
 plan, so that the team's verdict is one a team planner should not give.  The row keeps the
 plan's reason.
 
-Usage: ``python benchmarks/sweep_generated.py [--seeds 0:200] [--timeout 600] [--alone] [--out NAME]``
-(``results/NAME.json``; default ``sweep_generated``).
+Usage: ``python benchmarks/sweep_generated.py [--seeds 0:200] [--timeout 600] [--alone] [--mixed]
+[--out NAME]`` (``results/NAME.json``; default ``sweep_generated``).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
 import random
 import tempfile
 from pathlib import Path
@@ -69,21 +77,67 @@ def draw(rng: random.Random) -> dict:
     }
 
 
-def scene(seed: int) -> dict:
-    """The first physically possible draw of `seed`'s generator."""
-    rng = random.Random(seed)
+def draw_mixed(rng: random.Random) -> dict:
+    """One candidate scene of the ``--mixed`` kind (module docstring; may be physically impossible)."""
+    half = rng.choice([2500, 3000, 3500, 4000, 4500])
+    walls = [
+        [[-half, -half], [half, -half]],
+        [[half, -half], [half, half]],
+        [[half, half], [-half, half]],
+        [[-half, half], [-half, -half]],
+    ]
+
+    def spot(margin: int) -> list[int]:  # on a 50 mm grid
+        return [rng.randrange(-half + margin, half - margin + 1, GRID // 2) for _ in range(2)]
+
+    for _ in range(rng.randint(0, 5)):
+        x, y = spot(400)
+        length = rng.randrange(500, 3001, GRID // 2)
+        walls.append(
+            [[x, y], [min(x + length, half), y] if rng.random() < 0.5 else [x, min(y + length, half)]]
+        )
+    n, side = rng.randint(2, 7), rng.choice([300, 350, 400, 450, 500])
+    headings = [0.0, 0.0, math.pi / 2, math.pi, -math.pi / 2]
+    robots = {}
+    for i in range(1, n + 1):
+        heading = rng.choice([*headings, round(rng.uniform(-3.14, 3.14), 3)])
+        robots[f"R{i}"] = {"size": side, "pose": [*spot(300), heading]}
+    goods, size = n + rng.randint(0, 2), rng.choice([100, 100, 150, 200])
+    objects = {f"O{i}": {"size": size, "position": spot(400)} for i in range(1, goods + 1)}
+    docks, width = rng.randint(max(1, n - 2), n), rng.choice([600, 600, 700, 800])
+    workspaces = {}
+    for i in range(1, docks + 1):
+        x, y = spot(300 + width)
+        workspaces[f"W{i}"] = {"x": [x, x + width], "y": [y, y + width]}
+    tasks: dict[str, list[str]] = {f"R{i}": [] for i in range(1, n + 1)}
+    for j in range(1, goods + 1):
+        tasks[f"R{(j - 1) % n + 1}"] += [f"pick O{j}", f"drop O{j} at W{rng.randint(1, docks)}"]
+    for words in tasks.values():
+        if rng.random() < 0.8:
+            words.append("return")
+    return {
+        "name": "generated-mixed",
+        "scene": {"obstacles": walls, "robots": robots, "objects": objects, "workspaces": workspaces},
+        "mission": {"tasks": tasks},
+    }
+
+
+def scene(seed: int, mixed: bool = False) -> dict:
+    """The first physically possible draw of `seed`'s generator (`mixed`: of the ``--mixed``
+    kind, from a stream apart from the plain draws')."""
+    rng = random.Random(seed * 7919 + 13 if mixed else seed)
     while True:
-        data = draw(rng)
+        data = draw_mixed(rng) if mixed else draw(rng)
         try:
             parse_scenario(data)
         except ScenarioError:
             continue
-        data["name"] = f"generated-{seed}"
+        data["name"] = f"generated-{'mixed-' if mixed else ''}{seed}"
         return data
 
 
-def run_seed(seed: int, timeout: float, folder: Path, alone: bool = False) -> dict:
-    data = scene(seed)
+def run_seed(seed: int, timeout: float, folder: Path, alone: bool = False, mixed: bool = False) -> dict:
+    data = scene(seed, mixed)
     row = {"seed": seed, "robots": len(data["scene"]["robots"]), "walls": len(data["scene"]["obstacles"])}
     row |= plan_and_simulate(data, folder / f"scene_{seed}", timeout)
     if alone and row["plan"] != "feasible":
@@ -109,13 +163,16 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seeds", default="0:200", help="first:last (exclusive)")
     parser.add_argument("--timeout", type=float, default=600.0)
     parser.add_argument("--alone", action="store_true", help="plan each robot of a team not planned alone")
+    parser.add_argument(
+        "--mixed", action="store_true", help="harder scenes: shared docks, no return, radians"
+    )
     parser.add_argument("--out", default="sweep_generated", help="results/OUT.json")
     args = parser.parse_args(argv)
     first, last = (int(v) for v in args.seeds.split(":"))
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for seed in range(first, last):
-            rows.append(run_seed(seed, args.timeout, Path(tmp), args.alone))
+            rows.append(run_seed(seed, args.timeout, Path(tmp), args.alone, args.mixed))
             print(json.dumps(rows[-1]), flush=True)
     save_results(args.out, rows)
     feasible = [r for r in rows if r["plan"] == "feasible"]

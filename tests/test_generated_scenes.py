@@ -12,7 +12,8 @@ so neither could go first; 1000, another: two robots start side by side and each
 pose lies on the other's start: in both, one robot now picks its goods from another side; with
 one side only, the waiting robot's request is forbidden and it drives around the goods;
 1056 and 1093, two more: two robots whose homes touch, each one's last drive crossing the
-other's home, so one of them must come home another way -- the one whose way around works).
+other's home, so one of them must come home another way -- the one whose way around works;
+1203: a robot's home lies in the dock another robot drops its goods in).
 """
 
 from __future__ import annotations
@@ -27,10 +28,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
 
 from cosmop.scenario import parse_scenario
 from cosmop.sim import SimSettings, simulate
+from cosmop.team.conflicts import ConflictSettings
 from cosmop.team.loop import plan_team
 from sweep_generated import scene
 
-SEEDS = (15, 53, 55, 187, 726, 1000, 1056, 1093)
+SEEDS = (15, 53, 55, 187, 726, 1000, 1056, 1093, 1203)
 
 
 def _run(seed: int) -> tuple[int, bool, bool, int]:
@@ -141,3 +143,17 @@ def test_a_drive_past_a_home_at_the_scene_gap_is_not_the_conflict_set_aside():
     assert any(
         note.startswith("R2 re-planned") and "R1 standing at (-1100, 600)" in note for note in team.replans
     )
+
+
+def test_goods_dropped_in_a_dock_that_holds_a_home_rest_beside_it():
+    """Seed 1203: R2's home lies in W3, where R3 drops O3, and no spot of W3 keeps the clearance
+    from R2's home.  Goods need only keep off a robot's body by the room it may stop off its
+    pose: O3 is dropped where it does, and the team is planned with no time lost."""
+    scenario = parse_scenario(scene(1203))
+    team = plan_team(scenario, workers=1)
+    assert team.plans.feasible, team.plans.reason
+    assert team.replans[0].split(" instead")[0] == "R3 drops O3 at (-400, 3187.5)"
+    home, rest = scenario.scene.robots["R2"], ConflictSettings().rest
+    gap = (3187.5 - 50) - (home.pose[1] + home.size / 2)  # O3's lower side above R2's upper side
+    assert rest <= gap < ConflictSettings().clearance
+    assert team.safety is not None and team.safety.makespan < 1.01 * team.safety.makespan_alone

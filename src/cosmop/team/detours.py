@@ -209,21 +209,40 @@ def _drop_elsewhere(
                 continue
             if any(goods.what in placed for r, placed in planner.placed.items() if r != robot):
                 continue  # handed over or packed: others' models have the goods at that spot
-            keep = [other.region] + [g for r, places in safety.fixed.items() if r != robot for g in places]
-            avoid = shapely.unary_union(keep).buffer(settings.clearance, join_style="mitre")
             own = goods_at(scene, planner.placed.get(robot, {}))
-            spot = handover_spot(own, goods.what, drops[0].workspace, (robot,), avoid=avoid)
-            if spot is None or planner.spots.get(robot, {}).get(drops[0]) == spot:
-                continue  # no spot, or the one it has already: nothing new to try
-            saved = dict(planner.spots.get(robot, {}))
-            planner.spots.setdefault(robot, {})[drops[0]] = spot
-            result = planner.run({robot: current[robot]})[robot]
-            if result.feasible:
-                where = show_point(spot, scene.units)
-                out[robot] = (result, f"{robot} drops {goods.what} at {where} instead: {conflict.describe()}")
+            for avoid in _drop_avoid(robot, other, safety.fixed, settings):
+                spot = handover_spot(own, goods.what, drops[0].workspace, (robot,), avoid=avoid)
+                if spot is None or planner.spots.get(robot, {}).get(drops[0]) == spot:
+                    continue  # no spot, or the one it has already: nothing new to try
+                saved = dict(planner.spots.get(robot, {}))
+                planner.spots.setdefault(robot, {})[drops[0]] = spot
+                result = planner.run({robot: current[robot]})[robot]
+                if result.feasible:
+                    where = show_point(spot, scene.units)
+                    out[robot] = (
+                        result,
+                        f"{robot} drops {goods.what} at {where} instead: {conflict.describe()}",
+                    )
+                    break
+                planner.spots[robot] = saved
+            if robot in out:
                 break
-            planner.spots[robot] = saved
     return out
+
+
+def _drop_avoid(
+    robot: str, other: Occupancy, fixed: Mapping[str, Sequence[BaseGeometry]], settings: ConflictSettings
+) -> tuple[BaseGeometry, BaseGeometry]:
+    """Where goods `robot` drops elsewhere must not lie, the roomier choice first: the other
+    side and every other robot's fixed places grown by the clearance (room to pass them), then
+    only what the conflict rule asks of goods at rest (a robot's body and the room it may stop
+    off its pose, :attr:`ConflictSettings.rest`): a dock that holds a robot's home may have no
+    spot that keeps the clearance from it, but one the goods can rest in once dropped."""
+    others = [g for r, places in fixed.items() if r != robot for g in places]
+    wide = shapely.unary_union([other.region, *others]).buffer(settings.clearance, join_style="mitre")
+    shrink = settings.rest - settings.clearance / 2  # fixed places are grown by half the clearance
+    bodies = [g.buffer(shrink, join_style="mitre") for g in others]
+    return wide, shapely.unary_union([other.body or other.region, *bodies])
 
 
 def _pick_elsewhere(
