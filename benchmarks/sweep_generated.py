@@ -13,10 +13,10 @@ times.
 
 With ``--mixed`` the scenes are harder and closer to what users write: 2 to 7 robots of one
 side from 300 to 500 mm with headings in radians, 0 to 5 inner walls, as many goods as robots
-or up to two more (a robot may move several, one after another), fewer docks than goods (several
-goods into one dock), goods of 100 to 200 mm, docks of 600 to 800 mm, and a fifth of the robots
-ending where they drop their last goods (no ``return``).  Its draws are another stream of the
-same seeds.
+or up to two more (a robot may move several, one after another), at most as many docks as
+robots (several goods may go into one dock), goods of 100 to 200 mm, docks of 600 to 800 mm,
+and a fifth of the robots ending where they drop their last goods (no ``return``).  Its draws
+are another stream of the same seeds.
 
 With ``--alone`` (issue 36, point 4: complete as a team), every scene the team is not planned
 for (infeasible or out of time) is planned again robot by robot, each alone in the same scene

@@ -130,7 +130,7 @@ def order_conflicts(
     schedule = _Schedule(found, horizons, links, starts, durations, rlimit, implied)
     while (core := schedule.solve(implied.left(gone))) is not None:
         if not core:  # undecided within the solver's budget: what the search fails on stays
-            return _give_up(found, horizons, links, starts, durations, max_backtracks, fixed, implied)
+            return _give_up(found, horizons, links, starts, durations, max_backtracks, fixed, implied, futile)
         unresolved.append(picker.pick(core))
         gone.add(id(unresolved[-1]))
         cores[id(unresolved[-1])] = core
@@ -178,13 +178,14 @@ def _give_up(
     max_backtracks: int,
     fixed: Mapping[str, Sequence[BaseGeometry]] | None,
     implied: _Dominance,
+    futile: Futile = frozenset(),
 ) -> _Ordered:
     """Order what the search can, leaving each conflict it fails on unresolved (sound, not minimal)."""
     unresolved: list[Conflict] = []
     gone: set[int] = set()
     while True:
         left = implied.left(gone)
-        chosen, culprit = depth_first(left, horizons, links, starts, durations, max_backtracks, fixed)
+        chosen, culprit = depth_first(left, horizons, links, starts, durations, max_backtracks, fixed, futile)
         if culprit is None:
             return chosen, unresolved
         unresolved.append(culprit)

@@ -813,6 +813,7 @@ def depth_first(
     durations: Mapping[str, Sequence[float]],
     max_backtracks: int,
     fixed: Mapping[str, Sequence[BaseGeometry]] | None,
+    futile: Futile = frozenset(),
 ) -> tuple[list[tuple[Edge, Conflict]], Conflict | None]:
     """Depth-first search for edges ordering every conflict; ``(edges, None)`` or ``([], culprit)``.
 
@@ -840,6 +841,8 @@ def depth_first(
     fixed : Mapping[str, sequence of shapely geometry] or None
         Each robot's places re-planning cannot move
         (:func:`~cosmop.team.conflicts.fixed_places`).
+    futile : Futile
+        Ways around known not to work (:func:`~cosmop.team.conflicts.replan_rank`).
     """
     precedence = Precedence(horizons, links, starts, durations)
     orientations = _OrientationTests(found, precedence)
@@ -856,8 +859,11 @@ def depth_first(
         if stuck:
             if len(chosen) > deepest:
                 edges = [(e, c) for e, c, _ in chosen]
-                worst = min(stuck, key=lambda c: replan_rank(c, fixed))
-                deepest, culprit = len(chosen), _culprit(worst, precedence, links, starts, edges, fixed)
+                worst = min(stuck, key=lambda c: replan_rank(c, fixed, futile))
+                deepest, culprit = (
+                    len(chosen),
+                    _culprit(worst, precedence, links, starts, edges, fixed, futile),
+                )
             if not stack or backtracks >= max_backtracks:
                 return [], culprit
             backtracks += 1
@@ -919,13 +925,14 @@ def _culprit(
     starts: Sequence[Edge],
     chosen: Sequence[tuple[Edge, Conflict]],
     fixed: Mapping[str, Sequence[BaseGeometry]] | None,
+    futile: Futile = frozenset(),
 ) -> Conflict:
     """The conflict to re-plan around when `stuck` has no way to be ordered.
 
     If `stuck` itself cannot be re-planned (two robots standing where their goods require), the
     orders that close its cycles came from other conflicts: the most re-plannable of those.
     """
-    if replan_rank(stuck, fixed) < 3:
+    if replan_rank(stuck, fixed, futile) < 3:
         return stuck
     graph: _Graph[Conflict] = _Graph(precedence, links, starts)
     for edge, conflict in chosen:
@@ -934,7 +941,7 @@ def _culprit(
     for edge in possible_orientations(stuck):
         on_cycles += graph.path(*edge) or []
     best = min(on_cycles, key=lambda c: replan_rank(c, fixed), default=stuck)
-    return best if replan_rank(best, fixed) < 3 else stuck
+    return best if replan_rank(best, fixed, futile) < 3 else stuck
 
 
 def _ways(conflict: Conflict, precedence: Precedence) -> list[Edge]:

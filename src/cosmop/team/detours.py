@@ -58,7 +58,8 @@ class MadeSafe:
     reasons : tuple of str
         Why the team cannot be planned (empty: the plans are team-safe).
     stuck : Conflict or None
-        When that is why: the conflict that no order resolves and no re-plan tried moves.
+        When that is why: the conflict that no order resolves and no re-plan moves (none
+        applies, or only ways around known not to work).
     """
 
     results: Mapping[str, Synthesis]
@@ -138,17 +139,18 @@ def make_safe(
             return MadeSafe(results, safety, tuple(replans), refused or (why,), stuck[0] if stuck else None)
         step = _give_way_round(planner, current, results, safety, settings, explain=not refused)
         replans.extend(step.replans)
+        learned, futile = step.futile - futile, futile | step.futile
         if step.failed:
             reasons = tuple(
                 f"{robot} cannot keep clear of the space it shares with another robot "
                 f"({conflict.describe()}): {why}"
                 for robot, (conflict, why) in step.failed.items()
             )
-            if step.futile <= futile:  # nothing new known: the same round would come again
+            if not learned:  # nothing new known: the same round would come again
                 return MadeSafe(results, safety, tuple(replans), refused or reasons)
             # the search sets aside another conflict of the same cycle next round, where one has
             # a way around that may work (another robot's drive, say)
-            futile, refused = futile | step.futile, refused or reasons
+            refused = refused or reasons
         results.update(step.results)
     return MadeSafe(results, safety, tuple(replans))
 
@@ -193,8 +195,9 @@ def _drop_elsewhere(
     Walls cannot settle such a conflict when the robot that drops the goods must itself pass
     through the other's place (to pick them, say): instead the drop is pinned to another spot
     of its workspace, one the robot can dock to whose square keeps the clearance from the other
-    side and from every other robot's fixed places (:func:`cosmop.team.aside.handover_spot`
-    with `avoid`), and the robot is re-planned.  Returns, per robot re-planned, its synthesis and
+    side and from every other robot's fixed places, or else only what the conflict rule asks
+    (:func:`_drop_avoid`; :func:`cosmop.team.aside.handover_spot` with `avoid`), and the robot
+    is re-planned.  Returns, per robot re-planned, its synthesis and
     why; a robot whose re-plan fails keeps its plan and its drop.
     """
     scene = planner.scenario.scene
@@ -450,7 +453,7 @@ def shorten_waits(
         }
         fresh = _replan_within(planner, current, walls, False, windows)
         if all(res.feasible for res in fresh.values()):
-            candidate = _team_safe(planner, _plans({**results, **fresh}), settings)
+            candidate = _team_safe(planner, _plans({**results, **fresh}), settings, safety.futile)
             if candidate.safe and candidate.makespan < safety.makespan - 1e-6:
                 replans.append(
                     f"{why}: the team is expected done in {candidate.makespan:.1f} s instead of "

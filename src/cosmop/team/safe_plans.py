@@ -77,7 +77,7 @@ _Context = tuple[
     Futile,
 ]
 """What every ordering attempt shares: ``(scene, settings, starts, positions, about, used, also,
-max_set_aside)``."""
+max_set_aside, futile)``."""
 
 
 @dataclass(frozen=True)
