@@ -30,6 +30,7 @@ from cosmop.scenario import parse_scenario
 from cosmop.sim import SimSettings, simulate
 from cosmop.team.conflicts import ConflictSettings
 from cosmop.team.loop import plan_team
+from cosmop.team.plan_set_checker import check_plan
 from sweep_generated import scene
 
 SEEDS = (15, 53, 55, 187, 726, 1000, 1056, 1093, 1203)
@@ -157,3 +158,19 @@ def test_goods_dropped_in_a_dock_that_holds_a_home_rest_beside_it():
     gap = (3187.5 - 50) - (home.pose[1] + home.size / 2)  # O3's lower side above R2's upper side
     assert rest <= gap < ConflictSettings().clearance
     assert team.safety is not None and team.safety.makespan < 1.01 * team.safety.makespan_alone
+
+
+def test_a_robot_done_in_a_dock_others_drop_in_drives_home():
+    """A scene of the sweep's ``--mixed`` kind (seed 27): three robots drop their goods in W3, and
+    R1's mission ends there (no return), so R1 would stand for good where R2 and R3 must drop
+    theirs.  R1 drives home when done: its plan ends where it started, its word is its mission's."""
+    scenario = parse_scenario(scene(27, mixed=True))
+    team = plan_team(scenario, workers=1)
+    assert team.plans.feasible, team.plans.reason
+    assert "R1 drives home when done, out of the others' way" in team.replans
+    plan = team.plans.robots["R1"]
+    assert [e.kind for e in plan.mission if e.kind != "msg"] == ["pick", "drop"]
+    assert plan.steps[-1].robot[:2] == pytest.approx(scenario.scene.robots["R1"].pose[:2])
+    assert check_plan(scenario, team.plans).ok
+    run = simulate(scenario, team.plans, settings=SimSettings(max_time=600))
+    assert run.completed and run.contacts_while_moving == 0

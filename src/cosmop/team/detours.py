@@ -123,15 +123,10 @@ def make_safe(
         best, since = (left, 0) if best is None or left < best else (best, since + 1)
         last = since >= max_rounds or n == max_total
         stuck = [c for c in safety.unresolved if not safety.detours(c)]
-        moved = _drop_elsewhere(stuck, safety, current, planner, settings) if stuck and not last else {}
-        if moved:  # goods that rested in the way for good lie elsewhere now: order the new plans
-            results.update({robot: result for robot, (result, _) in moved.items()})
-            replans.extend(why for _, why in moved.values())
-            continue
-        picked = _pick_elsewhere(stuck, safety, current, planner, settings) if stuck and not last else None
-        if picked is not None:  # goods picked from another side: order the new plan
-            results.update(picked.results)
-            replans.extend(picked.replans)
+        unstuck = _unstick(stuck, safety, current, planner, settings) if stuck and not last else None
+        if unstuck is not None:  # goods put or picked elsewhere, or a robot sent home: order again
+            results.update(unstuck.results)
+            replans.extend(unstuck.replans)
             continue
         if stuck or last:
             conflict = (stuck or list(safety.unresolved))[0]
@@ -146,6 +141,11 @@ def make_safe(
                 f"({conflict.describe()}): {why}"
                 for robot, (conflict, why) in step.failed.items()
             )
+            homed = None if learned else _send_home(safety.unresolved, current, planner)
+            if homed is not None:  # a robot done in the way goes home: order again
+                results.update(homed.results)
+                replans.extend(homed.replans)
+                continue
             if not learned:  # nothing new known: the same round would come again
                 return MadeSafe(results, safety, tuple(replans), refused or reasons)
             # the search sets aside another conflict of the same cycle next round, where one has
@@ -153,6 +153,67 @@ def make_safe(
             refused = refused or reasons
         results.update(step.results)
     return MadeSafe(results, safety, tuple(replans))
+
+
+def _unstick(
+    stuck: Sequence[Conflict],
+    safety: TeamSafety,
+    current: Mapping[str, tuple[Event, ...]],
+    planner: Planner,
+    settings: ConflictSettings,
+) -> _Detoured | None:
+    """What may settle conflicts no order resolves and no way around moves, in this order: goods
+    that rest for good in the way dropped elsewhere (:func:`_drop_elsewhere`), goods picked from
+    another side (:func:`_pick_elsewhere`), a robot done in the way sent home
+    (:func:`_send_home`); ``None`` when none of them works."""
+    moved = _drop_elsewhere(stuck, safety, current, planner, settings)
+    if moved:
+        return _Detoured(
+            {r: res for r, (res, _) in moved.items()}, tuple(why for _, why in moved.values()), {}
+        )
+    picked = _pick_elsewhere(stuck, safety, current, planner, settings)
+    if picked is not None:
+        return picked
+    return _send_home(stuck, current, planner)
+
+
+def _send_home(
+    conflicts: Sequence[Conflict], current: Mapping[str, tuple[Event, ...]], planner: Planner
+) -> _Detoured | None:
+    """Robots done where their missions end, in the way of others (a dock others drop in, a way
+    they must pass), re-planned to drive home when done (:attr:`Planner.homing`): a robot whose
+    mission does not say where to stop may stop where it started, out of the way (its home is a
+    place the scene gave it, kept clear of the others' plans).  The drive is motion only: the
+    robot's word stays its mission's.
+
+    The robots that stand for good in `conflicts` are sent home first; where none of them can
+    go, every robot of `conflicts` that does not end at home (its end may close their cycle from
+    afar).  ``None`` when no such robot has a plan home.
+    """
+    standing = [
+        s.what for c in conflicts for s in (c.a, c.b) if s.what in s.parties and s.last is None and s.movable
+    ]
+    for robots in (standing, [r for c in conflicts for r in c.robots]):
+        results: dict[str, Synthesis] = {}
+        why: list[str] = []
+        for robot in dict.fromkeys(robots):  # in order, once each
+            if robot in planner.homing or robot not in current or not _ends_away(current[robot]):
+                continue
+            planner.homing.add(robot)
+            result = planner.run({robot: current[robot]})[robot]
+            if not result.feasible:
+                planner.homing.discard(robot)
+                continue
+            results[robot] = result
+            why.append(f"{robot} drives home when done, out of the others' way")
+        if results:
+            return _Detoured(results, tuple(why), {})
+    return None
+
+
+def _ends_away(events: tuple[Event, ...]) -> bool:
+    """Whether a robot's word `events` lets its plan end away from home (it has no ``return``)."""
+    return not any(e.kind == "return" for e in events)
 
 
 def _give_way_round(

@@ -69,6 +69,9 @@ class SynthesisJob:
         Drops pinned for a hand-over: ``(drop event, (x, y) mm)``.
     min_horizon : int
         No shorter plan exists (a re-plan with more walls starts here).
+    home : bool
+        The plan ends at the robot's home although its mission does not say so (the last of
+        `events` is a ``return`` added for it: the plan's word leaves it out).
     """
 
     scene: Scene
@@ -80,6 +83,7 @@ class SynthesisJob:
     explain: bool = True
     spots: tuple[tuple[Event, tuple[float, float]], ...] = ()
     min_horizon: int = 0
+    home: bool = False
 
 
 def synthesize_job(job: SynthesisJob) -> Synthesis:
@@ -90,7 +94,7 @@ def synthesize_job(job: SynthesisJob) -> Synthesis:
     job : SynthesisJob
         The question, whole.
     """
-    return synthesize(
+    result = synthesize(
         job.scene,
         job.robot,
         job.events,
@@ -101,6 +105,13 @@ def synthesize_job(job: SynthesisJob) -> Synthesis:
         spots=job.spots,
         min_horizon=job.min_horizon,
     )
+    if not job.home or result.plan is None:
+        return result
+    # the drive home is motion only: the word is the mission's, without the return added
+    plan, last = result.plan, len(result.plan.mission) - 1
+    while plan.mission[last].kind != "return":
+        last -= 1
+    return replace(result, plan=replace(plan, mission=plan.mission[:last] + plan.mission[last + 1 :]))
 
 
 class Workers(ProcessPoolExecutor):
@@ -240,6 +251,8 @@ class Checkpoint:
         The scenario with their places.
     placed, spots : mapping
         The hand-overs' and shared docks' spots (:attr:`Planner.placed`, :attr:`Planner.spots`).
+    homing : frozenset of str
+        The robots sent home at the end (:attr:`Planner.homing`).
     """
 
     restrictions: Restrictions
@@ -247,6 +260,7 @@ class Checkpoint:
     scenario: Scenario
     placed: Mapping[str, Mapping[str, tuple[float, float]]]
     spots: Mapping[str, Mapping[Event, tuple[float, float]]]
+    homing: frozenset[str] = frozenset()
 
 
 @dataclass
@@ -284,6 +298,10 @@ class Planner:
         Hand-overs: per receiver, goods it finds where the giver drops them, ``{goods: (x, y)}`` mm.
     spots : dict of str to dict
         Hand-overs and shared docks: per robot, drops held to a spot, ``{drop event: (x, y)}`` mm.
+    homing : set of str
+        Robots whose plans end at home although their missions end elsewhere: a robot done
+        where others must pass (in a dock they drop in, say) drives home out of their way.  The
+        drive is motion only; the plan's word stays the mission's.
     cache : dict
         Every answer, by question (:meth:`key`).
     """
@@ -299,6 +317,7 @@ class Planner:
     obstacles: dict[str, tuple[Wall, ...]] = field(default_factory=dict, init=False)
     placed: dict[str, dict[str, tuple[float, float]]] = field(default_factory=dict, init=False)
     spots: dict[str, dict[Event, tuple[float, float]]] = field(default_factory=dict, init=False)
+    homing: set[str] = field(default_factory=set, init=False)
     cache: dict[tuple[Hashable, ...], Synthesis] = field(default_factory=dict, init=False)
 
     def count_time(self, phase: str, seconds: float) -> None:
@@ -335,6 +354,7 @@ class Planner:
             self.scenario,
             {r: dict(p) for r, p in self.placed.items()},
             {r: dict(s) for r, s in self.spots.items()},
+            frozenset(self.homing),
         )
 
     def rewind(self, mark: Checkpoint) -> None:
@@ -349,6 +369,7 @@ class Planner:
         self.added, self.scenario = list(mark.added), mark.scenario
         self.placed = {r: dict(p) for r, p in mark.placed.items()}
         self.spots = {r: dict(s) for r, s in mark.spots.items()}
+        self.homing = set(mark.homing)
 
     def forbid(self, robot: str, objects: frozenset[str]) -> None:
         """From now on `robot` may not request `objects` either.
@@ -384,6 +405,7 @@ class Planner:
             tuple(sorted(self.placed.get(robot, {}).items())),
             tuple(sorted(self.spots.get(robot, {}).items())),
             tuple((t.workspace, t.object, t.point) for t in self.added if t.robot == robot),
+            robot in self.homing,
         )
 
     def key(
@@ -479,6 +501,9 @@ class Planner:
         scene = goods_at(scene, self.placed.get(robot, {}))
         # a branching mission gets the horizon of its alphabet: no word of it has more events
         mission = tuple(parse_event(e) for e in events.alphabet) if isinstance(events, DFA) else tuple(events)
+        home = self.sent_home(robot, events)
+        if home:
+            mission = (*mission, Event("return", robot))
         horizon = self.max_horizon if self.max_horizon is not None else default_horizon(mission)
         least = 0
         if window is not None:
@@ -495,7 +520,23 @@ class Planner:
             explain,
             spots,
             least,
+            home,
         )
+
+    def sent_home(self, robot: str, events: LocalMission) -> bool:
+        """Whether `robot`'s plan of `events` gets a drive home its mission does not ask for
+        (:attr:`homing`; a word only, that does not end with a return already).
+
+        Parameters
+        ----------
+        robot : str
+            The robot.
+        events : tuple of Event, or DFA
+            Its mission.
+        """
+        if robot not in self.homing or isinstance(events, DFA):
+            return False
+        return not any(e.kind == "return" for e in events)
 
     def run(
         self,
