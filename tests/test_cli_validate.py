@@ -153,6 +153,14 @@ def test_usage_errors_exit_2() -> None:
             "cosmop plan: Invalid value for '--workers'",
         ),
         (
+            ["plan", str(TASKS_FILE), "-o", "p.json", "--budget", "0"],
+            "cosmop plan: Invalid value for '--budget'",
+        ),
+        (
+            ["plan", str(TASKS_FILE), "-o", "p.json", "--budget", "inf"],
+            "cosmop plan: Invalid value for '--budget': expected a finite number, got inf",
+        ),
+        (
             ["simulate", str(TASKS_FILE), "--max-time", "-1"],
             "cosmop simulate: Invalid value for '--max-time'",
         ),
@@ -173,6 +181,8 @@ def test_usage_errors_exit_2() -> None:
     ],
     ids=[
         "workers-0",
+        "budget-0",
+        "budget-infinite",
         "max-time-negative",
         "max-time-infinite",
         "until-infinite",

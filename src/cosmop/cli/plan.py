@@ -13,7 +13,7 @@ from rich.console import Console
 from rich.table import Table
 from rich.text import Text
 
-from cosmop.cli._app import EXIT_INPUT_ERROR, ScenarioArgument, load, stderr, stdout
+from cosmop.cli._app import EXIT_INPUT_ERROR, ScenarioArgument, finite, load, stderr, stdout
 from cosmop.cli.words import plan_verdict
 from cosmop.io import check_writable
 from cosmop.planning.plan_file import load_plan
@@ -24,7 +24,15 @@ from cosmop.team.plan_set_checker import check_plan
 if TYPE_CHECKING:
     from cosmop.team.loop import TeamResult
 
-__all__ = ["SchedulerOption", "WorkersOption", "check", "check_engine", "plan", "plan_with_progress"]
+__all__ = [
+    "SchedulerOption",
+    "WorkersOption",
+    "check",
+    "check_engine",
+    "default_budget",
+    "plan",
+    "plan_with_progress",
+]
 
 WorkersOption = Annotated[
     int | None,
@@ -119,6 +127,16 @@ def plan(
     ] = None,
     workers: WorkersOption = None,
     scheduler: SchedulerOption = None,
+    budget: Annotated[
+        float | None,
+        typer.Option(
+            help="Seconds the planning may take before it gives up on a team it has not planned "
+            "yet, saying so \\[default: 60 + 10 per robot]",
+            min=1.0,
+            show_default=False,
+            callback=finite,
+        ),
+    ] = None,
 ) -> None:
     """Plan, coordinate and verify the team (paper, Fig. "Overall framework").
 
@@ -149,6 +167,8 @@ def plan(
         one per robot).
     scheduler : str or None
         ``--scheduler``: the address of a Dask scheduler to run the syntheses on (None: local).
+    budget : float or None
+        ``--budget``: seconds the planning may take (None: :func:`default_budget`).
     """
     check_engine(workers, scheduler)
     loaded = load(scenario)
@@ -156,7 +176,8 @@ def plan(
     check_writable(png, "--png")
     if png is not None:
         _need_viz()
-    result = plan_with_progress(loaded, max_horizon, workers, scheduler)
+    budget = default_budget(loaded) if budget is None else budget
+    result = plan_with_progress(loaded, max_horizon, workers, scheduler, budget)
     result.plans.save(output)
     if png is not None:
         from cosmop.viz import save_plan_png
@@ -206,8 +227,27 @@ def check_engine(workers: int | None, scheduler: str | None) -> None:
         )
 
 
+def default_budget(loaded: Scenario) -> float:
+    """The planning budget of ``cosmop plan`` when none is given: 60 s and 10 s per robot (s).
+
+    A team is planned well within it (50 robots of the MovingAI warehouse map, the largest
+    benchmark, take about 300 s of its 560 s on a 2-core machine); it bounds the time spent on
+    a team that cannot be planned.
+
+    Parameters
+    ----------
+    loaded : Scenario
+        The scenario planned.
+    """
+    return 60.0 + 10.0 * len(loaded.scene.robots)
+
+
 def plan_with_progress(
-    loaded: Scenario, max_horizon: int | None = None, workers: int | None = None, scheduler: str | None = None
+    loaded: Scenario,
+    max_horizon: int | None = None,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    budget: float | None = None,
 ) -> TeamResult:
     """:func:`cosmop.team.loop.plan_team` under a spinner that names each robot as it is planned;
     in local processes, or on the Dask cluster whose scheduler is at `scheduler`.
@@ -222,6 +262,8 @@ def plan_with_progress(
         Local processes for the syntheses (None: one per core, at most one per robot).
     scheduler : str or None
         The address of a Dask scheduler to run the syntheses on (None: local processes).
+    budget : float or None
+        Seconds the planning may take (:func:`cosmop.team.loop.plan_team`; None: no limit).
 
     Returns
     -------
@@ -252,6 +294,7 @@ def plan_with_progress(
                 on_robot=lambda robot, res: progress.update(
                     task, description=f"planned {robot} ({res.horizon} steps)"
                 ),
+                budget=budget,
             )
 
 

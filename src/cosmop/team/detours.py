@@ -121,7 +121,8 @@ def make_safe(
             return MadeSafe(results, safety, tuple(replans))
         left = len(safety.unresolved)
         best, since = (left, 0) if best is None or left < best else (best, since + 1)
-        last = since >= max_rounds or n == max_total
+        over = planner.over_budget()
+        last = since >= max_rounds or n == max_total or over
         stuck = [c for c in safety.unresolved if not safety.detours(c)]
         unstuck = _unstick(stuck, safety, current, planner, settings) if stuck and not last else None
         if unstuck is not None:  # goods put or picked elsewhere, or a robot sent home: order again
@@ -131,6 +132,10 @@ def make_safe(
         if stuck or last:
             conflict = (stuck or list(safety.unresolved))[0]
             why = f"no order or re-plan keeps {' and '.join(conflict.robots)} apart: {conflict.describe()}"
+            if over:  # stopped, not proved: say so first
+                first = (refused or (why,))[0]
+                why = f"no team plan found within the planning budget of {planner.budget:g} s ({first})"
+                return MadeSafe(results, safety, tuple(replans), (why,))
             return MadeSafe(results, safety, tuple(replans), refused or (why,), stuck[0] if stuck else None)
         step = _give_way_round(planner, current, results, safety, settings, explain=not refused)
         replans.extend(step.replans)
@@ -496,7 +501,7 @@ def shorten_waits(
     scene = planner.scenario.scene
     results, safety, replans = dict(made.results), made.safety, list(made.replans)
     tried: set[Hashable] = set()
-    while budget > 0:
+    while budget > 0 and not planner.over_budget():
         worth = (w for w in safety.waits if w.critical and w.seconds >= MIN_WAIT)
         way = next(
             (way for w in worth for way in _ways_around(w, safety, scene, settings) if way[0] not in tried),

@@ -120,6 +120,7 @@ def plan_team(
     on_robot: Callable[[str, Synthesis], None] | None = None,
     conflicts: ConflictSettings | None = None,
     ways_around: int = WAYS_AROUND,
+    budget: float | None = None,
 ) -> TeamResult:
     """Plan, coordinate, make team-safe and verify the whole team (see the module docstring).
 
@@ -145,6 +146,12 @@ def plan_team(
     ways_around : int
         Re-plans tried to take a way around a long wait for a shared place instead of waiting
         (:func:`_shorten_waits`; 0: none).
+    budget : float, optional
+        Seconds of wall time the planning may take (default: no limit).  Past it, nothing more
+        is tried for a team not planned yet (no further round of re-plans around conflicts, no
+        request forbidden to try again, no way around a wait): the team is called infeasible
+        with a reason that says the budget ran out.  A budget makes the answer depend on the
+        machine's speed; the rest of the planning is deterministic.
 
     Raises
     ------
@@ -165,6 +172,7 @@ def plan_team(
         n_workers = min(os.cpu_count() or 1, team) if workers is None else max(1, workers)
         pool = Workers(n_workers) if n_workers > 1 else None
     planner = Planner(scenario, executor or pool, on_robot, max_horizon, rlimit, phases)
+    planner.set_budget(budget)
     try:
         if start is None:  # the mission leaves choices open: commit to the cheapest way
             t = time.perf_counter()
@@ -305,8 +313,8 @@ def _answer_and_order(
             for robot, goods in _requests_in_the_way(answered, made).items()
             if (new := goods - forbidden.get(robot, frozenset()))
         }
-        if not more or attempt == REQUEST_RETRIES:
-            break  # nothing new to forbid, or no try left
+        if not more or attempt == REQUEST_RETRIES or planner.over_budget():
+            break  # nothing new to forbid, or no try (or time) left
         for robot, goods in more.items():
             forbidden[robot] = forbidden.get(robot, frozenset()) | goods
             assert made is not None and made.stuck is not None  # (what `more` comes from)

@@ -302,6 +302,9 @@ class Planner:
         Robots whose plans end at home although their missions end elsewhere: a robot done
         where others must pass (in a dock they drop in, say) drives home out of their way.  The
         drive is motion only; the plan's word stays the mission's.
+    budget, deadline : float or None
+        The planning budget (s) and when it ends (:func:`time.perf_counter`), from
+        :meth:`set_budget`; ``None``: no budget.
     cache : dict
         Every answer, by question (:meth:`key`).
     """
@@ -318,6 +321,8 @@ class Planner:
     placed: dict[str, dict[str, tuple[float, float]]] = field(default_factory=dict, init=False)
     spots: dict[str, dict[Event, tuple[float, float]]] = field(default_factory=dict, init=False)
     homing: set[str] = field(default_factory=set, init=False)
+    budget: float | None = field(default=None, init=False)
+    deadline: float | None = field(default=None, init=False)
     cache: dict[tuple[Hashable, ...], Synthesis] = field(default_factory=dict, init=False)
 
     def count_time(self, phase: str, seconds: float) -> None:
@@ -331,6 +336,22 @@ class Planner:
             Wall time spent, s.
         """
         self.phases[phase] = self.phases.get(phase, 0.0) + seconds
+
+    def set_budget(self, seconds: float | None) -> None:
+        """From now on, the team's planning may take `seconds` (``None``: no limit): past it, the
+        loop tries nothing more for a team it has not planned yet (:meth:`over_budget`).
+
+        Parameters
+        ----------
+        seconds : float or None
+            The budget, s of wall time.
+        """
+        self.budget = seconds
+        self.deadline = None if seconds is None else time.perf_counter() + seconds
+
+    def over_budget(self) -> bool:
+        """Whether the planning budget (:meth:`set_budget`) is spent."""
+        return self.deadline is not None and time.perf_counter() > self.deadline
 
     def restrictions(self) -> Restrictions:
         """The forbidden requests and added walls now, to :meth:`restore` after a trial."""
