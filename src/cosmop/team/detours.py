@@ -21,6 +21,7 @@ from shapely.geometry.base import BaseGeometry
 
 from cosmop.events import Event
 from cosmop.planning.plan_types import RobotPlan
+from cosmop.planning.realisation import at_pose
 from cosmop.planning.synthesis import Synthesis
 from cosmop.scene import Scene, Wall
 from cosmop.team.aside import handover_spot
@@ -31,7 +32,7 @@ from cosmop.team.safe_plans import TeamSafety, Wait, make_team_safe
 from cosmop.team.walls import walls_around
 from cosmop.units import show_point
 
-__all__ = ["MIN_WAIT", "TRIAL_STEPS", "MadeSafe", "make_safe", "shorten_waits"]
+__all__ = ["MIN_WAIT", "OUT_OF_BUDGET", "TRIAL_STEPS", "MadeSafe", "make_safe", "shorten_waits"]
 
 TRIAL_STEPS = 2
 """Steps a way around may add to a robot's plan: a trial searches no longer plans."""
@@ -41,6 +42,9 @@ MIN_WAIT = 2.0
 
 # robot -> the conflicts it gives way in, and the space it keeps out of in each
 _Moves = dict[str, list[tuple[Conflict, Occupancy]]]
+
+OUT_OF_BUDGET = "no team plan found within the planning budget"
+"""How a reason given when the planning budget ran out begins (:meth:`Planner.set_budget`)."""
 
 
 @dataclass(frozen=True)
@@ -134,7 +138,7 @@ def make_safe(
             why = f"no order or re-plan keeps {' and '.join(conflict.robots)} apart: {conflict.describe()}"
             if over:  # stopped, not proved: say so first
                 first = (refused or (why,))[0]
-                why = f"no team plan found within the planning budget of {planner.budget:g} s ({first})"
+                why = f"{OUT_OF_BUDGET} of {planner.budget:g} s ({first})"
                 return MadeSafe(results, safety, tuple(replans), (why,))
             return MadeSafe(results, safety, tuple(replans), refused or (why,), stuck[0] if stuck else None)
         step = _give_way_round(planner, current, results, safety, settings, explain=not refused)
@@ -146,11 +150,6 @@ def make_safe(
                 f"({conflict.describe()}): {why}"
                 for robot, (conflict, why) in step.failed.items()
             )
-            homed = None if learned else _send_home(safety.unresolved, current, planner)
-            if homed is not None:  # a robot done in the way goes home: order again
-                results.update(homed.results)
-                replans.extend(homed.replans)
-                continue
             if not learned:  # nothing new known: the same round would come again
                 return MadeSafe(results, safety, tuple(replans), refused or reasons)
             # the search sets aside another conflict of the same cycle next round, where one has
@@ -179,11 +178,14 @@ def _unstick(
     picked = _pick_elsewhere(stuck, safety, current, planner, settings)
     if picked is not None:
         return picked
-    return _send_home(stuck, current, planner)
+    return _send_home(stuck, current, planner, safety.plans)
 
 
 def _send_home(
-    conflicts: Sequence[Conflict], current: Mapping[str, tuple[Event, ...]], planner: Planner
+    conflicts: Sequence[Conflict],
+    current: Mapping[str, tuple[Event, ...]],
+    planner: Planner,
+    plans: Mapping[str, RobotPlan],
 ) -> _Detoured | None:
     """Robots done where their missions end, in the way of others (a dock others drop in, a way
     they must pass), re-planned to drive home when done (:attr:`Planner.homing`): a robot whose
@@ -193,7 +195,7 @@ def _send_home(
 
     The robots that stand for good in `conflicts` are sent home first; where none of them can
     go, every robot of `conflicts` that does not end at home (its end may close their cycle from
-    afar).  ``None`` when no such robot has a plan home.
+    afar; `plans`, the team's, say where each ends).  ``None`` when no such robot has a plan home.
     """
     standing = [
         s.what for c in conflicts for s in (c.a, c.b) if s.what in s.parties and s.last is None and s.movable
@@ -204,8 +206,11 @@ def _send_home(
         for robot in dict.fromkeys(robots):  # in order, once each
             if robot in planner.homing or robot not in current or not _ends_away(current[robot]):
                 continue
+            plan, home = plans.get(robot), planner.scenario.scene.robots[robot].pose
+            if plan is None or not plan.steps or at_pose(plan.steps[-1].robot, home):
+                continue  # at home at the end already: nothing to change
             planner.homing.add(robot)
-            result = planner.run({robot: current[robot]})[robot]
+            result = _replan_asking_no_more(planner, current, robot)
             if not result.feasible:
                 planner.homing.discard(robot)
                 continue
@@ -214,6 +219,21 @@ def _send_home(
         if results:
             return _Detoured(results, tuple(why), {})
     return None
+
+
+def _replan_asking_no_more(
+    planner: Planner, current: Mapping[str, tuple[Event, ...]], robot: str
+) -> Synthesis:
+    """`robot` re-planned under the planner's restrictions, asking for no goods it does not ask
+    for already: the requests are answered by now, and a new one would have no answer.  A robot
+    that finds no plan gets its restrictions back."""
+    saved = planner.restrictions()
+    asked = {e.obj for e in current[robot] if e.kind == "away" and e.receiver == robot and e.obj}
+    planner.forbid(robot, frozenset(planner.scenario.scene.objects) - asked)
+    result = planner.run({robot: current[robot]})[robot]
+    if not result.feasible:
+        planner.restore(saved)
+    return result
 
 
 def _ends_away(events: tuple[Event, ...]) -> bool:
@@ -285,7 +305,7 @@ def _drop_elsewhere(
                     continue  # no spot, or the one it has already: nothing new to try
                 saved = dict(planner.spots.get(robot, {}))
                 planner.spots.setdefault(robot, {})[drops[0]] = spot
-                result = planner.run({robot: current[robot]})[robot]
+                result = _replan_asking_no_more(planner, current, robot)
                 if result.feasible:
                     where = show_point(spot, scene.units)
                     out[robot] = (

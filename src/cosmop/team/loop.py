@@ -42,7 +42,7 @@ from cosmop.scene import Scenario
 from cosmop.team.choices import Allocation, allocate
 from cosmop.team.conflicts import ConflictSettings
 from cosmop.team.coordination_events import Coordinated
-from cosmop.team.detours import MadeSafe, make_safe, shorten_waits
+from cosmop.team.detours import OUT_OF_BUDGET, MadeSafe, make_safe, shorten_waits
 from cosmop.team.handover import Handovers, handovers
 from cosmop.team.initial_plans import pack_docks, plan_in_turn
 from cosmop.team.mission_proof import TeamVerdict, check_words
@@ -261,6 +261,9 @@ def _loop(
     if not reasons:
         answered, made = _answer_and_order(base, givers, planner, max_iterations, settings, ways_around)
         reasons = answered.reasons if made is None else made.reasons
+        if reasons and planner.over_budget() and not reasons[0].startswith(OUT_OF_BUDGET):
+            # the search was cut short, whatever the last round found: say so first
+            reasons = (f"{OUT_OF_BUDGET} of {planner.budget:g} s ({reasons[0]})", *reasons[1:])
     results = made.results if made is not None else answered.results if answered is not None else {}
     plans = dict(made.safety.plans) if made is not None else _plans_of(results)
     verdict = None

@@ -546,7 +546,7 @@ class Planner:
 
     def sent_home(self, robot: str, events: LocalMission) -> bool:
         """Whether `robot`'s plan of `events` gets a drive home its mission does not ask for
-        (:attr:`homing`; a word only, that does not end with a return already).
+        (:attr:`homing`; a word, not a DFA, with no ``return`` of its own).
 
         Parameters
         ----------
