@@ -89,6 +89,7 @@ def make_safe(
     settings: ConflictSettings,
     max_rounds: int = 6,
     max_total: int = 16,
+    explain: bool = True,
 ) -> MadeSafe:
     """Order every conflict by messages; re-plan around the ones no order resolves (step 4).
 
@@ -113,6 +114,9 @@ def make_safe(
         How conflicts are found (clearance, cuts).
     max_rounds, max_total : int
         Rounds without progress, and rounds in all, after which the step gives up.
+    explain : bool
+        Whether a re-plan that fails says why (false: a trial, whose reasons nobody reads; the
+        first failure's reason is sought only with it, later ones never).
     """
     results = dict(results)
     replans: list[str] = []
@@ -141,7 +145,7 @@ def make_safe(
                 why = f"{OUT_OF_BUDGET} of {planner.budget:g} s ({first})"
                 return MadeSafe(results, safety, tuple(replans), (why,))
             return MadeSafe(results, safety, tuple(replans), refused or (why,), stuck[0] if stuck else None)
-        step = _give_way_round(planner, current, results, safety, settings, explain=not refused)
+        step = _give_way_round(planner, current, results, safety, settings, explain=explain and not refused)
         replans.extend(step.replans)
         learned, futile = step.futile - futile, futile | step.futile
         if step.failed:
@@ -226,11 +230,12 @@ def _replan_asking_no_more(
 ) -> Synthesis:
     """`robot` re-planned under the planner's restrictions, asking for no goods it does not ask
     for already: the requests are answered by now, and a new one would have no answer.  A robot
-    that finds no plan gets its restrictions back."""
+    that finds no plan gets its restrictions back.  A trial: an answer without a plan does not
+    say why (proving why costs unsat cores, and only a plan is of use here)."""
     saved = planner.restrictions()
     asked = {e.obj for e in current[robot] if e.kind == "away" and e.receiver == robot and e.obj}
     planner.forbid(robot, frozenset(planner.scenario.scene.objects) - asked)
-    result = planner.run({robot: current[robot]})[robot]
+    result = planner.run({robot: current[robot]}, explain=False)[robot]
     if not result.feasible:
         planner.restore(saved)
     return result
@@ -361,7 +366,8 @@ def _pick_elsewhere(
             walls = _keep_out(robot, other, fixed, settings.clearance)
             if set(walls) <= set(planner.obstacles.get(robot, ())):
                 continue  # kept out of that space already: nothing new to try
-            step = _detour(planner, current, {robot: [(conflict, other)]}, settings, fixed)
+            # a trial: only a plan is of use here, not why there is none
+            step = _detour(planner, current, {robot: [(conflict, other)]}, settings, fixed, explain=False)
             if step.results:
                 return step
     return None

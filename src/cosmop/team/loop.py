@@ -304,7 +304,8 @@ def _answer_and_order(
         answered = coordinate_requests(base, plan_in_turn(base, givers, planner), planner, max_iterations)
         made = None
         if answered.ok:  # the scenario with the places of goods set aside, if any
-            made = make_safe(answered.current, answered.results, planner, settings)
+            # a try after the first is a trial: if it fails, the first outcome's reason stands
+            made = make_safe(answered.current, answered.results, planner, settings, explain=attempt == 0)
             if made.ok and ways_around > 0:
                 made = shorten_waits(answered.current, made, planner, settings, ways_around)
             if made.ok:
