@@ -940,7 +940,7 @@ def _culprit(
     on_cycles: list[Conflict] = []
     for edge in possible_orientations(stuck):
         on_cycles += graph.path(*edge) or []
-    best = min(on_cycles, key=lambda c: replan_rank(c, fixed), default=stuck)
+    best = min(on_cycles, key=lambda c: replan_rank(c, fixed, futile), default=stuck)
     return best if replan_rank(best, fixed, futile) < 3 else stuck
 
 
