@@ -27,7 +27,7 @@ from cosmop.scene import Scene, Wall
 from cosmop.team.aside import handover_spot
 from cosmop.team.conflicts import Conflict, ConflictSettings, Futile, Occupancy, kept_out
 from cosmop.team.lanes import lanes
-from cosmop.team.planner import Planner, Window, goods_at
+from cosmop.team.planner import Planner, Window, ends_away, goods_at
 from cosmop.team.safe_plans import TeamSafety, Wait, make_team_safe
 from cosmop.team.walls import walls_around
 from cosmop.units import show_point
@@ -208,7 +208,7 @@ def _send_home(
         results: dict[str, Synthesis] = {}
         why: list[str] = []
         for robot in dict.fromkeys(robots):  # in order, once each
-            if robot in planner.homing or robot not in current or not _ends_away(current[robot]):
+            if robot in planner.homing or robot not in current or not ends_away(current[robot]):
                 continue
             plan, home = plans.get(robot), planner.scenario.scene.robots[robot].pose
             if plan is None or not plan.steps or at_pose(plan.steps[-1].robot, home):
@@ -233,17 +233,18 @@ def _replan_asking_no_more(
     that finds no plan gets its restrictions back.  A trial: an answer without a plan does not
     say why (proving why costs unsat cores, and only a plan is of use here)."""
     saved = planner.restrictions()
-    asked = {e.obj for e in current[robot] if e.kind == "away" and e.receiver == robot and e.obj}
-    planner.forbid(robot, frozenset(planner.scenario.scene.objects) - asked)
+    _ask_no_more(planner, current, robot)
     result = planner.run({robot: current[robot]}, explain=False)[robot]
     if not result.feasible:
         planner.restore(saved)
     return result
 
 
-def _ends_away(events: tuple[Event, ...]) -> bool:
-    """Whether a robot's word `events` lets its plan end away from home (it has no ``return``)."""
-    return not any(e.kind == "return" for e in events)
+def _ask_no_more(planner: Planner, current: Mapping[str, tuple[Event, ...]], robot: str) -> None:
+    """From now on `robot` may request only the goods its word `current[robot]` asks for already
+    (the requests are settled: a new one would have no answer)."""
+    asked = {e.obj for e in current[robot] if e.kind == "away" and e.receiver == robot and e.obj}
+    planner.forbid(robot, frozenset(planner.scenario.scene.objects) - asked)
 
 
 def _give_way_round(
@@ -483,11 +484,9 @@ def _replan_within(
     for.  With `explain` false an infeasible answer only says so (a trial); `windows` bounds
     the lengths searched (:meth:`Planner.run`).
     """
-    objects = frozenset(planner.scenario.scene.objects)
     for robot, extra in walls.items():
         planner.wall_off(robot, extra)
-        asked = {e.obj for e in current[robot] if e.kind == "away" and e.receiver == robot and e.obj}
-        planner.forbid(robot, objects - asked)
+        _ask_no_more(planner, current, robot)
     return planner.run({robot: current[robot] for robot in walls}, explain=explain, windows=windows)
 
 

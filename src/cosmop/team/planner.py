@@ -13,7 +13,7 @@ from __future__ import annotations
 import multiprocessing
 import signal
 import time
-from collections.abc import Callable, Hashable, Mapping
+from collections.abc import Callable, Hashable, Mapping, Sequence
 from concurrent.futures import Executor, Future, ProcessPoolExecutor
 from dataclasses import dataclass, field, replace
 from typing import Any, ParamSpec, TypeVar
@@ -34,6 +34,7 @@ __all__ = [
     "SynthesisJob",
     "Workers",
     "default_horizon",
+    "ends_away",
     "goods_at",
 ]
 
@@ -84,6 +85,17 @@ class SynthesisJob:
     spots: tuple[tuple[Event, tuple[float, float]], ...] = ()
     min_horizon: int = 0
     home: bool = False
+
+
+def ends_away(events: Sequence[Event]) -> bool:
+    """Whether a robot's word `events` lets its plan end away from home (it has no ``return``).
+
+    Parameters
+    ----------
+    events : sequence of Event
+        The robot's word.
+    """
+    return not any(e.kind == "return" for e in events)
 
 
 def synthesize_job(job: SynthesisJob) -> Synthesis:
@@ -555,9 +567,7 @@ class Planner:
         events : tuple of Event, or DFA
             Its mission.
         """
-        if robot not in self.homing or isinstance(events, DFA):
-            return False
-        return not any(e.kind == "return" for e in events)
+        return robot in self.homing and not isinstance(events, DFA) and ends_away(events)
 
     def run(
         self,
